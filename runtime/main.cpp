@@ -1,0 +1,169 @@
+// kanegen: the command-line interface (interface.md).
+// Exit status: 0 success, 2 refused input (message names file, line, field),
+// 1 failure while running.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "diagnostics.hpp"
+#include "eval_report.hpp"
+#include "generic_engine.hpp"
+#include "integrators.hpp"
+#include "model_checks.hpp"
+#include "model_loader.hpp"
+#include "simulate.hpp"
+#include "state_io.hpp"
+
+using namespace kanegen;
+
+namespace {
+
+constexpr int kExitFailure = 1;
+constexpr int kExitRefused = 2;
+
+struct Args {
+  std::string model, state, engine = "generic", output, integrator = "cvode-bdf";
+  double t_end = 10.0, rtol = 1e-8, atol = 1e-10, dt_out = 0.01, h = 1e-3;
+  bool no_progress = false;
+};
+
+Model load_checked(const std::string& path) {
+  Model model = load_model(path);
+  check_mass_matrix_at_initial_state(model);
+  return model;
+}
+
+std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name) {
+  if (name == "generic") return std::make_unique<GenericEngine>(model);
+  throw InputError(Diagnostic{"--engine", 0, "", fmt::format("unknown engine '{}'; expected generic", name)});
+}
+
+State state_for(const Model& model, const std::string& state_path) {
+  return state_path.empty() ? initial_state(model) : load_state(model, state_path);
+}
+
+int cmd_check(const Args& a) {
+  const Model model = load_checked(a.model);
+  fmt::print("model {}: {} bodies, nq = {}, nu = {}\n", model.name, model.bodies.size(), model.nq, model.nu);
+  if (!model.description.empty()) fmt::print("  {}\n", model.description);
+  for (const Body& b : model.bodies) {
+    const std::string parent = b.parent < 0 ? "ground" : model.bodies[b.parent].name;
+    fmt::print("  {:<16} {:<9} joint to {:<16} mass {:.6g} kg", b.name, to_string(b.joint.type), parent,
+               b.integrals.mass);
+    if (b.flex) fmt::print(", flexible: {} modes, {} nodes", b.n_modes(), b.flex->nodes.size());
+    fmt::print("\n");
+  }
+  std::string dofs;
+  for (const auto& n : model.u_names) dofs += (dofs.empty() ? "" : ", ") + n;
+  fmt::print("  speeds: {}\n", dofs);
+  return 0;
+}
+
+int cmd_eval(const Args& a) {
+  const Model model = load_checked(a.model);
+  const State state = state_for(model, a.state);
+  auto engine = make_engine(model, a.engine);
+  nlohmann::ordered_json j;
+  try {
+    j = eval_report(*engine, state);
+  } catch (const SingularMassMatrix& e) {
+    throw InputError(Diagnostic{a.state.empty() ? a.model : a.state, 0, "q", e.what()});
+  }
+  std::cout << j.dump(1) << '\n';
+  return 0;
+}
+
+int cmd_simulate(const Args& a) {
+  const Model model = load_checked(a.model);
+  const State state = state_for(model, a.state);
+  auto engine = make_engine(model, a.engine);
+  SimulationOptions opt;
+  opt.t_end = a.t_end;
+  opt.dt_out = a.dt_out;
+  try {
+    opt.integrator.kind = integrator_from_string(a.integrator);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(Diagnostic{"--integrator", 0, "", e.what()});
+  }
+  opt.integrator.rtol = a.rtol;
+  opt.integrator.atol = a.atol;
+  opt.integrator.h = a.h;
+  opt.progress = !a.no_progress;
+  if (!(a.t_end > state.t)) throw InputError(Diagnostic{"--t-end", 0, "", "must be after the initial time"});
+  if (!(a.dt_out > 0)) throw InputError(Diagnostic{"--dt-out", 0, "", "must be positive"});
+  try {
+    const SimulationResult r = simulate_to_file(*engine, state, opt, a.output);
+    fmt::print(stderr, "{} [{} engine], {} rows to {}, max quaternion drift {:.2e}\n", r.stats.summary(),
+               engine->name(), r.rows, a.output, r.max_quaternion_drift);
+  } catch (const IntegrationError& e) {
+    std::string where;
+    const int n = std::min<int>(static_cast<int>(e.x.size()), model.nq + model.nu);
+    for (int i = 0; i < n; ++i)
+      where += fmt::format("\n  {} = {:.17g}", i < model.nq ? model.q_names[i] : model.u_names[i - model.nq], e.x(i));
+    fmt::print(stderr, "kanegen simulate: integration failed at t = {:.17g}: {}\nstate there:{}\nno output written\n",
+               e.t, e.what(), where);
+    return kExitFailure;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"kanegen: Kane's-method equations of motion for multibody spacecraft"};
+  app.require_subcommand(1);
+  Args a;
+  auto add_model = [&](CLI::App* c) {
+    c->add_option("MODEL", a.model, "model file (YAML, model-format.md)")->required()->check(CLI::ExistingFile);
+  };
+  auto add_engine = [&](CLI::App* c) {
+    c->add_option("--engine", a.engine, "generic: the numeric path, reads the model at run time")
+        ->capture_default_str();
+  };
+
+  CLI::App* check = app.add_subcommand("check", "validate a model; print bodies, joints, dofs, modes");
+  add_model(check);
+
+  CLI::App* eval = app.add_subcommand("eval", "evaluate M, F, u-dot (and the requested outputs) at one state, as JSON");
+  add_model(eval);
+  eval->add_option("--state", a.state, "STATE.json (default: the model's initial state)")
+      ->check(CLI::ExistingFile);
+  add_engine(eval);
+
+  CLI::App* sim = app.add_subcommand("simulate", "integrate the equations of motion and write a CSV time history");
+  add_model(sim);
+  sim->add_option("--t-end", a.t_end, "final time [s]")->required();
+  sim->add_option("-o,--output", a.output, "output CSV file")->required();
+  sim->add_option("--state", a.state, "initial STATE.json (default: the model's initial state)")
+      ->check(CLI::ExistingFile);
+  add_engine(sim);
+  sim->add_option("--integrator", a.integrator, "cvode-bdf | cvode-adams | arkode-erk | arkode-dirk | rk4")
+      ->capture_default_str();
+  sim->add_option("--rtol", a.rtol, "relative tolerance (adaptive integrators)")->capture_default_str();
+  sim->add_option("--atol", a.atol, "absolute tolerance (adaptive integrators)")->capture_default_str();
+  sim->add_option("--dt-out", a.dt_out, "output interval [s]")->capture_default_str();
+  sim->add_option("--h", a.h, "fixed step of rk4 [s]")->capture_default_str();
+  sim->add_flag("--no-progress", a.no_progress, "no progress bar on stderr");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitRefused;
+  }
+  try {
+    if (*check) return cmd_check(a);
+    if (*eval) return cmd_eval(a);
+    if (*sim) return cmd_simulate(a);
+  } catch (const InputError& e) {
+    for (const Diagnostic& d : e.diagnostics()) fmt::print(stderr, "{}\n", d.str());
+    return kExitRefused;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "kanegen: {}\n", e.what());
+    return kExitFailure;
+  }
+  return kExitFailure;
+}

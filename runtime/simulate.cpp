@@ -1,0 +1,189 @@
+#include "simulate.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+namespace kanegen {
+
+namespace {
+
+/// Normalizes every free joint's quaternion in x = [q; u] in place; returns
+/// the largest | |quat| - 1 | found.
+double normalize_quaternions(const Model& model, double* x) {
+  double drift = 0.0;
+  for (const Body& b : model.bodies) {
+    if (b.joint.type != JointType::free) continue;
+    double* quat = x + b.q_joint + 3;
+    const double n = std::sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]);
+    drift = std::max(drift, std::abs(n - 1.0));
+    if (n > 0)
+      for (int k = 0; k < 4; ++k) quat[k] /= n;
+  }
+  return drift;
+}
+
+class ProgressBar {
+ public:
+  ProgressBar(bool enabled, double t0, double t1) : enabled_(enabled && isatty(2)), t0_(t0), t1_(t1) {}
+  void update(double t) {
+    if (!enabled_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < std::chrono::milliseconds(100) && t < t1_) return;
+    last_ = now;
+    const double f = t1_ > t0_ ? std::clamp((t - t0_) / (t1_ - t0_), 0.0, 1.0) : 1.0;
+    const int w = 40, n = static_cast<int>(f * w);
+    fmt::print(stderr, "\r[{}{}] {:5.1f}%  t = {:.6g}", std::string(n, '='), std::string(w - n, ' '), 100 * f, t);
+    std::fflush(stderr);
+  }
+  void finish() {
+    if (enabled_) fmt::print(stderr, "\n");
+  }
+
+ private:
+  bool enabled_;
+  double t0_, t1_;
+  std::chrono::steady_clock::time_point last_{};
+};
+
+}  // namespace
+
+OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure) {
+  const Model& model = engine.model();
+  const int nq = model.nq, nu = model.nu;
+  struct Scratch {
+    VecX x, q, u, qdot, udot;
+  };
+  auto scratch = std::make_shared<Scratch>();
+  scratch->x.resize(nq + nu);
+  OdeProblem p;
+  p.n = nq + nu;
+  p.rhs = [&engine, tau, scratch, failure, nq, nu](double t, const double* x, double* xdot) -> int {
+    Scratch& s = *scratch;
+    s.x = Eigen::Map<const VecX>(x, nq + nu);
+    if (!s.x.allFinite()) {
+      if (failure) *failure = fmt::format("non-finite state at t = {:.17g}", t);
+      return -1;
+    }
+    // The engines normalize quaternions for M and F; q_dot uses the quaternion
+    // as integrated, whose norm the flow quat_dot = 1/2 quat (x) [0, w] preserves.
+    s.q = s.x.head(nq);
+    s.u = s.x.tail(nu);
+    try {
+      engine.qdot(s.q, s.u, s.qdot);
+      engine.udot(s.q, s.u, tau, s.udot);
+    } catch (const SingularMassMatrix& e) {
+      if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
+      return -1;
+    }
+    Eigen::Map<VecX>(xdot, nq) = s.qdot;
+    Eigen::Map<VecX>(xdot + nq, nu) = s.udot;
+    if (!s.udot.allFinite()) {
+      if (failure) *failure = fmt::format("non-finite accelerations at t = {:.17g}", t);
+      return 1;  // recoverable: the integrator retries with a smaller step
+    }
+    return 0;
+  };
+  p.project = [&model](double* x) { normalize_quaternions(model, x); };
+  return p;
+}
+
+std::vector<std::string> csv_columns(const Model& model) {
+  std::vector<std::string> cols{"t"};
+  cols.insert(cols.end(), model.q_names.begin(), model.q_names.end());
+  cols.insert(cols.end(), model.u_names.begin(), model.u_names.end());
+  if (model.outputs.energy) cols.insert(cols.end(), {"T", "V"});
+  if (model.outputs.momentum) cols.insert(cols.end(), {"Hx", "Hy", "Hz"});
+  if (model.outputs.reactions)
+    for (const Body& b : model.bodies)
+      for (const char* s : {".fx", ".fy", ".fz", ".tx", ".ty", ".tz"}) cols.push_back(b.name + s);
+  return cols;
+}
+
+SimulationResult simulate(Engine& engine, const State& initial, const SimulationOptions& options, std::ostream& csv) {
+  const Model& model = engine.model();
+  const int nq = model.nq, nu = model.nu;
+  std::string failure;
+  OdeProblem problem = make_ode_problem(engine, initial.tau, &failure);
+  VecX x0(nq + nu);
+  x0 << initial.q, initial.u;
+
+  SimulationResult result;
+  const auto cols = csv_columns(model);
+  for (std::size_t c = 0; c < cols.size(); ++c) csv << (c ? "," : "") << cols[c];
+  csv << '\n';
+
+  ProgressBar bar(options.progress, initial.t, options.t_end);
+  VecX q(nq), u(nu), udot(nu);
+  std::vector<Reaction> reactions;
+  std::string line;
+  auto write = [&](double t, const VecX& x) -> bool {
+    // x arrives projected; measure the drift on the raw integrated state
+    q = x.head(nq);
+    u = x.tail(nu);
+    line = fmt::format("{:.17g}", t);
+    for (int i = 0; i < nq + nu; ++i) line += fmt::format(",{:.17g}", x(i));
+    if (model.outputs.energy) {
+      const EnergyValues E = engine.energy(q, u);
+      line += fmt::format(",{:.17g},{:.17g}", E.T, E.V);
+    }
+    if (model.outputs.momentum) {
+      const MomentumValues P = engine.momentum(q, u);
+      line += fmt::format(",{:.17g},{:.17g},{:.17g}", P.H_N(0), P.H_N(1), P.H_N(2));
+    }
+    if (model.outputs.reactions) {
+      engine.udot(q, u, initial.tau, udot);
+      engine.reactions(q, u, udot, reactions);
+      for (const Reaction& r : reactions)
+        line += fmt::format(",{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", r.force_B(0), r.force_B(1),
+                            r.force_B(2), r.torque_B(0), r.torque_B(1), r.torque_B(2));
+    }
+    csv << line << '\n';
+    ++result.rows;
+    bar.update(t);
+    return true;
+  };
+  // Drift is measured on the unprojected state: wrap project.
+  auto project = problem.project;
+  problem.project = [&](double* x) {
+    VecX raw = Eigen::Map<VecX>(x, nq + nu);
+    result.max_quaternion_drift = std::max(result.max_quaternion_drift, normalize_quaternions(model, raw.data()));
+    project(x);
+  };
+  try {
+    result.stats = integrate(problem, options.integrator, initial.t, x0, options.t_end, options.dt_out, write);
+  } catch (const IntegrationError& e) {
+    bar.finish();
+    throw IntegrationError(failure.empty() ? e.what() : fmt::format("{} ({})", e.what(), failure), e.t, e.x);
+  }
+  bar.finish();
+  return result;
+}
+
+SimulationResult simulate_to_file(Engine& engine, const State& initial, const SimulationOptions& options,
+                                  const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path tmp = target.parent_path() / (target.filename().string() + fmt::format(".tmp{}", getpid()));
+  SimulationResult r;
+  try {
+    std::ofstream out(tmp);
+    if (!out) throw std::runtime_error(fmt::format("cannot write {}", tmp.string()));
+    r = simulate(engine, initial, options, out);
+    out.close();
+    if (!out) throw std::runtime_error(fmt::format("error writing {}", tmp.string()));
+    fs::rename(tmp, target);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw;
+  }
+  return r;
+}
+
+}  // namespace kanegen

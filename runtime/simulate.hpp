@@ -1,0 +1,45 @@
+// Time histories: integrates q_dot = W(q) u, M(q) u_dot = F(q, u, tau) with
+// constant inputs tau from a state, and writes the CSV of interface.md.
+#pragma once
+
+#include <ostream>
+#include <string>
+
+#include "engine.hpp"
+#include "integrators.hpp"
+#include "state_io.hpp"
+
+namespace kanegen {
+
+struct SimulationOptions {
+  double t_end = 10.0;
+  double dt_out = 0.01;
+  IntegratorOptions integrator;
+  bool progress = false;  ///< progress bar on stderr
+};
+
+struct SimulationResult {
+  IntegratorStats stats;
+  double max_quaternion_drift = 0.0;  ///< max | |quat| - 1 | seen at output times, before normalization
+  long rows = 0;
+};
+
+/// The ODE x = [q; u] of an engine, for the integrators. The right-hand side
+/// normalizes quaternions before use; a singular M or a non-finite state
+/// makes it fail (unrecoverably) with the reason stored in `failure`.
+OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure);
+
+/// Column names of the CSV: t, q names, u names, then T V / Hx Hy Hz /
+/// <body>.fx .fy .fz .tx .ty .tz as the model's outputs ask.
+std::vector<std::string> csv_columns(const Model& model);
+
+/// Integrates from `initial` to options.t_end writing CSV rows to `csv`.
+/// Throws IntegrationError (with time and state) on failure.
+SimulationResult simulate(Engine& engine, const State& initial, const SimulationOptions& options, std::ostream& csv);
+
+/// Simulates into `path` atomically: the file appears only if the whole run
+/// succeeded (written to a temporary beside it, then renamed).
+SimulationResult simulate_to_file(Engine& engine, const State& initial, const SimulationOptions& options,
+                                  const std::string& path);
+
+}  // namespace kanegen
