@@ -1,0 +1,350 @@
+#!/usr/bin/python3
+"""Plot a `kanegen simulate` CSV time history (interface.md) into PNG files.
+
+    plot_simulation.py OUT.csv [--model MODEL.yaml] [--axis x|y|z] [--prefix P] -o DIR
+
+Writes, when the columns are there:
+  P_omega_<body>.png     angular velocity components of every free body (body frame),
+                         and |omega| along / across the chosen body axis (log scale)
+  P_nutation_<body>.png  nutation angle of every free body: angle between its body axis
+                         (--axis, default z) and the angular momentum H, in body axes
+  P_energy.png           T, V and T + V
+  P_momentum.png         |H| and its relative drift
+  P_reactions.png        joint reaction force and torque magnitudes per body
+  P_joints.png           revolute / prismatic / modal coordinates
+P is the model name (from --model) or the CSV file stem, unless --prefix is given.
+Prints the files written. Exit status 2 on a missing file or column.
+Run with /usr/bin/python3 (needs numpy, matplotlib; PyYAML for --model).
+"""
+import argparse
+import math
+import os
+import sys
+
+import numpy as np
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+DPI = 100
+QUAT = ("qw", "qx", "qy", "qz")
+OMEGA = ("wx", "wy", "wz")
+WRENCH = ("fx", "fy", "fz", "tx", "ty", "tz")
+AXES = {"x": 0, "y": 1, "z": 2}
+
+
+class InputError(Exception):
+    """A missing or unusable input: reported with exit status 2."""
+
+
+# ---------------------------------------------------------------- rotations
+def quat_to_R(w, x, y, z):
+    """R(quat) of dynamics.md (child -> parent components); arrays broadcast. Normalizes."""
+    n = np.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = w / n, x / n, y / n, z / n
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def rot_axis(a, th):
+    a = np.asarray(a, float)
+    a = a / np.linalg.norm(a)
+    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + math.sin(th) * K + (1 - math.cos(th)) * K @ K
+
+
+def rotation_of(spec):
+    """Joint-frame rotation of a model file (model-format.md), as a 3x3 matrix."""
+    if not spec:
+        return np.eye(3)
+    if "rpy" in spec:
+        r, p, y = spec["rpy"]
+        return rot_axis([0, 0, 1], y) @ rot_axis([0, 1, 0], p) @ rot_axis([1, 0, 0], r)
+    if "matrix" in spec:
+        return np.asarray(spec["matrix"], float)
+    if "axis_angle" in spec:
+        a, th = spec["axis_angle"]
+        return rot_axis(a, th)
+    if "quaternion" in spec:
+        return quat_to_R(*[float(v) for v in spec["quaternion"]])
+    raise InputError(f"unknown rotation {spec!r}")
+
+
+# ---------------------------------------------------------------- inputs
+class History:
+    """The CSV: names may repeat (a revolute q and its speed share a name): first = q."""
+
+    def __init__(self, path):
+        if not os.path.isfile(path):
+            raise InputError(f"{path}: no such file")
+        with open(path) as f:
+            header = f.readline().strip()
+        if not header:
+            raise InputError(f"{path}: empty file, expected a kanegen simulate CSV")
+        self.path = path
+        self.names = [h.strip() for h in header.split(",")]
+        try:
+            self.data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        except ValueError as e:
+            raise InputError(f"{path}: unreadable CSV data ({e})")
+        if self.data.shape[0] == 0:
+            raise InputError(f"{path}: no data rows")
+        if self.data.shape[1] != len(self.names):
+            raise InputError(f"{path}: {self.data.shape[1]} values per row but {len(self.names)} header names")
+        self.index = {}
+        for i, n in enumerate(self.names):
+            self.index.setdefault(n, []).append(i)
+        self.require(["t"], "the time column")
+        self.t = self.col("t")
+
+    def has(self, *names):
+        return all(n in self.index for n in names)
+
+    def col(self, name, occurrence=0):
+        return self.data[:, self.index[name][occurrence]]
+
+    def require(self, names, what):
+        missing = [n for n in names if n not in self.index]
+        if missing:
+            raise InputError(f"{self.path}: missing column(s) {', '.join(missing)} ({what})")
+
+
+def load_model(path):
+    if not os.path.isfile(path):
+        raise InputError(f"{path}: no such file")
+    try:
+        import yaml
+    except ImportError:
+        raise InputError("--model needs PyYAML (run with /usr/bin/python3)")
+    with open(path) as f:
+        try:
+            m = yaml.safe_load(f)
+        except yaml.YAMLError as e:
+            raise InputError(f"{path}: not valid YAML ({e})")
+    if not isinstance(m, dict) or not isinstance(m.get("bodies"), list):
+        raise InputError(f"{path}: no 'bodies' list; expected a kanegen model file")
+    return m
+
+
+# ---------------------------------------------------------------- plots
+def finish(fig, ax_list, path, written):
+    for ax in ax_list:
+        ax.grid(True, alpha=0.4)
+    fig.tight_layout()
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    written.append(path)
+
+
+def plot_omega(h, body, axis, out, written):
+    w = np.stack([h.col(f"{body}.{c}") for c in OMEGA], 1)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    for k, c in enumerate(OMEGA):
+        a1.plot(h.t, w[:, k], lw=0.6, label=f"$\\omega_{c[1]}$")
+    a1.set_ylabel("angular velocity [rad/s]")
+    a1.set_title(f"{body}: angular velocity in body axes")
+    a1.legend(loc="best")
+    i = AXES[axis]
+    along = np.abs(w[:, i])
+    across = np.sqrt(np.sum(np.delete(w, i, axis=1) ** 2, 1))
+    a2.semilogy(h.t, np.maximum(along, 1e-300), lw=0.8, label=f"|$\\omega_{axis}$| (along body {axis})")
+    a2.semilogy(h.t, np.maximum(across, 1e-300), lw=0.8, label=f"transverse |$\\omega$| (across body {axis})")
+    a2.set_xlabel("time [s]")
+    a2.set_ylabel("|angular velocity| [rad/s]")
+    a2.legend(loc="best")
+    finish(fig, (a1, a2), os.path.join(out, f"{h.prefix}_omega_{body}.png"), written)
+
+
+def nutation(h, body, axis, R_J):
+    q = [h.col(f"{body}.{c}") for c in QUAT]
+    R = quat_to_R(*q)                                   # 3x3xN, body -> joint frame
+    R = np.einsum("ij,jkn->ikn", R_J, R)                # body -> N (parent is ground)
+    H = np.stack([h.col("Hx"), h.col("Hy"), h.col("Hz")], 0)   # 3xN, N components
+    HB = np.einsum("jin,jn->in", R, H)                  # R^T H: body components
+    Hn = np.linalg.norm(HB, axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c = np.where(Hn > 0, HB[AXES[axis]] / Hn, np.nan)
+    return np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
+
+
+def plot_nutation(h, body, axis, R_J, out, written):
+    th = nutation(h, body, axis, R_J)
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    ax.plot(h.t, th, lw=1.0, color="C3")
+    ax.axhline(45, ls="--", lw=0.8, color="gray")
+    ax.axhline(90, ls=":", lw=0.8, color="gray")
+    msg = f"{body}: nutation (body {axis} vs H) start {th[0]:.2f} deg, end {th[-1]:.2f} deg"
+    above = np.nonzero(th > 45)[0]
+    if th[0] < 45 and above.size:
+        k = above[0]
+        # linear interpolation of the 45 deg crossing
+        t45 = h.t[k - 1] + (45 - th[k - 1]) * (h.t[k] - h.t[k - 1]) / (th[k] - th[k - 1])
+        ax.axvline(t45, ls="--", lw=0.8, color="C0")
+        ax.annotate(f"45° at t = {t45:.0f} s", (t45, 45), xytext=(8, -18), textcoords="offset points")
+        msg += f", crosses 45 deg at t = {t45:.1f} s"
+    print(msg)
+    ax.set_ylim(0, 95)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("nutation angle [deg]")
+    ax.set_title(f"{body}: angle between body {axis} axis and angular momentum H")
+    finish(fig, (ax,), os.path.join(out, f"{h.prefix}_nutation_{body}.png"), written)
+
+
+def plot_energy(h, out, written):
+    T, V = h.col("T"), h.col("V")
+    E = T + V
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    a1.plot(h.t, T, lw=2.0, label="T (kinetic)")
+    a1.plot(h.t, V, lw=2.0, label="V (potential)")
+    a1.plot(h.t, E, "--", lw=1.0, color="k", label="E = T + V")
+    a1.set_ylabel("energy [J]")
+    a1.set_title("energy")
+    a1.legend(loc="best")
+    scale = max(abs(E[0]), np.max(np.abs(T)), 1e-300)
+    a2.plot(h.t, (E - E[0]) / scale, lw=0.8, color="k")
+    a2.set_ylabel("(E - E(0)) / max(|E(0)|, max T)")
+    a2.set_xlabel("time [s]")
+    a2.set_title("energy change")
+    finish(fig, (a1, a2), os.path.join(out, f"{h.prefix}_energy.png"), written)
+
+
+def plot_momentum(h, out, written):
+    H = np.stack([h.col("Hx"), h.col("Hy"), h.col("Hz")], 1)
+    Hn = np.linalg.norm(H, axis=1)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    for k, c in enumerate("xyz"):
+        a1.plot(h.t, H[:, k], lw=0.8, label=f"$H_{c}$")
+    a1.plot(h.t, Hn, lw=1.2, color="k", label="|H|")
+    a1.set_ylabel("angular momentum [N·m·s]")
+    a1.set_title("angular momentum about N's origin (N components)")
+    a1.legend(loc="best")
+    if Hn[0] > 0:
+        a2.plot(h.t, (Hn - Hn[0]) / Hn[0], lw=0.8, color="k")
+        a2.set_ylabel("(|H| - |H(0)|) / |H(0)|")
+        print(f"|H| relative drift: max {np.max(np.abs(Hn - Hn[0])) / Hn[0]:.2e}")
+    else:
+        a2.plot(h.t, Hn - Hn[0], lw=0.8, color="k")
+        a2.set_ylabel("|H| - |H(0)| [N·m·s]")
+    a2.set_xlabel("time [s]")
+    a2.set_title("change of |H| (zero when no external torque acts)")
+    finish(fig, (a1, a2), os.path.join(out, f"{h.prefix}_momentum.png"), written)
+
+
+def plot_reactions(h, bodies, out, written):
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    for b in bodies:
+        f = np.sqrt(sum(h.col(f"{b}.{c}") ** 2 for c in WRENCH[:3]))
+        t = np.sqrt(sum(h.col(f"{b}.{c}") ** 2 for c in WRENCH[3:]))
+        a1.plot(h.t, f, lw=0.7, label=b)
+        a2.plot(h.t, t, lw=0.7, label=b)
+    a1.set_ylabel("|force| [N]")
+    a1.set_title("joint reaction on each body from its parent")
+    a2.set_ylabel("|torque about joint point| [N·m]")
+    a2.set_xlabel("time [s]")
+    for a in (a1, a2):
+        a.legend(loc="best", fontsize="small", ncol=2)
+    finish(fig, (a1, a2), os.path.join(out, f"{h.prefix}_reactions.png"), written)
+
+
+def plot_joints(h, coords, out, written):
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for n in coords:
+        ax.plot(h.t, h.col(n, 0), lw=0.7, label=n)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("joint coordinate [rad, m or modal]")
+    ax.set_title("joint coordinates")
+    ax.legend(loc="best", fontsize="small", ncol=2)
+    finish(fig, (ax,), os.path.join(out, f"{h.prefix}_joints.png"), written)
+
+
+# ---------------------------------------------------------------- main
+def run(args):
+    h = History(args.csv)
+    model = load_model(args.model) if args.model else None
+    h.prefix = args.prefix or (model.get("name") if model and model.get("name") else
+                               os.path.splitext(os.path.basename(args.csv))[0])
+
+    free, reaction_bodies, rot_J, coords = [], [], {}, []
+    if model:
+        outputs = model.get("outputs") or []
+        for b in model["bodies"]:
+            name, joint = b.get("name"), b.get("joint") or {}
+            jt = joint.get("type")
+            if jt == "free":
+                h.require([f"{name}.{c}" for c in QUAT + OMEGA], f"free body {name}")
+                free.append(name)
+                if b.get("parent") == "ground":
+                    rot_J[name] = rotation_of(joint.get("rotation"))
+            elif jt == "revolute":
+                coords.append(f"{name}.angle")
+            elif jt == "prismatic":
+                coords.append(f"{name}.disp")
+            coords += [n for n in h.index if n.startswith(f"{name}.eta")]
+            if "reactions" in outputs:
+                reaction_bodies.append(name)
+        h.require(coords, "joint coordinates of the model")
+        if "energy" in outputs:
+            h.require(["T", "V"], "the model's outputs list energy")
+        if "momentum" in outputs:
+            h.require(["Hx", "Hy", "Hz"], "the model's outputs list momentum")
+        if reaction_bodies:
+            h.require([f"{b}.{c}" for b in reaction_bodies for c in WRENCH],
+                      "the model's outputs list reactions")
+    else:
+        # no model: bodies are recognized by their columns
+        for n in h.names:
+            b, _, c = n.rpartition(".")
+            if c == "qw" and h.has(*[f"{b}.{x}" for x in QUAT + OMEGA]) and b not in free:
+                free.append(b)
+                rot_J[b] = np.eye(3)     # assumed: parent ground, identity joint rotation
+            if c == "fx" and h.has(*[f"{b}.{x}" for x in WRENCH]) and b not in reaction_bodies:
+                reaction_bodies.append(b)
+            if (c in ("angle", "disp") or c.startswith("eta")) and n not in coords:
+                coords.append(n)
+
+    os.makedirs(args.output, exist_ok=True)
+    written = []
+    for b in free:
+        plot_omega(h, b, args.axis, args.output, written)
+    if h.has("T", "V"):
+        plot_energy(h, args.output, written)
+    if h.has("Hx", "Hy", "Hz"):
+        plot_momentum(h, args.output, written)
+        for b in free:
+            if b in rot_J:
+                plot_nutation(h, b, args.axis, rot_J[b], args.output, written)
+            else:
+                print(f"note: {b} is free but not attached to ground; no nutation plot", file=sys.stderr)
+    if reaction_bodies:
+        plot_reactions(h, reaction_bodies, args.output, written)
+    if coords:
+        plot_joints(h, coords, args.output, written)
+    if not written:
+        raise InputError(f"{args.csv}: nothing to plot (no free-body, energy, momentum, reaction or joint columns)")
+    print("wrote:")
+    for p in written:
+        print("  " + p)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description="Plot a kanegen simulate CSV time history into PNG files.")
+    ap.add_argument("csv", help="CSV written by `kanegen simulate`")
+    ap.add_argument("--model", help="the model YAML (gives the body list, joint frames and file prefix)")
+    ap.add_argument("-o", "--output", required=True, help="directory for the PNG files (created if needed)")
+    ap.add_argument("--axis", choices=("x", "y", "z"), default="z",
+                    help="body axis taken as the long (spin) axis for the nutation angle (default z)")
+    ap.add_argument("--prefix", help="file name prefix (default: model name or CSV stem)")
+    args = ap.parse_args(argv)
+    try:
+        run(args)
+    except InputError as e:
+        print(f"plot_simulation.py: error: {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
