@@ -14,7 +14,7 @@ namespace kanegen {
 enum class IntegratorKind {
   cvode_bdf,    ///< CVODE, variable-order BDF, Newton with dense linear solver
   cvode_adams,  ///< CVODE, Adams-Moulton, fixed-point iteration (non-stiff)
-  arkode_erk,   ///< ARKODE ERKStep, adaptive explicit RK (default table, order 4)
+  arkode_erk,   ///< ARKODE ERKStep, adaptive explicit Dormand-Prince 5(4)
   arkode_dirk,  ///< ARKODE ARKStep, fully implicit adaptive DIRK (order 4), Newton + dense
   rk4,          ///< classical fixed-step Runge-Kutta 4 (step = IntegratorOptions::h)
 };

@@ -10,6 +10,7 @@
 
 #include "diagnostics.hpp"
 #include "eval_report.hpp"
+#include "generate.hpp"
 #include "generic_engine.hpp"
 #include "integrators.hpp"
 #include "model_checks.hpp"
@@ -59,6 +60,21 @@ int cmd_check(const Args& a) {
   std::string dofs;
   for (const auto& n : model.u_names) dofs += (dofs.empty() ? "" : ", ") + n;
   fmt::print("  speeds: {}\n", dofs);
+  return 0;
+}
+
+int cmd_generate(const Args& a) {
+  const Model model = load_checked(a.model);
+  const gen::GeneratedCode code = gen::generate(model);
+  // Written beside the target and renamed: never a half-written header.
+  const std::string tmp = a.output + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!(out << code.header)) throw std::runtime_error("cannot write " + tmp);
+  }
+  std::filesystem::rename(tmp, a.output);
+  fmt::print(stderr, "{}: u_dot {} operations, M {}, F {}\n", a.output, code.ops.at("udot").total(),
+             code.ops.at("mass_matrix").total(), code.ops.at("forcing").total());
   return 0;
 }
 
@@ -127,6 +143,10 @@ int main(int argc, char** argv) {
   CLI::App* check = app.add_subcommand("check", "validate a model; print bodies, joints, dofs, modes");
   add_model(check);
 
+  CLI::App* generate = app.add_subcommand("generate", "write the specialized C++ header of a model");
+  add_model(generate);
+  generate->add_option("-o,--output", a.output, "output header (.hpp)")->required();
+
   CLI::App* eval = app.add_subcommand("eval", "evaluate M, F, u-dot (and the requested outputs) at one state, as JSON");
   add_model(eval);
   eval->add_option("--state", a.state, "STATE.json (default: the model's initial state)")
@@ -156,6 +176,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*check) return cmd_check(a);
+    if (*generate) return cmd_generate(a);
     if (*eval) return cmd_eval(a);
     if (*sim) return cmd_simulate(a);
   } catch (const InputError& e) {

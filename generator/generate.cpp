@@ -1,0 +1,207 @@
+#include "generate.hpp"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "kane_builder.hpp"
+#include "merge_fixed.hpp"
+#include "model_hash.hpp"
+
+namespace kanegen::gen {
+
+namespace {
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read template " + path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void replace_all(std::string& s, const std::string& key, const std::string& value) {
+  const std::string k = "{{" + key + "}}";
+  for (std::size_t pos = s.find(k); pos != std::string::npos; pos = s.find(k, pos + value.size()))
+    s.replace(pos, k.size(), value);
+}
+
+std::string join(const std::vector<std::string>& v, const std::string& sep) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
+  return s;
+}
+
+constexpr const char* kIndent = "  ";
+
+struct FunctionBody {
+  std::string code;
+  OpCount ops;
+};
+
+FunctionBody finish(const Program& p) {
+  FunctionBody f;
+  f.code = p.emit(kIndent, f.ops);
+  return f;
+}
+
+std::string body_comment(const Model& model, const Body& b) {
+  const std::string parent = b.parent < 0 ? "ground" : model.bodies[b.parent].name;
+  std::string s = fmt::format("// body {}: {} joint to {}", b.name, to_string(b.joint.type), parent);
+  if (b.joint.node >= 0) s += fmt::format(" at node {}", model.bodies[b.parent].flex->nodes[b.joint.node].id);
+  s += fmt::format(", mass {:.6g} kg", b.integrals.mass);
+  if (b.flex) s += fmt::format(", flexible: {} modes from {}", b.n_modes(), b.flex->source);
+  return s + "\n";
+}
+
+}  // namespace
+
+GeneratedCode generate(const Model& model_in, const GeneratorOptions& options) {
+  const Model merged = options.merge_fixed ? merge_fixed_bodies(model_in) : model_in;
+  const Model& dyn = merged;  // used for M, F, u_dot, energy, momentum
+  Constants C;
+  const StateSymbols x(dyn);
+  GeneratedCode out;
+  std::map<std::string, FunctionBody> fn;
+
+  {  // q_dot
+    Program p;
+    KaneBuilder kb(dyn, p, C, x);
+    const auto qd = kb.qdot();
+    for (int i = 0; i < dyn.nq; ++i) p.assign(fmt::format("qdot[{}]", i), qd[i]);
+    fn["qdot"] = finish(p);
+  }
+  {  // M
+    Program p;
+    KaneBuilder kb(dyn, p, C, x);
+    kb.kinematics(false);
+    kb.body_terms(false);
+    const SMat M = kb.mass_matrix();
+    for (int r = 0; r < dyn.nu; ++r)
+      for (int c = 0; c < dyn.nu; ++c) p.assign(fmt::format("M[{}]", r * dyn.nu + c), M(r, c));
+    fn["mass_matrix"] = finish(p);
+  }
+  {  // F
+    Program p;
+    KaneBuilder kb(dyn, p, C, x);
+    kb.kinematics(true);
+    kb.body_terms(true);
+    const auto F = kb.forcing();
+    for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("F[{}]", r), F[r]);
+    fn["forcing"] = finish(p);
+  }
+  {  // u_dot
+    Program p;
+    KaneBuilder kb(dyn, p, C, x);
+    kb.kinematics(true);
+    kb.body_terms(true);
+    const SMat M = kb.mass_matrix();
+    const auto F = kb.forcing();
+    std::vector<ex> pivots;
+    const auto ud = kb.solve(M, F, pivots);
+    OpCount dummy;
+    for (int k = 0; k < dyn.nu; ++k)
+      p.statement(fmt::format("if (!({} > 0.0)) return {};", print_cpp(pivots[k], dummy), k + 1), pivots[k]);
+    for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("udot[{}]", r), ud[r]);
+    fn["udot"] = finish(p);
+  }
+  std::string optional;
+  std::string macros;
+  const auto& outs = model_in.outputs;
+  if (outs.energy) {
+    Program p;
+    KaneBuilder kb(dyn, p, C, x);
+    kb.kinematics(true);
+    kb.body_terms(true);
+    p.assign("TV[0]", kb.kinetic_energy());
+    p.assign("TV[1]", kb.potential_energy());
+    fn["energy"] = finish(p);
+    optional += "\n// ---- energy: T, V -----------------------------------------------------------------\n"
+                "template <class T>\nvoid energy(const T* q, const T* u, T* TV) {\n"
+                "  using std::cos; using std::sin; using std::sqrt;\n  (void)q; (void)u;\n" +
+                fn["energy"].code + "}\n";
+    macros += "#define KANEGEN_HAS_ENERGY 1\n";
+  }
+  if (outs.momentum) {
+    Program p;
+    KaneBuilder kb(dyn, p, C, x);
+    kb.kinematics(true);
+    kb.body_terms(true);
+    const auto pH = kb.momentum();
+    for (int i = 0; i < 6; ++i) p.assign(fmt::format("pH[{}]", i), pH[i]);
+    fn["momentum"] = finish(p);
+    optional += "\n// ---- momentum: p_N[3], H_N[3] about N's origin ------------------------------------\n"
+                "template <class T>\nvoid momentum(const T* q, const T* u, T* pH) {\n"
+                "  using std::cos; using std::sin; using std::sqrt;\n  (void)q; (void)u;\n" +
+                fn["momentum"].code + "}\n";
+    macros += "#define KANEGEN_HAS_MOMENTUM 1\n";
+  }
+  if (outs.reactions) {  // on the unmerged tree: every body, fixed ones included
+    const StateSymbols xr(model_in);
+    Program p;
+    KaneBuilder kb(model_in, p, C, xr);
+    kb.kinematics(true);
+    kb.body_terms(true);
+    const auto W = kb.reactions(xr.udot);
+    for (std::size_t i = 0; i < W.size(); ++i) p.assign(fmt::format("wrenches[{}]", i), W[i]);
+    fn["reactions"] = finish(p);
+    optional += "\n// ---- reactions on each body from its parent: [force; torque about O_B], body axes --\n"
+                "template <class T>\nvoid reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {\n"
+                "  using std::cos; using std::sin; using std::sqrt;\n  (void)q; (void)u; (void)udot_in;\n" +
+                fn["reactions"].code + "}\n";
+    macros += "#define KANEGEN_HAS_REACTIONS 1\n";
+  }
+
+  // Constants, grouped per body with a comment block.
+  std::string constants;
+  for (const std::string& g : C.groups()) {
+    const int bi = model_in.body_index(g);
+    if (bi >= 0)
+      constants += body_comment(model_in, model_in.bodies[bi]);
+    else
+      constants += "// model\n";
+    constants += C.emit(g, "") + "\n";
+  }
+
+  std::string op_counts;
+  for (const auto& [name, f] : fn) {
+    out.ops[name] = f.ops;
+    op_counts += fmt::format("//   {:<12} {:>7} ({} add, {} mul, {} div, {} func)\n", name, f.ops.total(), f.ops.add,
+                             f.ops.mul, f.ops.div, f.ops.func);
+  }
+
+  const std::string tdir =
+      options.template_dir.empty() ? std::string(KANEGEN_SOURCE_DIR) + "/templates" : options.template_dir;
+  std::string h = read_file(tdir + "/model.hpp.in");
+  replace_all(h, "GENERATOR_VERSION", KANEGEN_VERSION);
+  replace_all(h, "MODEL_DESCRIPTION", model_in.description.empty() ? "" : " -- " + model_in.description);
+  replace_all(h, "MODEL_NAME", model_in.name);
+  replace_all(h, "MODEL_HASH", model_hash(model_in));
+  replace_all(h, "NQ", std::to_string(model_in.nq));
+  replace_all(h, "NU", std::to_string(model_in.nu));
+  replace_all(h, "NX", std::to_string(model_in.nq + model_in.nu));
+  replace_all(h, "NBODIES", std::to_string(model_in.bodies.size()));
+  replace_all(h, "Q_NAMES", join(model_in.q_names, ", "));
+  replace_all(h, "U_NAMES", join(model_in.u_names, ", "));
+  replace_all(h, "OP_COUNTS", op_counts);
+  replace_all(h, "HAS_ENERGY", outs.energy ? "true" : "false");
+  replace_all(h, "HAS_MOMENTUM", outs.momentum ? "true" : "false");
+  replace_all(h, "HAS_REACTIONS", outs.reactions ? "true" : "false");
+  replace_all(h, "OPTIONAL_MACROS", macros);
+  replace_all(h, "CONSTANTS", constants);
+  replace_all(h, "QDOT_BODY", fn["qdot"].code);
+  replace_all(h, "MASS_MATRIX_BODY", fn["mass_matrix"].code);
+  replace_all(h, "FORCING_BODY", fn["forcing"].code);
+  replace_all(h, "UDOT_BODY", fn["udot"].code);
+  replace_all(h, "OPTIONAL_FUNCTIONS", optional);
+  replace_all(h, "DUAL_WIDTH", std::to_string(std::min(8, std::max(1, model_in.nq + model_in.nu))));
+  out.header = std::move(h);
+  return out;
+}
+
+std::string generate_header(const Model& model) { return generate(model).header; }
+
+}  // namespace kanegen::gen
