@@ -14,6 +14,7 @@
 #include "generic_engine.hpp"
 #include "integrators.hpp"
 #include "model_checks.hpp"
+#include "modal_data.hpp"
 #include "model_loader.hpp"
 #include "simulate.hpp"
 #include "state_io.hpp"
@@ -26,7 +27,7 @@ constexpr int kExitFailure = 1;
 constexpr int kExitRefused = 2;
 
 struct Args {
-  std::string model, state, engine = "generic", output, integrator = "cvode-bdf";
+  std::string model, state, engine = "generic", output, integrator = "cvode-bdf", body;
   double t_end = 10.0, rtol = 1e-8, atol = 1e-10, dt_out = 0.01, h = 1e-3;
   bool no_progress = false;
 };
@@ -75,6 +76,19 @@ int cmd_generate(const Args& a) {
   std::filesystem::rename(tmp, a.output);
   fmt::print(stderr, "{}: u_dot {} operations, M {}, F {}\n", a.output, code.ops.at("udot").total(),
              code.ops.at("mass_matrix").total(), code.ops.at("forcing").total());
+  return 0;
+}
+
+int cmd_modes(const Args& a) {
+  const Model model = load_model(a.model);
+  const int i = model.body_index(a.body);
+  if (i < 0 || !model.bodies[i].flex)
+    throw InputError(Diagnostic{a.model, 0, "--body",
+                                fmt::format("'{}' is not a flexible body of model {}", a.body, model.name)});
+  const FlexibleData& f = *model.bodies[i].flex;
+  write_modal_file(f, a.output);
+  fmt::print("{}: {} nodes, {} modes of body {} ({})\n", a.output, f.nodes.size(), f.modes(), a.body, f.source);
+  for (int k = 0; k < f.modes(); ++k) fmt::print("  mode {}: {:.6g} Hz\n", k + 1, f.frequency_hz(k));
   return 0;
 }
 
@@ -147,6 +161,11 @@ int main(int argc, char** argv) {
   add_model(generate);
   generate->add_option("-o,--output", a.output, "output header (.hpp)")->required();
 
+  CLI::App* modes = app.add_subcommand("modes", "write a flexible body's modes (e.g. of a built-in beam) as a modal file");
+  add_model(modes);
+  modes->add_option("--body", a.body, "flexible body")->required();
+  modes->add_option("-o,--output", a.output, "output *.modal.yaml")->required();
+
   CLI::App* eval = app.add_subcommand("eval", "evaluate M, F, u-dot (and the requested outputs) at one state, as JSON");
   add_model(eval);
   eval->add_option("--state", a.state, "STATE.json (default: the model's initial state)")
@@ -177,6 +196,7 @@ int main(int argc, char** argv) {
   try {
     if (*check) return cmd_check(a);
     if (*generate) return cmd_generate(a);
+    if (*modes) return cmd_modes(a);
     if (*eval) return cmd_eval(a);
     if (*sim) return cmd_simulate(a);
   } catch (const InputError& e) {
