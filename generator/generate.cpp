@@ -60,6 +60,8 @@ std::string body_comment(const Model& model, const Body& b) {
 }  // namespace
 
 GeneratedCode generate(const Model& model_in, const GeneratorOptions& options) {
+  if (options.udot_form != "auto" && options.udot_form != "composite" && options.udot_form != "articulated")
+    throw std::invalid_argument("udot form must be auto, composite or articulated");
   const Model merged = options.merge_fixed ? merge_fixed_bodies(model_in) : model_in;
   const Model& dyn = merged;  // used for M, F, u_dot, energy, momentum
   Constants C;
@@ -93,20 +95,34 @@ GeneratedCode generate(const Model& model_in, const GeneratorOptions& options) {
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("F[{}]", r), F[r]);
     fn["forcing"] = finish(p);
   }
-  {  // u_dot
+  // u_dot: the composite-inertia form (M by composite inertias, F by the
+  // inward pass, L^T D L along the tree; O(n^2) plus O(n d^2)) or the
+  // articulated-body form (O(n)), whichever takes fewer operations here.
+  for (const char* form : {"composite", "articulated"}) {
     Program p;
     KaneBuilder kb(dyn, p, C, x);
     kb.kinematics(true);
     kb.body_terms(true);
-    const SMat M = kb.mass_matrix();
-    const auto F = kb.forcing();
-    std::vector<ex> pivots;
-    const auto ud = kb.solve(M, F, pivots);
+    std::vector<ex> pivots, ud;
+    if (std::string(form) == "composite") {
+      const SMat M = kb.mass_matrix();
+      const auto F = kb.forcing();
+      ud = kb.solve(M, F, pivots);
+    } else {
+      ud = kb.udot_articulated(pivots);
+    }
     OpCount dummy;
-    for (int k = 0; k < dyn.nu; ++k)
+    for (std::size_t k = 0; k < pivots.size(); ++k)
       p.statement(fmt::format("if (!({} > 0.0)) return {};", print_cpp(pivots[k], dummy), k + 1), pivots[k]);
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("udot[{}]", r), ud[r]);
-    fn["udot"] = finish(p);
+    FunctionBody f = finish(p);
+    out.ops[std::string("udot_") + form] = f.ops;
+    const bool forced = options.udot_form == form;
+    const bool chosen_forced = options.udot_form != "auto" && fn.count("udot");
+    if (forced || (!chosen_forced && (!fn.count("udot") || f.ops.total() < fn["udot"].ops.total()))) {
+      fn["udot"] = std::move(f);
+      out.udot_form = form;
+    }
   }
   std::string optional;
   std::string macros;
@@ -169,6 +185,12 @@ GeneratedCode generate(const Model& model_in, const GeneratorOptions& options) {
   std::string op_counts;
   for (const auto& [name, f] : fn) {
     out.ops[name] = f.ops;
+    if (name == "udot") {
+      op_counts += fmt::format("//   {:<12} {:>7} ({} add, {} mul, {} div, {} func) -- {} form; composite {}, articulated {}\n",
+                               name, f.ops.total(), f.ops.add, f.ops.mul, f.ops.div, f.ops.func, out.udot_form,
+                               out.ops.at("udot_composite").total(), out.ops.at("udot_articulated").total());
+      continue;
+    }
     op_counts += fmt::format("//   {:<12} {:>7} ({} add, {} mul, {} div, {} func)\n", name, f.ops.total(), f.ops.add,
                              f.ops.mul, f.ops.div, f.ops.func);
   }

@@ -424,49 +424,216 @@ static ex dot(const std::vector<ex>& a, const std::vector<ex>& b) {
   return s;
 }
 
-std::vector<ex> KaneBuilder::forcing() {
+std::vector<std::vector<ex>> KaneBuilder::bias_forces() {
   const int nb = static_cast<int>(model_.bodies.size());
-  std::vector<std::vector<ex>> W(nb);
+  std::vector<std::vector<ex>> y(nb);
   for (int j = 0; j < nb; ++j) {  // y_j = g_j - h_j - M_j z_R
     const SymBody& s = body_[j];
     const int n = 6 + model_.bodies[j].n_modes();
-    W[j].resize(n);
+    y[j].resize(n);
     for (int r = 0; r < n; ++r) {
       ex sum = s.g[r] - s.h[r];
       for (int a = 0; a < 3; ++a) sum -= s.Mb(r, a) * s.aR[a] + s.Mb(r, 3 + a) * s.alR[a];
-      W[j][r] = A_.let(sum);
+      y[j][r] = A_.let(sum);
     }
   }
+  return y;
+}
+
+ex KaneBuilder::applied_force(int j, int k) {
+  const Body& b = model_.bodies[j];
+  const int r = b.u_joint + k;
+  ex f = x_.tau[r];
+  C_.group = b.name;
+  if (k < joint_nu(b.joint.type) && (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic)) {
+    const ex kk = c(b.joint.stiffness, b.name + "_k", "N m/rad or N/m", "joint spring stiffness");
+    const ex cc = c(b.joint.damping, b.name + "_c", "N m s/rad or N s/m", "joint damping");
+    const ex rest = c(b.joint.rest, b.name + "_rest", "rad or m", "spring rest value");
+    f -= kk * (x_.q[b.q_joint] - rest) + cc * x_.u[b.u_joint];
+  }
+  if (k >= joint_nu(b.joint.type)) {
+    const int i = k - joint_nu(b.joint.type);
+    const ex K = c(b.flex->K(i), fmt::format("{}_K{}", b.name, i + 1), "N m", "modal stiffness");
+    const ex D = c(b.flex->D(i), fmt::format("{}_D{}", b.name, i + 1), "N m s", "modal damping");
+    f -= K * x_.q[b.q_eta + i] + D * x_.u[b.u_eta + i];
+  }
+  return A_.let(f);
+}
+
+std::vector<ex> KaneBuilder::forcing() {
+  const int nb = static_cast<int>(model_.bodies.size());
+  std::vector<std::vector<ex>> W = bias_forces();
   std::vector<ex> F(model_.nu, ex(0));
   for (int j = nb - 1; j >= 0; --j) {
     const Body& b = model_.bodies[j];
     const auto S = motion_subspace(j);
     const auto cols = own_columns(j);
-    for (std::size_t k = 0; k < cols.size(); ++k) {
-      const int r = cols[k];
-      ex f = x_.tau[r] + dot(S[k], W[j]);
-      C_.group = b.name;
-      if (k < static_cast<std::size_t>(joint_nu(b.joint.type)) &&
-          (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic)) {
-        const ex kk = c(b.joint.stiffness, b.name + "_k", "N m/rad or N/m", "joint spring stiffness");
-        const ex cc = c(b.joint.damping, b.name + "_c", "N m s/rad or N s/m", "joint damping");
-        const ex rest = c(b.joint.rest, b.name + "_rest", "rad or m", "spring rest value");
-        f -= kk * (x_.q[b.q_joint] - rest) + cc * x_.u[b.u_joint];
-      }
-      if (k >= static_cast<std::size_t>(joint_nu(b.joint.type))) {
-        const int i = static_cast<int>(k) - joint_nu(b.joint.type);
-        const ex K = c(b.flex->K(i), fmt::format("{}_K{}", b.name, i + 1), "N m", "modal stiffness");
-        const ex D = c(b.flex->D(i), fmt::format("{}_D{}", b.name, i + 1), "N m s", "modal damping");
-        f -= K * x_.q[b.q_eta + i] + D * x_.u[b.u_eta + i];
-      }
-      F[r] = A_.let(f);
-    }
+    for (std::size_t k = 0; k < cols.size(); ++k) F[cols[k]] = A_.let(applied_force(j, static_cast<int>(k)) + dot(S[k], W[j]));
     if (b.parent >= 0) {
       const auto Wp = transform_wrench_to_parent(j, {W[j].begin(), W[j].begin() + 6});
       for (std::size_t r = 0; r < Wp.size(); ++r) W[b.parent][r] = A_.let(W[b.parent][r] + Wp[r]);
     }
   }
   return F;
+}
+
+// ---------------------------------------------------------------------------
+// Articulated-body form, O(n): with delta_j = body accelerations minus their
+// remainders (delta_j = Xe_j delta_p + S_j udot_j), the subtree wrench of j is
+// IA_j delta_j + pA_j. Inward: U = IA S, D = S^T U, r = tau' - S^T pA,
+// Ia = IA - U D^-1 U^T, pa = pA + U D^-1 r, passed to the parent through
+// Xe^T; outward: udot_j = D^-1 (r - U^T Xe_j delta_p).
+std::vector<ex> KaneBuilder::udot_articulated(std::vector<ex>& pivots) {
+  const int nb = static_cast<int>(model_.bodies.size());
+  std::vector<std::vector<ex>> pA = bias_forces();
+  for (auto& v : pA)
+    for (auto& e : v) e = A_.let(-e);
+  std::vector<SMat> IA(nb);
+  for (int j = 0; j < nb; ++j) IA[j] = body_[j].Mb;
+  struct Joint {
+    std::vector<std::vector<ex>> U;   // (6+m) x k, by column
+    SMat Dinv;                        // k x k
+    std::vector<ex> r;                // k
+  };
+  std::vector<Joint> J(nb);
+  pivots.clear();
+  for (int j = nb - 1; j >= 0; --j) {
+    const Body& b = model_.bodies[j];
+    const auto S = motion_subspace(j);
+    const int k = static_cast<int>(S.size());
+    const int n = IA[j].rows;
+    SMat& I = IA[j];
+    for (auto& e : I.a) e = A_.let(e);
+    Joint& jt = J[j];
+    jt.U.assign(k, std::vector<ex>(n));
+    for (int c = 0; c < k; ++c)
+      for (int r = 0; r < n; ++r) {
+        ex sum = 0;
+        for (int t = 0; t < n; ++t) sum += I(r, t) * S[c][t];
+        jt.U[c][r] = A_.let(sum);
+      }
+    SMat D(k, k);
+    jt.r.resize(k);
+    for (int c = 0; c < k; ++c) {
+      for (int c2 = 0; c2 <= c; ++c2) D(c, c2) = D(c2, c) = A_.let(dot(S[c2], jt.U[c]));
+      jt.r[c] = A_.let(applied_force(j, c) - dot(S[c], pA[j]));
+    }
+    jt.Dinv = spd_inverse(D, pivots);
+    if (b.parent < 0) continue;
+    // Ia = IA - U Dinv U^T (rows/cols 0-5 are all the parent sees), pa = pA + U Dinv r
+    std::vector<std::vector<ex>> UD(k, std::vector<ex>(6));  // (U Dinv) by column, rows 0-5
+    for (int c = 0; c < k; ++c)
+      for (int r = 0; r < 6; ++r) {
+        ex sum = 0;
+        for (int t = 0; t < k; ++t) sum += jt.U[t][r] * jt.Dinv(t, c);
+        UD[c][r] = A_.let(sum);
+      }
+    SMat Ia(6, 6);
+    std::vector<ex> pa(6);
+    for (int r = 0; r < 6; ++r) {
+      for (int c = r; c < 6; ++c) {
+        ex sum = I(r, c);
+        for (int t = 0; t < k; ++t) sum -= UD[t][r] * jt.U[t][c];
+        Ia(r, c) = Ia(c, r) = A_.let(sum);
+      }
+      ex sum = pA[j][r];
+      for (int t = 0; t < k; ++t) sum += UD[t][r] * jt.r[t];
+      pa[r] = A_.let(sum);
+    }
+    // Parent: IA_p += Xe^T Ia Xe, pA_p += Xe^T pa, Xe = [X6 | N] acting on the parent's (6 + m_p).
+    const int np = IA[b.parent].rows;
+    std::vector<std::vector<ex>> XtIa(6);  // XtIa[c] = Xe^T Ia[:, c]  (np entries)
+    for (int c = 0; c < 6; ++c) {
+      std::vector<ex> col(6);
+      for (int r = 0; r < 6; ++r) col[r] = Ia(r, c);
+      XtIa[c] = transform_wrench_to_parent(j, col);
+    }
+    // Xe^T Ia Xe = Xe^T (Xe^T Ia)^T: row a of (Xe^T Ia) is the np-vector over c -> XtIa[c][a]
+    for (int a = 0; a < np; ++a) {
+      std::vector<ex> row(6);
+      for (int c = 0; c < 6; ++c) row[c] = XtIa[c][a];
+      const auto t = transform_wrench_to_parent(j, row);
+      for (int bb = a; bb < np; ++bb) {
+        const ex v = A_.let(IA[b.parent](a, bb) + t[bb]);
+        IA[b.parent](a, bb) = IA[b.parent](bb, a) = v;
+      }
+    }
+    const auto pt = transform_wrench_to_parent(j, pa);
+    for (int r = 0; r < np; ++r) pA[b.parent][r] = A_.let(pA[b.parent][r] + pt[r]);
+  }
+  // Outward.
+  std::vector<ex> ud(model_.nu, ex(0));
+  std::vector<std::vector<ex>> delta(nb);
+  for (int j = 0; j < nb; ++j) {
+    const Body& b = model_.bodies[j];
+    const SymBody& s = body_[j];
+    const int n = IA[j].rows;
+    std::vector<ex> dl(n, ex(0));
+    if (b.parent >= 0) {
+      const auto& dp = delta[b.parent];
+      const SM3 R_BP = s.R_PB.transpose();
+      const SV3 ap{{dp[0], dp[1], dp[2]}}, alp{{dp[3], dp[4], dp[5]}};
+      const SV3 lin = A_.mul(R_BP, A_.add(ap, A_.cross(alp, s.d)));
+      const SV3 ang = A_.mul(R_BP, alp);
+      for (int a = 0; a < 3; ++a) dl[a] = lin[a], dl[3 + a] = ang[a];
+      for (int i = 0; i < static_cast<int>(s.N.size()); ++i)
+        for (int kk = 0; kk < 6; ++kk) dl[kk] = dl[kk] + s.N[i][kk] * dp[6 + i];
+    }
+    const auto S = motion_subspace(j);
+    const int k = static_cast<int>(S.size());
+    const Joint& jt = J[j];
+    std::vector<ex> rhs(k);
+    for (int c = 0; c < k; ++c) rhs[c] = A_.let(jt.r[c] - dot(jt.U[c], dl));
+    const auto cols = own_columns(j);
+    for (int c = 0; c < k; ++c) {
+      ex sum = 0;
+      for (int t = 0; t < k; ++t) sum += jt.Dinv(c, t) * rhs[t];
+      ud[cols[c]] = A_.let(sum);
+    }
+    for (int c = 0; c < k; ++c)
+      for (int r = 0; r < n; ++r) dl[r] = dl[r] + S[c][r] * ud[cols[c]];
+    for (auto& e : dl) e = A_.let(e);
+    delta[j] = dl;
+  }
+  return ud;
+}
+
+SMat KaneBuilder::spd_inverse(const SMat& D, std::vector<ex>& pivots) {
+  const int k = D.rows;
+  // L D L^T, then inverse = L^-T Dg^-1 L^-1
+  SMat L(k, k);
+  std::vector<ex> Dg(k);
+  for (int i = 0; i < k; ++i) {
+    ex d = D(i, i);
+    for (int t = 0; t < i; ++t) d -= L(i, t) * L(i, t) * Dg[t];
+    Dg[i] = A_.let(d);
+    pivots.push_back(Dg[i]);
+    L(i, i) = 1;
+    const ex inv = A_.let(1 / Dg[i]);
+    for (int r = i + 1; r < k; ++r) {
+      ex v = D(r, i);
+      for (int t = 0; t < i; ++t) v -= L(r, t) * L(i, t) * Dg[t];
+      L(r, i) = A_.let(v * inv);
+    }
+  }
+  // Linv (unit lower)
+  SMat Li(k, k);
+  for (int c = 0; c < k; ++c) {
+    Li(c, c) = 1;
+    for (int r = c + 1; r < k; ++r) {
+      ex v = 0;
+      for (int t = c; t < r; ++t) v -= L(r, t) * Li(t, c);
+      Li(r, c) = A_.let(v);
+    }
+  }
+  SMat inv(k, k);
+  for (int r = 0; r < k; ++r)
+    for (int c = r; c < k; ++c) {
+      ex v = 0;
+      for (int t = std::max(r, c); t < k; ++t) v += Li(t, r) * Li(t, c) / Dg[t];
+      inv(r, c) = inv(c, r) = A_.let(v);
+    }
+  return inv;
 }
 
 // ---------------------------------------------------------------------------

@@ -52,6 +52,9 @@ class KaneBuilder {
   /// Body inertia, velocity and gravity terms (after kinematics).
   void body_terms(bool with_velocity);
   std::vector<ex> forcing();
+  /// u_dot by the articulated-body recursion (O(n)); binds the pivots of
+  /// every joint's D matrix.
+  std::vector<ex> udot_articulated(std::vector<ex>& pivots);
   SMat mass_matrix();
   /// Solves M x = b by L^T D L along the dof tree; binds `pivots` (D_ii).
   std::vector<ex> solve(SMat M, std::vector<ex> b, std::vector<ex>& pivots);
@@ -75,6 +78,13 @@ class KaneBuilder {
   /// Motion subspace S of body j: own columns (joint then modes) as (6+m) vectors.
   std::vector<std::vector<ex>> motion_subspace(int j);
   std::vector<int> own_columns(int j) const;
+  /// y_j = g_j - h_j - M_body z_R for every body (generalized gravity and
+  /// velocity forces with the remainder accelerations' inertia forces).
+  std::vector<std::vector<ex>> bias_forces();
+  /// tau + spring/damper or modal stiffness/damping of body j's k-th own speed.
+  ex applied_force(int j, int k);
+  /// Inverse of a small symmetric positive-definite matrix by L D L^T; appends its pivots.
+  SMat spd_inverse(const SMat& D, std::vector<ex>& pivots);
 
   const Model& model_;
   Program& P_;

@@ -28,6 +28,7 @@ constexpr int kExitRefused = 2;
 
 struct Args {
   std::string model, state, engine = "generic", output, integrator = "cvode-bdf", body;
+  std::string form = "auto";
   double t_end = 10.0, rtol = 1e-8, atol = 1e-10, dt_out = 0.01, h = 1e-3;
   bool no_progress = false;
 };
@@ -66,7 +67,9 @@ int cmd_check(const Args& a) {
 
 int cmd_generate(const Args& a) {
   const Model model = load_checked(a.model);
-  const gen::GeneratedCode code = gen::generate(model);
+  gen::GeneratorOptions opt;
+  opt.udot_form = a.form;
+  const gen::GeneratedCode code = gen::generate(model, opt);
   // Written beside the target and renamed: never a half-written header.
   const std::string tmp = a.output + ".tmp";
   {
@@ -74,7 +77,8 @@ int cmd_generate(const Args& a) {
     if (!(out << code.header)) throw std::runtime_error("cannot write " + tmp);
   }
   std::filesystem::rename(tmp, a.output);
-  fmt::print(stderr, "{}: u_dot {} operations, M {}, F {}\n", a.output, code.ops.at("udot").total(),
+  fmt::print(stderr, "{}: u_dot {} operations ({} form), M {}, F {}\n", a.output, code.ops.at("udot").total(),
+             code.udot_form,
              code.ops.at("mass_matrix").total(), code.ops.at("forcing").total());
   return 0;
 }
@@ -160,6 +164,9 @@ int main(int argc, char** argv) {
   CLI::App* generate = app.add_subcommand("generate", "write the specialized C++ header of a model");
   add_model(generate);
   generate->add_option("-o,--output", a.output, "output header (.hpp)")->required();
+  generate->add_option("--udot-form", a.form, "auto (fewer operations) | composite (M, F, tree LTDL) | articulated (O(n))")
+      ->check(CLI::IsMember({"auto", "composite", "articulated"}))
+      ->capture_default_str();
 
   CLI::App* modes = app.add_subcommand("modes", "write a flexible body's modes (e.g. of a built-in beam) as a modal file");
   add_model(modes);
