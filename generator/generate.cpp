@@ -219,7 +219,10 @@ GeneratedCode generate(const Model& model_in, const GeneratorOptions& options) {
   replace_all(h, "FORCING_BODY", fn["forcing"].code);
   replace_all(h, "UDOT_BODY", fn["udot"].code);
   replace_all(h, "OPTIONAL_FUNCTIONS", optional);
-  replace_all(h, "DUAL_WIDTH", std::to_string(std::min(8, std::max(1, model_in.nq + model_in.nu))));
+  // One direction per pass: the code of each pass stays about twice the size of
+  // u_dot itself, which keeps compile times low (8 directions per pass compiled
+  // 5x slower for a 1.5x faster Jacobian).
+  replace_all(h, "DUAL_WIDTH", "1");
   out.header = std::move(h);
   return out;
 }

@@ -51,6 +51,13 @@ class Engine {
   virtual MomentumValues momentum(const VecX& q, const VecX& u) = 0;
   /// Reactions on every body given the accelerations u_dot (from udot()).
   virtual void reactions(const VecX& q, const VecX& u, const VecX& udot, std::vector<Reaction>& out) = 0;
+  /// Exact Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u] (column-major
+  /// into J, (nq+nu)^2), if this engine provides one; false otherwise (the
+  /// implicit integrators then use finite differences).
+  virtual bool jacobian(const VecX& q, const VecX& u, const VecX& tau, MatX& J) {
+    (void)q, (void)u, (void)tau, (void)J;
+    return false;
+  }
 
  private:
   const Model& model_;

@@ -8,11 +8,13 @@
 #include <fstream>
 #include <iostream>
 
+#include "crosscheck.hpp"
 #include "diagnostics.hpp"
 #include "eval_report.hpp"
 #include "generate.hpp"
 #include "generic_engine.hpp"
 #include "integrators.hpp"
+#include "jit.hpp"
 #include "model_checks.hpp"
 #include "modal_data.hpp"
 #include "model_loader.hpp"
@@ -27,10 +29,12 @@ constexpr int kExitFailure = 1;
 constexpr int kExitRefused = 2;
 
 struct Args {
-  std::string model, state, engine = "generic", output, integrator = "cvode-bdf", body;
+  std::string model, state, engine = "generated", output, integrator = "cvode-bdf", body;
   std::string form = "auto";
   double t_end = 10.0, rtol = 1e-8, atol = 1e-10, dt_out = 0.01, h = 1e-3;
   bool no_progress = false;
+  int samples = 20;
+  unsigned seed = 1;
 };
 
 Model load_checked(const std::string& path) {
@@ -41,7 +45,15 @@ Model load_checked(const std::string& path) {
 
 std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name) {
   if (name == "generic") return std::make_unique<GenericEngine>(model);
-  throw InputError(Diagnostic{"--engine", 0, "", fmt::format("unknown engine '{}'; expected generic", name)});
+  if (name == "generated") {
+    try {
+      return jit_load(model);
+    } catch (const JitError& e) {  // the generated code of this model does not compile
+      throw InputError(Diagnostic{model.source_path, 0, "", e.what()});
+    }
+  }
+  throw InputError(
+      Diagnostic{"--engine", 0, "", fmt::format("unknown engine '{}'; expected generated or generic", name)});
 }
 
 State state_for(const Model& model, const std::string& state_path) {
@@ -94,6 +106,20 @@ int cmd_modes(const Args& a) {
   fmt::print("{}: {} nodes, {} modes of body {} ({})\n", a.output, f.nodes.size(), f.modes(), a.body, f.source);
   for (int k = 0; k < f.modes(); ++k) fmt::print("  mode {}: {:.6g} Hz\n", k + 1, f.frequency_hz(k));
   return 0;
+}
+
+int cmd_crosscheck(const Args& a) {
+  const Model model = load_checked(a.model);
+  auto generated = make_engine(model, "generated");
+  GenericEngine generic(model);
+  const CrosscheckResult r = crosscheck(*generated, generic, a.samples, a.seed);
+  fmt::print("crosscheck {}: generated vs generic at {} random states (seed {})\n", model.name, r.samples, a.seed);
+  for (const auto& [q, v] : r.worst) {
+    const double tol = CrosscheckResult::tolerance(q);
+    fmt::print("  {:<18} {:.3e}   {}\n", q, v, tol > 1 ? "(not judged: grows with cond(M))" : fmt::format("tolerance {:.0e}{}", tol, v <= tol ? "" : "  FAILED"));
+  }
+  fmt::print("{}\n", r.passed() ? "passed" : "FAILED");
+  return r.passed() ? 0 : kExitFailure;
 }
 
 int cmd_eval(const Args& a) {
@@ -154,7 +180,9 @@ int main(int argc, char** argv) {
     c->add_option("MODEL", a.model, "model file (YAML, model-format.md)")->required()->check(CLI::ExistingFile);
   };
   auto add_engine = [&](CLI::App* c) {
-    c->add_option("--engine", a.engine, "generic: the numeric path, reads the model at run time")
+    c->add_option("--engine", a.engine,
+                  "generated: the model's generated code (JIT-compiled, cached); generic: the numeric path")
+        ->check(CLI::IsMember({"generated", "generic"}))
         ->capture_default_str();
   };
 
@@ -172,6 +200,11 @@ int main(int argc, char** argv) {
   add_model(modes);
   modes->add_option("--body", a.body, "flexible body")->required();
   modes->add_option("-o,--output", a.output, "output *.modal.yaml")->required();
+
+  CLI::App* cross = app.add_subcommand("crosscheck", "compare generated and generic engines at random states");
+  add_model(cross);
+  cross->add_option("--samples", a.samples, "number of random states")->capture_default_str()->check(CLI::PositiveNumber);
+  cross->add_option("--seed", a.seed, "random seed")->capture_default_str();
 
   CLI::App* eval = app.add_subcommand("eval", "evaluate M, F, u-dot (and the requested outputs) at one state, as JSON");
   add_model(eval);
@@ -204,6 +237,7 @@ int main(int argc, char** argv) {
     if (*check) return cmd_check(a);
     if (*generate) return cmd_generate(a);
     if (*modes) return cmd_modes(a);
+    if (*cross) return cmd_crosscheck(a);
     if (*eval) return cmd_eval(a);
     if (*sim) return cmd_simulate(a);
   } catch (const InputError& e) {

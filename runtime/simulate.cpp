@@ -53,7 +53,7 @@ class ProgressBar {
 
 }  // namespace
 
-OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure) {
+OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure, bool use_jacobian) {
   const Model& model = engine.model();
   const int nq = model.nq, nu = model.nu;
   struct Scratch {
@@ -90,6 +90,23 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
     return 0;
   };
   p.project = [&model](double* x) { normalize_quaternions(model, x); };
+  MatX probe;
+  if (use_jacobian && engine.jacobian(model.q0, model.u0, tau, probe)) {
+    auto J = std::make_shared<MatX>(nq + nu, nq + nu);
+    p.jacobian = [&engine, tau, scratch, J, failure, nq, nu](double t, const double* x, const double*, double* out) -> int {
+      Scratch& s = *scratch;
+      s.q = Eigen::Map<const VecX>(x, nq);
+      s.u = Eigen::Map<const VecX>(x + nq, nu);
+      try {
+        if (!engine.jacobian(s.q, s.u, tau, *J)) return -1;
+      } catch (const SingularMassMatrix& e) {
+        if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
+        return -1;
+      }
+      Eigen::Map<MatX>(out, nq + nu, nq + nu) = *J;
+      return J->allFinite() ? 0 : 1;
+    };
+  }
   return p;
 }
 
@@ -109,7 +126,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   const Model& model = engine.model();
   const int nq = model.nq, nu = model.nu;
   std::string failure;
-  OdeProblem problem = make_ode_problem(engine, initial.tau, &failure);
+  OdeProblem problem = make_ode_problem(engine, initial.tau, &failure, options.use_jacobian);
   VecX x0(nq + nu);
   x0 << initial.q, initial.u;
 

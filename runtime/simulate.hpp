@@ -16,6 +16,7 @@ struct SimulationOptions {
   double dt_out = 0.01;
   IntegratorOptions integrator;
   bool progress = false;  ///< progress bar on stderr
+  bool use_jacobian = true;  ///< give implicit integrators the engine's exact Jacobian when it has one
 };
 
 struct SimulationResult {
@@ -27,7 +28,7 @@ struct SimulationResult {
 /// The ODE x = [q; u] of an engine, for the integrators. The right-hand side
 /// normalizes quaternions before use; a singular M or a non-finite state
 /// makes it fail (unrecoverably) with the reason stored in `failure`.
-OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure);
+OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure, bool use_jacobian = true);
 
 /// Column names of the CSV: t, q names, u names, then T V / Hx Hy Hz /
 /// <body>.fx .fy .fz .tx .ty .tz as the model's outputs ask.

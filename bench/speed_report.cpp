@@ -1,0 +1,154 @@
+// Speed report: ns per u-dot evaluation of the generated and the generic
+// engine, measured interleaved in one run (median of repeated batches), for
+// every model in models/ and tests/reference/ and for programmatic pin chains
+// of 2..64 bodies; for the chains also generation time, compile time (cold
+// JIT cache), header size and the operation count of u-dot. Prints markdown.
+//   ./build/bench/kanegen_speed_report [--quick] [--chains 2,4,8,16,32,64]
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <random>
+#include <sstream>
+
+#include "chain_model.hpp"
+#include "generate.hpp"
+#include "generic_engine.hpp"
+#include "jit.hpp"
+#include "model_loader.hpp"
+#include "state_io.hpp"
+
+using namespace kanegen;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+State random_state(const Model& model, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(-1, 1);
+  State s = initial_state(model);
+  for (int i = 0; i < model.nq; ++i) s.q(i) += 0.3 * U(rng);
+  for (const Body& b : model.bodies)
+    if (b.joint.type == JointType::free) s.q.segment<4>(b.q_joint + 3).normalize();
+  for (int i = 0; i < model.nu; ++i) s.u(i) = 0.5 * U(rng);
+  return s;
+}
+
+/// ns per call of f: median over `repeats` batches sized to ~2 ms each.
+template <class F>
+double ns_per_call(F&& f, int repeats) {
+  int batch = 1;
+  for (;;) {
+    const auto t0 = Clock::now();
+    for (int i = 0; i < batch; ++i) f();
+    const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+    if (dt > 2e-3 || batch > (1 << 24)) break;
+    batch *= 2;
+  }
+  std::vector<double> v;
+  for (int r = 0; r < repeats; ++r) {
+    const auto t0 = Clock::now();
+    for (int i = 0; i < batch; ++i) f();
+    v.push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / batch);
+  }
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+struct Row {
+  std::string name;
+  int bodies, nu;
+  double generic_ns, generated_ns;
+  long ops;
+  std::string form;
+  double gen_s = 0, compile_s = 0;
+  std::size_t header_bytes = 0;
+};
+
+Row measure(const Model& model, const JitOptions& jit, int repeats, bool cold) {
+  Row r{model.name, static_cast<int>(model.bodies.size()), model.nu, 0, 0, 0, "", 0, 0, 0};
+  const auto t0 = Clock::now();
+  const gen::GeneratedCode code = gen::generate(model);
+  r.gen_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  r.ops = code.ops.at("udot").total();
+  r.form = code.udot_form;
+  r.header_bytes = code.header.size();
+  JitOptions o = jit;
+  if (cold) {
+    o.cache_dir = (fs::path(jit.cache_dir) / ("cold-" + model.name)).string();
+    fs::remove_all(o.cache_dir);
+  }
+  const auto t1 = Clock::now();
+  auto generated = jit_load(model, o);
+  r.compile_s = std::chrono::duration<double>(Clock::now() - t1).count() - (cold ? r.gen_s : 0.0);
+  GenericEngine generic(model);
+  const State s = random_state(model, 1);
+  VecX ud(model.nu);
+  // Interleave the two engines so that machine noise hits both alike.
+  std::vector<double> g, c;
+  for (int k = 0; k < 3; ++k) {
+    g.push_back(ns_per_call([&] { generic.udot(s.q, s.u, s.tau, ud); }, repeats));
+    c.push_back(ns_per_call([&] { generated->udot(s.q, s.u, s.tau, ud); }, repeats));
+  }
+  std::sort(g.begin(), g.end());
+  std::sort(c.begin(), c.end());
+  r.generic_ns = g[1];
+  r.generated_ns = c[1];
+  return r;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool quick = false;
+  std::vector<int> chains{2, 4, 8, 16, 32, 64};
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--quick") quick = true;
+    if (a == "--chains" && i + 1 < argc) {
+      chains.clear();
+      std::stringstream ss(argv[++i]);
+      for (std::string t; std::getline(ss, t, ',');) chains.push_back(std::stoi(t));
+    }
+  }
+  const int repeats = quick ? 3 : 9;
+  JitOptions jit;
+  jit.cache_dir = (fs::temp_directory_path() / "kanegen_speed_report").string();
+
+  std::vector<fs::path> files;
+  for (const char* dir : {"models", "tests/reference"})
+    for (const auto& e : fs::recursive_directory_iterator(fs::path(KANEGEN_SOURCE_DIR) / dir))
+      if (e.path().extension() == ".yaml" && e.path().string().find(".modal.") == std::string::npos)
+        files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+
+  fmt::print("## u-dot evaluation, generated vs generic (median ns, one run)\n\n");
+  fmt::print("| model | bodies | nu | u-dot ops (form) | generic ns | generated ns | speed-up |\n");
+  fmt::print("|---|---:|---:|---:|---:|---:|---:|\n");
+  for (const auto& f : files) {
+    Model model;
+    try {
+      model = load_model(f.string());
+    } catch (const std::exception&) {
+      continue;
+    }
+    const Row r = measure(model, jit, repeats, false);
+    fmt::print("| {} | {} | {} | {} ({}) | {:.0f} | {:.0f} | {:.1f}x |\n", r.name, r.bodies, r.nu, r.ops, r.form,
+               r.generic_ns, r.generated_ns, r.generic_ns / r.generated_ns);
+    std::fflush(stdout);
+  }
+  fmt::print("\n## Pin chains (spatial, axes cycling z, y, x)\n\n");
+  fmt::print("| bodies | u-dot ops (form) | generic ns | generated ns | speed-up | generate s | compile s | header KiB |\n");
+  fmt::print("|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (int n : chains) {
+    const Model model = make_chain_model(n);
+    const Row r = measure(model, jit, repeats, true);
+    fmt::print("| {} | {} ({}) | {:.0f} | {:.0f} | {:.1f}x | {:.2f} | {:.2f} | {:.0f} |\n", n, r.ops, r.form,
+               r.generic_ns, r.generated_ns, r.generic_ns / r.generated_ns, r.gen_s, r.compile_s,
+               r.header_bytes / 1024.0);
+    std::fflush(stdout);
+  }
+  return 0;
+}
