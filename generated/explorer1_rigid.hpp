@@ -2146,7 +2146,7 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u] -------------------------
-// Forward-mode differentiation of the code above with dual numbers, 8
+// Forward-mode differentiation of the code above with dual numbers, 1
 // directions per pass: exact to rounding. J column-major (21 x 21).
 template <int W>
 struct Dual {
@@ -2175,7 +2175,7 @@ template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::s
 
 inline int jacobian(const double* q, const double* u, const double* tau, double* J) {
   constexpr int nx = nq + nu;
-  constexpr int W = 8;
+  constexpr int W = 1;
   using D = Dual<W>;
   D qd[nq > 0 ? nq : 1], ud[nu > 0 ? nu : 1], td[nu > 0 ? nu : 1], qdot_out[nq > 0 ? nq : 1], udot_out[nu > 0 ? nu : 1];
   for (int c0 = 0; c0 < nx; c0 += W) {

@@ -10,6 +10,7 @@
 
 #include "eval_report.hpp"
 #include "generic_engine.hpp"
+#include "jit.hpp"
 #include "model_loader.hpp"
 #include "test_support.hpp"
 
@@ -35,14 +36,20 @@ Eigen::VectorXd reorder(const json& got, const json& got_names, const json& name
   return v;
 }
 
-void check_case(const std::filesystem::path& model_path, const std::filesystem::path& state_path) {
+void check_case(const std::filesystem::path& model_path, const std::filesystem::path& state_path,
+                const std::string& engine_name) {
   const std::filesystem::path expected_path =
       state_path.parent_path() / (state_path.stem().string() + ".expected.json");
   INFO(state_path.string());
   const Model model = load_model(model_path.string());
   const State state = load_state(model, state_path.string());
-  GenericEngine engine(model);
-  const json got = json::parse(eval_report(engine, state).dump());
+  std::unique_ptr<Engine> engine;
+  if (engine_name == "generic")
+    engine = std::make_unique<GenericEngine>(model);
+  else
+    engine = jit_load(model, test::jit_options());
+  const json got = json::parse(eval_report(*engine, state).dump());
+  CHECK(got["engine"] == engine_name);
   json exp;
   std::ifstream(expected_path) >> exp;
 
@@ -92,7 +99,7 @@ void check_case(const std::filesystem::path& model_path, const std::filesystem::
 
 }  // namespace
 
-TEST_CASE("generic engine reproduces every reference vector", "[reference][generic]") {
+void check_all(const std::string& engine_name) {
   const std::filesystem::path root = test::source_path("tests/reference");
   int cases = 0;
   for (const auto& dir : std::filesystem::directory_iterator(root)) {
@@ -101,9 +108,15 @@ TEST_CASE("generic engine reproduces every reference vector", "[reference][gener
     for (int k = 1; k <= 2; ++k) {
       const auto state_path = dir.path() / ("state" + std::to_string(k) + ".json");
       if (!std::filesystem::exists(state_path)) continue;
-      SECTION(dir.path().filename().string() + " state" + std::to_string(k)) { check_case(model_path, state_path); }
+      SECTION(dir.path().filename().string() + " state" + std::to_string(k)) {
+        check_case(model_path, state_path, engine_name);
+      }
       ++cases;
     }
   }
   CHECK(cases == 14);
 }
+
+TEST_CASE("generic engine reproduces every reference vector", "[reference][generic]") { check_all("generic"); }
+
+TEST_CASE("generated engine reproduces every reference vector", "[reference][generated]") { check_all("generated"); }

@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <string>
 
+#include "jit.hpp"
 #include "model.hpp"
 
 namespace kanegen::test {
@@ -19,6 +20,14 @@ inline std::string source_path(const std::string& rel) { return std::string(KANE
 inline double rel_err(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double floor = 1e-300) {
   const double scale = std::max(b.cwiseAbs().maxCoeff(), floor);
   return (a - b).cwiseAbs().maxCoeff() / scale;
+}
+
+/// JIT options of the test suite: a cache inside the build tree, shared by
+/// the test runs (KANEGEN_TEST_CACHE_DIR).
+inline JitOptions jit_options() {
+  JitOptions o;
+  o.cache_dir = KANEGEN_TEST_CACHE_DIR;
+  return o;
 }
 
 /// Writes `text` to a fresh temporary file with the given name and returns its path.
