@@ -23,42 +23,46 @@ inline int levi(int a, int b, int c) { return (a - b) * (b - c) * (c - a) / 2; }
 }  // namespace detail
 
 /// Fills M_body, h_body and g_body (generalized gravity, g_B = gravity in B).
+/// Q: 3 x 3 scratch vectors of size m (allocated by the caller, see workspace.hpp).
 template <class S, class VecS, class MatS>
 void compute_body_inertia(const BodyMassIntegrals& I, const VecS& eta, const VecS& eta_dot, const V3<S>& w,
-                          const V3<S>& g_B, MatS& M_body, VecS& h_body, VecS& g_body) {
+                          const V3<S>& g_B, MatS& M_body, VecS& h_body, VecS& g_body, VecS (&Q)[3][3]) {
   const int m = I.m;
   const M3<S> I3 = M3<S>::Identity();
-  const V3<S> S_B = I.S0.cast<S>() + (m ? V3<S>(I.B.cast<S>() * eta) : V3<S>::Zero());
+  V3<S> S_B = I.S0.cast<S>();
+  if (m) S_B.noalias() += as_scalar<S>(I.B) * eta;
   M3<S> J_O = I.J0.cast<S>();
   V3<S> h_w_extra = V3<S>::Zero();
   V3<S> h_v_extra = V3<S>::Zero();
   M_body.setZero();
   if (m > 0) {
     // Q[a][b] = Sum m_k s_k[a] Phi_k[b,:]  (m-vectors, affine in eta)
-    Eigen::Matrix<S, Eigen::Dynamic, 1> Q[3][3];
     for (int a = 0; a < 3; ++a)
-      for (int c = 0; c < 3; ++c) Q[a][c] = I.Prf[a][c].cast<S>() + I.Pff[a][c].transpose().cast<S>() * eta;
+      for (int c = 0; c < 3; ++c) {
+        Q[a][c] = as_scalar<S>(I.Prf[a][c]);
+        Q[a][c].noalias() += as_scalar<S>(I.Pff[a][c]).transpose() * eta;
+      }
     // J_O(eta) = J0 + tr(D) I - D, D[a][b] = Sum m s_a s_b - Sum m rho_a rho_b
     M3<S> D;
     for (int a = 0; a < 3; ++a)
-      for (int c = 0; c < 3; ++c) D(a, c) = I.Prf[c][a].cast<S>().dot(eta) + Q[a][c].dot(eta);
+      for (int c = 0; c < 3; ++c) D(a, c) = as_scalar<S>(I.Prf[c][a]).dot(eta) + Q[a][c].dot(eta);
     J_O += D.trace() * I3 - D;
-    // C[a,i] = eps_abc Q[b][c]_i
-    Eigen::Matrix<S, 3, Eigen::Dynamic> C = Eigen::Matrix<S, 3, Eigen::Dynamic>::Zero(3, m);
+    // C[a,i] = eps_abc Q[b][c]_i, written straight into M_body
+    auto C = M_body.block(3, 6, 3, m);
     for (int a = 0; a < 3; ++a)
       for (int bb = 0; bb < 3; ++bb)
         for (int c = 0; c < 3; ++c) {
           const int e = detail::levi(a, bb, c);
           if (e != 0) C.row(a) += S(e) * Q[bb][c].transpose();
         }
-    const Eigen::Matrix<S, 3, Eigen::Dynamic> B = I.B.cast<S>();
+    M_body.block(6, 3, m, 3) = C.transpose();
+    const auto& B = as_scalar<S>(I.B);
     M_body.block(0, 6, 3, m) = B;
     M_body.block(6, 0, m, 3) = B.transpose();
-    M_body.block(3, 6, 3, m) = C;
-    M_body.block(6, 3, m, 3) = C.transpose();
-    M_body.block(6, 6, m, m) = I.Y.cast<S>();
+    M_body.block(6, 6, m, m) = as_scalar<S>(I.Y);
     // Velocity terms.
-    const V3<S> B_eta_dot = B * eta_dot;
+    V3<S> B_eta_dot;
+    B_eta_dot.noalias() = B * eta_dot;
     h_v_extra = S(2) * w.cross(B_eta_dot);
     M3<S> G;  // G[a][b] = Sum m (Phi eta_dot)_a s_b = Q[b][a] . eta_dot
     for (int a = 0; a < 3; ++a)
@@ -73,11 +77,11 @@ void compute_body_inertia(const BodyMassIntegrals& I, const VecS& eta, const Vec
         h_eta += (w(a) * w(c)) * Q[c][a];
         for (int bb = 0; bb < 3; ++bb) {
           const int e = detail::levi(a, bb, c);
-          if (e != 0) h_eta += (S(2 * e) * w(bb)) * (I.Pff[a][c].cast<S>() * eta_dot);
+          if (e != 0) h_eta.noalias() += ((S(2 * e) * w(bb)) * as_scalar<S>(I.Pff[a][c])) * eta_dot;
         }
       }
     }
-    g_body.segment(6, m) = B.transpose() * g_B;
+    g_body.segment(6, m).noalias() = B.transpose() * g_B;
   }
   M_body.block(0, 0, 3, 3) = S(I.mass) * I3;
   M_body.block(0, 3, 3, 3) = -skew<S>(S_B);

@@ -13,7 +13,8 @@ void compute_body_terms(const Model& model, Workspace<S>& ws) {
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
     BodyWorkspace<S>& s = ws.body[i];
     const V3<S> g_B = s.R_NB.transpose() * g_N;
-    compute_body_inertia<S>(model.bodies[i].integrals, s.eta, s.eta_dot, s.w_B, g_B, s.M_body, s.h_body, s.g_body);
+    compute_body_inertia<S>(model.bodies[i].integrals, s.eta, s.eta_dot, s.w_B, g_B, s.M_body, s.h_body, s.g_body,
+                            s.Q);
   }
 }
 

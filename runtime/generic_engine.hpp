@@ -30,6 +30,7 @@ class GenericEngine final : public Engine {
   void update(const VecX& q, const VecX& u);
   Workspace<double> ws_;
   Eigen::LLT<MatX> llt_;
+  VecX zero_u_;
 };
 
 /// Throws SingularMassMatrix (with the rcond) unless M is positive definite

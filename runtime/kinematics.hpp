@@ -52,19 +52,21 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, const VecQ& q, con
     V3<S> w_J = V3<S>::Zero();        // angular velocity of J relative to P, P components
     V3<S> w_J_dot_R = V3<S>::Zero();  // its remainder rate
     V3<S> v_node = V3<S>::Zero();     // Phi_k eta_dot_P
-    Eigen::Matrix<S, 3, Eigen::Dynamic> H, Phi_k;
+    auto& H = s.H_node;
     const int m_P = has_parent ? model.bodies[b.parent].n_modes() : 0;
+    const FlexibleData* pf_ptr = b.joint.node >= 0 ? &*model.bodies[b.parent].flex : nullptr;
     if (b.joint.node >= 0) {
-      const FlexibleData& pf = *model.bodies[b.parent].flex;
+      const FlexibleData& pf = *pf_ptr;
       const int k = b.joint.node;
-      Phi_k = pf.Phi.middleRows(3 * k, 3).cast<S>();
-      const Eigen::Matrix<S, 3, Eigen::Dynamic> Psi_k = pf.Psi.middleRows(3 * k, 3).cast<S>();
+      const auto Phi_k = as_scalar<S>(pf.Phi.template middleRows<3>(3 * k));
+      const auto Psi_k = as_scalar<S>(pf.Psi.template middleRows<3>(3 * k));
       const V3<S> theta = Psi_k * p->eta;
       const V3<S> g = theta / S(2);
       const S denom = S(1) + g.dot(g);
       R_PJ = rodrigues_R<S>(theta) * R_PJ;
       p_PJ = pf.nodes[k].rho_B.cast<S>() + Phi_k * p->eta;
-      H = (I3 + skew<S>(g)) * Psi_k / denom;
+      H.noalias() = (I3 + skew<S>(g)) * Psi_k;
+      H /= denom;
       w_J = H * p->eta_dot;
       const V3<S> g_dot = Psi_k * p->eta_dot / S(2);
       w_J_dot_R = -(S(2) * g.dot(g_dot) / denom) * w_J;
@@ -129,12 +131,14 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, const VecQ& q, con
       const auto V_P = p->P.topRows(3);
       const auto W_P = p->P.middleRows(3, 3);
       // V_B = R_BP (V_P + W_P x d) = R_BP V_P - R_BP d^x W_P ; W_B = R_BP W_P
-      s.P.topLeftCorner(3, k_P).noalias() = R_BP * V_P - (R_BP * skew<S>(d)) * W_P;
+      s.P.topLeftCorner(3, k_P).noalias() = R_BP * V_P;
+      s.P.topLeftCorner(3, k_P).noalias() -= (R_BP * skew<S>(d)) * W_P;
       s.P.block(3, 0, 3, k_P).noalias() = R_BP * W_P;
       if (b.joint.node >= 0) {  // ... plus the node's motion driven by the parent's modes
         const int c0 = k_P - m_P;
-        s.P.block(0, c0, 3, m_P) += R_BP * (Phi_k - skew<S>(e) * H);
-        s.P.block(3, c0, 3, m_P) += R_BP * H;
+        s.P.block(0, c0, 3, m_P).noalias() += R_BP * as_scalar<S>(pf_ptr->Phi.template middleRows<3>(3 * b.joint.node));
+        s.P.block(0, c0, 3, m_P).noalias() -= (R_BP * skew<S>(e)) * H;
+        s.P.block(3, c0, 3, m_P).noalias() += R_BP * H;
       }
     }
     // ... then the joint's own columns (axis in B equals axis in J for both joints) ...

@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <type_traits>
 
 namespace kanegen {
 
@@ -15,6 +16,15 @@ template <class S>
 using M3 = Eigen::Matrix<S, 3, 3>;
 template <class S>
 using V4 = Eigen::Matrix<S, 4, 1>;
+
+/// The matrix itself when its scalar is already S (no temporary), else a cast.
+template <class S, class Derived>
+decltype(auto) as_scalar(const Eigen::MatrixBase<Derived>& m) {
+  if constexpr (std::is_same_v<S, typename Derived::Scalar>)
+    return (m.derived());
+  else
+    return m.template cast<S>();
+}
 
 /// a^x: skew matrix with a^x b = a x b.
 template <class S>

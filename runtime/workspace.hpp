@@ -37,6 +37,8 @@ struct BodyWorkspace {
   VecS z_dot;        ///< 6+m  scratch: body accelerations [a_O_B, alpha_B, eta_ddot]
   MatS MP;           ///< (6+m) x k scratch: M_body * P
   Eigen::Matrix<S, 6, 1> wrench_B;  ///< reaction on the body from its parent [force; torque about O_B], B
+  Eigen::Matrix<S, 3, Eigen::Dynamic> H_node;  ///< 3 x m_parent: w_J = H eta_dot_parent (at a node)
+  VecS Q[3][3];      ///< m each: Sum m_k s_k[a] Phi_k[b,:] (body_inertia.hpp scratch)
 };
 
 template <class S>
@@ -59,6 +61,10 @@ struct Workspace {
       w.g_body = VecS::Zero(6 + m);
       w.z_dot = VecS::Zero(6 + m);
       w.MP = MatS::Zero(6 + m, k);
+      const int m_parent = b.parent >= 0 ? model.bodies[b.parent].n_modes() : 0;
+      w.H_node = Eigen::Matrix<S, 3, Eigen::Dynamic>::Zero(3, b.joint.node >= 0 ? m_parent : 0);
+      for (auto& row : w.Q)
+        for (auto& v : row) v = VecS::Zero(m);
     }
     M = MatS::Zero(model.nu, model.nu);
     F = VecS::Zero(model.nu);
