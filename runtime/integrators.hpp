@@ -17,9 +17,10 @@ enum class IntegratorKind {
   arkode_erk,   ///< ARKODE ERKStep, adaptive explicit Dormand-Prince 5(4)
   arkode_dirk,  ///< ARKODE ARKStep, fully implicit adaptive DIRK (order 4), Newton + dense
   rk4,          ///< classical fixed-step Runge-Kutta 4 (step = IntegratorOptions::h)
+  cvode_bdf2,   ///< cvode_bdf with the order capped at 2 (A-stable): lightly damped stiff modes
 };
 
-/// CLI names: "cvode-bdf", "cvode-adams", "arkode-erk", "arkode-dirk", "rk4".
+/// CLI names: "cvode-bdf", "cvode-bdf2", "cvode-adams", "arkode-erk", "arkode-dirk", "rk4".
 std::string to_string(IntegratorKind kind);
 /// Throws std::invalid_argument listing the valid names.
 IntegratorKind integrator_from_string(const std::string& name);
@@ -44,6 +45,8 @@ struct IntegratorOptions {
   double atol = 1e-10;
   double h = 1e-3;         ///< rk4 step; for adaptive methods: ignored
   long max_steps = 10'000'000;  ///< total steps before giving up
+  int max_order = 0;       ///< cvode-bdf / cvode-adams: cap on the method order (0: CVODE's default, 5 / 12)
+  bool bdf_stability_limit_detection = false;  ///< cvode-bdf: CVodeSetStabLimDet
 };
 
 struct IntegratorStats {

@@ -20,6 +20,7 @@
 #include "model_loader.hpp"
 #include "simulate.hpp"
 #include "state_io.hpp"
+#include "work_precision.hpp"
 
 using namespace kanegen;
 
@@ -219,13 +220,31 @@ int main(int argc, char** argv) {
   sim->add_option("--state", a.state, "initial STATE.json (default: the model's initial state)")
       ->check(CLI::ExistingFile);
   add_engine(sim);
-  sim->add_option("--integrator", a.integrator, "cvode-bdf | cvode-adams | arkode-erk | arkode-dirk | rk4")
+  sim->add_option("--integrator", a.integrator, "cvode-bdf | cvode-bdf2 (BDF capped at order 2, for lightly damped stiff modes) | cvode-adams | arkode-erk | arkode-dirk | rk4")
       ->capture_default_str();
   sim->add_option("--rtol", a.rtol, "relative tolerance (adaptive integrators)")->capture_default_str();
   sim->add_option("--atol", a.atol, "absolute tolerance (adaptive integrators)")->capture_default_str();
   sim->add_option("--dt-out", a.dt_out, "output interval [s]")->capture_default_str();
   sim->add_option("--h", a.h, "fixed step of rk4 [s]")->capture_default_str();
   sim->add_flag("--no-progress", a.no_progress, "no progress bar on stderr");
+
+  bench::BenchOptions bench_opt;
+  std::vector<std::string> bench_models;
+  std::string bench_suite;
+  CLI::App* bench_cmd = app.add_subcommand("bench", "work-precision: error against wall time for models x engines x integrators");
+  bench_cmd->add_option("MODEL", bench_models, "model files (YAML)")->check(CLI::ExistingFile);
+  bench_cmd->add_option("--engines", bench_opt.engines, "engines to compare")->delimiter(',')->capture_default_str();
+  bench_cmd->add_option("--integrators", bench_opt.integrators,
+                        "integrators (cvode-bdf-fd: BDF with finite-difference Jacobian)")->delimiter(',')->capture_default_str();
+  bench_cmd->add_option("--tolerances", bench_opt.tolerances, "rtol sweep (atol = 1e-2 rtol) [1e-4,1e-6,1e-8,1e-10]")->delimiter(',');
+  bench_cmd->add_option("--rk4-steps", bench_opt.rk4_steps, "rk4 step sizes [s] (default: 64,16,4,1 x the reference's mean step)")->delimiter(',');
+  bench_cmd->add_option("--t-end", bench_opt.t_end, "simulated time [s] (default: from the model's comments, 'bench: t_end = T', else 10)");
+  bench_cmd->add_option("--repeats", bench_opt.repeats, "timed runs per point (median)")->capture_default_str();
+  bench_cmd->add_option("--max-run-seconds", bench_opt.max_run_seconds, "time budget of one run")->capture_default_str();
+  bench_cmd->add_option("--out", bench_opt.out_dir, "output directory")->capture_default_str();
+  bench_cmd->add_option("--suite", bench_suite, "extreme: also models/extreme/*.yaml");
+  bench_cmd->add_flag("--quick", bench_opt.quick, "2 tolerances, 2 rk4 steps, 1 repeat");
+  bench_cmd->add_flag("!--no-plot", bench_opt.plot, "skip the PNGs");
 
   try {
     app.parse(argc, argv);
@@ -240,6 +259,7 @@ int main(int argc, char** argv) {
     if (*cross) return cmd_crosscheck(a);
     if (*eval) return cmd_eval(a);
     if (*sim) return cmd_simulate(a);
+    if (*bench_cmd) return bench::run_bench(bench_models, bench_opt, bench_suite);
   } catch (const InputError& e) {
     for (const Diagnostic& d : e.diagnostics()) fmt::print(stderr, "{}\n", d.str());
     return kExitRefused;

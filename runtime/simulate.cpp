@@ -8,24 +8,50 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 namespace kanegen {
 
 namespace {
 
+/// The free-joint quaternion of x = [q; u] farthest from unit norm.
+struct QuatDrift {
+  double drift = 0.0;  ///< | |quat| - 1 | (infinite if the norm is not finite)
+  double norm = 1.0;
+  int body = -1;       ///< index of its body, -1 if none drifted
+};
+
 /// Normalizes every free joint's quaternion in x = [q; u] in place; returns
-/// the largest | |quat| - 1 | found.
-double normalize_quaternions(const Model& model, double* x) {
+/// the largest | |quat| - 1 | found (and, if `worst` is given, where).
+double normalize_quaternions(const Model& model, double* x, QuatDrift* worst = nullptr) {
   double drift = 0.0;
-  for (const Body& b : model.bodies) {
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const Body& b = model.bodies[i];
     if (b.joint.type != JointType::free) continue;
     double* quat = x + b.q_joint + 3;
     const double n = std::sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]);
-    drift = std::max(drift, std::abs(n - 1.0));
+    const double d = std::isfinite(n) ? std::abs(n - 1.0) : std::numeric_limits<double>::infinity();
+    if (worst && d > worst->drift) *worst = QuatDrift{d, n, static_cast<int>(i)};
+    drift = std::max(drift, d);
     if (n > 0)
       for (int k = 0; k < 4; ++k) quat[k] /= n;
   }
   return drift;
+}
+
+/// The largest | |quat| - 1 | of an integrated (unprojected) free-joint
+/// quaternion that simulate() accepts at an output (docs/extreme.md). The
+/// engines normalize the quaternion, so the drift does not change M or F;
+/// but |quat - quat_exact| >= | |quat| - 1 |: it is a lower bound of the
+/// error accumulated in the integrated quaternion and a cheap symptom of the
+/// attitude error. Past the limit the run stops instead of writing rows.
+/// Adaptive methods may drift up to 100 rtol (a loose tolerance asks for a
+/// loose result), never less than 1e-6; rk4 projects after every step, so
+/// its limit, 1e-6, bounds the drift of one step.
+double quaternion_drift_limit(const IntegratorOptions& opt) {
+  constexpr double kFloor = 1e-6;
+  if (opt.kind == IntegratorKind::rk4) return kFloor;
+  return std::max(kFloor, 100.0 * opt.rtol);
 }
 
 class ProgressBar {
@@ -138,45 +164,90 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   ProgressBar bar(options.progress, initial.t, options.t_end);
   VecX q(nq), u(nu), udot(nu);
   std::vector<Reaction> reactions;
+  std::vector<double> row;
   std::string line;
+
+  // Checks on every output row, before it is written (a row with a bad value
+  // is never written; simulate_to_file then removes the whole file):
+  //  - the quaternion norm drift of the integrated state (see project below);
+  //  - every value of the row finite (state, energy, momentum, reactions);
+  //  - a singular M while computing the reactions.
+  // Each failure is an IntegrationError with the time and the state there
+  // (the unprojected state for a drifted quaternion).
+  const double drift_limit = quaternion_drift_limit(options.integrator);
+  QuatDrift pending;       // worst drift above the limit seen since the last output
+  VecX pending_raw;        // the unprojected state where it was seen
+  bool output_failure = false;  // the error comes from these checks, not from the integrator
+  auto fail_at = [&](double t, const VecX& x, const std::string& what) {
+    output_failure = true;
+    return IntegrationError(fmt::format("{}: output check failed at t = {:.17g}: {}",
+                                        to_string(options.integrator.kind), t, what),
+                            t, x);
+  };
+  auto column_of = [&](std::size_t k) { return k < cols.size() ? cols[k] : fmt::format("column {}", k); };
+
   auto write = [&](double t, const VecX& x) -> bool {
-    // x arrives projected; measure the drift on the raw integrated state
+    // x arrives projected; the drift was measured on the raw state by project below.
+    if (pending.body >= 0) {
+      const Body& b = model.bodies[pending.body];
+      const bool rk4 = options.integrator.kind == IntegratorKind::rk4;
+      throw fail_at(t, pending_raw,
+                    fmt::format("quaternion of free body '{}' has norm {:.17g} (| |q| - 1 | = {:.6g} > {:.3g}{}): the "
+                                "integrated attitude has drifted at least this much; {}",
+                                b.name, pending.norm, pending.drift, drift_limit,
+                                rk4 ? ", after one step" : ", the limit for this rtol",
+                                rk4 ? "reduce the step (--h)" : "tighten --rtol/--atol"));
+    }
     q = x.head(nq);
     u = x.tail(nu);
+    row.assign(x.data(), x.data() + nq + nu);
+    try {
+      if (model.outputs.energy) {
+        const EnergyValues E = engine.energy(q, u);
+        row.insert(row.end(), {E.T, E.V});
+      }
+      if (model.outputs.momentum) {
+        const MomentumValues P = engine.momentum(q, u);
+        row.insert(row.end(), {P.H_N(0), P.H_N(1), P.H_N(2)});
+      }
+      if (model.outputs.reactions) {
+        engine.udot(q, u, initial.tau, udot);
+        engine.reactions(q, u, udot, reactions);
+        for (const Reaction& r : reactions)
+          row.insert(row.end(), {r.force_B(0), r.force_B(1), r.force_B(2), r.torque_B(0), r.torque_B(1), r.torque_B(2)});
+      }
+    } catch (const SingularMassMatrix& e) {
+      throw fail_at(t, x, fmt::format("{} (while computing the reactions)", e.what()));
+    }
+    for (std::size_t k = 0; k < row.size(); ++k)
+      if (!std::isfinite(row[k]))
+        throw fail_at(t, x, fmt::format("non-finite value {} in column '{}'", row[k], column_of(k + 1)));
     line = fmt::format("{:.17g}", t);
-    for (int i = 0; i < nq + nu; ++i) line += fmt::format(",{:.17g}", x(i));
-    if (model.outputs.energy) {
-      const EnergyValues E = engine.energy(q, u);
-      line += fmt::format(",{:.17g},{:.17g}", E.T, E.V);
-    }
-    if (model.outputs.momentum) {
-      const MomentumValues P = engine.momentum(q, u);
-      line += fmt::format(",{:.17g},{:.17g},{:.17g}", P.H_N(0), P.H_N(1), P.H_N(2));
-    }
-    if (model.outputs.reactions) {
-      engine.udot(q, u, initial.tau, udot);
-      engine.reactions(q, u, udot, reactions);
-      for (const Reaction& r : reactions)
-        line += fmt::format(",{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", r.force_B(0), r.force_B(1),
-                            r.force_B(2), r.torque_B(0), r.torque_B(1), r.torque_B(2));
-    }
+    for (double v : row) line += fmt::format(",{:.17g}", v);
     csv << line << '\n';
     ++result.rows;
     bar.update(t);
     return true;
   };
-  // Drift is measured on the unprojected state: wrap project.
+  // Drift is measured on the unprojected state: wrap project (called on every
+  // output state, and after every rk4 step).
   auto project = problem.project;
   problem.project = [&](double* x) {
     VecX raw = Eigen::Map<VecX>(x, nq + nu);
-    result.max_quaternion_drift = std::max(result.max_quaternion_drift, normalize_quaternions(model, raw.data()));
+    QuatDrift worst;
+    result.max_quaternion_drift = std::max(result.max_quaternion_drift, normalize_quaternions(model, raw.data(), &worst));
+    if (worst.body >= 0 && !(worst.drift <= drift_limit) && pending.body < 0) {
+      pending = worst;
+      pending_raw = Eigen::Map<VecX>(x, nq + nu);
+    }
     project(x);
   };
   try {
     result.stats = integrate(problem, options.integrator, initial.t, x0, options.t_end, options.dt_out, write);
   } catch (const IntegrationError& e) {
     bar.finish();
-    throw IntegrationError(failure.empty() ? e.what() : fmt::format("{} ({})", e.what(), failure), e.t, e.x);
+    if (output_failure || failure.empty()) throw;
+    throw IntegrationError(fmt::format("{} ({})", e.what(), failure), e.t, e.x);
   }
   bar.finish();
   return result;
