@@ -163,7 +163,8 @@ int cmd_simulate(const Args& a) {
     std::string where;
     const int n = std::min<int>(static_cast<int>(e.x.size()), model.nq + model.nu);
     for (int i = 0; i < n; ++i)
-      where += fmt::format("\n  {} = {:.17g}", i < model.nq ? model.q_names[i] : model.u_names[i - model.nq], e.x(i));
+      where += i < model.nq ? fmt::format("\n  q {} = {:.17g}", model.q_names[i], e.x(i))
+                            : fmt::format("\n  u {} = {:.17g}", model.u_names[i - model.nq], e.x(i));
     fmt::print(stderr, "kanegen simulate: integration failed at t = {:.17g}: {}\nstate there:{}\nno output written\n",
                e.t, e.what(), where);
     return kExitFailure;
