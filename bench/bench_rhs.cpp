@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <random>
 
+#include "bench_support.hpp"
 #include "generic_engine.hpp"
 #include "model_loader.hpp"
 #include "state_io.hpp"
@@ -17,20 +18,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-State random_state(const Model& model, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> U(-1, 1);
-  State s = initial_state(model);
-  for (int i = 0; i < model.nq; ++i) s.q(i) += 0.3 * U(rng);
-  for (const Body& b : model.bodies)
-    if (b.joint.type == JointType::free) s.q.segment<4>(b.q_joint + 3).normalize();
-  for (int i = 0; i < model.nu; ++i) s.u(i) = U(rng);
-  return s;
-}
 
 void bench_udot(benchmark::State& st, std::shared_ptr<Model> model) {
   GenericEngine engine(*model);
-  const State s = random_state(*model, 1);
+  const State s = bench::random_state(*model, 1);
   VecX udot(model->nu);
   for (auto _ : st) {
     engine.udot(s.q, s.u, s.tau, udot);
@@ -42,7 +33,7 @@ void bench_udot(benchmark::State& st, std::shared_ptr<Model> model) {
 
 void bench_rhs(benchmark::State& st, std::shared_ptr<Model> model) {
   GenericEngine engine(*model);
-  const State s = random_state(*model, 2);
+  const State s = bench::random_state(*model, 2);
   VecX udot(model->nu), qdot(model->nq);
   for (auto _ : st) {
     engine.qdot(s.q, s.u, qdot);

@@ -14,6 +14,7 @@
 
 #include "chain_model.hpp"
 #include "generate.hpp"
+#include "bench_support.hpp"
 #include "generic_engine.hpp"
 #include "jit.hpp"
 #include "model_loader.hpp"
@@ -25,16 +26,6 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-State random_state(const Model& model, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> U(-1, 1);
-  State s = initial_state(model);
-  for (int i = 0; i < model.nq; ++i) s.q(i) += 0.3 * U(rng);
-  for (const Body& b : model.bodies)
-    if (b.joint.type == JointType::free) s.q.segment<4>(b.q_joint + 3).normalize();
-  for (int i = 0; i < model.nu; ++i) s.u(i) = 0.5 * U(rng);
-  return s;
-}
 
 /// ns per call of f: median over `repeats` batches sized to ~2 ms each.
 template <class F>
@@ -84,7 +75,7 @@ Row measure(const Model& model, const JitOptions& jit, int repeats, bool cold) {
   auto generated = jit_load(model, o);
   r.compile_s = std::chrono::duration<double>(Clock::now() - t1).count() - (cold ? r.gen_s : 0.0);
   GenericEngine generic(model);
-  const State s = random_state(model, 1);
+  const State s = bench::random_state(model, 1, 0.5);
   VecX ud(model.nu);
   // Interleave the two engines so that machine noise hits both alike.
   std::vector<double> g, c;

@@ -401,6 +401,20 @@ std::vector<std::vector<ex>> KaneBuilder::motion_subspace(int j) {
   return S;
 }
 
+std::vector<ex> KaneBuilder::transform_motion_from_parent(int j, const std::vector<ex>* dp) {
+  const SymBody& s = body_[j];
+  std::vector<ex> dl(6 + model_.bodies[j].n_modes(), ex(0));
+  if (!dp) return dl;
+  const SM3 R_BP = s.R_PB.transpose();
+  const SV3 ap{{(*dp)[0], (*dp)[1], (*dp)[2]}}, alp{{(*dp)[3], (*dp)[4], (*dp)[5]}};
+  const SV3 lin = A_.mul(R_BP, A_.add(ap, A_.cross(alp, s.d)));
+  const SV3 ang = A_.mul(R_BP, alp);
+  for (int a = 0; a < 3; ++a) dl[a] = lin[a], dl[3 + a] = ang[a];
+  for (int i = 0; i < static_cast<int>(s.N.size()); ++i)
+    for (int k = 0; k < 6; ++k) dl[k] = dl[k] + s.N[i][k] * (*dp)[6 + i];
+  return dl;
+}
+
 std::vector<ex> KaneBuilder::transform_wrench_to_parent(int cidx, const std::vector<ex>& W6) {
   const SymBody& s = body_[cidx];
   const int p = model_.bodies[cidx].parent;
@@ -566,19 +580,8 @@ std::vector<ex> KaneBuilder::udot_articulated(std::vector<ex>& pivots) {
   std::vector<std::vector<ex>> delta(nb);
   for (int j = 0; j < nb; ++j) {
     const Body& b = model_.bodies[j];
-    const SymBody& s = body_[j];
     const int n = IA[j].rows;
-    std::vector<ex> dl(n, ex(0));
-    if (b.parent >= 0) {
-      const auto& dp = delta[b.parent];
-      const SM3 R_BP = s.R_PB.transpose();
-      const SV3 ap{{dp[0], dp[1], dp[2]}}, alp{{dp[3], dp[4], dp[5]}};
-      const SV3 lin = A_.mul(R_BP, A_.add(ap, A_.cross(alp, s.d)));
-      const SV3 ang = A_.mul(R_BP, alp);
-      for (int a = 0; a < 3; ++a) dl[a] = lin[a], dl[3 + a] = ang[a];
-      for (int i = 0; i < static_cast<int>(s.N.size()); ++i)
-        for (int kk = 0; kk < 6; ++kk) dl[kk] = dl[kk] + s.N[i][kk] * dp[6 + i];
-    }
+    std::vector<ex> dl = transform_motion_from_parent(j, b.parent >= 0 ? &delta[b.parent] : nullptr);
     const auto S = motion_subspace(j);
     const int k = static_cast<int>(S.size());
     const Joint& jt = J[j];
@@ -790,17 +793,7 @@ std::vector<ex> KaneBuilder::reactions(const std::vector<ex>& udot) {
     const Body& b = model_.bodies[j];
     const SymBody& s = body_[j];
     const int m = b.n_modes();
-    std::vector<ex> dl(6 + m, ex(0));
-    if (b.parent >= 0) {
-      const auto& dp = delta[b.parent];
-      const SM3 R_BP = s.R_PB.transpose();
-      const SV3 ap{{dp[0], dp[1], dp[2]}}, alp{{dp[3], dp[4], dp[5]}};
-      const SV3 lin = A_.mul(R_BP, A_.add(ap, A_.cross(alp, s.d)));
-      const SV3 ang = A_.mul(R_BP, alp);
-      for (int a = 0; a < 3; ++a) dl[a] = lin[a], dl[3 + a] = ang[a];
-      for (int i = 0; i < static_cast<int>(s.N.size()); ++i)
-        for (int k = 0; k < 6; ++k) dl[k] = dl[k] + s.N[i][k] * dp[6 + i];
-    }
+    std::vector<ex> dl = transform_motion_from_parent(j, b.parent >= 0 ? &delta[b.parent] : nullptr);
     const auto S = motion_subspace(j);
     const auto cols = own_columns(j);
     for (std::size_t k = 0; k < cols.size(); ++k)

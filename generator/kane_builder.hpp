@@ -73,6 +73,9 @@ class KaneBuilder {
   SV3 cvec(const Vec3& v, const std::string& name, const std::string& unit, const std::string& what);
   SM3 cmat(const Mat3& m, const std::string& name, const std::string& unit, const std::string& what,
            bool symmetric = false);
+  /// Xe applied to the parent's (6 + m_p) motion: the first 6 rows of body j's
+  /// (6 + m_j) motion (the rest zero); all zero for a root (dp null).
+  std::vector<ex> transform_motion_from_parent(int j, const std::vector<ex>* dp);
   /// Xe^T applied to a 6-vector W of child c: returns the parent's (6 + m_p) contribution.
   std::vector<ex> transform_wrench_to_parent(int c, const std::vector<ex>& W6);
   /// Motion subspace S of body j: own columns (joint then modes) as (6+m) vectors.

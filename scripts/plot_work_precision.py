@@ -287,11 +287,12 @@ every run, this text is not: recheck it when they change):
 - Stiff scenes (lightly damped kHz modes next to slow rigid motion: stiff_appendage): an implicit
   method at loose tolerance steps over the modes, in tens to hundreds of steps where the explicit
   methods and cvode-adams need ~27000 steps per simulated second at their stability limit whatever the
-  tolerance: cvode-bdf with the generated exact Jacobian at 1e-4, arkode-dirk at 1e-6. cvode-bdf is
-  fragile there: from some tolerance on (1e-6 with finite differences, 1e-8 with the exact Jacobian
-  in this run) it collapses to the explicit methods' step count, presumably by raising its order to
-  3-5, which is not A-stable for lightly damped oscillations (CVODE's stability-limit detection,
-  CVodeSetStabLimDet, addresses this; it is not enabled). arkode-dirk degrades smoothly. Below 1e-8
+  tolerance: cvode-bdf with the generated exact Jacobian at 1e-4, arkode-dirk or cvode-bdf2 at 1e-6.
+  cvode-bdf is fragile there: from some tolerance on it collapses to the explicit methods' step count,
+  by raising its order to 3-5, which is not A-stable for lightly damped oscillations; cvode-bdf2 (BDF
+  capped at order 2) does not (20x fewer steps on such an oscillator in tests/test_integrators.cpp), and CVODE's
+  stability-limit detection did not help here (more steps, measured). arkode-dirk degrades smoothly.
+  Below 1e-8
   during the kHz transient only rk4 at the step its stability requires anyway got there.
 - cvode-bdf, the default of `kanegen simulate`, was the fastest only on the stiff scene at 1e-4;
   elsewhere it took 2-6 times the fastest time at 1e-4 and did not reach 1e-6 on the explorer models

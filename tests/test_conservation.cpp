@@ -15,46 +15,6 @@ using namespace kanegen;
 
 namespace {
 
-struct Drift {
-  double energy = 0, p = 0, H = 0;
-};
-
-/// Integrates the model from its initial state and returns the largest
-/// relative drifts of E = T + V (relative to max |T| + |V|), p and H
-/// (relative to their initial norms, floored at 1).
-Drift run(const Model& model, double t_end, IntegratorKind kind, double rtol) {
-  GenericEngine engine(model);
-  State s0 = initial_state(model);
-  OdeProblem ode = make_ode_problem(engine, s0.tau, nullptr);
-  IntegratorOptions opt;
-  opt.kind = kind;
-  opt.rtol = rtol;
-  opt.atol = rtol * 1e-2;
-  VecX x0(model.nq + model.nu);
-  x0 << s0.q, s0.u;
-  double E0 = 0, scaleE = 0;
-  Vec3 p0, H0;
-  Drift d;
-  bool first = true;
-  integrate(ode, opt, 0.0, x0, t_end, t_end / 50, [&](double, const VecX& x) {
-    const VecX q = x.head(model.nq), u = x.tail(model.nu);
-    const EnergyValues E = engine.energy(q, u);
-    const MomentumValues P = engine.momentum(q, u);
-    if (first) {
-      E0 = E.T + E.V;
-      p0 = P.p_N;
-      H0 = P.H_N;
-      first = false;
-    }
-    scaleE = std::max(scaleE, std::abs(E.T) + std::abs(E.V));
-    d.energy = std::max(d.energy, std::abs(E.T + E.V - E0) / scaleE);
-    d.p = std::max(d.p, (P.p_N - p0).norm() / std::max(1.0, p0.norm()));
-    d.H = std::max(d.H, (P.H_N - H0).norm() / std::max(1.0, H0.norm()));
-    return true;
-  });
-  return d;
-}
-
 const char* kDoublePendulum3D = R"(
 name: dp3d_undamped
 gravity: [0.5, -1.0, -9.81]
@@ -121,7 +81,7 @@ outputs: [energy, momentum]
 
 TEST_CASE("energy is conserved on an undamped 3D chain with gravity and springs", "[conservation][generic]") {
   const Model model = load_model(test::write_temp("dp3d_undamped.yaml", kDoublePendulum3D));
-  const Drift d = run(model, 10.0, IntegratorKind::cvode_bdf, 1e-12);
+  const test::Drift d = test::run_invariants(model, 10.0, IntegratorKind::cvode_bdf, 1e-12);
   INFO("energy drift " << d.energy);
   CHECK(d.energy < 1e-9);
 }
@@ -130,7 +90,7 @@ TEST_CASE("energy and momenta are conserved on a free-floating tree", "[conserva
   std::string text = kFreeAppendages;
   const Model model = load_model(test::write_temp("free_undamped.yaml", text));
   for (IntegratorKind kind : {IntegratorKind::cvode_bdf, IntegratorKind::arkode_erk}) {
-    const Drift d = run(model, 10.0, kind, 1e-12);
+    const test::Drift d = test::run_invariants(model, 10.0, kind, 1e-12);
     INFO(to_string(kind) << ": energy " << d.energy << ", p " << d.p << ", H " << d.H);
     CHECK(d.energy < 1e-9);
     CHECK(d.p < 1e-9);

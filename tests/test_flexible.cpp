@@ -20,48 +20,10 @@ using namespace kanegen;
 
 namespace {
 
-struct Drift {
-  double energy = 0, p = 0, H = 0;
-};
-
 VecX initial_x(const Model& model, const State& s0) {
   VecX x0(model.nq + model.nu);
   x0 << s0.q, s0.u;
   return x0;
-}
-
-/// Largest relative drifts of E = T + V (relative to max |T| + |V|), p and H
-/// (relative to their initial norms, floored at 1) along the motion from the
-/// model's initial state.
-Drift run_invariants(const Model& model, double t_end, IntegratorKind kind, double rtol) {
-  GenericEngine engine(model);
-  const State s0 = initial_state(model);
-  OdeProblem ode = make_ode_problem(engine, s0.tau, nullptr);
-  IntegratorOptions opt;
-  opt.kind = kind;
-  opt.rtol = rtol;
-  opt.atol = rtol * 1e-2;
-  double E0 = 0, scaleE = 0;
-  Vec3 p0, H0;
-  Drift d;
-  bool first = true;
-  integrate(ode, opt, 0.0, initial_x(model, s0), t_end, t_end / 100, [&](double, const VecX& x) {
-    const VecX q = x.head(model.nq), u = x.tail(model.nu);
-    const EnergyValues E = engine.energy(q, u);
-    const MomentumValues P = engine.momentum(q, u);
-    if (first) {
-      E0 = E.T + E.V;
-      p0 = P.p_N;
-      H0 = P.H_N;
-      first = false;
-    }
-    scaleE = std::max(scaleE, std::abs(E.T) + std::abs(E.V));
-    d.energy = std::max(d.energy, std::abs(E.T + E.V - E0) / scaleE);
-    d.p = std::max(d.p, (P.p_N - p0).norm() / std::max(1.0, p0.norm()));
-    d.H = std::max(d.H, (P.H_N - H0).norm() / std::max(1.0, H0.norm()));
-    return true;
-  });
-  return d;
 }
 
 // A flexible arm (revolute to ground, sprung) in a skew gravity field, with a
@@ -174,7 +136,7 @@ TEST_CASE("flexible: energy is conserved on an undamped flexible arm with gravit
   const Model model = load_model(test::write_temp("flex_pendulum_undamped.yaml", kFlexPendulum));
   REQUIRE(model.bodies[0].flex);
   REQUIRE(model.bodies[1].joint.node == 8);  // node id 9 = the tip, index 8
-  const Drift d = run_invariants(model, 5.0, IntegratorKind::cvode_bdf, 1e-12);
+  const test::Drift d = test::run_invariants(model, 5.0, IntegratorKind::cvode_bdf, 1e-12, 100);
   INFO("energy drift " << d.energy);
   CHECK(d.energy < 1e-9);
 }
@@ -184,7 +146,7 @@ TEST_CASE("flexible: momenta are conserved on the free-floating spacecraft_array
   // Modal and joint damping are internal: p and H stay constant, T + V falls.
   const Model model = load_model(test::source_path("models/spacecraft_arrays.yaml"));
   REQUIRE(model.has_flexible());
-  const Drift d = run_invariants(model, 20.0, IntegratorKind::cvode_adams, 1e-11);
+  const test::Drift d = test::run_invariants(model, 20.0, IntegratorKind::cvode_adams, 1e-11, 100);
   INFO("p drift " << d.p << ", H drift " << d.H);
   CHECK(d.p < 1e-9);
   CHECK(d.H < 1e-9);

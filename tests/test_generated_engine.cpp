@@ -24,12 +24,8 @@ namespace fs = std::filesystem;
 namespace {
 
 std::vector<fs::path> model_files() {
-  std::vector<fs::path> out;
-  for (const auto& e : fs::recursive_directory_iterator(test::source_path("models")))
-    if (e.path().extension() == ".yaml" && e.path().string().find(".modal.") == std::string::npos)
-      out.push_back(e.path());
-  std::sort(out.begin(), out.end());
-  return out;
+  const auto names = kanegen::test::model_files();
+  return {names.begin(), names.end()};
 }
 
 }  // namespace

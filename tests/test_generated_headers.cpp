@@ -23,12 +23,8 @@ std::string slurp(const fs::path& p) {
 }
 
 std::vector<fs::path> model_files() {
-  std::vector<fs::path> out;
-  for (const auto& e : fs::recursive_directory_iterator(kanegen::test::source_path("models")))
-    if (e.path().extension() == ".yaml" && e.path().string().find(".modal.") == std::string::npos)
-      out.push_back(e.path());
-  std::sort(out.begin(), out.end());
-  return out;
+  const auto names = kanegen::test::model_files();
+  return {names.begin(), names.end()};
 }
 
 }  // namespace

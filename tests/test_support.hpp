@@ -3,7 +3,9 @@
 
 #include <Eigen/Dense>
 #include <string>
+#include <vector>
 
+#include "integrators.hpp"
 #include "jit.hpp"
 #include "model.hpp"
 
@@ -29,6 +31,19 @@ inline JitOptions jit_options() {
   o.cache_dir = KANEGEN_TEST_CACHE_DIR;
   return o;
 }
+
+/// Largest relative drifts along a run: E = T + V relative to max |T| + |V|;
+/// p and H relative to their initial norms (floored at 1).
+struct Drift {
+  double energy = 0, p = 0, H = 0;
+};
+
+/// Integrates the model (generic engine) from its initial state to t_end with
+/// `kind` at rtol (atol = rtol/100), sampling the invariants `samples` times.
+Drift run_invariants(const Model& model, double t_end, IntegratorKind kind, double rtol, int samples = 50);
+
+/// Every model file under models/ (modal files excluded), sorted.
+std::vector<std::string> model_files();
 
 /// Writes `text` to a fresh temporary file with the given name and returns its path.
 std::string write_temp(const std::string& name, const std::string& text);
