@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, simulates explorer1_rigid (minor-axis spin
 # turning into major-axis spin through damping in the antenna hinges) and
-# writes its plots to out/explorer1_rigid/.
+# writes its plots to out/explorer1_rigid/. The default engine runs the
+# model's generated code (generated, compiled and cached on first use).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 bash scripts/build.sh
 mkdir -p out/explorer1_rigid
 ./build/kanegen check models/explorer1_rigid.yaml
-./build/kanegen simulate models/explorer1_rigid.yaml --engine generic --t-end 3000 --dt-out 0.1 \
+./build/kanegen simulate models/explorer1_rigid.yaml --t-end 3000 --dt-out 0.1 \
   --integrator cvode-adams --rtol 1e-10 --atol 1e-12 \
   -o out/explorer1_rigid/explorer1_rigid.csv
 /usr/bin/python3 scripts/plot_simulation.py out/explorer1_rigid/explorer1_rigid.csv \
