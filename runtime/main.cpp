@@ -66,10 +66,16 @@ int cmd_check(const Args& a) {
   fmt::print("model {}: {} bodies, nq = {}, nu = {}\n", model.name, model.bodies.size(), model.nq, model.nu);
   if (!model.description.empty()) fmt::print("  {}\n", model.description);
   for (const Body& b : model.bodies) {
-    const std::string parent = b.parent < 0 ? "ground" : model.bodies[b.parent].name;
+    std::string parent = b.parent < 0 ? "ground" : model.bodies[b.parent].name;
+    if (b.joint.node >= 0) parent += fmt::format(" @node {}", model.bodies[b.parent].flex->nodes[b.joint.node].id);
     fmt::print("  {:<16} {:<9} joint to {:<16} mass {:.6g} kg", b.name, to_string(b.joint.type), parent,
                b.integrals.mass);
-    if (b.flex) fmt::print(", flexible: {} modes, {} nodes", b.n_modes(), b.flex->nodes.size());
+    if (b.flex) {
+      fmt::print(", flexible: {} modes, {} nodes ({})", b.n_modes(), b.flex->nodes.size(), b.flex->source);
+      for (int k = 0; k < b.n_modes(); ++k)
+        fmt::print("\n    mode {}: {:.6g} Hz, damping ratio {:.3g}", k + 1, b.flex->frequency_hz(k),
+                   b.flex->damping_ratio(k));
+    }
     fmt::print("\n");
   }
   std::string dofs;
