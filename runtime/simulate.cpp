@@ -89,7 +89,7 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
   scratch->x.resize(nq + nu);
   OdeProblem p;
   p.n = nq + nu;
-  p.rhs = [&engine, tau, scratch, failure, nq, nu](double t, const double* x, double* xdot) -> int {
+  p.rhs = [&engine, &model, tau, scratch, failure, nq, nu](double t, const double* x, double* xdot) -> int {
     Scratch& s = *scratch;
     s.x = Eigen::Map<const VecX>(x, nq + nu);
     if (!s.x.allFinite()) {
@@ -106,6 +106,17 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
     } catch (const SingularMassMatrix& e) {
       if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
       return -1;
+    }
+    // Constraint stabilization of the quaternion norm: + lambda (1 - |q|^2) q,
+    // zero on the unit sphere (so q_dot there is exactly W(q) u of the spec)
+    // and attracting the integrated quaternion back to it at a rate 2 lambda,
+    // lambda = |w| + 1/s: the rotation's own time scale, so it adds no
+    // stiffness. Integration error would otherwise let the norm drift.
+    for (const Body& b : model.bodies) {
+      if (b.joint.type != JointType::free) continue;
+      const auto quat = s.q.segment<4>(b.q_joint + 3);
+      const double lambda = s.u.segment<3>(b.u_joint + 3).norm() + 1.0;
+      s.qdot.segment<4>(b.q_joint + 3) += lambda * (1.0 - quat.squaredNorm()) * quat;
     }
     Eigen::Map<VecX>(xdot, nq) = s.qdot;
     Eigen::Map<VecX>(xdot + nq, nu) = s.udot;
