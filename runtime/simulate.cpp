@@ -79,7 +79,8 @@ class ProgressBar {
 
 }  // namespace
 
-OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure, bool use_jacobian) {
+OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure, bool use_jacobian,
+                            bool stabilize_quaternions) {
   const Model& model = engine.model();
   const int nq = model.nq, nu = model.nu;
   struct Scratch {
@@ -89,7 +90,8 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
   scratch->x.resize(nq + nu);
   OdeProblem p;
   p.n = nq + nu;
-  p.rhs = [&engine, &model, tau, scratch, failure, nq, nu](double t, const double* x, double* xdot) -> int {
+  p.rhs = [&engine, &model, tau, scratch, failure, nq, nu, stabilize_quaternions](double t, const double* x,
+                                                                                  double* xdot) -> int {
     Scratch& s = *scratch;
     s.x = Eigen::Map<const VecX>(x, nq + nu);
     if (!s.x.allFinite()) {
@@ -113,7 +115,7 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
     // lambda = |w| + 1/s: the rotation's own time scale, so it adds no
     // stiffness. Integration error would otherwise let the norm drift.
     for (const Body& b : model.bodies) {
-      if (b.joint.type != JointType::free) continue;
+      if (b.joint.type != JointType::free || !stabilize_quaternions) continue;
       const auto quat = s.q.segment<4>(b.q_joint + 3);
       const double lambda = s.u.segment<3>(b.u_joint + 3).norm() + 1.0;
       s.qdot.segment<4>(b.q_joint + 3) += lambda * (1.0 - quat.squaredNorm()) * quat;
@@ -130,7 +132,8 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
   MatX probe;
   if (use_jacobian && engine.jacobian(model.q0, model.u0, tau, probe)) {
     auto J = std::make_shared<MatX>(nq + nu, nq + nu);
-    p.jacobian = [&engine, tau, scratch, J, failure, nq, nu](double t, const double* x, const double*, double* out) -> int {
+    p.jacobian = [&engine, &model, tau, scratch, J, failure, nq, nu, stabilize_quaternions](
+                     double t, const double* x, const double*, double* out) -> int {
       Scratch& s = *scratch;
       s.q = Eigen::Map<const VecX>(x, nq);
       s.u = Eigen::Map<const VecX>(x + nq, nu);
@@ -139,6 +142,16 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
       } catch (const SingularMassMatrix& e) {
         if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
         return -1;
+      }
+      // plus the derivative of the quaternion stabilization term of the rhs
+      for (const Body& b : model.bodies) {
+        if (b.joint.type != JointType::free || !stabilize_quaternions) continue;
+        const int iq = b.q_joint + 3, iw = nq + b.u_joint + 3;
+        const Eigen::Vector4d quat = s.q.segment<4>(b.q_joint + 3);
+        const Eigen::Vector3d w = s.u.segment<3>(b.u_joint + 3);
+        const double lambda = w.norm() + 1.0, c = 1.0 - quat.squaredNorm();
+        J->block<4, 4>(iq, iq) += lambda * (c * Eigen::Matrix4d::Identity() - 2.0 * quat * quat.transpose());
+        if (w.norm() > 0) J->block<4, 3>(iq, iw) += c * quat * (w / w.norm()).transpose();
       }
       Eigen::Map<MatX>(out, nq + nu, nq + nu) = *J;
       return J->allFinite() ? 0 : 1;
@@ -163,7 +176,8 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   const Model& model = engine.model();
   const int nq = model.nq, nu = model.nu;
   std::string failure;
-  OdeProblem problem = make_ode_problem(engine, initial.tau, &failure, options.use_jacobian);
+  OdeProblem problem = make_ode_problem(engine, initial.tau, &failure, options.use_jacobian,
+                                        options.integrator.kind != IntegratorKind::rk4);
   VecX x0(nq + nu);
   x0 << initial.q, initial.u;
 

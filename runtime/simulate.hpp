@@ -28,7 +28,11 @@ struct SimulationResult {
 /// The ODE x = [q; u] of an engine, for the integrators. The right-hand side
 /// normalizes quaternions before use; a singular M or a non-finite state
 /// makes it fail (unrecoverably) with the reason stored in `failure`.
-OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure, bool use_jacobian = true);
+/// With `stabilize_quaternions`, q_dot of each free joint's quaternion gets
+/// + lambda (1 - |q|^2) q (zero on the unit sphere; for adaptive methods: RK4
+/// renormalizes after each step instead).
+OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure, bool use_jacobian = true,
+                            bool stabilize_quaternions = true);
 
 /// Column names of the CSV: t, q names, u names, then T V / Hx Hy Hz /
 /// <body>.fx .fy .fz .tx .ty .tz as the model's outputs ask.

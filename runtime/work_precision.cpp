@@ -134,7 +134,7 @@ RunOutput run_once(Engine& engine, const State& s0, const Config& c, double tol_
                    double budget_s, long max_steps = IntegratorOptions{}.max_steps) {
   RunOutput r;
   std::string failure;
-  OdeProblem p = make_ode_problem(engine, s0.tau, &failure, c.use_jacobian);
+  OdeProblem p = make_ode_problem(engine, s0.tau, &failure, c.use_jacobian, c.kind != IntegratorKind::rk4);
   // Time budget: checked every 256 rhs evaluations; an exceeded budget is an
   // unrecoverable rhs failure, which ends the run.
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(budget_s));
