@@ -49,11 +49,12 @@ function(kanegen_add_model target model)
   add_custom_command(
     OUTPUT "${_out}/model.hpp" "${_out}/entry.cpp"
     COMMAND "${CMAKE_COMMAND}" -E make_directory "${_out}"
-    COMMAND $<TARGET_FILE:kanegen> generate "${_model}" -o "${_out}/model.hpp"
+    COMMAND $<TARGET_FILE:kanegen> generate "${_model}" -o "${_out}/model.hpp" --depfile "${_out}/model.d"
     COMMAND "${CMAKE_COMMAND}" -DKANEGEN_CONFIGURE_ENTRY=ON "-DKANEGEN_HEADER=${_out}/model.hpp"
             "-DKANEGEN_ENTRY_TEMPLATE=${_KANEGEN_ROOT}/templates/entry.cpp.in" "-DKANEGEN_OUTPUT=${_out}/entry.cpp"
             -P "${_KANEGEN_ADD_MODEL_FILE}"
     DEPENDS kanegen "${_model}" ${KANEGEN_TEMPLATE_FILES} "${_KANEGEN_ADD_MODEL_FILE}"
+    DEPFILE "${_out}/model.d"
     COMMENT "kanegen: generating the equations of motion of ${model} for ${target}"
     VERBATIM)
 

@@ -32,6 +32,7 @@ constexpr int kExitRefused = 2;
 struct Args {
   std::string model, state, engine = "generated", output, integrator = "cvode-bdf", body;
   std::string form = "auto";
+  std::string depfile;
   double t_end = 10.0, rtol = 1e-8, atol = 1e-10, dt_out = 0.01, h = 1e-3;
   bool no_progress = false;
   int samples = 20;
@@ -96,6 +97,18 @@ int cmd_generate(const Args& a) {
     if (!(out << code.header)) throw std::runtime_error("cannot write " + tmp);
   }
   std::filesystem::rename(tmp, a.output);
+  if (!a.depfile.empty()) {  // Make-style: the header depends on the model and its modal files
+    std::string deps = a.output + ":";
+    auto add = [&](const std::string& f) {
+      std::string e;
+      for (char c : std::filesystem::absolute(f).string()) e += (c == ' ' ? std::string("\\ ") : std::string(1, c));
+      deps += " " + e;
+    };
+    add(model.source_path);
+    for (const Body& b : model.bodies)
+      if (b.flex && b.flex->source != "beam") add(b.flex->source);
+    std::ofstream(a.depfile) << deps << "\n";
+  }
   fmt::print(stderr, "{}: u_dot {} operations ({} form), M {}, F {}\n", a.output, code.ops.at("udot").total(),
              code.udot_form,
              code.ops.at("mass_matrix").total(), code.ops.at("forcing").total());
@@ -200,6 +213,7 @@ int main(int argc, char** argv) {
   CLI::App* generate = app.add_subcommand("generate", "write the specialized C++ header of a model");
   add_model(generate);
   generate->add_option("-o,--output", a.output, "output header (.hpp)")->required();
+  generate->add_option("--depfile", a.depfile, "also write a Make-style dependency file (model and modal files)");
   generate->add_option("--udot-form", a.form, "auto (fewer operations) | composite (M, F, tree LTDL) | articulated (O(n))")
       ->check(CLI::IsMember({"auto", "composite", "articulated"}))
       ->capture_default_str();
