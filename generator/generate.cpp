@@ -81,8 +81,7 @@ GeneratedCode generate(const Model& model_in, const GeneratorOptions& options) {
   {  // M
     Program p;
     KaneBuilder kb(dyn, p, C, x);
-    kb.kinematics(false);
-    kb.body_terms(false);
+    kb.prepare(false);
     const SMat M = kb.mass_matrix();
     for (int r = 0; r < dyn.nu; ++r)
       for (int c = 0; c < dyn.nu; ++c) p.assign(fmt::format("M[{}]", r * dyn.nu + c), M(r, c));
@@ -91,8 +90,7 @@ GeneratedCode generate(const Model& model_in, const GeneratorOptions& options) {
   {  // F
     Program p;
     KaneBuilder kb(dyn, p, C, x);
-    kb.kinematics(true);
-    kb.body_terms(true);
+    kb.prepare(true);
     const auto F = kb.forcing();
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("F[{}]", r), F[r]);
     fn["forcing"] = finish(p);
@@ -103,8 +101,7 @@ GeneratedCode generate(const Model& model_in, const GeneratorOptions& options) {
   for (const char* form : {"composite", "articulated"}) {
     Program p;
     KaneBuilder kb(dyn, p, C, x);
-    kb.kinematics(true);
-    kb.body_terms(true);
+    kb.prepare(true);
     std::vector<ex> pivots, ud;
     if (std::string(form) == "composite") {
       const SMat M = kb.mass_matrix();
@@ -128,49 +125,46 @@ GeneratedCode generate(const Model& model_in, const GeneratorOptions& options) {
   }
   std::string optional;
   std::string macros;
+  // An optional output function: its section comment, signature and the
+  // macro that tells templates/entry.cpp.in it exists.
+  auto add_optional = [&](const std::string& name, const std::string& title, const std::string& signature,
+                          const std::string& unused, const std::string& macro) {
+    optional += "\n// ---- " + title + "\ntemplate <class T>\nvoid " + name + "(" + signature +
+                ") {\n  using std::cos; using std::sin; using std::sqrt;\n  " + unused + "\n" + fn[name].code + "}\n";
+    macros += "#define " + macro + " 1\n";
+  };
   const auto& outs = model_in.outputs;
   if (outs.energy) {
     Program p;
     KaneBuilder kb(dyn, p, C, x);
-    kb.kinematics(true);
-    kb.body_terms(true);
+    kb.prepare(true);
     p.assign("TV[0]", kb.kinetic_energy());
     p.assign("TV[1]", kb.potential_energy());
     fn["energy"] = finish(p);
-    optional += "\n// ---- energy: T, V -----------------------------------------------------------------\n"
-                "template <class T>\nvoid energy(const T* q, const T* u, T* TV) {\n"
-                "  using std::cos; using std::sin; using std::sqrt;\n  (void)q; (void)u;\n" +
-                fn["energy"].code + "}\n";
-    macros += "#define KANEGEN_HAS_ENERGY 1\n";
+    add_optional("energy", "energy: T, V -----------------------------------------------------------------",
+                 "const T* q, const T* u, T* TV", "(void)q; (void)u;", "KANEGEN_HAS_ENERGY");
   }
   if (outs.momentum) {
     Program p;
     KaneBuilder kb(dyn, p, C, x);
-    kb.kinematics(true);
-    kb.body_terms(true);
+    kb.prepare(true);
     const auto pH = kb.momentum();
     for (int i = 0; i < 6; ++i) p.assign(fmt::format("pH[{}]", i), pH[i]);
     fn["momentum"] = finish(p);
-    optional += "\n// ---- momentum: p_N[3], H_N[3] about N's origin ------------------------------------\n"
-                "template <class T>\nvoid momentum(const T* q, const T* u, T* pH) {\n"
-                "  using std::cos; using std::sin; using std::sqrt;\n  (void)q; (void)u;\n" +
-                fn["momentum"].code + "}\n";
-    macros += "#define KANEGEN_HAS_MOMENTUM 1\n";
+    add_optional("momentum", "momentum: p_N[3], H_N[3] about N's origin ------------------------------------",
+                 "const T* q, const T* u, T* pH", "(void)q; (void)u;", "KANEGEN_HAS_MOMENTUM");
   }
   if (outs.reactions) {  // on the unmerged tree: every body, fixed ones included
     const StateSymbols xr(model_in);
     Program p;
     KaneBuilder kb(model_in, p, C, xr);
-    kb.kinematics(true);
-    kb.body_terms(true);
+    kb.prepare(true);
     const auto W = kb.reactions(xr.udot);
     for (std::size_t i = 0; i < W.size(); ++i) p.assign(fmt::format("wrenches[{}]", i), W[i]);
     fn["reactions"] = finish(p);
-    optional += "\n// ---- reactions on each body from its parent: [force; torque about O_B], body axes --\n"
-                "template <class T>\nvoid reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {\n"
-                "  using std::cos; using std::sin; using std::sqrt;\n  (void)q; (void)u; (void)udot_in;\n" +
-                fn["reactions"].code + "}\n";
-    macros += "#define KANEGEN_HAS_REACTIONS 1\n";
+    add_optional("reactions", "reactions on each body from its parent: [force; torque about O_B], body axes --",
+                 "const T* q, const T* u, const T* udot_in, T* wrenches", "(void)q; (void)u; (void)udot_in;",
+                 "KANEGEN_HAS_REACTIONS");
   }
 
   // Constants, grouped per body with a comment block.

@@ -51,6 +51,11 @@ class KaneBuilder {
   void kinematics(bool with_velocity);
   /// Body inertia, velocity and gravity terms (after kinematics).
   void body_terms(bool with_velocity);
+  /// kinematics() then body_terms(): what every dynamics function starts with.
+  void prepare(bool with_velocity) {
+    kinematics(with_velocity);
+    body_terms(with_velocity);
+  }
   std::vector<ex> forcing();
   /// u_dot by the articulated-body recursion (O(n)); binds the pivots of
   /// every joint's D matrix.
