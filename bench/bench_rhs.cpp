@@ -9,9 +9,9 @@
 #include <random>
 
 #include "bench_support.hpp"
-#include "generic_engine.hpp"
-#include "model_loader.hpp"
-#include "state_io.hpp"
+#include "engine/generic_engine.hpp"
+#include "model/model_loader.hpp"
+#include "model/state_io.hpp"
 
 using namespace kanegen;
 namespace fs = std::filesystem;

@@ -3,8 +3,8 @@
 
 #include <random>
 
-#include "model.hpp"
-#include "state_io.hpp"
+#include "model/model.hpp"
+#include "model/state_io.hpp"
 
 namespace kanegen::bench {
 

@@ -12,13 +12,15 @@
 #include <random>
 #include <sstream>
 
-#include "chain_model.hpp"
-#include "generate.hpp"
+#include "model/chain_model.hpp"
+#include "codegen/assembler.hpp"
+#include "codegen/jit_generator.hpp"
+#include "engine/resources.hpp"
 #include "bench_support.hpp"
-#include "generic_engine.hpp"
-#include "jit.hpp"
-#include "model_loader.hpp"
-#include "state_io.hpp"
+#include "engine/generic_engine.hpp"
+#include "engine/jit.hpp"
+#include "model/model_loader.hpp"
+#include "model/state_io.hpp"
 
 using namespace kanegen;
 namespace fs = std::filesystem;
@@ -61,18 +63,19 @@ struct Row {
 Row measure(const Model& model, const JitOptions& jit, int repeats, bool cold) {
   Row r{model.name, static_cast<int>(model.bodies.size()), model.nu, 0, 0, 0, "", 0, 0, 0};
   const auto t0 = Clock::now();
-  const gen::GeneratedCode code = gen::generate(model);
+  const codegen::EmittedModel code = codegen::generate(model);
+  const codegen::AssembledFiles files = codegen::assemble(code, template_dir(), "model.hpp");
   r.gen_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  r.ops = code.ops.at("udot").total();
+  r.ops = code.find("udot")->ops.total();
   r.form = code.udot_form;
-  r.header_bytes = code.header.size();
+  r.header_bytes = files.header.size();
   JitOptions o = jit;
   if (cold) {
     o.cache_dir = (fs::path(jit.cache_dir) / ("cold-" + model.name)).string();
     fs::remove_all(o.cache_dir);
   }
   const auto t1 = Clock::now();
-  auto generated = jit_load(model, o);
+  auto generated = jit_load(model, codegen::jit_code_generator(), o);
   r.compile_s = std::chrono::duration<double>(Clock::now() - t1).count() - (cold ? r.gen_s : 0.0);
   GenericEngine generic(model);
   const State s = bench::random_state(model, 1, 0.5);

@@ -3,7 +3,7 @@
 # are committed; tests/test_generated_headers.cpp checks they are current).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-KANEGEN=${KANEGEN:-./build/kanegen}
+KANEGEN=${KANEGEN:-./build/bin/kanegen}
 mkdir -p generated
 find models -name '*.yaml' ! -name '*.modal.yaml' | sort | while read -r m; do
   name=$(basename "$m" .yaml)

@@ -1,5 +1,6 @@
 // Hand-written stand-in for a generated model header (the shape the generator
-// emits), used only by tests/test_jit.cpp to test the JIT/AOT plumbing.
+// emits), used with pendulum_handwritten.entry.cpp and .manifest.json only by
+// tests/engine/test_jit.cpp to test the JIT plumbing without the generator.
 //
 // Model (built programmatically in the test, see make_handwritten_pendulum()):
 // one body "bob", revolute about y of N at the origin, mass m, com [L, 0, 0],
@@ -10,11 +11,7 @@
 //   F = m g L cos(theta) - k (theta - r0) - c u + tau
 //   T = 1/2 M u^2,  V = -m g L sin(theta) + 1/2 k (theta - r0)^2
 //   p_N = m L u (-sin, 0, -cos),  H_N = (0, M u, 0)
-// "@MODEL_HASH@" is replaced by the test with model_hash() of that model.
 #pragma once
-
-#define KANEGEN_HAS_ENERGY 1
-#define KANEGEN_HAS_MOMENTUM 1
 
 #include <cmath>
 
@@ -23,12 +20,6 @@ namespace kanegen_gen::pendulum_handwritten {
 inline constexpr int nq = 1;
 inline constexpr int nu = 1;
 inline constexpr int nbodies = 1;
-inline constexpr const char model_name[] = "pendulum_handwritten";
-inline constexpr const char model_hash[] = "@MODEL_HASH@";
-inline constexpr const char generator_version[] = "@GENERATOR_VERSION@";
-inline constexpr bool has_energy = true;
-inline constexpr bool has_momentum = true;
-inline constexpr bool has_reactions = false;
 
 namespace p {
 inline constexpr double m = 2.0, L = 0.75, Iyy = 0.1, g = 9.81, k = 0.5, c = 0.2, r0 = 0.1;

@@ -1,0 +1,48 @@
+// Shared pieces of the kanegen CLI (interface.md): one file per subcommand
+// (cmd_*.cpp) registers its options and returns how to run it.
+// Exit status: 0 success, 2 refused input (message names file, line, field),
+// 1 failure while running.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "engine/engine.hpp"
+#include "model/model.hpp"
+#include "model/state_io.hpp"
+
+namespace kanegen::cli {
+
+constexpr int kExitFailure = 1;
+constexpr int kExitRefused = 2;
+
+struct Subcommand {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+Subcommand add_check(CLI::App& app);
+Subcommand add_generate(CLI::App& app);
+Subcommand add_modes(CLI::App& app);
+Subcommand add_crosscheck(CLI::App& app);
+Subcommand add_eval(CLI::App& app);
+Subcommand add_simulate(CLI::App& app);
+Subcommand add_bench(CLI::App& app);
+
+/// load_model() plus the check that M is not singular at the initial state.
+Model load_checked(const std::string& path);
+/// "generated" (JIT, with the generator of codegen/) or "generic"; a compile
+/// failure of the generated code is a refused input.
+std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name);
+/// The model's initial state, or STATE.json when a path is given.
+State state_for(const Model& model, const std::string& state_path);
+
+/// The MODEL positional argument.
+void add_model_option(CLI::App* c, std::string& model);
+/// --engine generated|generic.
+void add_engine_option(CLI::App* c, std::string& engine);
+
+}  // namespace kanegen::cli

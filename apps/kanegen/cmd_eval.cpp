@@ -1,0 +1,42 @@
+// kanegen eval MODEL [--state S.json] [--engine E]: the dynamics at one state, as JSON.
+#include <iostream>
+
+#include "apps/kanegen/cli_common.hpp"
+#include "model/diagnostics.hpp"
+#include "sim/eval_report.hpp"
+
+namespace kanegen::cli {
+
+namespace {
+
+struct Options {
+  std::string model, state, engine = "generated";
+};
+
+int run(const Options& o) {
+  const Model model = load_checked(o.model);
+  const State state = state_for(model, o.state);
+  auto engine = make_engine(model, o.engine);
+  nlohmann::ordered_json j;
+  try {
+    j = eval_report(*engine, state);
+  } catch (const SingularMassMatrix& e) {
+    throw InputError(Diagnostic{o.state.empty() ? o.model : o.state, 0, "q", e.what()});
+  }
+  std::cout << j.dump(1) << '\n';
+  return 0;
+}
+
+}  // namespace
+
+Subcommand add_eval(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  CLI::App* c =
+      app.add_subcommand("eval", "evaluate M, F, u-dot (and the requested outputs) at one state, as JSON");
+  add_model_option(c, o->model);
+  c->add_option("--state", o->state, "STATE.json (default: the model's initial state)")->check(CLI::ExistingFile);
+  add_engine_option(c, o->engine);
+  return {c, [o] { return run(*o); }};
+}
+
+}  // namespace kanegen::cli

@@ -1,0 +1,202 @@
+#include "codegen/assembler.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+
+namespace kanegen::codegen {
+
+namespace {
+
+std::string read_template(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read template " + path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void replace_all(std::string& s, const std::string& key, const std::string& value) {
+  const std::string k = "{{" + key + "}}";
+  for (std::size_t pos = s.find(k); pos != std::string::npos; pos = s.find(k, pos + value.size()))
+    s.replace(pos, k.size(), value);
+}
+
+std::string join(const std::vector<std::string>& v, const std::string& sep) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
+  return s;
+}
+
+/// A C string literal's contents.
+std::string escaped(const std::string& s) {
+  std::string r;
+  for (char c : s) {
+    if (c == '\\' || c == '"') r += '\\';
+    r += c;
+  }
+  return r;
+}
+
+const char* arg_name(Arg a) {
+  switch (a) {
+    case Arg::t: return "t";
+    case Arg::q: return "q";
+    case Arg::u: return "u";
+    case Arg::tau: return "tau";
+    case Arg::udot_in: return "udot_in";
+    case Arg::out: return "out";
+  }
+  return "?";
+}
+
+/// C++ parameter list of a function in the header.
+std::string parameters(const EmittedFunction& f) {
+  const std::string T = f.templated ? "T" : "double";
+  std::vector<std::string> ps;
+  for (Arg a : f.args) {
+    if (a == Arg::t)
+      ps.push_back(fmt::format("const {} t", T));
+    else if (a == Arg::out)
+      ps.push_back(fmt::format("{}* {}", T, f.out_name));
+    else
+      ps.push_back(fmt::format("const {}* {}", T, arg_name(a)));
+  }
+  return join(ps, ", ");
+}
+
+/// Arguments of the call from the C wrapper: taken from KanegenArgs* a.
+std::string call_arguments(const EmittedFunction& f) {
+  std::vector<std::string> as;
+  for (Arg a : f.args) {
+    switch (a) {
+      case Arg::t: as.push_back("a->t"); break;
+      case Arg::q: as.push_back("a->q"); break;
+      case Arg::u: as.push_back("a->u"); break;
+      case Arg::tau: as.push_back("a->tau"); break;
+      case Arg::udot_in: as.push_back("a->udot"); break;
+      case Arg::out: as.push_back("out"); break;
+    }
+  }
+  return join(as, ", ");
+}
+
+std::string function_text(const EmittedFunction& f) {
+  std::string s = fmt::format("\n// ---- {} {}\n", f.title, std::string(f.title.size() < 74 ? 74 - f.title.size() : 3, '-'));
+  s += f.note;
+  if (f.templated) s += "template <class T>\n";
+  s += fmt::format("{}{} {}({}) {{\n", f.templated ? "" : "inline ", f.returns_status ? "int" : "void", f.name,
+                   parameters(f));
+  if (f.templated) s += "  using std::cos; using std::sin; using std::sqrt;\n";
+  std::vector<std::string> unused;
+  for (Arg a : f.args)
+    if (a != Arg::out) unused.push_back(fmt::format("(void){};", arg_name(a)));
+  if (!unused.empty() && f.templated) s += "  " + join(unused, " ") + "\n";
+  s += f.body;
+  if (f.returns_status && f.templated) s += "  return 0;\n";
+  s += "}\n";
+  return s;
+}
+
+std::string op_counts(const EmittedModel& m) {
+  std::string s;
+  for (const auto& f : m.functions) {
+    if (f.name == "jacobian") continue;  // its cost is that of its passes (see its comment)
+    s += fmt::format("//   {:<12} {:>7} ({} add, {} mul, {} div, {} func)", f.name, f.ops.total(), f.ops.add, f.ops.mul,
+                     f.ops.div, f.ops.func);
+    if (f.name == "udot")
+      s += fmt::format(" -- {} form; composite {}, articulated {}", m.udot_form, m.udot_composite_ops.total(),
+                       m.udot_articulated_ops.total());
+    s += "\n";
+  }
+  return s;
+}
+
+}  // namespace
+
+std::string api_symbol(const EmittedModel& m) { return "kanegen_api_" + m.identifier; }
+
+AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, const std::string& header_name) {
+  AssembledFiles out;
+  // ---- header
+  std::string functions;
+  for (const auto& f : m.functions) functions += function_text(f);
+  std::string h = read_template(template_dir + "/model.hpp.in");
+  replace_all(h, "GENERATOR_VERSION", KANEGEN_VERSION);
+  replace_all(h, "MODEL_DESCRIPTION", m.description.empty() ? "" : " -- " + m.description);
+  replace_all(h, "MODEL_NAME_STRING", escaped(m.model_name));
+  replace_all(h, "MODEL_NAME", m.model_name);
+  replace_all(h, "IDENTIFIER", m.identifier);
+  replace_all(h, "MODEL_HASH", m.model_hash);
+  replace_all(h, "NQ", std::to_string(m.nq));
+  replace_all(h, "NU", std::to_string(m.nu));
+  replace_all(h, "NBODIES", std::to_string(m.nbodies));
+  replace_all(h, "Q_NAMES", join(m.q_names, ", "));
+  replace_all(h, "U_NAMES", join(m.u_names, ", "));
+  replace_all(h, "OP_COUNTS", op_counts(m));
+  replace_all(h, "CONSTANTS", m.constants);
+  replace_all(h, "FUNCTIONS", functions);
+  out.header = std::move(h);
+
+  // ---- entry
+  const std::string sym = api_symbol(m);
+  std::string any_part, declarations, wrappers, table;
+  for (const auto& f : m.functions) {
+    const std::string cname = fmt::format("kanegen_{}_{}", m.identifier, f.name);
+    any_part += fmt::format(" && !defined(KANEGEN_PART_{})", f.name);
+    declarations += fmt::format("int {}(const KanegenArgs* a, double* out);\n", cname);
+    const std::string call = fmt::format("ns::{}{}({})", f.name, f.templated ? "<double>" : "", call_arguments(f));
+    wrappers += fmt::format("#if defined(KANEGEN_WHOLE) || defined(KANEGEN_PART_{})\n", f.name);
+    if (f.returns_status)
+      wrappers += fmt::format("int {}(const KanegenArgs* a, double* out) {{ return {}; }}\n", cname, call);
+    else
+      wrappers += fmt::format("int {}(const KanegenArgs* a, double* out) {{\n  {};\n  return 0;\n}}\n", cname, call);
+    wrappers += "#endif\n";
+    table += fmt::format("#ifndef KANEGEN_OMIT_{}\n    {{\"{}\", &{}, {}}},\n#endif\n", f.name, f.name, cname,
+                         f.out_size);
+  }
+  std::string e = read_template(template_dir + "/entry.cpp.in");
+  replace_all(e, "GENERATOR_VERSION", KANEGEN_VERSION);
+  replace_all(e, "MODEL_NAME_STRING", escaped(m.model_name));
+  replace_all(e, "MODEL_NAME", m.model_name);
+  replace_all(e, "HEADER_NAME", header_name);
+  replace_all(e, "API_SYMBOL", sym);
+  replace_all(e, "ANY_PART", any_part);
+  replace_all(e, "IDENTIFIER", m.identifier);
+  replace_all(e, "DECLARATIONS", declarations);
+  replace_all(e, "WRAPPERS", wrappers);
+  replace_all(e, "TABLE_ENTRIES", table);
+  replace_all(e, "MODEL_HASH", m.model_hash);
+  replace_all(e, "GENERATOR_HASH", m.generator_hash);
+  replace_all(e, "NQ", std::to_string(m.nq));
+  replace_all(e, "NU", std::to_string(m.nu));
+  replace_all(e, "NBODIES", std::to_string(m.nbodies));
+  out.entry = std::move(e);
+
+  // ---- manifest
+  nlohmann::ordered_json j;
+  j["format"] = 1;
+  j["model"] = m.model_name;
+  j["identifier"] = m.identifier;
+  j["namespace"] = "kanegen_gen::" + m.identifier;
+  j["api_symbol"] = sym;
+  j["model_hash"] = m.model_hash;
+  j["generator_hash"] = m.generator_hash;
+  j["generator_version"] = KANEGEN_VERSION;
+  j["nq"] = m.nq;
+  j["nu"] = m.nu;
+  j["nbodies"] = m.nbodies;
+  j["udot_form"] = m.udot_form;
+  nlohmann::ordered_json fs = nlohmann::ordered_json::array();
+  for (const auto& f : m.functions)
+    fs.push_back({{"name", f.name}, {"ops", f.ops.total()}, {"out_size", f.out_size}});
+  j["functions"] = fs;
+  out.manifest = j.dump(1) + "\n";
+  return out;
+}
+
+}  // namespace kanegen::codegen

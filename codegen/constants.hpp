@@ -1,0 +1,39 @@
+// Model parameters as named constants of the emitted code: exact 0 and +-1
+// fold into the expressions (so the sparsity of the model is visible to the
+// generator); every other value becomes a symbol printed by name and emitted
+// once as `inline constexpr double name = value;  // what [unit]`, grouped
+// by the body (or "model") it belongs to.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace kanegen::codegen {
+
+class Constants {
+ public:
+  GiNaC::ex value(double v, const std::string& name, const std::string& unit, const std::string& what);
+  /// Declarations of one group, in creation order.
+  std::string emit(const std::string& group, const std::string& indent) const;
+  /// Groups in order of first use.
+  std::vector<std::string> groups() const;
+  /// Every constant's name (to keep temporaries from shadowing one).
+  std::set<std::string> names() const;
+
+  std::string group;  ///< group of the constants created next (set by the passes)
+
+ private:
+  struct Entry {
+    double value;
+    std::string unit, what, group;
+    GiNaC::symbol sym;
+  };
+  std::map<std::string, Entry> by_name_;
+  std::vector<std::string> order_;
+};
+
+}  // namespace kanegen::codegen

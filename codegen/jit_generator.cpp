@@ -1,0 +1,18 @@
+#include "codegen/jit_generator.hpp"
+
+#include "codegen/assembler.hpp"
+#include "engine/resources.hpp"
+
+namespace kanegen::codegen {
+
+CodeGenerator jit_code_generator(const GeneratorOptions& options) {
+  CodeGenerator g;
+  g.hash = generator_identity(options);
+  g.generate = [options](const Model& model) {
+    const AssembledFiles f = assemble(generate(model, options), template_dir(), "model.hpp");
+    return GeneratedSources{f.header, f.entry, f.manifest};
+  };
+  return g;
+}
+
+}  // namespace kanegen::codegen

@@ -1,0 +1,112 @@
+// The symbolic counterpart of dynamics/workspace.hpp: the per-body
+// quantities of Kane's method for one Model as expressions bound in one
+// Program, under the same names and frames as the generic engine
+// (w_B, v_O_B, R_NB, ...), and the context every symbolic pass works in.
+//
+// The passes, one file each, mirror dynamics/:
+//   kinematics.cpp            outward pass: orientations, velocities, remainder accelerations
+//   body_terms.cpp            per-body generalized mass M_body, velocity terms h, gravity g
+//   spatial_transforms.cpp    motion subspaces S_j and the parent <-> child transforms Xe_j
+//   forcing.cpp               F = tau + elastic + S^T W, inward pass (O(n))
+//   composite_inertia.cpp     M by composite inertias and column walks (O(n d))
+//   tree_ldlt.cpp             M u_dot = F by L^T D L along the dof tree (no fill-in)
+//   articulated_body.cpp      u_dot by the articulated-body recursion (O(n))
+//   reactions.cpp             inward Newton-Euler pass with the accelerations
+//   invariants.cpp            T, V, p_N, H_N
+//   kinematic_equations.cpp   q_dot = W(q) u
+// Body velocity coordinates are z_j = [v_O_B, w_B, eta_dot] (B components), as
+// in dynamics/body_inertia.hpp, which the generated code is checked against.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "codegen/constants.hpp"
+#include "codegen/symbolic.hpp"
+#include "model/model.hpp"
+
+namespace kanegen::codegen {
+
+struct SymBodyWorkspace {
+  SM3 R_PB, R_NB;                 ///< orientation of B in its parent, in N
+  SV3 p_PO_P;                     ///< O_B from the parent's origin, parent components
+  SV3 r_NO_N;                     ///< O_B from N's origin, N components
+  SV3 w_B, v_O_B;                 ///< angular velocity, velocity of O_B (B components)
+  SV3 a_R_B, alpha_R_B;           ///< remainder accelerations (B components)
+  std::vector<ex> eta, eta_dot;   ///< modal coordinates and speeds
+  /// Partials of [v_O_B; w_B] w.r.t. the parent's modal speeds, one 6-vector per
+  /// parent mode (a child attached at a node of a flexible parent).
+  std::vector<std::array<ex, 6>> P_node;
+  SMat M_body;                    ///< (6+m)^2 generalized mass in z
+  std::vector<ex> h_body, g_body; ///< 6+m velocity terms, generalized gravity
+};
+
+/// One Model's symbolic formulation in one Program.
+struct KaneContext {
+  KaneContext(const Model& model, Program& program, Constants& constants, const StateSymbols& x)
+      : model(model), P(program), C(constants), x(x), A(program), body(model.bodies.size()) {}
+
+  const Model& model;
+  Program& P;
+  Constants& C;
+  const StateSymbols& x;
+  Alg A;
+  std::vector<SymBodyWorkspace> body;
+
+  /// A named model constant (constants.hpp) of the current group.
+  ex c(double v, const std::string& name, const std::string& unit, const std::string& what) {
+    return C.value(v, name, unit, what);
+  }
+  SV3 cvec(const Vec3& v, const std::string& name, const std::string& unit, const std::string& what);
+  SM3 cmat(const Mat3& m, const std::string& name, const std::string& unit, const std::string& what,
+           bool symmetric = false);
+  /// Name of a quantity of body j for the emitted code, e.g. "w_B_ant2".
+  std::string name(const std::string& quantity, int j) const { return quantity + "_" + model.bodies[j].name; }
+};
+
+// ---- passes (one file each, see the header comment) ----------------------
+
+/// Outward pass; velocities and remainder accelerations only when
+/// `with_velocity` (M needs none).
+void compute_kinematics(KaneContext& ctx, bool with_velocity);
+/// Body inertia, velocity and gravity terms (after compute_kinematics).
+void compute_body_terms(KaneContext& ctx, bool with_velocity);
+/// compute_kinematics then compute_body_terms: what every dynamics function starts with.
+inline void prepare(KaneContext& ctx, bool with_velocity) {
+  compute_kinematics(ctx, with_velocity);
+  compute_body_terms(ctx, with_velocity);
+}
+
+/// Columns of u that body j owns (its joint's, then its modes'), ascending.
+std::vector<int> own_columns(const Model& model, int j);
+/// Motion subspace S of body j: its own columns as (6+m)-vectors of z_j.
+std::vector<std::vector<ex>> motion_subspace(KaneContext& ctx, int j);
+/// Xe_j applied to the parent's (6 + m_p) motion: the first 6 rows of body
+/// j's (6 + m_j) motion (the rest zero); all zero for a root (dp null).
+std::vector<ex> transform_motion_from_parent(KaneContext& ctx, int j, const std::vector<ex>* dp);
+/// Xe_j^T applied to a 6-vector wrench of body j: the parent's (6 + m_p) contribution.
+std::vector<ex> transform_wrench_to_parent(KaneContext& ctx, int j, const std::vector<ex>& W6);
+/// y_j = g_j - h_j - M_body z_R for every body (generalized gravity and
+/// velocity forces with the remainder accelerations' inertia forces).
+std::vector<std::vector<ex>> compute_bias_forces(KaneContext& ctx);
+/// tau + spring/damper or modal stiffness/damping of body j's own speed `own`.
+ex applied_force(KaneContext& ctx, int j, int own);
+
+std::vector<ex> compute_forcing(KaneContext& ctx);
+SMat compute_mass_matrix(KaneContext& ctx);
+/// Solves M x = b by L^T D L along the dof tree; returns x and binds the pivots D_ii
+/// in `pivots` (index = speed).
+std::vector<ex> solve_tree_ldlt(KaneContext& ctx, SMat M, std::vector<ex> b, std::vector<ex>& pivots);
+/// u_dot by the articulated-body recursion (O(n)); `pivots[r]` is the pivot
+/// of speed r in its joint's D matrix factorization.
+std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivots);
+/// 6 entries per body: reaction [force; torque about O_B] (B components).
+std::vector<ex> compute_reactions(KaneContext& ctx, const std::vector<ex>& udot);
+ex compute_kinetic_energy(KaneContext& ctx);
+ex compute_potential_energy(KaneContext& ctx);
+/// p_N[3], H_N[3]
+std::vector<ex> compute_momentum(KaneContext& ctx);
+std::vector<ex> compute_qdot(KaneContext& ctx);
+
+}  // namespace kanegen::codegen

@@ -1,0 +1,216 @@
+// Symbolic outward pass (dynamics/kinematics.hpp has the same recursion in
+// numbers): for child B of parent P through joint frame J,
+//   R_PB = R_PJ R_JB,   p_PO_P = p_PJ + e,   w_B = R_BP (w_P + w_J + w_rel),
+//   v_O_B = R_BP (v_P + w_P x p_PO_P + v_rel),  and the remainder accelerations.
+#include <fmt/format.h>
+
+#include "codegen/kane_context.hpp"
+
+namespace kanegen::codegen {
+
+using namespace GiNaC;
+
+static const char* kAxis[3] = {"x", "y", "z"};
+
+SV3 KaneContext::cvec(const Vec3& v, const std::string& n, const std::string& unit, const std::string& what) {
+  SV3 r;
+  for (int i = 0; i < 3; ++i) r[i] = c(v(i), n + "_" + kAxis[i], unit, what + " " + kAxis[i]);
+  return r;
+}
+
+SM3 KaneContext::cmat(const Mat3& m, const std::string& n, const std::string& unit, const std::string& what,
+                      bool symmetric) {
+  SM3 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const int a = symmetric ? std::min(i, j) : i, b = symmetric ? std::max(i, j) : j;
+      r(i, j) = c(m(a, b), fmt::format("{}_{}{}", n, kAxis[a], kAxis[b]), unit, what);
+    }
+  return r;
+}
+
+void compute_kinematics(KaneContext& ctx, bool with_velocity) {
+  Alg& A = ctx.A;
+  const Model& model = ctx.model;
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const int j = static_cast<int>(i);
+    const Body& b = model.bodies[i];
+    SymBodyWorkspace& s = ctx.body[i];
+    ctx.C.group = b.name;
+    const std::string& n = b.name;
+    ctx.P.section(fmt::format("body {}: outward pass ({})", n, with_velocity ? "velocities" : "positions"));
+    const int m = b.n_modes();
+    s.eta.clear(), s.eta_dot.clear();
+    for (int mode = 0; mode < m; ++mode) {
+      s.eta.push_back(ctx.x.q[b.q_eta + mode]);
+      s.eta_dot.push_back(ctx.x.u[b.u_eta + mode]);
+    }
+    const bool has_parent = b.parent >= 0;
+    const SymBodyWorkspace* p = has_parent ? &ctx.body[b.parent] : nullptr;
+    const SV3 zero;
+    const SV3 w_P = has_parent ? p->w_B : zero, v_P = has_parent ? p->v_O_B : zero;
+    const SV3 aR_P = has_parent ? p->a_R_B : zero, alR_P = has_parent ? p->alpha_R_B : zero;
+
+    // Joint frame.
+    SM3 R_PJ = ctx.cmat(b.joint.R_PJ, n + "_R_PJ", "", "joint frame orientation in the parent");
+    SV3 p_PJ;
+    SV3 w_J, w_J_dot_R, v_node;
+    std::vector<SV3> H_cols, Phi_cols;  // per parent mode
+    const int m_P = has_parent ? model.bodies[b.parent].n_modes() : 0;
+    if (b.joint.node >= 0) {
+      const FlexibleData& pf = *model.bodies[b.parent].flex;
+      const int node = b.joint.node;
+      const std::string nn = fmt::format("{}_node{}", n, pf.nodes[node].id);
+      for (int mode = 0; mode < m_P; ++mode) {
+        Phi_cols.push_back(ctx.cvec(pf.Phi.block(3 * node, mode, 3, 1), fmt::format("{}_Phi{}", nn, mode + 1), "m",
+                                  fmt::format("translational shape of mode {} at the attachment node", mode + 1)));
+      }
+      std::vector<SV3> Psi_cols;
+      for (int mode = 0; mode < m_P; ++mode)
+        Psi_cols.push_back(ctx.cvec(pf.Psi.block(3 * node, mode, 3, 1), fmt::format("{}_Psi{}", nn, mode + 1), "rad",
+                                  fmt::format("rotational shape of mode {} at the attachment node", mode + 1)));
+      // g = Psi eta / 2, C(g) = I + 2/(1+g.g) (g^x + g^x g^x)
+      SV3 g;
+      for (int a = 0; a < 3; ++a) {
+        ex sum = 0;
+        for (int mode = 0; mode < m_P; ++mode) sum += Psi_cols[mode][a] * p->eta[mode];
+        g[a] = A.let(sum / 2);
+      }
+      const ex denom = A.let(1 + g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+      const ex two_over = A.let(2 / denom);
+      const SM3 G = Alg::skew(g);
+      SM3 Cg;
+      for (int r = 0; r < 3; ++r)
+        for (int cc = 0; cc < 3; ++cc) {
+          ex gg = 0;
+          for (int t = 0; t < 3; ++t) gg += G(r, t) * G(t, cc);
+          Cg(r, cc) = A.let((r == cc ? 1 : 0) + two_over * (G(r, cc) + gg));
+        }
+      R_PJ = A.mul(Cg, R_PJ);
+      const SV3 rho = ctx.cvec(pf.nodes[node].rho_B, nn + "_rho", "m", "attachment node position in the parent");
+      for (int a = 0; a < 3; ++a) {
+        ex sum = rho[a];
+        for (int mode = 0; mode < m_P; ++mode) sum += Phi_cols[mode][a] * p->eta[mode];
+        p_PJ[a] = A.let(sum);
+      }
+      // H = (I + g^x) Psi / (1 + g.g): w_J = H eta_dot_P
+      const ex inv = A.let(1 / denom);
+      for (int mode = 0; mode < m_P; ++mode) {
+        SV3 h;
+        const SV3 gx = A.cross(g, Psi_cols[mode]);
+        for (int a = 0; a < 3; ++a) h[a] = A.let((Psi_cols[mode][a] + gx[a]) * inv);
+        H_cols.push_back(h);
+      }
+      if (with_velocity) {
+        for (int a = 0; a < 3; ++a) {
+          ex wj = 0, vn = 0;
+          for (int mode = 0; mode < m_P; ++mode) {
+            wj += H_cols[mode][a] * p->eta_dot[mode];
+            vn += Phi_cols[mode][a] * p->eta_dot[mode];
+          }
+          w_J[a] = A.let(wj);
+          v_node[a] = A.let(vn);
+        }
+        SV3 g_dot;
+        for (int a = 0; a < 3; ++a) {
+          ex sum = 0;
+          for (int mode = 0; mode < m_P; ++mode) sum += Psi_cols[mode][a] * p->eta_dot[mode];
+          g_dot[a] = A.let(sum / 2);
+        }
+        const ex f = A.let(-2 * A.dot(g, g_dot) * inv);
+        w_J_dot_R = A.scale(f, w_J);
+      }
+    } else {
+      p_PJ = ctx.cvec(b.joint.p_PJ, n + "_p_PJ", "m", "joint frame origin in the parent");
+    }
+
+    // Joint motion.
+    SM3 R_JB = SM3::identity();
+    SV3 e, e_dot, w_rel;
+    const SV3 axis = ctx.cvec(b.joint.axis_J, n + "_axis", "", "joint axis");
+    switch (b.joint.type) {
+      case JointType::revolute: {
+        const ex cq = A.let(cos(ctx.x.q[b.q_joint])), sq = A.let(sin(ctx.x.q[b.q_joint]));
+        // Rot(a, th) = a a^T + cos th (I - a a^T) + sin th a^x
+        const Eigen::Matrix3d aa = b.joint.axis_J * b.joint.axis_J.transpose();
+        const SM3 Ax = Alg::skew(axis);
+        for (int r = 0; r < 3; ++r)
+          for (int cc = 0; cc < 3; ++cc) {
+            const int lo = std::min(r, cc), hi = std::max(r, cc);
+            const ex aa_rc =
+                ctx.c(aa(r, cc), fmt::format("{}_axis_aa_{}{}", n, kAxis[lo], kAxis[hi]), "", "axis outer product");
+            const ex one_minus = ctx.c((r == cc ? 1.0 : 0.0) - aa(r, cc),
+                                     fmt::format("{}_axis_Iaa_{}{}", n, kAxis[lo], kAxis[hi]), "",
+                                     "I - axis outer product");
+            R_JB(r, cc) = A.let(aa_rc + cq * one_minus + sq * Ax(r, cc));
+          }
+        if (with_velocity) w_rel = A.scale(ctx.x.u[b.u_joint], A.mul(R_PJ, axis));
+        break;
+      }
+      case JointType::prismatic: {
+        const SV3 a_P = A.mul(R_PJ, axis);
+        e = A.scale(ctx.x.q[b.q_joint], a_P);
+        if (with_velocity) e_dot = A.scale(ctx.x.u[b.u_joint], a_P);
+        break;
+      }
+      case JointType::fixed: break;
+      case JointType::free: {
+        const auto& q = ctx.x.q;
+        const int q0 = b.q_joint;
+        const ex inv_norm = A.let(1 / sqrt(q[q0 + 3] * q[q0 + 3] + q[q0 + 4] * q[q0 + 4] + q[q0 + 5] * q[q0 + 5] +
+                                           q[q0 + 6] * q[q0 + 6]));
+        const ex w = A.let(q[q0 + 3] * inv_norm), xq = A.let(q[q0 + 4] * inv_norm), y = A.let(q[q0 + 5] * inv_norm),
+                 z = A.let(q[q0 + 6] * inv_norm);
+        const ex xx = A.let(xq * xq), yy = A.let(y * y), zz = A.let(z * z);
+        const ex xy = A.let(xq * y), xz = A.let(xq * z), yz = A.let(y * z);
+        const ex wx = A.let(w * xq), wy = A.let(w * y), wz = A.let(w * z);
+        R_JB(0, 0) = A.let(1 - 2 * (yy + zz)), R_JB(0, 1) = A.let(2 * (xy - wz)), R_JB(0, 2) = A.let(2 * (xz + wy));
+        R_JB(1, 0) = A.let(2 * (xy + wz)), R_JB(1, 1) = A.let(1 - 2 * (xx + zz)), R_JB(1, 2) = A.let(2 * (yz - wx));
+        R_JB(2, 0) = A.let(2 * (xz - wy)), R_JB(2, 1) = A.let(2 * (yz + wx)), R_JB(2, 2) = A.let(1 - 2 * (xx + yy));
+        const SV3 xyz{{q[q0], q[q0 + 1], q[q0 + 2]}};
+        e = A.mul(R_PJ, xyz);
+        break;
+      }
+    }
+    s.R_PB = A.mul(R_PJ, R_JB, ctx.name("R_PB", j));
+    s.p_PO_P = A.add(p_PJ, e, ctx.name("p_PO_P", j));
+    const SM3 R_BP = s.R_PB.transpose();
+    if (b.joint.type == JointType::free && with_velocity) {
+      const int u0 = b.u_joint;
+      const SV3 v{{ctx.x.u[u0], ctx.x.u[u0 + 1], ctx.x.u[u0 + 2]}}, w{{ctx.x.u[u0 + 3], ctx.x.u[u0 + 4], ctx.x.u[u0 + 5]}};
+      e_dot = A.mul(s.R_PB, v);
+      w_rel = A.mul(s.R_PB, w);
+    }
+    if (has_parent) {
+      s.R_NB = A.mul(p->R_NB, s.R_PB, ctx.name("R_NB", j));
+      s.r_NO_N = A.add(p->r_NO_N, A.mul(p->R_NB, s.p_PO_P), ctx.name("r_NO_N", j));
+    } else {
+      s.R_NB = s.R_PB;
+      s.r_NO_N = s.p_PO_P;
+    }
+    // Node coupling: partials of [v; w] w.r.t. the parent's modal speeds.
+    s.P_node.clear();
+    for (int mode = 0; mode < static_cast<int>(H_cols.size()); ++mode) {
+      const SV3 lin = A.mul(R_BP, A.sub(Phi_cols[mode], A.cross(e, H_cols[mode])));
+      const SV3 ang = A.mul(R_BP, H_cols[mode]);
+      s.P_node.push_back({lin[0], lin[1], lin[2], ang[0], ang[1], ang[2]});
+    }
+    if (!with_velocity) continue;
+    const SV3 w_BP = A.add(w_J, w_rel);
+    const SV3 v_rel = A.add(A.add(v_node, A.cross(w_J, e)), e_dot);
+    s.w_B = A.mul(R_BP, A.add(w_P, w_BP), ctx.name("w_B", j));
+    s.v_O_B = A.mul(R_BP, A.add(A.add(v_P, A.cross(w_P, s.p_PO_P)), v_rel), ctx.name("v_O_B", j));
+    SV3 al = A.add(A.add(alR_P, A.cross(w_P, w_BP)), A.add(w_J_dot_R, A.cross(w_J, w_rel)));
+    s.alpha_R_B = A.mul(R_BP, al, ctx.name("alpha_R_B", j));
+    SV3 a = A.add(aR_P, A.cross(alR_P, s.p_PO_P));
+    a = A.add(a, A.cross(w_P, A.cross(w_P, s.p_PO_P)));
+    a = A.add(a, A.scale(2, A.cross(w_P, v_rel)));
+    a = A.add(a, A.cross(w_J_dot_R, e));
+    a = A.add(a, A.cross(w_J, A.cross(w_J, e)));
+    a = A.add(a, A.cross(w_J, e_dot));
+    a = A.add(a, A.cross(w_BP, e_dot));
+    s.a_R_B = A.mul(R_BP, a, ctx.name("a_R_B", j));
+  }
+}
+
+}  // namespace kanegen::codegen

@@ -1,0 +1,65 @@
+// A straight-line program under construction: every non-trivial
+// intermediate quantity of the symbolic formulation is bound to a temporary
+// symbol by let(), with common-subexpression elimination (structurally equal
+// expressions share one temporary). This keeps every expression small, so
+// the emitted code grows with the number of operations the recursive
+// formulation performs, not with the size of expanded closed forms.
+//
+// Temporaries are named tNNN unless let() is given a name (e.g. "ant2_w_B_x":
+// what the quantity is, with its frame), and section() inserts comment
+// markers ("// ---- body ant2: outward pass (velocities)") that appear in the
+// emitted code above the first live temporary that follows them.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "codegen/printer.hpp"
+
+namespace kanegen::codegen {
+
+using GiNaC::ex;
+
+class Program {
+ public:
+  /// Binds e to a temporary (reusing one for an equal expression); numbers,
+  /// symbols and a number times a symbol are returned as they are. A new
+  /// temporary takes `name` when given (made unique with a suffix).
+  ex let(const ex& e, const std::string& name = {});
+  /// Records `lhs = e;` as an output statement (in order).
+  void assign(const std::string& lhs, const ex& e);
+  /// A plain statement emitted verbatim after the temporaries it needs
+  /// (e.g. `if (D3 <= 0) return 4;`), depending on expression `dep`.
+  void statement(const std::string& text, const ex& dep);
+  /// A comment marker for the temporaries bound after it.
+  void section(const std::string& title);
+
+  /// C++ body: temporaries that some output needs (dead ones dropped), in
+  /// order, as `const T name = ...;`, then the outputs. Counts operations.
+  std::string emit(const std::string& indent, OpCount& ops) const;
+  /// Names of the temporaries bound so far.
+  const std::set<std::string>& names() const { return names_; }
+
+ private:
+  struct Temp {
+    GiNaC::symbol sym;
+    ex value;
+    std::string section;  ///< non-empty: a comment marker, not a temporary
+  };
+  std::vector<Temp> temps_;
+  std::map<ex, ex, GiNaC::ex_is_less> cse_;
+  std::set<std::string> names_;
+  int unnamed_ = 0;
+  struct Stmt {
+    std::string lhs;  // empty for verbatim statements
+    std::string text;
+    ex value;
+  };
+  std::vector<Stmt> stmts_;
+};
+
+}  // namespace kanegen::codegen

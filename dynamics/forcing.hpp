@@ -1,0 +1,41 @@
+// F(q, u, tau) = tau + joint springs/dampers + modal stiffness/damping
+//              + Sum_j P_j^T (g_body - M_body z_R - h_body),
+// z_R = [a_R_B, alpha_R_B, 0] the body's remainder accelerations: the
+// generalized active forces (gravity on every mass element) plus the
+// generalized inertia forces without their u-dot part (dynamics.md).
+// Requires compute_kinematics and compute_body_terms.
+#pragma once
+
+#include "model/model.hpp"
+#include "dynamics/workspace.hpp"
+
+namespace kanegen {
+
+/// Joint spring/damper and modal stiffness/damping forces, added to F.
+template <class S, class VecF, class VecQ, class VecU>
+void add_elastic_forces(const Model& model, const VecQ& q, const VecU& u, VecF& F) {
+  for (const Body& b : model.bodies) {
+    const Joint& j = b.joint;
+    if ((j.type == JointType::revolute || j.type == JointType::prismatic) && (j.stiffness != 0 || j.damping != 0))
+      F(b.u_joint) -= S(j.stiffness) * (S(q(b.q_joint)) - S(j.rest)) + S(j.damping) * S(u(b.u_joint));
+    for (int k = 0; k < b.n_modes(); ++k)
+      F(b.u_eta + k) -= S(b.flex->K(k)) * S(q(b.q_eta + k)) + S(b.flex->D(k)) * S(u(b.u_eta + k));
+  }
+}
+
+template <class S, class VecQ, class VecU, class VecT>
+void compute_forcing(const Model& model, Workspace<S>& ws, const VecQ& q, const VecU& u, const VecT& tau) {
+  for (int r = 0; r < model.nu; ++r) ws.F(r) = S(tau(r));
+  add_elastic_forces<S>(model, q, u, ws.F);
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const std::vector<int>& chain = model.bodies[i].chain_u;
+    BodyWorkspace<S>& s = ws.body[i];
+    // y = g_body - M_body z_R - h_body, with z_R = [a_R, alpha_R, 0]
+    s.z_dot = s.g_body - s.h_body;
+    s.z_dot.noalias() -= s.M_body.template leftCols<3>() * s.a_R_B;
+    s.z_dot.noalias() -= s.M_body.template middleCols<3>(3) * s.alpha_R_B;
+    for (std::size_t c = 0; c < chain.size(); ++c) ws.F(chain[c]) += s.P.col(c).dot(s.z_dot);
+  }
+}
+
+}  // namespace kanegen

@@ -1,0 +1,157 @@
+// Forward kinematics along the kinematic chains (parents first): body
+// orientations and positions, velocities, the partial velocity matrices
+// (the paper's V and Omega blocks, Eqs. 4-5) and the remainder accelerations
+// (Eqs. 6-8), all in body components, for rigid and flexible bodies and
+// children attached at nodes of flexible parents (dynamics.md).
+//
+// For child B of parent P through joint frame J:
+//   R_PB = R_PJ R_JB,   p_PO = p_PJ + e,   e = R_PJ delta (translation in the joint)
+//   w_B  = w_P + w_J + w_rel            (w_J: rate of J in P, from the node's rotation)
+//   v_O  = v_P + w_P x p_PO + v_rel,    v_rel = Phi_k eta_dot_P + w_J x e + e_dot
+// and the remainders (u-dot terms removed):
+//   alpha_R = alpha_R_P + w_P x (w_J + w_rel) + w_J_dot_R + w_J x w_rel
+//   a_R     = a_R_P + alpha_R_P x p_PO + w_P x (w_P x p_PO) + 2 w_P x v_rel
+//             + w_J_dot_R x e + w_J x (w_J x e) + w_J x e_dot + (w_J + w_rel) x e_dot
+// At a node k with rotational shapes Psi_k: R_PJ = C(Psi_k eta_P) R_J0 (Rodrigues,
+// g = Psi_k eta_P / 2), w_J = (I + g^x) Psi_k eta_dot_P / (1 + g.g) and
+// w_J_dot_R = -(2 g.g_dot / (1 + g.g)) w_J.
+#pragma once
+
+#include <cmath>
+
+#include "model/model.hpp"
+#include "model/rotation.hpp"
+#include "dynamics/workspace.hpp"
+
+namespace kanegen {
+
+template <class S, class VecQ, class VecU>
+void compute_kinematics(const Model& model, Workspace<S>& ws, const VecQ& q, const VecU& u) {
+  using std::sqrt;
+  const M3<S> I3 = M3<S>::Identity();
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const Body& b = model.bodies[i];
+    BodyWorkspace<S>& s = ws.body[i];
+    const int m = b.n_modes();
+    for (int k = 0; k < m; ++k) {
+      s.eta(k) = S(q(b.q_eta + k));
+      s.eta_dot(k) = S(u(b.u_eta + k));
+    }
+
+    // Parent state (ground: at rest, identity).
+    const bool has_parent = b.parent >= 0;
+    const BodyWorkspace<S>* p = has_parent ? &ws.body[b.parent] : nullptr;
+    const V3<S> w_P = has_parent ? p->w_B : V3<S>::Zero();
+    const V3<S> v_P = has_parent ? p->v_O_B : V3<S>::Zero();
+    const V3<S> aR_P = has_parent ? p->a_R_B : V3<S>::Zero();
+    const V3<S> alR_P = has_parent ? p->alpha_R_B : V3<S>::Zero();
+
+    // Joint frame in the parent, and its motion when attached at a node.
+    M3<S> R_PJ = b.joint.R_PJ.cast<S>();
+    V3<S> p_PJ = b.joint.p_PJ.cast<S>();
+    V3<S> w_J = V3<S>::Zero();        // angular velocity of J relative to P, P components
+    V3<S> w_J_dot_R = V3<S>::Zero();  // its remainder rate
+    V3<S> v_node = V3<S>::Zero();     // Phi_k eta_dot_P
+    auto& H = s.H_node;
+    const int m_P = has_parent ? model.bodies[b.parent].n_modes() : 0;
+    const FlexibleData* pf_ptr = b.joint.node >= 0 ? &*model.bodies[b.parent].flex : nullptr;
+    if (b.joint.node >= 0) {
+      const FlexibleData& pf = *pf_ptr;
+      const int k = b.joint.node;
+      const auto Phi_k = as_scalar<S>(pf.Phi.template middleRows<3>(3 * k));
+      const auto Psi_k = as_scalar<S>(pf.Psi.template middleRows<3>(3 * k));
+      const V3<S> theta = Psi_k * p->eta;
+      const V3<S> g = theta / S(2);
+      const S denom = S(1) + g.dot(g);
+      R_PJ = rodrigues_R<S>(theta) * R_PJ;
+      p_PJ = pf.nodes[k].rho_B.cast<S>() + Phi_k * p->eta;
+      H.noalias() = (I3 + skew<S>(g)) * Psi_k;
+      H /= denom;
+      w_J = H * p->eta_dot;
+      const V3<S> g_dot = Psi_k * p->eta_dot / S(2);
+      w_J_dot_R = -(S(2) * g.dot(g_dot) / denom) * w_J;
+      v_node = Phi_k * p->eta_dot;
+    }
+
+    // Joint motion.
+    M3<S> R_JB = I3;
+    V3<S> e = V3<S>::Zero();      // O_B - origin of J, P components
+    V3<S> e_dot = V3<S>::Zero();  // its rate seen in J, P components
+    V3<S> w_rel = V3<S>::Zero();  // angular velocity of B relative to J, P components
+    const V3<S> a_J = b.joint.axis_J.cast<S>();
+    switch (b.joint.type) {
+      case JointType::revolute:
+        R_JB = axis_angle_R<S>(b.joint.axis_J, S(q(b.q_joint)));
+        w_rel = R_PJ * a_J * S(u(b.u_joint));
+        break;
+      case JointType::prismatic:
+        e = R_PJ * a_J * S(q(b.q_joint));
+        e_dot = R_PJ * a_J * S(u(b.u_joint));
+        break;
+      case JointType::fixed: break;
+      case JointType::free: {
+        V4<S> quat(S(q(b.q_joint + 3)), S(q(b.q_joint + 4)), S(q(b.q_joint + 5)), S(q(b.q_joint + 6)));
+        quat /= sqrt(quat.dot(quat));
+        R_JB = quat_to_R<S>(quat);
+        const V3<S> xyz(S(q(b.q_joint)), S(q(b.q_joint + 1)), S(q(b.q_joint + 2)));
+        e = R_PJ * xyz;
+        const M3<S> R_PB = R_PJ * R_JB;
+        const V3<S> v(S(u(b.u_joint)), S(u(b.u_joint + 1)), S(u(b.u_joint + 2)));
+        const V3<S> w(S(u(b.u_joint + 3)), S(u(b.u_joint + 4)), S(u(b.u_joint + 5)));
+        e_dot = R_PB * v;
+        w_rel = R_PB * w;
+        break;
+      }
+    }
+    s.R_PB = R_PJ * R_JB;
+    s.p_PO_P = p_PJ + e;
+    const M3<S> R_BP = s.R_PB.transpose();
+    const V3<S>& d = s.p_PO_P;
+
+    // Velocities and remainder accelerations, parent components, then into B.
+    const V3<S> w_BP = w_J + w_rel;
+    const V3<S> v_rel = v_node + w_J.cross(e) + e_dot;
+    s.w_B = R_BP * (w_P + w_BP);
+    s.v_O_B = R_BP * (v_P + w_P.cross(d) + v_rel);
+    s.alpha_R_B = R_BP * (alR_P + w_P.cross(w_BP) + w_J_dot_R + w_J.cross(w_rel));
+    s.a_R_B = R_BP * (aR_P + alR_P.cross(d) + w_P.cross(w_P.cross(d)) + S(2) * w_P.cross(v_rel) +
+                      w_J_dot_R.cross(e) + w_J.cross(w_J.cross(e)) + w_J.cross(e_dot) + w_BP.cross(e_dot));
+    if (has_parent) {
+      s.R_NB = p->R_NB * s.R_PB;
+      s.r_NO_N = p->r_NO_N + p->R_NB * d;
+    } else {
+      s.R_NB = s.R_PB;
+      s.r_NO_N = d;
+    }
+
+    // Partial velocities: the parent's chain carried across the joint ...
+    s.P.setZero();
+    const int k_P = has_parent ? static_cast<int>(p->P.cols()) : 0;
+    if (has_parent) {
+      const auto V_P = p->P.topRows(3);
+      const auto W_P = p->P.middleRows(3, 3);
+      // V_B = R_BP (V_P + W_P x d) = R_BP V_P - R_BP d^x W_P ; W_B = R_BP W_P
+      s.P.topLeftCorner(3, k_P).noalias() = R_BP * V_P;
+      s.P.topLeftCorner(3, k_P).noalias() -= (R_BP * skew<S>(d)) * W_P;
+      s.P.block(3, 0, 3, k_P).noalias() = R_BP * W_P;
+      if (b.joint.node >= 0) {  // ... plus the node's motion driven by the parent's modes
+        const int c0 = k_P - m_P;
+        s.P.block(0, c0, 3, m_P).noalias() += R_BP * as_scalar<S>(pf_ptr->Phi.template middleRows<3>(3 * b.joint.node));
+        s.P.block(0, c0, 3, m_P).noalias() -= (R_BP * skew<S>(e)) * H;
+        s.P.block(3, c0, 3, m_P).noalias() += R_BP * H;
+      }
+    }
+    // ... then the joint's own columns (axis in B equals axis in J for both joints) ...
+    switch (b.joint.type) {
+      case JointType::revolute: s.P.block(3, k_P, 3, 1) = a_J; break;
+      case JointType::prismatic: s.P.block(0, k_P, 3, 1) = a_J; break;
+      case JointType::fixed: break;
+      case JointType::free: s.P.block(0, k_P, 6, 6).setIdentity(); break;
+    }
+    // ... and the body's own modal speeds.
+    const int c_eta = k_P + joint_nu(b.joint.type);
+    for (int k = 0; k < m; ++k) s.P(6 + k, c_eta + k) = S(1);
+  }
+}
+
+}  // namespace kanegen

@@ -1,0 +1,98 @@
+// The runtime's view of a model's equations of motion, whichever way they are
+// computed: GenericEngine (reads the Model at run time, dynamics/) or
+// GeneratedEngine (the model's generated code, through the C table of
+// generated_api.h). Everything else (CLI, simulation, cross-checks) depends
+// only on this interface. All quantities follow dynamics.md; q holds unit
+// quaternions (the engines normalize what they use). `t` matters only for
+// models with prescribed motion; the overloads without it evaluate at t = 0.
+//
+// Public methods are non-virtual: they check sizes once and call the
+// protected do_* implementations (so that overloads are not hidden in
+// derived classes).
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "model/model.hpp"
+
+namespace kanegen {
+
+struct Reaction {
+  Vec3 force_B = Vec3::Zero();   ///< on the body from its parent, body components
+  Vec3 torque_B = Vec3::Zero();  ///< about the body's joint point O_B, body components
+};
+
+struct EnergyValues {
+  double T = 0, V = 0;
+};
+struct MomentumValues {
+  Vec3 p_N = Vec3::Zero(), H_N = Vec3::Zero();
+};
+
+/// M(q) is not positive definite at the state (e.g. a massless chain).
+/// `speed` is the index of a speed whose pivot failed (-1 if unknown).
+class SingularMassMatrix : public std::runtime_error {
+ public:
+  explicit SingularMassMatrix(const std::string& what, int speed = -1) : std::runtime_error(what), speed(speed) {}
+  int speed;
+};
+
+class Engine {
+ public:
+  explicit Engine(const Model& model) : model_(model) {}
+  virtual ~Engine() = default;
+  Engine(const Engine&) = delete;
+  Engine& operator=(const Engine&) = delete;
+
+  const Model& model() const { return model_; }
+  virtual std::string name() const = 0;
+
+  void qdot(const VecX& q, const VecX& u, VecX& qdot);
+  void mass_matrix(double t, const VecX& q, MatX& M);
+  void forcing(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& F);
+  /// Solves M u_dot = F; throws SingularMassMatrix.
+  void udot(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& udot);
+  EnergyValues energy(double t, const VecX& q, const VecX& u);
+  MomentumValues momentum(double t, const VecX& q, const VecX& u);
+  /// Reactions on every body given the accelerations u_dot (from udot()).
+  void reactions(double t, const VecX& q, const VecX& u, const VecX& udot, std::vector<Reaction>& out);
+  /// Exact Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u] ((nq+nu)^2),
+  /// if this engine provides one; false otherwise (the implicit integrators
+  /// then use finite differences). Throws SingularMassMatrix.
+  bool jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& J);
+  /// Whether jacobian() gives exact Jacobians.
+  virtual bool has_jacobian() const { return false; }
+
+  void mass_matrix(const VecX& q, MatX& M) { mass_matrix(0.0, q, M); }
+  void forcing(const VecX& q, const VecX& u, const VecX& tau, VecX& F) { forcing(0.0, q, u, tau, F); }
+  void udot(const VecX& q, const VecX& u, const VecX& tau, VecX& ud) { udot(0.0, q, u, tau, ud); }
+  EnergyValues energy(const VecX& q, const VecX& u) { return energy(0.0, q, u); }
+  MomentumValues momentum(const VecX& q, const VecX& u) { return momentum(0.0, q, u); }
+  void reactions(const VecX& q, const VecX& u, const VecX& ud, std::vector<Reaction>& out) {
+    reactions(0.0, q, u, ud, out);
+  }
+  bool jacobian(const VecX& q, const VecX& u, const VecX& tau, MatX& J) { return jacobian(0.0, q, u, tau, J); }
+
+ protected:
+  virtual void do_qdot(const VecX& q, const VecX& u, VecX& qdot) = 0;
+  virtual void do_mass_matrix(double t, const VecX& q, MatX& M) = 0;
+  virtual void do_forcing(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& F) = 0;
+  virtual void do_udot(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& udot) = 0;
+  virtual EnergyValues do_energy(double t, const VecX& q, const VecX& u) = 0;
+  virtual MomentumValues do_momentum(double t, const VecX& q, const VecX& u) = 0;
+  virtual void do_reactions(double t, const VecX& q, const VecX& u, const VecX& udot, std::vector<Reaction>& out) = 0;
+  virtual bool do_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& J) {
+    (void)t, (void)q, (void)u, (void)tau, (void)J;
+    return false;
+  }
+
+ private:
+  /// Throws std::invalid_argument unless q has nq entries and each of `nu_sized` nu.
+  void check_sizes(const VecX& q, std::initializer_list<const VecX*> nu_sized) const;
+  const Model& model_;
+};
+
+}  // namespace kanegen

@@ -1,0 +1,59 @@
+// The Engine over generated code: a KanegenGeneratedApi table
+// (generated_api.h) obtained from a JIT-compiled shared library (jit.hpp) or
+// linked in directly (ahead-of-time simulators, kanegen_add_model()). Its
+// functions are found by name; qdot, mass_matrix, forcing and udot are
+// required, the others optional. The table is checked against the Model on
+// construction: API version, nq/nu/nbodies and the model hash (model_hash.hpp)
+// must agree, and the generator hash too when one is expected.
+#pragma once
+
+#include <memory>
+
+#include "engine/engine.hpp"
+#include "engine/generated_api.h"
+
+namespace kanegen {
+
+class GeneratedEngine final : public Engine {
+ public:
+  /// `library` keeps the shared object holding `api` loaded (may be null when
+  /// the code is linked in). Throws std::runtime_error on any mismatch
+  /// between the table and the model (or `expected_generator_hash`, if not empty).
+  GeneratedEngine(const Model& model, const KanegenGeneratedApi* api, std::shared_ptr<void> library = nullptr,
+                  const std::string& expected_generator_hash = {});
+  std::string name() const override { return "generated"; }
+
+  bool has_jacobian() const override { return jacobian_ != nullptr; }
+  const KanegenGeneratedApi& api() const { return *api_; }
+  /// The function of the table called `name`, or null.
+  KanegenFunctionPtr function(const std::string& name) const;
+  /// Path of the shared library the code came from, empty when linked in.
+  const std::string& library_path() const { return library_path_; }
+  void set_library_path(std::string path) { library_path_ = std::move(path); }
+
+ protected:
+  void do_qdot(const VecX& q, const VecX& u, VecX& qdot) override;
+  void do_mass_matrix(double t, const VecX& q, MatX& M) override;
+  void do_forcing(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& F) override;
+  /// Throws SingularMassMatrix when the generated factorization meets a non-positive pivot.
+  void do_udot(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& udot) override;
+  /// These throw std::runtime_error when the model's `outputs:` did not ask for them.
+  EnergyValues do_energy(double t, const VecX& q, const VecX& u) override;
+  MomentumValues do_momentum(double t, const VecX& q, const VecX& u) override;
+  void do_reactions(double t, const VecX& q, const VecX& u, const VecX& udot, std::vector<Reaction>& out) override;
+  /// Returns false when the code has no Jacobian (left out of a very large model).
+  bool do_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& J) override;
+
+ private:
+  [[noreturn]] void missing_output(const char* what) const;
+  [[noreturn]] void singular(int pivot) const;
+  const KanegenGeneratedApi* api_;
+  std::shared_ptr<void> library_;
+  std::string library_path_;
+  KanegenFunctionPtr qdot_ = nullptr, mass_matrix_ = nullptr, forcing_ = nullptr, udot_ = nullptr,
+                     jacobian_ = nullptr, energy_ = nullptr, momentum_ = nullptr, reactions_ = nullptr;
+  std::vector<double> wrenches_;
+  MatX M_row_major_;
+};
+
+}  // namespace kanegen

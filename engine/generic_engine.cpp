@@ -1,0 +1,84 @@
+#include "engine/generic_engine.hpp"
+
+#include <fmt/format.h>
+
+#include "dynamics/body_terms.hpp"
+#include "dynamics/forcing.hpp"
+#include "dynamics/invariants.hpp"
+#include "dynamics/kinematic_equations.hpp"
+#include "dynamics/kinematics.hpp"
+#include "dynamics/mass_matrix.hpp"
+#include "dynamics/reactions.hpp"
+
+namespace kanegen {
+
+GenericEngine::GenericEngine(const Model& model)
+    : Engine(model), ws_(model), llt_(model.nu), zero_u_(VecX::Zero(model.nu)) {}
+
+void GenericEngine::update(double t, const VecX& q, const VecX& u) {
+  (void)t;
+  compute_kinematics(model(), ws_, q, u);
+  compute_body_terms(model(), ws_);
+}
+
+void GenericEngine::do_qdot(const VecX& q, const VecX& u, VecX& qdot) { compute_qdot<double>(model(), q, u, qdot); }
+
+void GenericEngine::do_mass_matrix(double t, const VecX& q, MatX& M) {
+  update(t, q, zero_u_);  // M does not depend on u
+  compute_mass_matrix(model(), ws_);
+  M = ws_.M;
+}
+
+void GenericEngine::do_forcing(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& F) {
+  update(t, q, u);
+  compute_forcing(model(), ws_, q, u, tau);
+  F = ws_.F;
+}
+
+void factorize_mass_matrix(const MatX& M, Eigen::LLT<MatX>& llt) {
+  llt.compute(M);
+  // cond(M) >= (max L_ii / min L_ii)^2: a ratio below 1e-14 leaves u-dot no
+  // correct digit. (Cheap and allocation-free, unlike Eigen's rcond estimate.)
+  double ratio = 0.0;
+  if (llt.info() == Eigen::Success && M.rows() > 0) {
+    const auto d = llt.matrixLLT().diagonal();
+    const double lo = d.minCoeff(), hi = d.maxCoeff();
+    ratio = hi > 0 ? (lo / hi) * (lo / hi) : 0.0;
+  } else if (M.rows() == 0) {
+    ratio = 1.0;
+  }
+  if (!(ratio > 1e-14))
+    throw SingularMassMatrix(
+        fmt::format("mass matrix is singular (Cholesky pivot ratio squared {:.3g}, i.e. cond(M) above 1e14)", ratio));
+}
+
+void GenericEngine::do_udot(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& udot) {
+  update(t, q, u);
+  compute_mass_matrix(model(), ws_);
+  compute_forcing(model(), ws_, q, u, tau);
+  factorize_mass_matrix(ws_.M, llt_);
+  udot = llt_.solve(ws_.F);
+}
+
+EnergyValues GenericEngine::do_energy(double t, const VecX& q, const VecX& u) {
+  update(t, q, u);
+  const auto E = compute_energy(model(), ws_, q);
+  return {E.T, E.V};
+}
+
+MomentumValues GenericEngine::do_momentum(double t, const VecX& q, const VecX& u) {
+  update(t, q, u);
+  const auto P = compute_momentum(model(), ws_);
+  return {P.p_N, P.H_N};
+}
+
+void GenericEngine::do_reactions(double t, const VecX& q, const VecX& u, const VecX& udot, std::vector<Reaction>& out) {
+  update(t, q, u);
+  compute_reactions(model(), ws_, udot);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i].force_B = ws_.body[i].wrench_B.head<3>();
+    out[i].torque_B = ws_.body[i].wrench_B.tail<3>();
+  }
+}
+
+}  // namespace kanegen

@@ -1,0 +1,398 @@
+#include "engine/jit.hpp"
+
+#include <dlfcn.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "engine/jit_cache.hpp"
+#include "engine/manifest.hpp"
+#include "engine/resources.hpp"
+#include "model/model_hash.hpp"
+
+#ifndef KANEGEN_VERSION
+#define KANEGEN_VERSION "unknown"
+#endif
+
+extern char** environ;
+
+namespace kanegen {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string env(const char* name) {
+  const char* v = std::getenv(name);
+  return v ? std::string(v) : std::string();
+}
+
+std::vector<std::string> split_words(const std::string& s) {
+  std::vector<std::string> out;
+  std::istringstream in(s);
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
+
+std::string shell_quote(const std::string& s) {
+  if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=./,:@%") ==
+                        std::string::npos)
+    return s;
+  std::string r = "'";
+  for (char c : s) r += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return r + "'";
+}
+
+std::string join_quoted(const std::vector<std::string>& argv) {
+  std::string r;
+  for (const auto& a : argv) {
+    if (!r.empty()) r += ' ';
+    r += shell_quote(a);
+  }
+  return r;
+}
+
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+  out.close();
+  if (!out) throw std::runtime_error(fmt::format("kanegen: cannot write {}", p.string()));
+}
+
+bool announce(const JitOptions& o) { return o.verbose || isatty(STDERR_FILENO); }
+
+/// Runs argv with stdout and stderr to `log_path`; returns the exit status,
+/// or -1 with `error` set when it could not be started or was killed.
+int run_logged(const std::vector<std::string>& argv, const std::string& log_path, std::string& error) {
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
+  posix_spawn_file_actions_addopen(&fa, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = posix_spawnp(&pid, args[0], &fa, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) {
+    error = fmt::format("cannot run '{}': {}", argv[0], std::strerror(rc));
+    return -1;
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) {
+      error = fmt::format("waiting for '{}': {}", argv[0], std::strerror(errno));
+      return -1;
+    }
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  error = fmt::format("'{}' killed by signal {}", argv[0], WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  return -1;
+}
+
+std::string first_lines(const std::string& path, int n, int* total) {
+  std::ifstream in(path);
+  std::string line, out;
+  int count = 0;
+  while (std::getline(in, line)) {
+    if (count < n) {
+      out += "  | ";
+      out += line;
+      out += '\n';
+    }
+    ++count;
+  }
+  if (total) *total = count;
+  return out;
+}
+
+/// One compiler invocation of a JIT build (a part compiled to an object, or the link).
+struct CompileStep {
+  std::vector<std::string> argv;
+  double cost = 0;  ///< estimated effort, to start the largest parts first
+};
+
+/// Functions whose u-dot takes more operations get no compiled Jacobian:
+/// the dual-number Jacobian costs about 3 u-dot per column; compiled below
+/// -O1 it is slower than SUNDIALS' finite differences of the -O2 u-dot
+/// (deep_chain: 5.3 s against 0.7 s), and at -O1 past ~6000 u-dot operations
+/// it takes minutes to compile.
+constexpr long kMaxJacobianUdotOps = 6000;
+
+/// The generated functions are compiled one per translation unit, in
+/// parallel, and linked. With the default flags each part gets an
+/// optimization level suited to its size (from the manifest's operation
+/// counts): GCC's time on one huge straight-line function grows faster than
+/// linearly (a 64-body chain's Jacobian took 174 s at -O2, 67 s at -O1 and
+/// 6 s at -O0 for that part alone).
+std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out, const Manifest& manifest,
+                                      const JitOptions& o) {
+  const bool default_flags = o.flags == default_jit_flags();
+  std::vector<std::string> base = split_words(o.compiler);
+  std::vector<std::string> flags;
+  for (auto& f : split_words(o.flags))
+    if (f != "-shared" && !(default_flags && f.rfind("-O", 0) == 0)) flags.push_back(f);
+  const std::string include = "-I" + o.include_dir;
+  const ManifestFunction* udot = manifest.find("udot");
+  const long udot_ops = udot ? udot->ops : 0;
+  const bool jacobian_left_out = udot_ops > kMaxJacobianUdotOps;
+  std::vector<CompileStep> steps;
+  std::vector<std::string> objects;
+  auto add = [&](const std::string& part, long ops, const std::string& opt, const std::vector<std::string>& extra) {
+    CompileStep st;
+    st.argv = base;
+    st.argv.insert(st.argv.end(), flags.begin(), flags.end());
+    if (default_flags) st.argv.push_back(opt);
+    const std::string obj = (out.parent_path() / ("part_" + part + ".o")).string();
+    st.argv.insert(st.argv.end(), {"-DKANEGEN_PART_" + part, include, "-c", entry.string(), "-o", obj});
+    st.argv.insert(st.argv.end(), extra.begin(), extra.end());
+    st.cost = static_cast<double>(ops);
+    steps.push_back(std::move(st));
+    objects.push_back(obj);
+  };
+  add("table", 0, "-O2", jacobian_left_out ? std::vector<std::string>{"-DKANEGEN_OMIT_jacobian"} : std::vector<std::string>{});
+  for (const ManifestFunction& f : manifest.functions) {
+    if (f.name == "jacobian") {
+      if (jacobian_left_out) continue;
+      add(f.name, f.ops, udot_ops <= 1500 ? "-O2" : "-O1", {});
+    } else {
+      add(f.name, f.ops, f.ops > 8000 ? "-O1" : "-O2", {});
+    }
+  }
+  std::stable_sort(steps.begin(), steps.end(), [](const CompileStep& a, const CompileStep& b) { return a.cost > b.cost; });
+  CompileStep link;
+  link.argv = base;
+  for (auto& f : split_words(o.flags))
+    if (f.rfind("-O", 0) != 0) link.argv.push_back(f);
+  if (std::find(link.argv.begin(), link.argv.end(), "-shared") == link.argv.end()) link.argv.push_back("-shared");
+  link.argv.insert(link.argv.end(), objects.begin(), objects.end());
+  link.argv.insert(link.argv.end(), {"-o", out.string()});
+  steps.push_back(std::move(link));
+  return steps;
+}
+
+/// Runs all but the last step concurrently (as many at once as there are
+/// cores), then the last (the link). Logs go to log_path (concatenated).
+/// Returns the first non-zero status; `failed` is the index of that step.
+int run_steps(const std::vector<CompileStep>& steps, const std::string& log_path, std::string& error,
+              std::size_t& failed) {
+  const std::size_t n = steps.size() - 1;
+  const unsigned jobs = std::max(1u, std::thread::hardware_concurrency());
+  std::vector<int> status(n, 0);
+  std::vector<std::string> errors(n);
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t i; (i = next++) < n;)
+      status[i] = run_logged(steps[i].argv, log_path + "." + std::to_string(i), errors[i]);
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < std::min<std::size_t>(jobs, n); ++t) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  std::ofstream log(log_path);
+  int first = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::ifstream part(log_path + "." + std::to_string(i));
+    log << part.rdbuf();
+    std::error_code ec;
+    fs::remove(log_path + "." + std::to_string(i), ec);
+    if (status[i] != 0 && first == 0) {
+      first = status[i];
+      error = errors[i];
+      failed = i;
+    }
+  }
+  log.close();
+  if (first != 0) return first;
+  std::string link_error;
+  const int s = run_logged(steps.back().argv, log_path + ".link", link_error);
+  std::ifstream part(log_path + ".link");
+  std::ofstream(log_path, std::ios::app) << part.rdbuf();
+  if (s != 0) {
+    error = link_error;
+    failed = n;
+  }
+  return s;
+}
+
+/// Compiles `sources` in a private temp dir beside so_path and publishes the
+/// library and its record (jit_cache.hpp).
+void build_library(const GeneratedSources& sources, const Manifest& manifest, const fs::path& so_path,
+                   const JitOptions& o) {
+  const fs::path dir = so_path.parent_path().empty() ? fs::path(".") : so_path.parent_path();
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(fmt::format("kanegen: cannot create cache directory {}: {}", dir.string(), ec.message()));
+  jit_cache::remove_stale_temps(dir.string());
+  const fs::path tmp = jit_cache::make_temp_dir(dir.string());
+  struct Cleanup {
+    fs::path p;
+    bool keep = false;
+    ~Cleanup() {
+      std::error_code e;
+      if (!keep) fs::remove_all(p, e);
+    }
+  } cleanup{tmp};
+
+  write_file(tmp / "model.hpp", sources.header);
+  write_file(tmp / "manifest.json", sources.manifest);
+  const fs::path entry_path = tmp / "entry.cpp";
+  write_file(entry_path, sources.entry);
+  const fs::path out_path = tmp / "lib.so";
+  const fs::path log_path = tmp / "compiler.log";
+  const std::vector<CompileStep> steps = plan_compile(entry_path, out_path, manifest, o);
+  const std::string label = manifest.model;
+
+  const bool talk = announce(o);
+  if (talk) {
+    fmt::print(stderr, "kanegen: compiling generated code for {} ...", label);
+    if (o.verbose)
+      for (const auto& st : steps) fmt::print(stderr, "\n  {}", join_quoted(st.argv));
+    if (o.verbose) fmt::print(stderr, "\n");
+    std::fflush(stderr);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string run_error;
+  std::size_t failed_step = steps.size() - 1;
+  const int status = run_steps(steps, log_path.string(), run_error, failed_step);
+  const std::string command = join_quoted(steps[failed_step].argv);  // for messages
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  if (status != 0 || !fs::exists(out_path)) {
+    if (talk) fmt::print(stderr, " failed\n");
+    fs::remove(out_path, ec);  // never keep a half-written library
+    // Keep sources and log for inspection, outside the library namespace of the cache.
+    fs::path kept = dir / "failed" / so_path.stem();
+    fs::create_directories(kept.parent_path(), ec);
+    fs::remove_all(kept, ec);
+    fs::rename(tmp, kept, ec);
+    if (ec) kept = tmp;  // raced with another failure: keep the temp dir itself
+    cleanup.keep = true;
+    const std::string log = (kept / "compiler.log").string();
+    int total = 0;
+    const std::string head = first_lines(log, 20, &total);
+    std::string what =
+        status < 0 ? fmt::format("kanegen: compiling generated code for model '{}' failed: {}\n", label, run_error)
+                   : fmt::format("kanegen: compiling generated code for model '{}' failed (compiler exit status {})\n",
+                                 label, status);
+    what += fmt::format("  command: {}\n", command);
+    what += fmt::format("  sources kept in: {}\n", kept.string());
+    if (!head.empty()) {
+      what += fmt::format("  compiler output ({}):\n", total > 20 ? fmt::format("first 20 of {} lines; all in {}", total, log)
+                                                                  : log);
+      what += head;
+    }
+    if (!what.empty() && what.back() == '\n') what.pop_back();
+    throw JitError(what, command, kept.string());
+  }
+
+  // Publish: the library, then its record (a library without a matching
+  // record is rebuilt, never loaded). A concurrent process publishing its own
+  // copy at the same time is harmless.
+  const jit_cache::LibraryRecord record = jit_cache::make_record(out_path.string(), manifest.api_symbol);
+  fs::rename(out_path, so_path, ec);
+  if (ec)
+    throw std::runtime_error(fmt::format("kanegen: cannot move the compiled library to {}: {}", so_path.string(),
+                                         ec.message()));
+  jit_cache::write_record(so_path.string(), record);
+  if (talk) fmt::print(stderr, " done in {:.1f} s\n", seconds);
+}
+
+/// dlopen + dlsym of a verified library; throws std::runtime_error.
+std::unique_ptr<GeneratedEngine> open_library(const Model& model, const std::string& path,
+                                              const std::string& api_symbol, const std::string& generator_hash) {
+  void* h = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!h) {
+    const char* e = dlerror();
+    throw std::runtime_error(fmt::format("kanegen: cannot load generated code {}: {}", path, e ? e : "dlopen failed"));
+  }
+  std::shared_ptr<void> handle(h, [](void* p) { dlclose(p); });
+  dlerror();
+  auto fn = reinterpret_cast<KanegenGeneratedApiFn>(dlsym(h, api_symbol.c_str()));
+  if (!fn) throw std::runtime_error(fmt::format("kanegen: {}: no symbol {}", path, api_symbol));
+  auto e = std::make_unique<GeneratedEngine>(model, fn(), std::move(handle), generator_hash);
+  e->set_library_path(path);
+  return e;
+}
+
+/// Loads so_path when its record verifies; otherwise builds it from the sources
+/// `make_sources()` gives (called only then) and loads the result.
+template <class MakeSources>
+std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::string& so_path,
+                                               const std::string& generator_hash, const JitOptions& o,
+                                               MakeSources make_sources) {
+  if (const auto record = jit_cache::verified_record(so_path))
+    return open_library(model, so_path, record->api_symbol, generator_hash);
+  const GeneratedSources sources = make_sources();
+  const Manifest manifest = parse_manifest(sources.manifest, "generated manifest of " + model.name);
+  build_library(sources, manifest, so_path, o);
+  const auto record = jit_cache::verified_record(so_path);
+  if (!record) throw std::runtime_error(fmt::format("kanegen: the library just built at {} does not verify", so_path));
+  return open_library(model, so_path, record->api_symbol, generator_hash);
+}
+
+}  // namespace
+
+std::string default_cache_dir() {
+  if (auto d = env("KANEGEN_CACHE_DIR"); !d.empty()) return d;
+  if (auto d = env("XDG_CACHE_HOME"); !d.empty()) return (fs::path(d) / "kanegen").string();
+  if (auto d = env("HOME"); !d.empty()) return (fs::path(d) / ".cache" / "kanegen").string();
+  return (fs::temp_directory_path() / "kanegen-cache").string();
+}
+
+std::string default_jit_flags() { return "-O2 -std=c++20 -fPIC -shared"; }
+
+JitOptions resolved(const JitOptions& opts) {
+  JitOptions o = opts;
+  if (o.cache_dir.empty()) o.cache_dir = default_cache_dir();
+  if (o.compiler.empty()) o.compiler = env("CXX");
+  if (o.compiler.empty()) o.compiler = "c++";
+  if (o.flags.empty()) o.flags = default_jit_flags();
+  if (o.include_dir.empty()) o.include_dir = include_dir();
+  return o;
+}
+
+std::string jit_cache_key(const Model& model, const std::string& generator_hash, const JitOptions& opts) {
+  const JitOptions o = resolved(opts);
+  const std::string flags = join_quoted(split_words(o.compiler)) + "\n" + join_quoted(split_words(o.flags));
+  return fnv1a64_hex(fmt::format("{}\n{}\n{}\n{}\n{}", model_hash(model), KANEGEN_VERSION,
+                                 KANEGEN_GENERATED_API_VERSION, generator_hash, flags));
+}
+
+std::string jit_library_path(const Model& model, const std::string& generator_hash, const JitOptions& opts) {
+  const JitOptions o = resolved(opts);
+  return (fs::path(o.cache_dir) /
+          (jit_cache::file_stem(model.name) + "-" + jit_cache_key(model, generator_hash, o) + ".so"))
+      .string();
+}
+
+std::unique_ptr<GeneratedEngine> compile_and_load(const Model& model, const GeneratedSources& sources,
+                                                  const std::string& so_path, const JitOptions& opts) {
+  const JitOptions o = resolved(opts);
+  return load_or_build(model, so_path, "", o, [&] { return sources; });
+}
+
+std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerator& generator,
+                                          const JitOptions& opts) {
+  const JitOptions o = resolved(opts);
+  const std::string so_path = jit_library_path(model, generator.hash, o);
+  return load_or_build(model, so_path, generator.hash, o, [&] { return generator.generate(model); });
+}
+
+}  // namespace kanegen

@@ -1,0 +1,70 @@
+// Just-in-time path of `--engine generated`: generate a model's code (header,
+// C entry, manifest: codegen/assembler.hpp), compile it with the system C++
+// compiler into a shared library, cache it (jit_cache.hpp) and load it.
+//
+// The engine library does not link the generator: whoever asks for a JIT
+// engine passes a CodeGenerator (the kanegen CLI passes codegen's), whose
+// hash is part of the cache key, so a changed generator never reuses a
+// library written by an older one.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "engine/generated_engine.hpp"
+#include "model/model.hpp"
+
+namespace kanegen {
+
+/// The three files of one model's generated code; `entry` #includes "model.hpp".
+struct GeneratedSources {
+  std::string header, entry, manifest;
+};
+
+struct CodeGenerator {
+  std::function<GeneratedSources(const Model&)> generate;
+  std::string hash;  ///< identifies the generator (its sources and templates)
+};
+
+struct JitOptions {
+  std::string cache_dir;    ///< empty: default_cache_dir()
+  std::string compiler;     ///< empty: $CXX, else "c++" (may hold several words, e.g. "ccache g++")
+  std::string flags;        ///< empty: default_jit_flags()
+  std::string include_dir;  ///< where engine/generated_api.h is; empty: resources.hpp's include_dir()
+  bool verbose = false;     ///< announce compiles on stderr (also done whenever stderr is a terminal)
+};
+
+/// $KANEGEN_CACHE_DIR, else $XDG_CACHE_HOME/kanegen, else ~/.cache/kanegen.
+std::string default_cache_dir();
+/// "-O2 -std=c++20 -fPIC -shared"
+std::string default_jit_flags();
+/// JitOptions with every empty field replaced by its default.
+JitOptions resolved(const JitOptions& opts);
+
+/// A compile of generated code failed. The CLI maps it to exit status 2.
+class JitError : public std::runtime_error {
+ public:
+  JitError(const std::string& what, std::string command, std::string kept_dir)
+      : std::runtime_error(what), command(std::move(command)), kept_dir(std::move(kept_dir)) {}
+  std::string command;   ///< the compiler command line, shell-quoted
+  std::string kept_dir;  ///< where the sources and compiler.log were kept (may be empty)
+};
+
+/// The cache key (16 hex digits) and library path of a model's code.
+std::string jit_cache_key(const Model& model, const std::string& generator_hash, const JitOptions& opts);
+std::string jit_library_path(const Model& model, const std::string& generator_hash, const JitOptions& opts);
+
+/// Lower level: makes sure `so_path` holds a verified build of `sources`
+/// (compiling them if it is missing or damaged), then loads it for `model`.
+/// Throws JitError when the compiler fails, std::runtime_error when loading
+/// or the checks of GeneratedEngine fail.
+std::unique_ptr<GeneratedEngine> compile_and_load(const Model& model, const GeneratedSources& sources,
+                                                  const std::string& so_path, const JitOptions& opts = {});
+
+/// The generated engine of `model`: from the cache, else generated, compiled and cached.
+std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerator& generator,
+                                          const JitOptions& opts = {});
+
+}  // namespace kanegen

@@ -1,0 +1,30 @@
+// The manifest of one model's generated code (written by codegen/assembler.cpp
+// next to the header and the entry file): what the JIT and
+// kanegen_add_model() need to know without reading any C++.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace kanegen {
+
+struct ManifestFunction {
+  std::string name;
+  long ops = 0;       ///< operation count of the function (jacobian: an estimate of its dual passes)
+  int out_size = 0;
+};
+
+struct Manifest {
+  std::string model, identifier, name_space, api_symbol;
+  std::string model_hash, generator_hash, generator_version;
+  int nq = 0, nu = 0, nbodies = 0;
+  std::string udot_form;
+  std::vector<ManifestFunction> functions;
+  const ManifestFunction* find(const std::string& name) const;
+};
+
+/// Parses manifest JSON; throws std::runtime_error naming `what` (a path or
+/// a description) and the missing or malformed field.
+Manifest parse_manifest(const std::string& json_text, const std::string& what);
+
+}  // namespace kanegen

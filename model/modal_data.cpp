@@ -1,0 +1,323 @@
+#include "model/modal_data.hpp"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+#include "model/yaml_check.hpp"
+
+namespace kanegen {
+
+using yamlcheck::Checker;
+using yamlcheck::key_line;
+using yamlcheck::line_of;
+using yamlcheck::num;
+
+namespace {
+
+// One mode as read from the file (before selection).
+struct RawMode {
+  int line = 0;         // the mode's first line
+  int shapes_line = 0;  // line of its `shapes:` key
+  double frequency = 0.0;
+  bool ok = true;
+  Eigen::VectorXd t, r;  // 3 * nodes
+};
+
+}  // namespace
+
+FlexibleData load_modal_file(const std::string& path, const std::vector<int>& keep,
+                             std::vector<Diagnostic>& diagnostics) {
+  FlexibleData flex;
+  flex.source = path;
+  bool parsed = false;
+  const YAML::Node root = yamlcheck::parse_file(path, diagnostics, parsed);
+  if (!parsed) return flex;
+  Checker ck(path, diagnostics);
+  if (!root.IsDefined() || root.IsNull()) {
+    ck.error(1, "", "empty file; expected modal data (a mapping with nodes, modes, mass_normalized)");
+    return flex;
+  }
+  if (!ck.expect_map(root, 1, "")) return flex;
+  ck.check_keys(root, "", {"nodes", "modes", "mass_normalized"});
+
+  // ---- nodes
+  const YAML::Node nodes = root["nodes"];
+  std::map<int, int> index_of_id;  // id -> index in flex.nodes
+  bool nodes_ok = true;
+  if (!nodes.IsDefined()) {
+    ck.error(1, "nodes", "missing; expected a list of nodes {id, position, mass, inertia}");
+    nodes_ok = false;
+  } else if (!ck.expect_seq(nodes, 1, "nodes")) {
+    nodes_ok = false;
+  } else if (nodes.size() == 0) {
+    ck.error(nodes, 1, "nodes", "empty; expected at least one node");
+    nodes_ok = false;
+  } else {
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      const YAML::Node nd = nodes[k];
+      const std::string f = fmt::format("nodes[{}]", k);
+      const int l = line_of(nd) ? line_of(nd) : line_of(nodes);
+      ModalNode node;
+      if (!ck.expect_map(nd, l, f)) {
+        nodes_ok = false;
+        continue;
+      }
+      ck.check_keys(nd, f, {"id", "position", "mass", "inertia"});
+      bool ok = true;
+      if (!nd["id"].IsDefined()) {
+        ck.error(l, f + ".id", "missing; expected an integer node id");
+        ok = false;
+      } else if (auto id = ck.integer(nd["id"], l, f + ".id")) {
+        node.id = static_cast<int>(*id);
+        if (index_of_id.count(node.id)) {
+          ck.error(nd["id"], l, f + ".id",
+                   fmt::format("duplicate node id {} (also nodes[{}]); expected unique ids", node.id,
+                               index_of_id[node.id]));
+          ok = false;
+        } else {
+          index_of_id[node.id] = static_cast<int>(k);
+        }
+      } else {
+        ok = false;
+      }
+      if (!nd["position"].IsDefined()) {
+        ck.error(l, f + ".position", "missing; expected the node position [x, y, z] in the body frame");
+        ok = false;
+      } else if (auto p = ck.vec3(nd["position"], l, f + ".position")) {
+        node.rho_B = *p;
+      } else {
+        ok = false;
+      }
+      if (!nd["mass"].IsDefined()) {
+        ck.error(l, f + ".mass", "missing; expected the node mass in kg (>= 0)");
+        ok = false;
+      } else if (auto m = ck.nonneg(nd["mass"], l, f + ".mass", "a mass")) {
+        node.mass = *m;
+      } else {
+        ok = false;
+      }
+      if (nd["inertia"].IsDefined()) {
+        if (auto I = ck.inertia(nd["inertia"], l, f + ".inertia"))
+          node.J_B = *I;
+        else
+          ok = false;
+      }
+      nodes_ok = nodes_ok && ok;
+      flex.nodes.push_back(node);
+    }
+  }
+  const int nn = static_cast<int>(flex.nodes.size());
+
+  // ---- mass_normalized
+  bool mass_normalized = true;
+  if (root["mass_normalized"].IsDefined()) {
+    const YAML::Node mn = root["mass_normalized"];
+    try {
+      if (!mn.IsScalar()) throw YAML::Exception(mn.Mark(), "not a scalar");
+      mass_normalized = mn.as<bool>();
+    } catch (const YAML::Exception&) {
+      ck.error(mn, 1, "mass_normalized", fmt::format("got {}; expected true or false", yamlcheck::describe(mn)));
+    }
+  }
+
+  // ---- modes
+  std::vector<RawMode> modes;
+  const YAML::Node ms = root["modes"];
+  if (!ms.IsDefined()) {
+    ck.error(1, "modes", "missing; expected a list of modes {frequency, shapes}");
+  } else if (!ck.expect_seq(ms, 1, "modes")) {
+  } else if (ms.size() == 0) {
+    ck.error(ms, 1, "modes", "empty; expected at least one mode");
+  } else {
+    for (std::size_t i = 0; i < ms.size(); ++i) {
+      const YAML::Node md = ms[i];
+      const std::string f = fmt::format("modes[{}]", i);
+      RawMode mode;
+      mode.line = line_of(md) ? line_of(md) : line_of(ms);
+      const int l = mode.line;
+      mode.t = Eigen::VectorXd::Zero(3 * nn);
+      mode.r = Eigen::VectorXd::Zero(3 * nn);
+      if (!ck.expect_map(md, l, f)) {
+        mode.ok = false;
+        modes.push_back(mode);
+        continue;
+      }
+      ck.check_keys(md, f, {"frequency", "shapes"});
+      if (!md["frequency"].IsDefined()) {
+        ck.error(l, f + ".frequency", "missing; expected the natural frequency in Hz (> 0)");
+        mode.ok = false;
+      } else if (auto fr = ck.positive(md["frequency"], l, f + ".frequency", "a frequency in Hz")) {
+        mode.frequency = *fr;
+      } else {
+        mode.ok = false;
+      }
+      const YAML::Node sh = md["shapes"];
+      mode.shapes_line = key_line(md, "shapes") ? key_line(md, "shapes") : l;
+      const std::string fs = f + ".shapes";
+      if (!sh.IsDefined()) {
+        ck.error(l, fs, "missing; expected a mapping node id: [tx, ty, tz, rx, ry, rz]");
+        mode.ok = false;
+      } else if (!ck.expect_map(sh, l, fs)) {
+        mode.ok = false;
+      } else {
+        std::set<int> given;
+        for (auto it = sh.begin(); it != sh.end(); ++it) {
+          const YAML::Node key = it->first;
+          const int kl = line_of(key) ? line_of(key) : line_of(sh);
+          auto id = ck.integer(key, kl, fs);
+          if (!id) {
+            mode.ok = false;
+            continue;
+          }
+          const int nid = static_cast<int>(*id);
+          const std::string fk = fmt::format("{}.{}", fs, nid);
+          if (given.count(nid)) {
+            ck.error(kl, fk, fmt::format("shape of node {} given twice; expected it once", nid));
+            mode.ok = false;
+            continue;
+          }
+          given.insert(nid);
+          auto v = ck.vector(it->second, kl, fk, 6);
+          if (!v) {
+            mode.ok = false;
+            continue;
+          }
+          if (!nodes_ok && !index_of_id.count(nid)) continue;  // node list already faulty
+          auto found = index_of_id.find(nid);
+          if (found == index_of_id.end()) {
+            ck.error(kl, fk,
+                     fmt::format("no node with id {} in nodes; expected shapes only for listed nodes", nid));
+            mode.ok = false;
+            continue;
+          }
+          const int k = found->second;
+          mode.t.segment<3>(3 * k) = v->head<3>();
+          mode.r.segment<3>(3 * k) = v->tail<3>();
+        }
+        if (nodes_ok) {
+          std::vector<std::string> missing;
+          // A node that carries no mass or rotary inertia (a clamp or reference
+          // point) may omit its shape, which is then zero: the reference data
+          // does so (docs/decisions.md). A node with mass may not.
+          for (const auto& node : flex.nodes)
+            if (!given.count(node.id) && (node.mass != 0.0 || !node.J_B.isZero()))
+              missing.push_back(std::to_string(node.id));
+          if (!missing.empty()) {
+            ck.error(mode.shapes_line, fs,
+                     fmt::format("no shape for node{} {}; expected a shape for every node that carries mass",
+                                 missing.size() > 1 ? "s" : "", yamlcheck::join(missing)));
+            mode.ok = false;
+          }
+        }
+      }
+      modes.push_back(mode);
+    }
+  }
+
+  // ---- mass normalization
+  if (nodes_ok) {
+    for (std::size_t i = 0; i < modes.size(); ++i) {
+      RawMode& mode = modes[i];
+      if (!mode.ok) continue;
+      double mm = 0.0;
+      for (int k = 0; k < nn; ++k) mm += flex.nodes[k].mass * mode.t.segment<3>(3 * k).squaredNorm();
+      const std::string f = fmt::format("modes[{}].shapes", i);
+      if (mass_normalized) {
+        if (std::abs(mm - 1.0) > 1e-6) {
+          ck.error(mode.shapes_line, f,
+                   fmt::format("modal mass sum_k m_k t_k.t_k = {} is not 1 (to within 1e-6); expected "
+                               "mass-normalized shapes, or set 'mass_normalized: false' to normalize them on load",
+                               num(mm)));
+          mode.ok = false;
+        }
+      } else if (!(mm > 0.0)) {
+        ck.error(mode.shapes_line, f,
+                 "zero modal mass (the mode moves no node mass); expected a mode with sum_k m_k t_k.t_k > 0");
+        mode.ok = false;
+      } else {
+        const double s = 1.0 / std::sqrt(mm);
+        mode.t *= s;
+        mode.r *= s;
+      }
+    }
+  }
+
+  // ---- selection
+  std::vector<int> sel;
+  if (keep.empty()) {
+    for (std::size_t i = 0; i < modes.size(); ++i) sel.push_back(static_cast<int>(i));
+  } else {
+    for (int k : keep) {
+      if (k < 1 || k > static_cast<int>(modes.size())) {
+        ck.error(0, "modes",
+                 fmt::format("mode {} requested, but the file has {} modes; expected 1-based mode numbers in 1..{}",
+                             k, modes.size(), modes.size()));
+      } else {
+        sel.push_back(k - 1);
+      }
+    }
+  }
+  const int m = static_cast<int>(sel.size());
+  flex.Phi = Eigen::MatrixXd::Zero(3 * nn, m);
+  flex.Psi = Eigen::MatrixXd::Zero(3 * nn, m);
+  flex.frequency_hz = Eigen::VectorXd::Zero(m);
+  for (int j = 0; j < m; ++j) {
+    const RawMode& mode = modes[sel[j]];
+    flex.Phi.col(j) = mode.t;
+    flex.Psi.col(j) = mode.r;
+    flex.frequency_hz(j) = mode.frequency;
+  }
+  flex.damping_ratio = Eigen::VectorXd::Zero(m);
+  flex.K = Eigen::VectorXd::Zero(m);
+  flex.D = Eigen::VectorXd::Zero(m);
+  return flex;
+}
+
+static std::string lossless(double x) { return fmt::format("{}", x); }
+
+static std::string vec_str(std::initializer_list<double> xs) {
+  std::string s = "[";
+  bool first = true;
+  for (double x : xs) {
+    s += (first ? "" : ", ") + lossless(x);
+    first = false;
+  }
+  return s + "]";
+}
+
+void write_modal_file(const FlexibleData& flex, const std::string& path) {
+  std::string out;
+  out += "# modal data written by kanegen";
+  if (!flex.source.empty()) out += " from " + flex.source;
+  out += "\nnodes:\n";
+  for (const auto& n : flex.nodes) {
+    const Mat3& J = n.J_B;
+    out += fmt::format("  - {{id: {}, position: {}, mass: {}", n.id, vec_str({n.rho_B(0), n.rho_B(1), n.rho_B(2)}),
+                       lossless(n.mass));
+    if (!J.isZero(0.0))
+      out += fmt::format(", inertia: {}", vec_str({J(0, 0), J(1, 1), J(2, 2), J(0, 1), J(0, 2), J(1, 2)}));
+    out += "}\n";
+  }
+  out += "modes:\n";
+  for (int j = 0; j < flex.modes(); ++j) {
+    out += fmt::format("  - frequency: {}\n    shapes:\n", lossless(flex.frequency_hz(j)));
+    for (std::size_t k = 0; k < flex.nodes.size(); ++k) {
+      const auto t = flex.Phi.block<3, 1>(3 * k, j);
+      const auto r = flex.Psi.block<3, 1>(3 * k, j);
+      out += fmt::format("      {}: {}\n", flex.nodes[k].id, vec_str({t(0), t(1), t(2), r(0), r(1), r(2)}));
+    }
+  }
+  out += "mass_normalized: true\n";
+  std::ofstream f(path, std::ios::binary);
+  if (!f) throw std::runtime_error(fmt::format("{}: cannot open for writing", path));
+  f << out;
+  if (!f) throw std::runtime_error(fmt::format("{}: write failed", path));
+}
+
+}  // namespace kanegen

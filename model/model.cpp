@@ -1,0 +1,134 @@
+#include "model/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace kanegen {
+
+const char* to_string(JointType t) {
+  switch (t) {
+    case JointType::revolute: return "revolute";
+    case JointType::prismatic: return "prismatic";
+    case JointType::fixed: return "fixed";
+    case JointType::free: return "free";
+  }
+  return "?";
+}
+
+int joint_nq(JointType t) {
+  switch (t) {
+    case JointType::revolute:
+    case JointType::prismatic: return 1;
+    case JointType::fixed: return 0;
+    case JointType::free: return 7;
+  }
+  return 0;
+}
+
+int joint_nu(JointType t) { return t == JointType::free ? 6 : joint_nq(t); }
+
+int FlexibleData::node_index(int id) const {
+  for (std::size_t k = 0; k < nodes.size(); ++k)
+    if (nodes[k].id == id) return static_cast<int>(k);
+  return -1;
+}
+
+static int find(const std::vector<std::string>& names, const std::string& name) {
+  auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+}
+
+int Model::body_index(const std::string& n) const {
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    if (bodies[i].name == n) return static_cast<int>(i);
+  return -1;
+}
+int Model::q_index(const std::string& n) const { return find(q_names, n); }
+int Model::u_index(const std::string& n) const { return find(u_names, n); }
+bool Model::has_flexible() const {
+  return std::any_of(bodies.begin(), bodies.end(), [](const Body& b) { return b.flex.has_value(); });
+}
+
+namespace {
+
+void snap_unit(double& x) {
+  for (double exact : {0.0, 1.0, -1.0})
+    if (std::abs(x - exact) <= kRoundoffResidue) x = exact;
+}
+
+template <class M>
+void snap_relative(M& m, double scale) {
+  for (Eigen::Index i = 0; i < m.size(); ++i)
+    if (std::abs(m(i)) <= kRoundoffResidue * scale) m(i) = 0.0;
+}
+
+}  // namespace
+
+void snap_roundoff_residues(Vec3& v) { snap_relative(v, v.cwiseAbs().maxCoeff()); }
+
+void snap_roundoff_residues(Body& b) {
+  for (Eigen::Index i = 0; i < 9; ++i) snap_unit(b.joint.R_PJ(i));
+  for (Eigen::Index i = 0; i < 3; ++i) snap_unit(b.joint.axis_J(i));
+  snap_roundoff_residues(b.joint.p_PJ);
+  snap_roundoff_residues(b.rigid.com_B);
+  snap_relative(b.rigid.I_c_B, b.rigid.I_c_B.diagonal().cwiseAbs().maxCoeff());
+}
+
+void finalize_model(Model& model) {
+  model.q_names.clear();
+  model.u_names.clear();
+  int nq = 0, nu = 0;
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    Body& b = model.bodies[i];
+    if (b.parent >= static_cast<int>(i)) throw std::logic_error("finalize_model: bodies not listed parents-first");
+    b.children.clear();
+    b.q_joint = nq;
+    b.u_joint = nu;
+    const std::string& n = b.name;
+    switch (b.joint.type) {
+      case JointType::revolute:
+        model.q_names.push_back(n + ".angle");
+        model.u_names.push_back(n + ".angle");
+        break;
+      case JointType::prismatic:
+        model.q_names.push_back(n + ".disp");
+        model.u_names.push_back(n + ".disp");
+        break;
+      case JointType::fixed: break;
+      case JointType::free:
+        for (const char* s : {".x", ".y", ".z", ".qw", ".qx", ".qy", ".qz"}) model.q_names.push_back(n + s);
+        for (const char* s : {".vx", ".vy", ".vz", ".wx", ".wy", ".wz"}) model.u_names.push_back(n + s);
+        break;
+    }
+    nq += joint_nq(b.joint.type);
+    nu += joint_nu(b.joint.type);
+    b.q_eta = nq;
+    b.u_eta = nu;
+    for (int k = 1; k <= b.n_modes(); ++k) {
+      model.q_names.push_back(n + ".eta" + std::to_string(k));
+      model.u_names.push_back(n + ".eta" + std::to_string(k));
+    }
+    nq += b.n_modes();
+    nu += b.n_modes();
+  }
+  model.nq = nq;
+  model.nu = nu;
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    Body& b = model.bodies[i];
+    if (b.parent >= 0) model.bodies[b.parent].children.push_back(static_cast<int>(i));
+    std::vector<int> chain = b.parent >= 0 ? model.bodies[b.parent].chain_u : std::vector<int>{};
+    for (int k = 0; k < joint_nu(b.joint.type) + b.n_modes(); ++k) chain.push_back(b.u_joint + k);
+    std::sort(chain.begin(), chain.end());
+    b.chain_u = std::move(chain);
+    b.integrals = compute_mass_integrals(b.rigid, b.flex ? &*b.flex : nullptr);
+  }
+  if (model.q0.size() != nq) {
+    model.q0 = VecX::Zero(nq);
+    for (const Body& b : model.bodies)
+      if (b.joint.type == JointType::free) model.q0(b.q_joint + 3) = 1.0;
+  }
+  if (model.u0.size() != nu) model.u0 = VecX::Zero(nu);
+}
+
+}  // namespace kanegen

@@ -1,0 +1,143 @@
+// The read-only description of a multibody system: tree topology, joints,
+// mass data (rigid part and modal data of flexible bodies), forces, initial
+// state and requested outputs. Built once by load_model() (model_loader.hpp)
+// and never modified by the engines; all per-evaluation data lives in a
+// Workspace (workspace.hpp).
+//
+// Conventions (../shared/spec/dynamics.md):
+//   - B_j: body frame, origin O_j at the inboard joint point.
+//   - R_PJ: joint frame orientation in parent components (x_P = R_PJ x_J).
+//   - Vectors carry the frame of their components as a suffix: p_PJ (in P).
+#pragma once
+
+#include <Eigen/Dense>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/modal_integrals.hpp"
+
+namespace kanegen {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using VecX = Eigen::VectorXd;
+using MatX = Eigen::MatrixXd;
+
+enum class JointType { revolute, prismatic, fixed, free };
+
+const char* to_string(JointType t);
+/// Number of generalized coordinates / speeds the joint contributes.
+int joint_nq(JointType t);
+int joint_nu(JointType t);
+
+struct Joint {
+  JointType type = JointType::fixed;
+  Vec3 axis_J = Vec3::UnitZ();      ///< unit axis in the joint frame (revolute, prismatic)
+  Vec3 p_PJ = Vec3::Zero();         ///< joint frame origin in parent frame (used when node < 0)
+  Mat3 R_PJ = Mat3::Identity();     ///< joint frame orientation in parent (the `rotation:`)
+  int node = -1;                    ///< index into the parent's FlexibleData::nodes, or -1
+  double stiffness = 0.0;           ///< spring on the joint coordinate
+  double damping = 0.0;             ///< damper on the joint coordinate
+  double rest = 0.0;                ///< spring rest value
+};
+
+/// Rigid part of a body: moves with B. Mass may be zero.
+struct RigidPart {
+  double mass = 0.0;
+  Vec3 com_B = Vec3::Zero();        ///< centre of mass from O, B components
+  Mat3 I_c_B = Mat3::Zero();        ///< inertia about the com, B axes
+};
+
+/// One node of a lumped-mass FEA model.
+struct ModalNode {
+  int id = 0;                       ///< id in the modal data file
+  Vec3 rho_B = Vec3::Zero();        ///< undeformed position from O, B components
+  double mass = 0.0;
+  Mat3 J_B = Mat3::Zero();          ///< rotary inertia (turns with B)
+};
+
+/// Modal description of a flexible body, modes already selected and
+/// mass-normalized (Sum_k m_k t_k.t_k = 1 for each kept mode).
+struct FlexibleData {
+  std::string source;               ///< modal file path or "beam" (for messages)
+  std::vector<ModalNode> nodes;
+  MatX Phi;                         ///< 3*nodes x m: translational shapes, node k rows 3k..3k+2
+  MatX Psi;                         ///< 3*nodes x m: rotational shapes
+  VecX frequency_hz;                ///< m natural frequencies (clamped at O)
+  VecX damping_ratio;               ///< m modal damping ratios
+  VecX K;                           ///< m diagonal modal stiffness (2 pi f)^2 Y_ii
+  VecX D;                           ///< m diagonal modal damping 2 zeta (2 pi f) Y_ii
+  int modes() const { return static_cast<int>(Phi.cols()); }
+  int node_index(int id) const;     ///< -1 if no node with that id
+};
+
+struct Body {
+  std::string name;
+  int parent = -1;                  ///< index of the parent body, -1 for ground
+  std::vector<int> children;
+  Joint joint;
+  RigidPart rigid;
+  std::optional<FlexibleData> flex;
+  BodyMassIntegrals integrals;      ///< mass data of rigid part + nodes (modal_integrals.hpp)
+
+  // Layout in the state vectors.
+  int q_joint = 0;                  ///< first joint coordinate in q
+  int u_joint = 0;                  ///< first joint speed in u
+  int q_eta = 0;                    ///< first modal coordinate in q
+  int u_eta = 0;                    ///< first modal speed in u
+  int n_modes() const { return flex ? flex->modes() : 0; }
+  /// Speeds that move this body: those of its joint and modes and of all its
+  /// ancestors (its kinematic chain), ascending. The partial velocities of the
+  /// body are zero in every other column.
+  std::vector<int> chain_u;
+};
+
+struct Outputs {
+  bool energy = false;
+  bool momentum = false;
+  bool reactions = false;
+};
+
+struct Model {
+  std::string name;
+  std::string description;
+  std::string source_path;          ///< the YAML file it was read from
+  Vec3 g_N = Vec3::Zero();          ///< gravity, N components
+  std::vector<Body> bodies;         ///< parents before children
+  int nq = 0;
+  int nu = 0;
+  std::vector<std::string> q_names;
+  std::vector<std::string> u_names;
+  VecX q0;                          ///< initial coordinates (quaternions unit)
+  VecX u0;                          ///< initial speeds
+  Outputs outputs;
+
+  int body_index(const std::string& name) const;  ///< -1 if absent
+  int q_index(const std::string& name) const;     ///< -1 if absent
+  int u_index(const std::string& name) const;     ///< -1 if absent
+  bool has_flexible() const;
+};
+
+/// Relative size below which a model constant is a round-off residue of an
+/// exact value (docs/decisions.md): a few ulps of the largest entry of its
+/// vector or matrix.
+inline constexpr double kRoundoffResidue = 1e-14;
+
+/// Snaps the round-off residues of exact values in a body's geometry to the
+/// exact values, so that the generator sees the model's sparsity: in a joint
+/// rotation or axis (unit quantities), entries within kRoundoffResidue of 0
+/// or +-1 become 0 or +-1 (e.g. the 6.1e-17 and 2.2e-16 of rpy(pi/2)); in a
+/// position, com or inertia, entries at most kRoundoffResidue times the
+/// largest entry of the same vector (inertia: its largest diagonal) become 0.
+/// Changes the dynamics by less than the rounding of its own evaluation.
+void snap_roundoff_residues(Body& body);
+/// The same for gravity.
+void snap_roundoff_residues(Vec3& g_N);
+
+/// Fills q/u layout, names, children and chain_u of an otherwise complete
+/// model, and the mass integrals of every body. Called by the loader, and by
+/// code that builds models programmatically (benchmarks, tests).
+void finalize_model(Model& model);
+
+}  // namespace kanegen

@@ -1,0 +1,138 @@
+#include "model/model_hash.hpp"
+
+#include <fmt/format.h>
+
+#include <iterator>
+
+namespace kanegen {
+
+namespace {
+
+// Appends to a string; every number with {:.17g} (round-trips a double).
+class Writer {
+ public:
+  std::string out;
+
+  void num(double x) {
+    if (x == 0.0) x = 0.0;  // -0 and +0 describe the same model
+    fmt::format_to(std::back_inserter(out), " {:.17g}", x);
+  }
+  void integer(long long i) { fmt::format_to(std::back_inserter(out), " {}", i); }
+  // Strings are length-prefixed so that no name can imitate a field separator.
+  void str(const std::string& s) { fmt::format_to(std::back_inserter(out), " {}:{}", s.size(), s); }
+  void key(const char* k) {
+    if (!out.empty()) out += '\n';
+    out += k;
+  }
+  template <class Derived>
+  void mat(const Eigen::DenseBase<Derived>& m) {
+    integer(m.rows());
+    integer(m.cols());
+    for (Eigen::Index i = 0; i < m.rows(); ++i)
+      for (Eigen::Index j = 0; j < m.cols(); ++j) num(m(i, j));
+  }
+};
+
+}  // namespace
+
+std::string model_fingerprint(const Model& model) {
+  Writer w;
+  w.key("kanegen-model-fingerprint 1");
+  w.key("name");
+  w.str(model.name);
+  w.key("gravity");
+  w.mat(model.g_N);
+  w.key("nq");
+  w.integer(model.nq);
+  w.key("nu");
+  w.integer(model.nu);
+  w.key("q_names");
+  w.integer(static_cast<long long>(model.q_names.size()));
+  for (const auto& n : model.q_names) w.str(n);
+  w.key("u_names");
+  w.integer(static_cast<long long>(model.u_names.size()));
+  for (const auto& n : model.u_names) w.str(n);
+  w.key("outputs");
+  w.integer(model.outputs.energy);
+  w.integer(model.outputs.momentum);
+  w.integer(model.outputs.reactions);
+  w.key("bodies");
+  w.integer(static_cast<long long>(model.bodies.size()));
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const Body& b = model.bodies[i];
+    w.key("body");
+    w.integer(static_cast<long long>(i));
+    w.str(b.name);
+    w.key(" parent");
+    w.integer(b.parent);
+    w.key(" layout");
+    w.integer(b.q_joint);
+    w.integer(b.u_joint);
+    w.integer(b.q_eta);
+    w.integer(b.u_eta);
+    const Joint& j = b.joint;
+    w.key(" joint");
+    w.str(to_string(j.type));
+    w.key(" axis");
+    w.mat(j.axis_J);
+    w.key(" position");
+    w.mat(j.p_PJ);
+    w.key(" rotation");
+    w.mat(j.R_PJ);
+    w.key(" node");
+    w.integer(j.node);
+    w.key(" spring");
+    w.num(j.stiffness);
+    w.num(j.damping);
+    w.num(j.rest);
+    w.key(" mass");
+    w.num(b.rigid.mass);
+    w.key(" com");
+    w.mat(b.rigid.com_B);
+    w.key(" inertia");
+    w.mat(b.rigid.I_c_B);
+    w.key(" flexible");
+    w.integer(b.flex.has_value());
+    if (b.flex) {
+      const FlexibleData& f = *b.flex;
+      w.key(" nodes");
+      w.integer(static_cast<long long>(f.nodes.size()));
+      for (const ModalNode& n : f.nodes) {
+        w.key("  node");
+        w.integer(n.id);
+        w.mat(n.rho_B);
+        w.num(n.mass);
+        w.mat(n.J_B);
+      }
+      w.key(" Phi");
+      w.mat(f.Phi);
+      w.key(" Psi");
+      w.mat(f.Psi);
+      w.key(" frequency_hz");
+      w.mat(f.frequency_hz);
+      w.key(" damping_ratio");
+      w.mat(f.damping_ratio);
+      w.key(" K");
+      w.mat(f.K);
+      w.key(" D");
+      w.mat(f.D);
+    }
+  }
+  w.out += '\n';
+  return w.out;
+}
+
+std::uint64_t fnv1a64(std::string_view bytes) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+std::string fnv1a64_hex(std::string_view bytes) { return fmt::format("{:016x}", fnv1a64(bytes)); }
+
+std::string model_hash(const Model& model) { return fnv1a64_hex(model_fingerprint(model)); }
+
+}  // namespace kanegen

@@ -1,0 +1,853 @@
+// YAML model file -> validated Model (model-format.md). Every fault found is
+// recorded as a Diagnostic (file, line, field, message); all are reported
+// together in one InputError.
+#include "model/model_loader.hpp"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include "model/beam.hpp"
+#include "model/modal_data.hpp"
+#include "model/rotation.hpp"
+#include "model/yaml_check.hpp"
+
+namespace kanegen {
+
+using yamlcheck::Checker;
+using yamlcheck::describe;
+using yamlcheck::did_you_mean;
+using yamlcheck::join;
+using yamlcheck::key_line;
+using yamlcheck::line_of;
+using yamlcheck::num;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+bool valid_model_name(const std::string& s) {
+  if (s.empty()) return false;
+  for (char c : s)
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_')) return false;
+  return true;
+}
+
+bool valid_body_name(const std::string& s) {
+  if (s.empty() || !(s[0] >= 'a' && s[0] <= 'z')) return false;
+  return valid_model_name(s);
+}
+
+/// What the loader knows about one body while validating.
+struct BodyInfo {
+  int line = 0;
+  std::string name;             ///< empty if invalid
+  std::string raw_name;         ///< as written (may be invalid or a duplicate)
+  std::string parent_name;      ///< as written
+  int parent = -2;              ///< -1 ground, >= 0 body, -2 unresolved
+  bool type_known = false;
+  bool has_flex_block = false;
+  bool flex_known = false;      ///< modal data loaded without faults
+  bool mass_known = true;       ///< rigid mass and node masses valid
+  int mass_line = 0;
+  int node_id = -1;             ///< `node:` id if given and valid
+  int node_line = 0;
+  Body body;
+};
+
+class Loader {
+ public:
+  explicit Loader(const std::string& path) : path_(path), ck_(path, diags_) {}
+
+  Model load() {
+    bool parsed = false;
+    const YAML::Node root = yamlcheck::parse_file(path_, diags_, parsed);
+    if (!parsed) throw InputError(diags_);
+    try {
+      read_root(root);
+    } catch (const YAML::Exception& e) {
+      ck_.error(e.mark.is_null() ? 0 : e.mark.line + 1, "", fmt::format("cannot read YAML: {}", e.msg));
+    }
+    if (!diags_.empty()) {
+      yamlcheck::sort_diagnostics(diags_);
+      throw InputError(diags_);
+    }
+    return build();
+  }
+
+ private:
+  std::string path_;
+  std::vector<Diagnostic> diags_;
+  Checker ck_;
+  Model model_;
+  std::vector<BodyInfo> info_;
+  // initial: name -> value, line
+  struct Given {
+    double value;
+    int line;
+  };
+  std::map<std::string, Given> init_q_, init_u_;
+
+  // ------------------------------------------------------------------ root
+  void read_root(const YAML::Node& root) {
+    model_.source_path = path_;
+    if (!root.IsDefined() || root.IsNull()) {
+      ck_.error(1, "", "empty file; expected a model (a mapping with name, bodies, ...)");
+      return;
+    }
+    if (!ck_.expect_map(root, 1, "")) return;
+    ck_.check_keys(root, "", {"name", "description", "gravity", "bodies", "initial", "outputs"});
+
+    const YAML::Node name = root["name"];
+    if (!name.IsDefined()) {
+      ck_.error(1, "name", "missing; expected a model name matching [a-z0-9_]+");
+    } else if (auto s = ck_.string(name, 1, "name")) {
+      if (!valid_model_name(*s))
+        ck_.error(name, 1, "name", fmt::format("'{}' is not a valid model name; expected [a-z0-9_]+", *s));
+      else
+        model_.name = *s;
+    }
+    if (root["description"].IsDefined()) {
+      if (auto s = ck_.string(root["description"], 1, "description")) model_.description = *s;
+    }
+    if (root["gravity"].IsDefined()) {
+      if (auto g = ck_.vec3(root["gravity"], 1, "gravity")) model_.g_N = *g;
+    }
+
+    const YAML::Node bodies = root["bodies"];
+    if (!bodies.IsDefined()) {
+      ck_.error(1, "bodies", "missing; expected a non-empty list of bodies");
+    } else if (ck_.expect_seq(bodies, 1, "bodies")) {
+      if (bodies.size() == 0)
+        ck_.error(bodies, 1, "bodies", "empty; expected a non-empty list of bodies");
+      else
+        read_bodies(bodies);
+    }
+
+    if (root["initial"].IsDefined()) read_initial(root["initial"]);
+    if (root["outputs"].IsDefined()) read_outputs(root["outputs"]);
+  }
+
+  void read_outputs(const YAML::Node& n) {
+    const std::vector<std::string> allowed = {"energy", "momentum", "reactions"};
+    if (!ck_.expect_seq(n, 1, "outputs")) return;
+    std::set<std::string> seen;
+    for (std::size_t i = 0; i < n.size(); ++i) {
+      const std::string f = fmt::format("outputs[{}]", i);
+      auto s = ck_.string(n[i], line_of(n), f);
+      if (!s) continue;
+      if (*s == "energy")
+        model_.outputs.energy = true;
+      else if (*s == "momentum")
+        model_.outputs.momentum = true;
+      else if (*s == "reactions")
+        model_.outputs.reactions = true;
+      else {
+        const std::string hint = did_you_mean(*s, allowed);
+        ck_.error(n[i], line_of(n), f,
+                  fmt::format("unknown output '{}'{}{}expected any of: energy, momentum, reactions", *s, hint,
+                              hint.empty() ? "; " : " "));
+        continue;
+      }
+      if (!seen.insert(*s).second) ck_.error(n[i], line_of(n), f, fmt::format("'{}' listed twice; expected it once", *s));
+    }
+  }
+
+  // ---------------------------------------------------------------- bodies
+  void read_bodies(const YAML::Node& bodies) {
+    const int nb = static_cast<int>(bodies.size());
+    info_.resize(nb);
+    // Names first, so that parents named after their children are told apart
+    // from unknown names.
+    std::map<std::string, int> first_index;
+    for (int i = 0; i < nb; ++i) {
+      const YAML::Node b = bodies[i];
+      BodyInfo& bi = info_[i];
+      bi.line = line_of(b) ? line_of(b) : line_of(bodies);
+      const std::string f = fmt::format("bodies[{}]", i);
+      if (!b.IsMap()) continue;
+      const YAML::Node name = b["name"];
+      if (!name.IsDefined()) {
+        ck_.error(bi.line, f + ".name", "missing; expected a body name matching [a-z][a-z0-9_]*");
+        continue;
+      }
+      auto s = ck_.string(name, bi.line, f + ".name");
+      if (!s) continue;
+      bi.raw_name = *s;
+      if (*s == "ground") {
+        ck_.error(name, bi.line, f + ".name", "'ground' is reserved for the inertial frame; expected another name");
+        continue;
+      }
+      if (!valid_body_name(*s)) {
+        ck_.error(name, bi.line, f + ".name",
+                  fmt::format("'{}' is not a valid body name; expected [a-z][a-z0-9_]*", *s));
+        continue;
+      }
+      auto it = first_index.find(*s);
+      if (it != first_index.end()) {
+        ck_.error(name, bi.line, f + ".name",
+                  fmt::format("duplicate body name '{}' (also bodies[{}]); expected unique names", *s, it->second));
+        continue;
+      }
+      first_index[*s] = i;
+      bi.name = *s;
+    }
+    for (int i = 0; i < nb; ++i) read_body(bodies[i], i, first_index);
+
+    // Massless leaves with degrees of freedom.
+    for (int i = 0; i < nb; ++i) {
+      BodyInfo& bi = info_[i];
+      if (!bi.type_known || !bi.mass_known) continue;
+      if (bi.has_flex_block && !bi.flex_known) continue;
+      if (bi.body.joint.type == JointType::fixed) continue;
+      double mass = bi.body.rigid.mass;
+      if (bi.body.flex)
+        for (const auto& n : bi.body.flex->nodes) mass += n.mass;
+      if (mass > 0) continue;
+      bool has_children = false;
+      for (int j = 0; j < nb; ++j)
+        if (j != i && !bi.name.empty() && info_[j].parent_name == bi.name) has_children = true;
+      if (has_children) continue;
+      ck_.error(bi.mass_line ? bi.mass_line : bi.line, fmt::format("bodies[{}].mass", i),
+                fmt::format("body '{}' has zero mass and no children, but its {} joint has degrees of freedom; "
+                            "expected mass > 0, a fixed joint, or children",
+                            bi.name, to_string(bi.body.joint.type)));
+    }
+  }
+
+  void read_body(const YAML::Node& b, int i, const std::map<std::string, int>& first_index) {
+    BodyInfo& bi = info_[i];
+    const std::string f = fmt::format("bodies[{}]", i);
+    const int l = bi.line;
+    if (!ck_.expect_map(b, l, f)) {
+      bi.mass_known = false;
+      return;
+    }
+    ck_.check_keys(b, f, {"name", "parent", "joint", "mass", "com", "inertia", "flexible"});
+    bi.body.name = bi.name;
+
+    // parent
+    const YAML::Node parent = b["parent"];
+    if (!parent.IsDefined()) {
+      ck_.error(l, f + ".parent", "missing; expected 'ground' or the name of an earlier body");
+    } else if (auto p = ck_.string(parent, l, f + ".parent")) {
+      bi.parent_name = *p;
+      if (*p == "ground") {
+        bi.parent = -1;
+      } else {
+        auto it = first_index.find(*p);
+        if (it != first_index.end() && it->second < i) {
+          bi.parent = it->second;
+        } else if (it != first_index.end() && it->second == i) {
+          ck_.error(parent, l, f + ".parent",
+                    fmt::format("body '{}' cannot be its own parent; expected 'ground' or an earlier body", *p));
+        } else if (it != first_index.end()) {
+          ck_.error(parent, l, f + ".parent",
+                    fmt::format("'{}' is listed after this body (bodies[{}]); expected bodies listed parents-first{}",
+                                *p, it->second, i == 0 ? " (the first body's parent is ground)" : ""));
+        } else {
+          std::vector<std::string> cands = {"ground"};
+          for (int j = 0; j < i; ++j)
+            if (!info_[j].name.empty()) cands.push_back(info_[j].name);
+          const std::string hint = did_you_mean(*p, cands);
+          ck_.error(parent, l, f + ".parent",
+                    fmt::format("no body named '{}'{}{}expected 'ground' or an earlier body", *p, hint,
+                                hint.empty() ? "; " : " "));
+        }
+      }
+    }
+
+    // mass data (rigid part)
+    const bool flexible = b["flexible"].IsDefined();
+    bi.has_flex_block = flexible;
+    const YAML::Node mass = b["mass"];
+    if (mass.IsDefined()) {
+      bi.mass_line = line_of(mass);
+      if (auto m = ck_.nonneg(mass, l, f + ".mass", "a mass"))
+        bi.body.rigid.mass = *m;
+      else
+        bi.mass_known = false;
+    } else if (!flexible) {
+      ck_.error(l, f + ".mass", "missing; expected the body mass in kg (>= 0)");
+      bi.mass_known = false;
+    }
+    if (b["com"].IsDefined()) {
+      if (auto c = ck_.vec3(b["com"], l, f + ".com")) bi.body.rigid.com_B = *c;
+    }
+    if (b["inertia"].IsDefined()) {
+      if (auto I = ck_.inertia(b["inertia"], l, f + ".inertia")) bi.body.rigid.I_c_B = *I;
+    }
+
+    if (flexible) read_flexible(b["flexible"], i, key_line(b, "flexible"));
+
+    // joint (after the parent's flexible data is known: node ids)
+    const YAML::Node joint = b["joint"];
+    if (!joint.IsDefined())
+      ck_.error(l, f + ".joint", "missing; expected a joint {type: revolute|prismatic|fixed|free, ...}");
+    else
+      read_joint(joint, i, key_line(b, "joint"));
+  }
+
+  // ----------------------------------------------------------------- joint
+  /// kl: line of the `joint:` key
+  void read_joint(const YAML::Node& j, int i, int kl) {
+    BodyInfo& bi = info_[i];
+    Joint& joint = bi.body.joint;
+    const std::string f = fmt::format("bodies[{}].joint", i);
+    if (!ck_.expect_map(j, bi.line, f)) return;
+    const int l = kl ? kl : line_of(j);
+    ck_.check_keys(j, f, {"type", "axis", "position", "node", "rotation", "stiffness", "damping", "rest"});
+
+    const YAML::Node type = j["type"];
+    if (!type.IsDefined()) {
+      ck_.error(l, f + ".type", "missing; expected one of revolute, prismatic, fixed, free");
+    } else if (auto s = ck_.string(type, l, f + ".type")) {
+      const std::vector<std::string> types = {"revolute", "prismatic", "fixed", "free"};
+      bi.type_known = true;
+      if (*s == "revolute")
+        joint.type = JointType::revolute;
+      else if (*s == "prismatic")
+        joint.type = JointType::prismatic;
+      else if (*s == "fixed")
+        joint.type = JointType::fixed;
+      else if (*s == "free")
+        joint.type = JointType::free;
+      else {
+        bi.type_known = false;
+        const std::string hint = did_you_mean(*s, types);
+        ck_.error(type, l, f + ".type",
+                  fmt::format("unknown joint type '{}'{}{}expected one of revolute, prismatic, fixed, free", *s, hint,
+                              hint.empty() ? "; " : " "));
+      }
+    }
+    const bool one_dof =
+        bi.type_known && (joint.type == JointType::revolute || joint.type == JointType::prismatic);
+    const std::string tname = bi.type_known ? to_string(joint.type) : "";
+
+    // axis
+    const YAML::Node axis = j["axis"];
+    if (one_dof) {
+      if (!axis.IsDefined())
+        ck_.error(l, f + ".axis", fmt::format("missing; a {} joint needs a unit 3-vector axis", tname));
+      else if (auto a = ck_.unit(axis, l, f + ".axis", 3, "a unit 3-vector"))
+        joint.axis_J = Vec3(*a);
+    } else if (bi.type_known && axis.IsDefined()) {
+      ck_.error(axis, l, f + ".axis",
+                fmt::format("not allowed on a {} joint; expected axis only on revolute and prismatic joints", tname));
+    }
+
+    // spring / damper
+    for (const char* key : {"stiffness", "damping", "rest"}) {
+      const YAML::Node n = j[key];
+      if (!n.IsDefined()) continue;
+      const std::string fk = f + "." + key;
+      if (bi.type_known && !one_dof) {
+        ck_.error(n, l, fk,
+                  fmt::format("not allowed on a {} joint; expected {} only on revolute and prismatic joints", tname,
+                              key));
+        continue;
+      }
+      std::string k = key;
+      if (k == "rest") {
+        if (auto x = ck_.number(n, l, fk)) joint.rest = *x;
+      } else if (auto x = ck_.nonneg(n, l, fk, key)) {
+        (k == "stiffness" ? joint.stiffness : joint.damping) = *x;
+      }
+    }
+
+    // position / node
+    const YAML::Node position = j["position"];
+    const YAML::Node node = j["node"];
+    if (position.IsDefined() && node.IsDefined()) {
+      ck_.error(node, l, f + ".node",
+                "both position and node given; expected one of them (position on a rigid parent, node on a "
+                "flexible parent)");
+    } else if (position.IsDefined()) {
+      if (auto p = ck_.vec3(position, l, f + ".position")) joint.p_PJ = *p;
+    } else if (node.IsDefined()) {
+      read_node(node, i, f + ".node");
+    }
+
+    // rotation
+    const YAML::Node rot = j["rotation"];
+    if (rot.IsDefined()) {
+      if (auto R = read_rotation(rot, key_line(j, "rotation"), f + ".rotation")) joint.R_PJ = *R;
+    }
+  }
+
+  void read_node(const YAML::Node& node, int i, const std::string& f) {
+    BodyInfo& bi = info_[i];
+    const auto id = ck_.integer(node, bi.line, f);
+    if (!id) return;
+    if (bi.parent == -2) return;  // parent already faulty
+    if (bi.parent == -1) {
+      ck_.error(node, bi.line, f, "node attachment on ground; expected a flexible parent (use position on ground)");
+      return;
+    }
+    const BodyInfo& pi = info_[bi.parent];
+    if (!pi.has_flex_block) {
+      ck_.error(node, bi.line, f,
+                fmt::format("parent '{}' is rigid (no flexible: block); expected node only on a flexible parent, "
+                            "use position instead",
+                            pi.name));
+      return;
+    }
+    if (!pi.flex_known) return;  // parent's modal data already faulty
+    const FlexibleData& flex = *pi.body.flex;
+    const int k = flex.node_index(static_cast<int>(*id));
+    if (k < 0) {
+      std::vector<std::string> ids;
+      for (const auto& n : flex.nodes) ids.push_back(std::to_string(n.id));
+      std::string list = ids.size() <= 12 ? join(ids) : join({ids.begin(), ids.begin() + 12}) + ", ...";
+      ck_.error(node, bi.line, f,
+                fmt::format("no node {} in the modal data of parent '{}' ({}); expected one of its node ids: {}", *id,
+                            pi.name, flex.source, list));
+      return;
+    }
+    bi.body.joint.node = k;
+    bi.node_id = static_cast<int>(*id);
+  }
+
+  std::optional<Mat3> read_rotation(const YAML::Node& n, int fallback, const std::string& f) {
+    const std::vector<std::string> forms = {"rpy", "matrix", "axis_angle", "quaternion"};
+    if (!n.IsMap()) {
+      ck_.error(n, fallback, f,
+                fmt::format("got {}; expected one of {{rpy: [r, p, y]}}, {{matrix: [[..], [..], [..]]}}, "
+                            "{{axis_angle: [[x, y, z], angle]}}, {{quaternion: [w, x, y, z]}}",
+                            describe(n)));
+      return std::nullopt;
+    }
+    ck_.check_keys(n, f, forms);
+    std::vector<std::string> given;
+    for (const auto& k : forms)
+      if (n[k].IsDefined()) given.push_back(k);
+    const int l = fallback ? fallback : line_of(n);
+    if (given.size() != 1) {
+      if (given.empty() && n.size() > 0) return std::nullopt;  // only unknown keys: already reported
+      ck_.error(l, f,
+                given.empty() ? "empty; expected exactly one of rpy, matrix, axis_angle, quaternion"
+                              : fmt::format("{} given; expected exactly one of rpy, matrix, axis_angle, quaternion",
+                                            join(given, " and ")));
+      return std::nullopt;
+    }
+    const std::string form = given[0];
+    const YAML::Node v = n[form];
+    const std::string fv = f + "." + form;
+    if (form == "rpy") {
+      auto a = ck_.vec3(v, l, fv);
+      if (!a) return std::nullopt;
+      return rpy_R((*a)(0), (*a)(1), (*a)(2));
+    }
+    if (form == "matrix") {
+      auto R = ck_.mat3(v, l, fv);
+      if (!R) return std::nullopt;
+      const double scale = R->cwiseAbs().maxCoeff();
+      const double orth = (R->transpose() * *R - Mat3::Identity()).cwiseAbs().maxCoeff();
+      if (!(orth <= 1e-9 * std::max(scale, 1e-300))) {
+        ck_.error(v, l, fv,
+                  fmt::format("not orthonormal (largest |R^T R - I| entry {}); expected a rotation matrix "
+                              "(orthonormal to 1e-9, determinant +1)",
+                              num(orth)));
+        return std::nullopt;
+      }
+      const double det = R->determinant();
+      if (std::abs(det - 1.0) > 1e-9 * scale * scale * scale) {
+        ck_.error(v, l, fv,
+                  fmt::format("determinant {} (a reflection); expected a proper rotation with determinant +1",
+                              num(det)));
+        return std::nullopt;
+      }
+      return *R;
+    }
+    if (form == "axis_angle") {
+      if (!v.IsSequence() || v.size() != 2) {
+        ck_.error(v, l, fv, fmt::format("got {}; expected [[x, y, z], angle]", describe(v)));
+        return std::nullopt;
+      }
+      auto a = ck_.unit(v[0], line_of(v), fv + "[0]", 3, "a unit 3-vector axis");
+      auto angle = ck_.number(v[1], line_of(v), fv + "[1]");
+      if (!a || !angle) return std::nullopt;
+      return axis_angle_R<double>(Vec3(*a), *angle);
+    }
+    // quaternion
+    auto q = ck_.unit(v, l, fv, 4, "a unit quaternion [w, x, y, z]");
+    if (!q) return std::nullopt;
+    return quat_to_R<double>(Eigen::Vector4d(*q));
+  }
+
+  // -------------------------------------------------------------- flexible
+  /// kl: line of the `flexible:` key
+  void read_flexible(const YAML::Node& n, int i, int kl) {
+    BodyInfo& bi = info_[i];
+    const std::string f = fmt::format("bodies[{}].flexible", i);
+    if (!ck_.expect_map(n, bi.line, f)) return;
+    const int l = kl ? kl : line_of(n);
+    ck_.check_keys(n, f, {"modal", "beam", "damping_ratio", "modes"});
+
+    // modes subset (validated before the data, range checked after)
+    std::vector<int> keep;
+    std::vector<int> keep_line;
+    bool keep_ok = true;
+    const YAML::Node modes = n["modes"];
+    if (modes.IsDefined()) {
+      if (!ck_.expect_seq(modes, l, f + ".modes") || modes.size() == 0) {
+        if (modes.IsSequence()) ck_.error(modes, l, f + ".modes", "empty; expected a list of 1-based mode numbers");
+        keep_ok = false;
+      } else {
+        for (std::size_t k = 0; k < modes.size(); ++k) {
+          const std::string fk = fmt::format("{}.modes[{}]", f, k);
+          auto m = ck_.integer(modes[k], line_of(modes), fk);
+          if (!m) {
+            keep_ok = false;
+            continue;
+          }
+          if (*m < 1) {
+            ck_.error(modes[k], line_of(modes), fk, fmt::format("{} is not a mode number; expected 1-based mode numbers (>= 1)", *m));
+            keep_ok = false;
+            continue;
+          }
+          if (std::find(keep.begin(), keep.end(), static_cast<int>(*m)) != keep.end()) {
+            ck_.error(modes[k], line_of(modes), fk, fmt::format("mode {} listed twice; expected unique mode numbers", *m));
+            keep_ok = false;
+            continue;
+          }
+          keep.push_back(static_cast<int>(*m));
+          keep_line.push_back(line_of(modes[k]) ? line_of(modes[k]) : line_of(modes));
+        }
+      }
+    }
+
+    const YAML::Node modal = n["modal"];
+    const YAML::Node beam = n["beam"];
+    std::optional<FlexibleData> data;
+    const std::size_t before = diags_.size();
+    if (modal.IsDefined() && beam.IsDefined()) {
+      ck_.error(beam, l, f + ".beam", "both modal and beam given; expected exactly one of them");
+    } else if (!modal.IsDefined() && !beam.IsDefined()) {
+      ck_.error(l, f, "no modal data; expected 'modal: FILE.modal.yaml' or a 'beam:' block");
+    } else if (modal.IsDefined()) {
+      if (auto s = ck_.string(modal, l, f + ".modal")) {
+        namespace fs = std::filesystem;
+        const fs::path rel(*s);
+        const std::string resolved =
+            rel.is_absolute() ? rel.string() : (fs::path(path_).parent_path() / rel).string();
+        std::error_code ec;
+        if (!fs::is_regular_file(resolved, ec)) {
+          ck_.error(modal, l, f + ".modal",
+                    fmt::format("cannot open modal file '{}'; expected a modal data file (path relative to the "
+                                "model file)",
+                                resolved));
+        } else {
+          FlexibleData d = load_modal_file(resolved, {}, diags_);
+          if (diags_.size() == before) data = std::move(d);
+        }
+      }
+    } else {
+      if (auto spec = read_beam(beam, f + ".beam", key_line(n, "beam"))) {
+        try {
+          data = beam_modal_data(*spec);
+          data->source = "beam";
+        } catch (const std::exception& e) {
+          ck_.error(beam, l, f + ".beam", fmt::format("cannot compute the beam modes: {}", e.what()));
+        }
+      }
+    }
+
+    // subset
+    if (data && keep_ok && !keep.empty()) {
+      bool in_range = true;
+      for (std::size_t k = 0; k < keep.size(); ++k) {
+        if (keep[k] > data->modes()) {
+          ck_.error(keep_line[k], fmt::format("{}.modes[{}]", f, k),
+                    fmt::format("mode {} does not exist: {} has {} modes; expected mode numbers in 1..{}", keep[k],
+                                data->source, data->modes(), data->modes()));
+          in_range = false;
+        }
+      }
+      if (in_range) {
+        const int m = static_cast<int>(keep.size());
+        FlexibleData s = *data;
+        s.Phi.resize(data->Phi.rows(), m);
+        s.Psi.resize(data->Psi.rows(), m);
+        s.frequency_hz.resize(m);
+        for (int c = 0; c < m; ++c) {
+          s.Phi.col(c) = data->Phi.col(keep[c] - 1);
+          s.Psi.col(c) = data->Psi.col(keep[c] - 1);
+          s.frequency_hz(c) = data->frequency_hz(keep[c] - 1);
+        }
+        data = std::move(s);
+      } else {
+        data.reset();
+      }
+    } else if (!keep_ok) {
+      data.reset();
+    }
+
+    // damping ratios
+    const int m = data ? data->modes() : -1;
+    Eigen::VectorXd zeta = Eigen::VectorXd::Zero(std::max(m, 0));
+    bool zeta_ok = true;
+    const YAML::Node dr = n["damping_ratio"];
+    const std::string fd = f + ".damping_ratio";
+    if (dr.IsDefined()) {
+      if (dr.IsSequence()) {
+        Eigen::VectorXd z(dr.size());
+        for (std::size_t k = 0; k < dr.size(); ++k) {
+          if (auto x = ck_.nonneg(dr[k], line_of(dr), fmt::format("{}[{}]", fd, k), "a damping ratio"))
+            z(k) = *x;
+          else
+            zeta_ok = false;
+        }
+        if (m >= 0 && static_cast<int>(dr.size()) != m) {
+          ck_.error(dr, l, fd,
+                    fmt::format("{} values for {} kept modes; expected a number or one value per kept mode",
+                                dr.size(), m));
+          zeta_ok = false;
+        } else if (zeta_ok && m >= 0) {
+          zeta = z;
+        }
+      } else if (auto x = ck_.nonneg(dr, l, fd, "a damping ratio")) {
+        zeta.setConstant(*x);
+      } else {
+        zeta_ok = false;
+      }
+    }
+
+    if (!data || !zeta_ok) return;
+    FlexibleData& fd_ = *data;
+    const int nn = static_cast<int>(fd_.nodes.size());
+    fd_.damping_ratio = zeta;
+    fd_.K = Eigen::VectorXd::Zero(m);
+    fd_.D = Eigen::VectorXd::Zero(m);
+    for (int c = 0; c < m; ++c) {
+      double Y = 0.0;
+      for (int k = 0; k < nn; ++k) Y += fd_.nodes[k].mass * fd_.Phi.block<3, 1>(3 * k, c).squaredNorm();
+      const double w = 2.0 * kPi * fd_.frequency_hz(c);
+      fd_.K(c) = w * w * Y;
+      fd_.D(c) = 2.0 * zeta(c) * w * Y;
+    }
+    bi.body.flex = std::move(fd_);
+    bi.flex_known = true;
+  }
+
+  std::optional<BeamSpec> read_beam(const YAML::Node& n, const std::string& f, int kl) {
+    if (!ck_.expect_map(n, kl, f)) return std::nullopt;
+    const int l = kl ? kl : line_of(n);
+    ck_.check_keys(n, f, {"length", "direction", "mass_per_length", "EI", "GJ", "EA", "elements", "modes"});
+    BeamSpec spec;
+    bool ok = true;
+    auto required = [&](const char* key, const char* expected) -> YAML::Node {
+      const YAML::Node v = n[key];
+      if (!v.IsDefined()) {
+        ck_.error(l, f + "." + key, fmt::format("missing; expected {}", expected));
+        ok = false;
+      }
+      return v;
+    };
+    if (auto v = required("length", "the beam length in m (> 0)"); v.IsDefined()) {
+      if (auto x = ck_.positive(v, l, f + ".length", "a length"))
+        spec.length = *x;
+      else
+        ok = false;
+    }
+    if (auto v = required("direction", "one of x, y, z, -x, -y, -z"); v.IsDefined()) {
+      const std::vector<std::string> dirs = {"x", "y", "z", "-x", "-y", "-z"};
+      if (auto s = ck_.string(v, l, f + ".direction")) {
+        auto it = std::find(dirs.begin(), dirs.end(), *s);
+        if (it == dirs.end()) {
+          ck_.error(v, l, f + ".direction", fmt::format("'{}' is not a direction; expected one of x, y, z, -x, -y, -z", *s));
+          ok = false;
+        } else {
+          const int k = static_cast<int>(it - dirs.begin());
+          spec.axis = k % 3;
+          spec.sign = k < 3 ? 1 : -1;
+        }
+      } else {
+        ok = false;
+      }
+    }
+    if (auto v = required("mass_per_length", "the mass per length in kg/m (> 0)"); v.IsDefined()) {
+      if (auto x = ck_.positive(v, l, f + ".mass_per_length", "a mass per length"))
+        spec.mass_per_length = *x;
+      else
+        ok = false;
+    }
+    if (auto v = required("EI", "two bending stiffnesses [EI1, EI2] in N·m² (> 0)"); v.IsDefined()) {
+      if (auto e = ck_.vector(v, l, f + ".EI", 2)) {
+        for (int k = 0; k < 2; ++k) {
+          if (!((*e)(k) > 0)) {
+            ck_.error(v, l, fmt::format("{}.EI[{}]", f, k),
+                      fmt::format("{} is not positive; expected a bending stiffness > 0", num((*e)(k))));
+            ok = false;
+          }
+          spec.EI[k] = (*e)(k);
+        }
+      } else {
+        ok = false;
+      }
+    }
+    for (const char* key : {"GJ", "EA"}) {
+      const YAML::Node v = n[key];
+      if (!v.IsDefined()) continue;
+      if (auto x = ck_.positive(v, l, f + "." + key, key))
+        (std::string(key) == "GJ" ? spec.GJ : spec.EA) = *x;
+      else
+        ok = false;
+    }
+    for (const char* key : {"elements", "modes"}) {
+      const YAML::Node v = required(key, std::string(key) == "elements" ? "the number of finite elements (>= 1)"
+                                                                         : "the number of modes kept (>= 1)");
+      if (!v.IsDefined()) continue;
+      auto x = ck_.integer(v, l, f + "." + key);
+      if (!x) {
+        ok = false;
+      } else if (*x < 1 || *x > (std::string(key) == "elements" ? 2000 : 100000)) {
+        ck_.error(v, l, f + "." + key, fmt::format("{} is out of range; expected an integer in 1..{}", *x,
+                                                         std::string(key) == "elements" ? 2000 : 100000));
+        ok = false;
+      } else {
+        (std::string(key) == "elements" ? spec.elements : spec.modes) = static_cast<int>(*x);
+      }
+    }
+    if (!ok) return std::nullopt;
+    return spec;
+  }
+
+  // --------------------------------------------------------------- initial
+  /// Names of the coordinates (q) or speeds (u) of body i; `certain` is false
+  /// when the body's faults leave its names unknown.
+  std::vector<std::string> body_names(int i, bool speeds, bool& certain) const {
+    const BodyInfo& bi = info_[i];
+    std::vector<std::string> names;
+    certain = !bi.name.empty() && bi.type_known && (!bi.has_flex_block || bi.flex_known);
+    if (bi.name.empty()) return names;
+    const std::string& n = bi.name;
+    if (bi.type_known) {
+      switch (bi.body.joint.type) {
+        case JointType::revolute: names.push_back(n + ".angle"); break;
+        case JointType::prismatic: names.push_back(n + ".disp"); break;
+        case JointType::fixed: break;
+        case JointType::free:
+          if (speeds)
+            for (const char* s : {".vx", ".vy", ".vz", ".wx", ".wy", ".wz"}) names.push_back(n + s);
+          else
+            for (const char* s : {".x", ".y", ".z", ".qw", ".qx", ".qy", ".qz"}) names.push_back(n + s);
+          break;
+      }
+    }
+    if (bi.body.flex)
+      for (int k = 1; k <= bi.body.flex->modes(); ++k) names.push_back(n + ".eta" + std::to_string(k));
+    return names;
+  }
+
+  void read_initial(const YAML::Node& n) {
+    if (!ck_.expect_map(n, 1, "initial")) return;
+    ck_.check_keys(n, "initial", {"q", "u"});
+    for (const bool speeds : {false, true}) {
+      const char* key = speeds ? "u" : "q";
+      const YAML::Node m = n[key];
+      if (!m.IsDefined()) continue;
+      const std::string f = std::string("initial.") + key;
+      if (!ck_.expect_map(m, line_of(n), f)) continue;
+      std::vector<std::string> known;
+      std::vector<std::string> uncertain_prefix;
+      for (int i = 0; i < static_cast<int>(info_.size()); ++i) {
+        bool certain = true;
+        auto names = body_names(i, speeds, certain);
+        known.insert(known.end(), names.begin(), names.end());
+        // names of a faulty body are unknown: do not report them again
+        if (!certain && !info_[i].raw_name.empty()) uncertain_prefix.push_back(info_[i].raw_name + ".");
+      }
+      auto& given = speeds ? init_u_ : init_q_;
+      for (auto it = m.begin(); it != m.end(); ++it) {
+        const int kl = line_of(it->first) ? line_of(it->first) : line_of(m);
+        if (!it->first.IsScalar()) {
+          ck_.error(kl, f, "a key must be a coordinate name");
+          continue;
+        }
+        const std::string name = it->first.Scalar();
+        const std::string fk = f + "." + name;
+        auto x = ck_.number(it->second, kl, fk);
+        if (std::find(known.begin(), known.end(), name) == known.end()) {
+          bool uncertain = false;
+          for (const auto& p : uncertain_prefix)
+            if (name.rfind(p, 0) == 0) uncertain = true;
+          if (!uncertain)
+            ck_.error(kl, fk,
+                      fmt::format("unknown {} name '{}'{}{}expected one of: {}", speeds ? "speed" : "coordinate", name,
+                                  did_you_mean(name, known), did_you_mean(name, known).empty() ? "; " : " ",
+                                  known.empty() ? "(none)" : join(known)));
+          continue;
+        }
+        if (given.count(name)) {
+          ck_.error(kl, fk, fmt::format("'{}' given twice; expected it once", name));
+          continue;
+        }
+        if (x) given[name] = Given{*x, kl};
+      }
+      if (speeds) continue;
+      // quaternions: all four components or none; unit to 1e-6
+      for (const BodyInfo& bi : info_) {
+        if (bi.name.empty() || !bi.type_known || bi.body.joint.type != JointType::free) continue;
+        std::vector<std::string> comp, have, lack;
+        for (const char* s : {".qw", ".qx", ".qy", ".qz"}) {
+          comp.push_back(bi.name + s);
+          (given.count(comp.back()) ? have : lack).push_back(comp.back());
+        }
+        if (have.empty()) continue;
+        const int ql = given[have[0]].line;
+        if (!lack.empty()) {
+          ck_.error(ql, f + "." + have[0],
+                    fmt::format("quaternion of '{}' given in part ({} missing); expected all of {} or none", bi.name,
+                                join(lack), join(comp)));
+          for (const auto& c : have) given.erase(c);
+          continue;
+        }
+        Eigen::Vector4d q;
+        for (int k = 0; k < 4; ++k) q(k) = given[comp[k]].value;
+        const double nrm = q.norm();
+        if (std::abs(nrm - 1.0) > 1e-6) {
+          ck_.error(ql, f + "." + have[0],
+                    fmt::format("quaternion of '{}' has norm {}; expected a unit quaternion (norm 1 to within 1e-6)",
+                                bi.name, num(nrm)));
+          continue;
+        }
+        for (int k = 0; k < 4; ++k) given[comp[k]].value = q(k) / nrm;
+      }
+    }
+  }
+
+  // ----------------------------------------------------------------- build
+  Model build() {
+    for (BodyInfo& bi : info_) {
+      bi.body.parent = bi.parent;
+      snap_roundoff_residues(bi.body);
+      model_.bodies.push_back(std::move(bi.body));
+    }
+    snap_roundoff_residues(model_.g_N);
+    finalize_model(model_);
+    model_.q0 = VecX::Zero(model_.nq);
+    model_.u0 = VecX::Zero(model_.nu);
+    for (const Body& b : model_.bodies)
+      if (b.joint.type == JointType::free) model_.q0(b.q_joint + 3) = 1.0;
+    for (const auto& [name, g] : init_q_) {
+      const int k = model_.q_index(name);
+      if (k >= 0) model_.q0(k) = g.value;
+    }
+    for (const auto& [name, g] : init_u_) {
+      const int k = model_.u_index(name);
+      if (k >= 0) model_.u0(k) = g.value;
+    }
+    return std::move(model_);
+  }
+};
+
+}  // namespace
+
+Model load_model(const std::string& path) { return Loader(path).load(); }
+
+}  // namespace kanegen

@@ -1,0 +1,27 @@
+// STATE.json (interface.md) and initial states.
+#pragma once
+
+#include <string>
+
+#include "model/diagnostics.hpp"
+#include "model/model.hpp"
+
+namespace kanegen {
+
+struct State {
+  double t = 0.0;
+  VecX q;    ///< nq, quaternions normalized
+  VecX u;    ///< nu
+  VecX tau;  ///< nu generalized inputs
+};
+
+/// The model's `initial:` state, zero inputs.
+State initial_state(const Model& model);
+
+/// Reads STATE.json: names not given take the model's initial value (else 0);
+/// a quaternion given in part is refused; quaternions of any non-zero norm are
+/// normalized. Unknown names, wrong types, zero quaternions, a missing file or
+/// malformed JSON throw InputError naming the file and the field (e.g. "q.foo").
+State load_state(const Model& model, const std::string& path);
+
+}  // namespace kanegen

@@ -1,0 +1,354 @@
+// Internal helpers shared by the YAML readers (model_loader.cpp,
+// modal_data.cpp): typed access to yaml-cpp nodes that records a Diagnostic
+// (file, line, field, message) for every fault instead of throwing.
+// Not part of the public API.
+#pragma once
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <initializer_list>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/diagnostics.hpp"
+
+namespace kanegen::yamlcheck {
+
+/// 1-based line of a node, 0 if the node has no mark (e.g. undefined).
+inline int line_of(const YAML::Node& n) {
+  if (!n.IsDefined()) return 0;
+  const YAML::Mark m = n.Mark();
+  return m.is_null() ? 0 : m.line + 1;
+}
+
+/// Line of `key` in mapping `map` (where a block value's field is written);
+/// the value's own line, else 0, if the key is not found.
+inline int key_line(const YAML::Node& map, const std::string& key) {
+  if (map.IsMap())
+    for (auto it = map.begin(); it != map.end(); ++it)
+      if (it->first.IsScalar() && it->first.Scalar() == key) {
+        const int l = line_of(it->first);
+        return l ? l : line_of(it->second);
+      }
+  return 0;
+}
+
+inline std::string describe(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "nothing";
+  if (n.IsScalar()) return fmt::format("'{}'", n.Scalar());
+  if (n.IsSequence()) return fmt::format("a list of {}", n.size());
+  if (n.IsMap()) return "a mapping";
+  return "?";
+}
+
+inline int edit_distance(const std::string& a, const std::string& b) {
+  std::vector<int> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = static_cast<int>(j);
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = static_cast<int>(i);
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const int sub = prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, sub});
+    }
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+/// "; did you mean 'x'?" when a candidate is within edit distance 2, else "".
+inline std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {
+  int best = 3;
+  std::string hit;
+  for (const auto& c : candidates) {
+    const int d = edit_distance(word, c);
+    if (d < best) {
+      best = d;
+      hit = c;
+    }
+  }
+  return hit.empty() ? std::string() : fmt::format("; did you mean '{}'?", hit);
+}
+
+inline std::string join(const std::vector<std::string>& v, const char* sep = ", ") {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
+  return s;
+}
+
+inline std::string num(double x) { return fmt::format("{:.9g}", x); }
+
+/// Collects diagnostics for one file.
+class Checker {
+ public:
+  Checker(std::string file, std::vector<Diagnostic>& diags) : file_(std::move(file)), diags_(diags) {}
+  const std::string& file() const { return file_; }
+  std::vector<Diagnostic>& diags() { return diags_; }
+
+  void error(int line, const std::string& field, const std::string& message) {
+    diags_.push_back(Diagnostic{file_, line, field, message});
+  }
+  /// Error at node n, or at `fallback` line when n has no position.
+  void error(const YAML::Node& n, int fallback, const std::string& field, const std::string& message) {
+    const int l = line_of(n);
+    error(l > 0 ? l : fallback, field, message);
+  }
+
+  /// True if n is a mapping; otherwise records a fault.
+  bool expect_map(const YAML::Node& n, int fallback, const std::string& field) {
+    if (n.IsMap()) return true;
+    error(n, fallback, field, fmt::format("got {}; expected a mapping (key: value)", describe(n)));
+    return false;
+  }
+  bool expect_seq(const YAML::Node& n, int fallback, const std::string& field) {
+    if (n.IsSequence()) return true;
+    error(n, fallback, field, fmt::format("got {}; expected a list", describe(n)));
+    return false;
+  }
+
+  /// Every key of map n must be one of `allowed` (and appear once).
+  void check_keys(const YAML::Node& n, const std::string& field, const std::vector<std::string>& allowed) {
+    if (!n.IsMap()) return;
+    std::vector<std::string> seen;
+    for (auto it = n.begin(); it != n.end(); ++it) {
+      const YAML::Node& k = it->first;
+      if (!k.IsScalar()) {
+        error(k, line_of(n), field, "a key must be a plain name");
+        continue;
+      }
+      const std::string key = k.Scalar();
+      const std::string f = field.empty() ? key : field + "." + key;
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+        std::string msg = fmt::format("unknown key '{}'", key);
+        const std::string hint = did_you_mean(key, allowed);
+        msg += hint.empty() ? fmt::format("; expected one of: {}", join(allowed)) : hint;
+        error(k, line_of(n), f, msg);
+      } else if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
+        error(k, line_of(n), f, fmt::format("key '{}' given twice; expected it once", key));
+      }
+      seen.push_back(key);
+    }
+  }
+
+  std::optional<double> number(const YAML::Node& n, int fallback, const std::string& field) {
+    if (!n.IsScalar()) {
+      error(n, fallback, field, fmt::format("got {}; expected a number", describe(n)));
+      return std::nullopt;
+    }
+    double x = 0;
+    try {
+      x = n.as<double>();
+    } catch (const YAML::Exception&) {
+      error(n, fallback, field, fmt::format("'{}' is not a number; expected a number", n.Scalar()));
+      return std::nullopt;
+    }
+    if (!std::isfinite(x)) {
+      error(n, fallback, field, fmt::format("'{}' is not finite; expected a finite number", n.Scalar()));
+      return std::nullopt;
+    }
+    return x;
+  }
+
+  std::optional<double> nonneg(const YAML::Node& n, int fallback, const std::string& field, const char* what) {
+    auto x = number(n, fallback, field);
+    if (x && *x < 0) {
+      error(n, fallback, field, fmt::format("{} is negative; expected {} >= 0", num(*x), what));
+      return std::nullopt;
+    }
+    return x;
+  }
+
+  std::optional<double> positive(const YAML::Node& n, int fallback, const std::string& field, const char* what) {
+    auto x = number(n, fallback, field);
+    if (x && !(*x > 0)) {
+      error(n, fallback, field, fmt::format("{} is not positive; expected {} > 0", num(*x), what));
+      return std::nullopt;
+    }
+    return x;
+  }
+
+  std::optional<long long> integer(const YAML::Node& n, int fallback, const std::string& field) {
+    if (!n.IsScalar()) {
+      error(n, fallback, field, fmt::format("got {}; expected an integer", describe(n)));
+      return std::nullopt;
+    }
+    try {
+      return n.as<long long>();
+    } catch (const YAML::Exception&) {
+      error(n, fallback, field, fmt::format("'{}' is not an integer; expected an integer", n.Scalar()));
+      return std::nullopt;
+    }
+  }
+
+  std::optional<std::string> string(const YAML::Node& n, int fallback, const std::string& field) {
+    if (!n.IsScalar()) {
+      error(n, fallback, field, fmt::format("got {}; expected a string", describe(n)));
+      return std::nullopt;
+    }
+    return n.Scalar();
+  }
+
+  /// A list of exactly `size` numbers.
+  std::optional<Eigen::VectorXd> vector(const YAML::Node& n, int fallback, const std::string& field, int size) {
+    if (!n.IsSequence() || static_cast<int>(n.size()) != size) {
+      error(n, fallback, field, fmt::format("got {}; expected a list of {} numbers", describe(n), size));
+      return std::nullopt;
+    }
+    Eigen::VectorXd v(size);
+    bool ok = true;
+    for (int i = 0; i < size; ++i) {
+      auto x = number(n[i], line_of(n), fmt::format("{}[{}]", field, i));
+      if (x)
+        v(i) = *x;
+      else
+        ok = false;
+    }
+    if (!ok) return std::nullopt;
+    return v;
+  }
+
+  std::optional<Eigen::Vector3d> vec3(const YAML::Node& n, int fallback, const std::string& field) {
+    auto v = vector(n, fallback, field, 3);
+    if (!v) return std::nullopt;
+    return Eigen::Vector3d(*v);
+  }
+
+  /// A 3x3 matrix as a list of three rows of three numbers.
+  std::optional<Eigen::Matrix3d> mat3(const YAML::Node& n, int fallback, const std::string& field) {
+    const char* expected = "expected a 3x3 matrix as a list of 3 rows of 3 numbers";
+    if (!n.IsSequence() || n.size() != 3) {
+      error(n, fallback, field, fmt::format("got {}; {}", describe(n), expected));
+      return std::nullopt;
+    }
+    Eigen::Matrix3d M;
+    bool ok = true;
+    for (int i = 0; i < 3; ++i) {
+      auto row = vector(n[i], line_of(n), fmt::format("{}[{}]", field, i), 3);
+      if (row)
+        M.row(i) = row->transpose();
+      else
+        ok = false;
+    }
+    if (!ok) return std::nullopt;
+    return M;
+  }
+
+  /// A vector whose norm must be within 1e-6 of 1 (then normalized).
+  std::optional<Eigen::VectorXd> unit(const YAML::Node& n, int fallback, const std::string& field, int size,
+                                      const char* expected) {
+    auto v = vector(n, fallback, field, size);
+    if (!v) return std::nullopt;
+    const double nrm = v->norm();
+    if (nrm == 0.0) {
+      error(n, fallback, field, fmt::format("zero vector; expected {}", expected));
+      return std::nullopt;
+    }
+    if (std::abs(nrm - 1.0) > 1e-6) {
+      error(n, fallback, field,
+            fmt::format("norm {} is not 1 (to within 1e-6); expected {}", num(nrm), expected));
+      return std::nullopt;
+    }
+    return Eigen::VectorXd(*v / nrm);
+  }
+
+  /// Inertia matrix: 6 numbers [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 list;
+  /// symmetric, positive semi-definite, triangle inequalities on the principal
+  /// moments (tolerance 1e-9 of the largest entry).
+  std::optional<Eigen::Matrix3d> inertia(const YAML::Node& n, int fallback, const std::string& field) {
+    Eigen::Matrix3d I;
+    if (n.IsSequence() && n.size() == 6) {
+      auto v = vector(n, fallback, field, 6);
+      if (!v) return std::nullopt;
+      const auto& a = *v;
+      I << a(0), a(3), a(4), a(3), a(1), a(5), a(4), a(5), a(2);
+    } else if (n.IsSequence() && n.size() == 3) {
+      auto M = mat3(n, fallback, field);
+      if (!M) return std::nullopt;
+      I = *M;
+      const double scale = I.cwiseAbs().maxCoeff();
+      const double asym = (I - I.transpose()).cwiseAbs().maxCoeff();
+      if (asym > 1e-9 * scale) {
+        error(n, fallback, field,
+              fmt::format("not symmetric (largest |I - I^T| entry {}); expected a symmetric inertia matrix",
+                          num(asym)));
+        return std::nullopt;
+      }
+      I = 0.5 * (I + I.transpose());
+    } else {
+      error(n, fallback, field,
+            fmt::format("got {}; expected [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 list", describe(n)));
+      return std::nullopt;
+    }
+    const double scale = I.cwiseAbs().maxCoeff();
+    const double tol = 1e-9 * scale;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(I, Eigen::EigenvaluesOnly);
+    const Eigen::Vector3d l = es.eigenvalues();
+    const std::string moments = fmt::format("{}, {}, {}", num(l(0)), num(l(1)), num(l(2)));
+    if (l.minCoeff() < -tol) {
+      error(n, fallback, field,
+            fmt::format("not positive semi-definite (principal moments {}); expected principal moments >= 0",
+                        moments));
+      return std::nullopt;
+    }
+    for (int i = 0; i < 3; ++i) {
+      if (l(i) > l((i + 1) % 3) + l((i + 2) % 3) + tol) {
+        error(n, fallback, field,
+              fmt::format("principal moments {} violate the triangle inequality; expected each to be at most "
+                          "the sum of the other two",
+                          moments));
+        return std::nullopt;
+      }
+    }
+    return I;
+  }
+
+ private:
+  std::string file_;
+  std::vector<Diagnostic>& diags_;
+};
+
+/// Orders diagnostics by file (in order of first appearance), then line.
+inline void sort_diagnostics(std::vector<Diagnostic>& ds) {
+  std::vector<std::string> files;
+  for (const auto& d : ds)
+    if (std::find(files.begin(), files.end(), d.file) == files.end()) files.push_back(d.file);
+  auto rank = [&](const Diagnostic& d) { return std::find(files.begin(), files.end(), d.file) - files.begin(); };
+  std::stable_sort(ds.begin(), ds.end(), [&](const Diagnostic& a, const Diagnostic& b) {
+    return rank(a) != rank(b) ? rank(a) < rank(b) : a.line < b.line;
+  });
+}
+
+/// Parses a YAML file; a missing file or a syntax error is recorded and an
+/// undefined node returned.
+inline YAML::Node parse_file(const std::string& path, std::vector<Diagnostic>& diags, bool& ok) {
+  ok = false;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    diags.push_back(Diagnostic{path, 0, "",
+                               std::filesystem::exists(path, ec) ? "cannot open file (not a regular file); expected a YAML file"
+                                                                 : "cannot open file (no such file); expected a YAML file"});
+    return YAML::Node();
+  }
+  try {
+    YAML::Node root = YAML::LoadFile(path);
+    ok = true;
+    return root;
+  } catch (const YAML::BadFile&) {
+    diags.push_back(Diagnostic{path, 0, "", "cannot open file; expected a readable YAML file"});
+  } catch (const YAML::ParserException& e) {
+    diags.push_back(Diagnostic{path, e.mark.is_null() ? 0 : e.mark.line + 1, "",
+                               fmt::format("YAML syntax error: {}", e.msg)});
+  } catch (const YAML::Exception& e) {
+    diags.push_back(Diagnostic{path, e.mark.is_null() ? 0 : e.mark.line + 1, "",
+                               fmt::format("cannot read YAML: {}", e.msg)});
+  }
+  return YAML::Node();
+}
+
+}  // namespace kanegen::yamlcheck

@@ -1,0 +1,98 @@
+#include "sim/crosscheck.hpp"
+
+#include <random>
+
+namespace kanegen {
+
+double CrosscheckResult::tolerance(const std::string& quantity) {
+  // Both engines agree to ~1e-13 on well-scaled models; reactions subtract
+  // large inertia and gravity terms, u_dot's plain difference is amplified by
+  // cond(M) (reported, not judged).
+  if (quantity == "udot (relative)") return 1e300;
+  if (quantity == "reactions") return 1e-11;
+  return 1e-12;
+}
+
+bool CrosscheckResult::passed() const {
+  for (const auto& [q, v] : worst)
+    if (!(v <= tolerance(q))) return false;
+  return true;
+}
+
+namespace {
+
+double rel(const Eigen::Ref<const MatX>& a, const Eigen::Ref<const MatX>& b) {
+  if (b.size() == 0) return 0.0;
+  const double scale = std::max(b.cwiseAbs().maxCoeff(), 1e-300);
+  return (a - b).cwiseAbs().maxCoeff() / scale;
+}
+
+}  // namespace
+
+CrosscheckResult crosscheck(Engine& tested, Engine& reference, int samples, unsigned seed) {
+  const Model& model = reference.model();
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  std::normal_distribution<double> N(0.0, 1.0);
+  CrosscheckResult r;
+  auto note = [&](const std::string& k, double v) { r.worst[k] = std::max(r.worst[k], std::isnan(v) ? 1e300 : v); };
+  for (int s = 0; s < samples; ++s) {
+    VecX q = model.q0, u(model.nu), tau(model.nu);
+    for (const Body& b : model.bodies) {
+      switch (b.joint.type) {
+        case JointType::revolute: q(b.q_joint) = M_PI * U(rng); break;
+        case JointType::prismatic: q(b.q_joint) = U(rng); break;
+        case JointType::fixed: break;
+        case JointType::free: {
+          for (int k = 0; k < 3; ++k) q(b.q_joint + k) = U(rng);
+          Eigen::Vector4d quat(N(rng), N(rng), N(rng), N(rng));
+          q.segment<4>(b.q_joint + 3) = quat.normalized();
+          break;
+        }
+      }
+      for (int k = 0; k < b.n_modes(); ++k) q(b.q_eta + k) = 0.1 * U(rng);
+    }
+    for (int i = 0; i < model.nu; ++i) u(i) = U(rng), tau(i) = U(rng);
+    VecX qd_t, qd_r, F_t, F_r, ud_t, ud_r;
+    MatX M_t, M_r;
+    tested.qdot(q, u, qd_t);
+    reference.qdot(q, u, qd_r);
+    note("qdot", rel(qd_t, qd_r));
+    tested.mass_matrix(q, M_t);
+    reference.mass_matrix(q, M_r);
+    note("M", rel(M_t, M_r));
+    tested.forcing(q, u, tau, F_t);
+    reference.forcing(q, u, tau, F_r);
+    note("F", rel(F_t, F_r));
+    tested.udot(q, u, tau, ud_t);
+    reference.udot(q, u, tau, ud_r);
+    note("udot (relative)", rel(ud_t, ud_r));
+    note("udot (residual)", (M_r * ud_t - F_r).norm() / (M_r.norm() * ud_t.norm() + F_r.norm()));
+    if (model.outputs.energy) {
+      const EnergyValues a = tested.energy(q, u), b = reference.energy(q, u);
+      note("energy", rel(Eigen::Vector2d(a.T, a.V), Eigen::Vector2d(b.T, b.V)));
+    }
+    if (model.outputs.momentum) {
+      const MomentumValues a = tested.momentum(q, u), b = reference.momentum(q, u);
+      Eigen::Matrix<double, 6, 1> x, y;
+      x << a.p_N, a.H_N;
+      y << b.p_N, b.H_N;
+      note("momentum", rel(x, y));
+    }
+    if (model.outputs.reactions) {
+      std::vector<Reaction> a, b;
+      tested.reactions(q, u, ud_r, a);
+      reference.reactions(q, u, ud_r, b);
+      MatX x(6, a.size()), y(6, b.size());
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        x.col(i) << a[i].force_B, a[i].torque_B;
+        y.col(i) << b[i].force_B, b[i].torque_B;
+      }
+      note("reactions", rel(x, y));
+    }
+    ++r.samples;
+  }
+  return r;
+}
+
+}  // namespace kanegen

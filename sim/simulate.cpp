@@ -1,0 +1,290 @@
+#include "sim/simulate.hpp"
+
+#include "model/output_file.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+namespace kanegen {
+
+namespace {
+
+/// The free-joint quaternion of x = [q; u] farthest from unit norm.
+struct QuatDrift {
+  double drift = 0.0;  ///< | |quat| - 1 | (infinite if the norm is not finite)
+  double norm = 1.0;
+  int body = -1;       ///< index of its body, -1 if none drifted
+};
+
+/// Normalizes every free joint's quaternion in x = [q; u] in place; returns
+/// the largest | |quat| - 1 | found (and, if `worst` is given, where).
+double normalize_quaternions(const Model& model, double* x, QuatDrift* worst = nullptr) {
+  double drift = 0.0;
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const Body& b = model.bodies[i];
+    if (b.joint.type != JointType::free) continue;
+    double* quat = x + b.q_joint + 3;
+    const double n = std::sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]);
+    const double d = std::isfinite(n) ? std::abs(n - 1.0) : std::numeric_limits<double>::infinity();
+    if (worst && d > worst->drift) *worst = QuatDrift{d, n, static_cast<int>(i)};
+    drift = std::max(drift, d);
+    if (n > 0)
+      for (int k = 0; k < 4; ++k) quat[k] /= n;
+  }
+  return drift;
+}
+
+/// The largest | |quat| - 1 | of an integrated (unprojected) free-joint
+/// quaternion that simulate() accepts at an output (docs/extreme.md). The
+/// engines normalize the quaternion, so the drift does not change M or F;
+/// but |quat - quat_exact| >= | |quat| - 1 |: it is a lower bound of the
+/// error accumulated in the integrated quaternion and a cheap symptom of the
+/// attitude error. Past the limit the run stops instead of writing rows.
+/// Adaptive methods may drift up to 100 rtol (a loose tolerance asks for a
+/// loose result), never less than 1e-6; rk4 projects after every step, so
+/// its limit, 1e-6, bounds the drift of one step.
+double quaternion_drift_limit(const IntegratorOptions& opt) {
+  constexpr double kFloor = 1e-6;
+  if (opt.kind == IntegratorKind::rk4) return kFloor;
+  return std::max(kFloor, 100.0 * opt.rtol);
+}
+
+class ProgressBar {
+ public:
+  ProgressBar(bool enabled, double t0, double t1) : enabled_(enabled && isatty(2)), t0_(t0), t1_(t1) {}
+  void update(double t) {
+    if (!enabled_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < std::chrono::milliseconds(100) && t < t1_) return;
+    last_ = now;
+    const double f = t1_ > t0_ ? std::clamp((t - t0_) / (t1_ - t0_), 0.0, 1.0) : 1.0;
+    const int w = 40, n = static_cast<int>(f * w);
+    fmt::print(stderr, "\r[{}{}] {:5.1f}%  t = {:.6g}", std::string(n, '='), std::string(w - n, ' '), 100 * f, t);
+    std::fflush(stderr);
+  }
+  void finish() {
+    if (enabled_) fmt::print(stderr, "\n");
+  }
+
+ private:
+  bool enabled_;
+  double t0_, t1_;
+  std::chrono::steady_clock::time_point last_{};
+};
+
+}  // namespace
+
+OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure, bool use_jacobian,
+                            bool stabilize_quaternions) {
+  const Model& model = engine.model();
+  const int nq = model.nq, nu = model.nu;
+  struct Scratch {
+    VecX x, q, u, qdot, udot;
+  };
+  auto scratch = std::make_shared<Scratch>();
+  scratch->x.resize(nq + nu);
+  OdeProblem p;
+  p.n = nq + nu;
+  p.rhs = [&engine, &model, tau, scratch, failure, nq, nu, stabilize_quaternions](double t, const double* x,
+                                                                                  double* xdot) -> int {
+    Scratch& s = *scratch;
+    s.x = Eigen::Map<const VecX>(x, nq + nu);
+    if (!s.x.allFinite()) {
+      if (failure) *failure = fmt::format("non-finite state at t = {:.17g}", t);
+      return -1;
+    }
+    // The engines normalize quaternions for M and F; q_dot uses the quaternion
+    // as integrated, whose norm the flow quat_dot = 1/2 quat (x) [0, w] preserves.
+    s.q = s.x.head(nq);
+    s.u = s.x.tail(nu);
+    try {
+      engine.qdot(s.q, s.u, s.qdot);
+      engine.udot(t, s.q, s.u, tau, s.udot);
+    } catch (const SingularMassMatrix& e) {
+      if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
+      return -1;
+    }
+    // Constraint stabilization of the quaternion norm: + lambda (1 - |q|^2) q,
+    // zero on the unit sphere (so q_dot there is exactly W(q) u of the spec)
+    // and attracting the integrated quaternion back to it at a rate 2 lambda,
+    // lambda = |w| + 1/s: the rotation's own time scale, so it adds no
+    // stiffness. Integration error would otherwise let the norm drift.
+    for (const Body& b : model.bodies) {
+      if (b.joint.type != JointType::free || !stabilize_quaternions) continue;
+      const auto quat = s.q.segment<4>(b.q_joint + 3);
+      const double lambda = s.u.segment<3>(b.u_joint + 3).norm() + 1.0;
+      s.qdot.segment<4>(b.q_joint + 3) += lambda * (1.0 - quat.squaredNorm()) * quat;
+    }
+    Eigen::Map<VecX>(xdot, nq) = s.qdot;
+    Eigen::Map<VecX>(xdot + nq, nu) = s.udot;
+    if (!s.udot.allFinite()) {
+      if (failure) *failure = fmt::format("non-finite accelerations at t = {:.17g}", t);
+      return 1;  // recoverable: the integrator retries with a smaller step
+    }
+    return 0;
+  };
+  p.project = [&model](double* x) { normalize_quaternions(model, x); };
+  if (use_jacobian && engine.has_jacobian()) {
+    auto J = std::make_shared<MatX>(nq + nu, nq + nu);
+    p.jacobian = [&engine, &model, tau, scratch, J, failure, nq, nu, stabilize_quaternions](
+                     double t, const double* x, const double*, double* out) -> int {
+      Scratch& s = *scratch;
+      s.q = Eigen::Map<const VecX>(x, nq);
+      s.u = Eigen::Map<const VecX>(x + nq, nu);
+      try {
+        if (!engine.jacobian(t, s.q, s.u, tau, *J)) return -1;
+      } catch (const SingularMassMatrix& e) {
+        if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
+        return -1;
+      }
+      // plus the derivative of the quaternion stabilization term of the rhs
+      for (const Body& b : model.bodies) {
+        if (b.joint.type != JointType::free || !stabilize_quaternions) continue;
+        const int iq = b.q_joint + 3, iw = nq + b.u_joint + 3;
+        const Eigen::Vector4d quat = s.q.segment<4>(b.q_joint + 3);
+        const Eigen::Vector3d w = s.u.segment<3>(b.u_joint + 3);
+        const double lambda = w.norm() + 1.0, c = 1.0 - quat.squaredNorm();
+        J->block<4, 4>(iq, iq) += lambda * (c * Eigen::Matrix4d::Identity() - 2.0 * quat * quat.transpose());
+        if (w.norm() > 0) J->block<4, 3>(iq, iw) += c * quat * (w / w.norm()).transpose();
+      }
+      Eigen::Map<MatX>(out, nq + nu, nq + nu) = *J;
+      return J->allFinite() ? 0 : 1;
+    };
+  }
+  return p;
+}
+
+std::vector<std::string> csv_columns(const Model& model) {
+  std::vector<std::string> cols{"t"};
+  cols.insert(cols.end(), model.q_names.begin(), model.q_names.end());
+  cols.insert(cols.end(), model.u_names.begin(), model.u_names.end());
+  if (model.outputs.energy) cols.insert(cols.end(), {"T", "V"});
+  if (model.outputs.momentum) cols.insert(cols.end(), {"Hx", "Hy", "Hz"});
+  if (model.outputs.reactions)
+    for (const Body& b : model.bodies)
+      for (const char* s : {".fx", ".fy", ".fz", ".tx", ".ty", ".tz"}) cols.push_back(b.name + s);
+  return cols;
+}
+
+SimulationResult simulate(Engine& engine, const State& initial, const SimulationOptions& options, std::ostream& csv) {
+  const Model& model = engine.model();
+  const int nq = model.nq, nu = model.nu;
+  std::string failure;
+  OdeProblem problem = make_ode_problem(engine, initial.tau, &failure, options.use_jacobian,
+                                        options.integrator.kind != IntegratorKind::rk4);
+  VecX x0(nq + nu);
+  x0 << initial.q, initial.u;
+
+  SimulationResult result;
+  const auto cols = csv_columns(model);
+  for (std::size_t c = 0; c < cols.size(); ++c) csv << (c ? "," : "") << cols[c];
+  csv << '\n';
+
+  ProgressBar bar(options.progress, initial.t, options.t_end);
+  VecX q(nq), u(nu), udot(nu);
+  std::vector<Reaction> reactions;
+  std::vector<double> row;
+  std::string line;
+
+  // Checks on every output row, before it is written (a row with a bad value
+  // is never written; simulate_to_file then removes the whole file):
+  //  - the quaternion norm drift of the integrated state (see project below);
+  //  - every value of the row finite (state, energy, momentum, reactions);
+  //  - a singular M while computing the reactions.
+  // Each failure is an IntegrationError with the time and the state there
+  // (the unprojected state for a drifted quaternion).
+  const double drift_limit = quaternion_drift_limit(options.integrator);
+  QuatDrift pending;       // worst drift above the limit seen since the last output
+  VecX pending_raw;        // the unprojected state where it was seen
+  bool output_failure = false;  // the error comes from these checks, not from the integrator
+  auto fail_at = [&](double t, const VecX& x, const std::string& what) {
+    output_failure = true;
+    return IntegrationError(fmt::format("{}: output check failed at t = {:.17g}: {}",
+                                        to_string(options.integrator.kind), t, what),
+                            t, x);
+  };
+  auto column_of = [&](std::size_t k) { return k < cols.size() ? cols[k] : fmt::format("column {}", k); };
+
+  auto write = [&](double t, const VecX& x) -> bool {
+    // x arrives projected; the drift was measured on the raw state by project below.
+    if (pending.body >= 0) {
+      const Body& b = model.bodies[pending.body];
+      const bool rk4 = options.integrator.kind == IntegratorKind::rk4;
+      throw fail_at(t, pending_raw,
+                    fmt::format("quaternion of free body '{}' has norm {:.17g} (| |q| - 1 | = {:.6g} > {:.3g}{}): the "
+                                "integrated attitude has drifted at least this much; {}",
+                                b.name, pending.norm, pending.drift, drift_limit,
+                                rk4 ? ", after one step" : ", the limit for this rtol",
+                                rk4 ? "reduce the step (--h)" : "tighten --rtol/--atol"));
+    }
+    q = x.head(nq);
+    u = x.tail(nu);
+    row.assign(x.data(), x.data() + nq + nu);
+    try {
+      if (model.outputs.energy) {
+        const EnergyValues E = engine.energy(t, q, u);
+        row.insert(row.end(), {E.T, E.V});
+      }
+      if (model.outputs.momentum) {
+        const MomentumValues P = engine.momentum(t, q, u);
+        row.insert(row.end(), {P.H_N(0), P.H_N(1), P.H_N(2)});
+      }
+      if (model.outputs.reactions) {
+        engine.udot(t, q, u, initial.tau, udot);
+        engine.reactions(t, q, u, udot, reactions);
+        for (const Reaction& r : reactions)
+          row.insert(row.end(), {r.force_B(0), r.force_B(1), r.force_B(2), r.torque_B(0), r.torque_B(1), r.torque_B(2)});
+      }
+    } catch (const SingularMassMatrix& e) {
+      throw fail_at(t, x, fmt::format("{} (while computing the reactions)", e.what()));
+    }
+    for (std::size_t k = 0; k < row.size(); ++k)
+      if (!std::isfinite(row[k]))
+        throw fail_at(t, x, fmt::format("non-finite value {} in column '{}'", row[k], column_of(k + 1)));
+    line = fmt::format("{:.17g}", t);
+    for (double v : row) line += fmt::format(",{:.17g}", v);
+    csv << line << '\n';
+    ++result.rows;
+    bar.update(t);
+    return true;
+  };
+  // Drift is measured on the unprojected state: wrap project (called on every
+  // output state, and after every rk4 step).
+  auto project = problem.project;
+  problem.project = [&](double* x) {
+    VecX raw = Eigen::Map<VecX>(x, nq + nu);
+    QuatDrift worst;
+    result.max_quaternion_drift = std::max(result.max_quaternion_drift, normalize_quaternions(model, raw.data(), &worst));
+    if (worst.body >= 0 && !(worst.drift <= drift_limit) && pending.body < 0) {
+      pending = worst;
+      pending_raw = Eigen::Map<VecX>(x, nq + nu);
+    }
+    project(x);
+  };
+  try {
+    result.stats = integrate(problem, options.integrator, initial.t, x0, options.t_end, options.dt_out, write);
+  } catch (const IntegrationError& e) {
+    bar.finish();
+    if (output_failure || failure.empty()) throw;
+    throw IntegrationError(fmt::format("{} ({})", e.reason, failure), e.t, e.x);
+  }
+  bar.finish();
+  return result;
+}
+
+SimulationResult simulate_to_file(Engine& engine, const State& initial, const SimulationOptions& options,
+                                  const std::string& path) {
+  OutputFile out(path);  // the file appears only if the whole run succeeded
+  const SimulationResult r = simulate(engine, initial, options, out.stream());
+  out.commit();
+  return r;
+}
+
+}  // namespace kanegen

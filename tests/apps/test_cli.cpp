@@ -1,0 +1,129 @@
+// The command line as users and outside checks drive it (interface.md):
+// exit statuses, messages naming file, line and field, outputs by name.
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "tests/support/test_support.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int status;
+  std::string out;  // stdout and stderr
+};
+
+Run run(const std::string& args, const std::string& env = "") {
+  const std::string cmd = env + " " + std::string(KANEGEN_BINARY) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  for (std::size_t n; (n = fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+std::string src(const std::string& rel) { return kanegen::test::source_path(rel); }
+
+fs::path temp_dir() {
+  const fs::path d = fs::temp_directory_path() / ("kanegen_cli_" + std::to_string(getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("cli: every subcommand has --help", "[cli]") {
+  for (const char* sub : {"check", "eval", "simulate", "generate", "crosscheck", "modes"}) {
+    INFO(sub);
+    const Run r = run(std::string(sub) + " --help");
+    CHECK(r.status == 0);
+    CHECK(r.out.find("Usage") != std::string::npos);
+  }
+}
+
+TEST_CASE("cli: a refused model exits 2 naming file, line and field", "[cli]") {
+  const Run r = run("check " + src("tests/data/bad/axis_zero.yaml"));
+  CHECK(r.status == 2);
+  CHECK(r.out.find("axis_zero.yaml:") != std::string::npos);
+  CHECK(r.out.find(".joint.axis: ") != std::string::npos);
+}
+
+TEST_CASE("cli: missing model file, unknown state name, bad option exit 2", "[cli]") {
+  CHECK(run("check /nonexistent/model.yaml").status == 2);
+  const fs::path d = temp_dir();
+  const std::string state = (d / "bad_state.json").string();
+  std::ofstream(state) << R"({"q": {"link9.angle": 0.1}})";
+  const Run r = run("eval " + src("models/double_pendulum.yaml") + " --engine generic --state " + state);
+  CHECK(r.status == 2);
+  CHECK(r.out.find("link9.angle") != std::string::npos);
+  CHECK(run("simulate " + src("models/pendulum.yaml") + " --t-end 1 -o x.csv --integrator nonsense").status == 2);
+  CHECK(run("eval " + src("models/pendulum.yaml") + " --engine nonsense").status == 2);
+}
+
+TEST_CASE("cli: eval prints the interface.md document, generated engine by default", "[cli][generated]") {
+  const Run r = run("eval " + src("models/double_pendulum.yaml"),
+                    "KANEGEN_CACHE_DIR=" + std::string(KANEGEN_TEST_CACHE_DIR));
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.out.substr(r.out.find('{')));
+  CHECK(j["engine"] == "generated");
+  for (const char* k : {"model", "q_names", "u_names", "q", "u", "qdot", "M", "F", "udot"}) CHECK(j.contains(k));
+}
+
+TEST_CASE("cli: simulate writes the CSV columns of interface.md, a failed run leaves no file", "[cli]") {
+  const fs::path d = temp_dir();
+  const std::string csv = (d / "e1.csv").string();
+  const Run r = run("simulate " + src("models/explorer1_rigid.yaml") +
+                    " --engine generic --t-end 1 --dt-out 0.5 --no-progress -o " + csv);
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("rhs evals") != std::string::npos);  // the summary line
+  std::ifstream in(csv);
+  std::string header;
+  std::getline(in, header);
+  CHECK(header.rfind("t,bus.x,bus.y,bus.z,bus.qw,bus.qx,bus.qy,bus.qz,", 0) == 0);
+  CHECK(header.find(",T,V,Hx,Hy,Hz,bus.fx,bus.fy,bus.fz,bus.tx,bus.ty,bus.tz") != std::string::npos);
+  int rows = 0;
+  for (std::string line; std::getline(in, line);) ++rows;
+  CHECK(rows == 3);  // t = 0, 0.5, 1
+
+  // A run that cannot finish: a stiff spring (1000 rad/s) under RK4 with a
+  // step 10x beyond its stability limit grows until the state overflows.
+  const std::string model = (d / "stiff_spring.yaml").string();
+  std::ofstream(model) << "name: stiff_spring\nbodies:\n  - name: slider\n    parent: ground\n"
+                          "    joint: {type: prismatic, axis: [1, 0, 0], stiffness: 1.0e6}\n    mass: 1.0\n"
+                          "initial:\n  q: {slider.disp: 0.1}\n";
+  const std::string bad = (d / "bad.csv").string();
+  const Run f = run("simulate " + model + " --engine generic --integrator rk4 --h 0.01 --t-end 10 --dt-out 1 --no-progress -o " + bad);
+  CHECK(f.status == 1);
+  CHECK(f.out.find("t = ") != std::string::npos);
+  CHECK_FALSE(fs::exists(bad));
+}
+
+TEST_CASE("cli: a compiler failure in the JIT is a clear error with exit 2", "[cli][jit]") {
+  const fs::path d = temp_dir() / "empty-cache";
+  fs::remove_all(d);
+  const Run r = run("eval " + src("models/pendulum.yaml"), "KANEGEN_CACHE_DIR=" + d.string() + " CXX=false");
+  CHECK(r.status == 2);
+  CHECK(r.out.find("compiling generated code") != std::string::npos);
+  CHECK(r.out.find("false") != std::string::npos);  // names the compiler command
+}
+
+TEST_CASE("cli: generate writes a header, modes writes a modal file that loads back", "[cli]") {
+  const fs::path d = temp_dir();
+  const std::string hpp = (d / "dp.hpp").string();
+  REQUIRE(run("generate " + src("models/double_pendulum.yaml") + " -o " + hpp).status == 0);
+  std::ifstream in(hpp);
+  std::string first;
+  std::getline(in, first);
+  CHECK(first.find("GENERATED") != std::string::npos);
+  const std::string modal = (d / "boom.modal.yaml").string();
+  CHECK(run("modes " + src("models/spacecraft_arrays.yaml") + " --body boom -o " + modal).status == 0);
+  CHECK(fs::exists(modal));
+  CHECK(run("modes " + src("models/spacecraft_arrays.yaml") + " --body nosuchbody -o " + modal).status == 2);
+}

@@ -1,0 +1,56 @@
+// Shared helpers and tolerances of the test suite.
+#pragma once
+
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+#include "codegen/jit_generator.hpp"
+#include "engine/jit.hpp"
+#include "model/model.hpp"
+#include "sim/integrators.hpp"
+#include "tests/support/tolerances.hpp"
+
+namespace kanegen::test {
+
+inline std::string source_path(const std::string& rel) { return std::string(KANEGEN_SOURCE_DIR) + "/" + rel; }
+
+/// max |a - b| / max(max|b|, floor): the error relative to the largest entry.
+inline double rel_err(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double floor = 1e-300) {
+  const double scale = std::max(b.cwiseAbs().maxCoeff(), floor);
+  return (a - b).cwiseAbs().maxCoeff() / scale;
+}
+
+/// JIT options of the test suite: a cache inside the build tree, shared by
+/// the test runs (KANEGEN_TEST_CACHE_DIR).
+inline JitOptions jit_options() {
+  JitOptions o;
+  o.cache_dir = KANEGEN_TEST_CACHE_DIR;
+  return o;
+}
+
+/// The model's generated engine, through the JIT with the suite's cache
+/// (`form`: the generator's u-dot form, "auto", "composite" or "articulated").
+inline std::unique_ptr<GeneratedEngine> generated_engine(const Model& model, const std::string& form = "auto") {
+  codegen::GeneratorOptions g;
+  g.udot_form = form;
+  return jit_load(model, codegen::jit_code_generator(g), jit_options());
+}
+
+/// Largest relative drifts along a run: E = T + V relative to max |T| + |V|;
+/// p and H relative to their initial norms (floored at 1).
+struct Drift {
+  double energy = 0, p = 0, H = 0;
+};
+
+/// Integrates the model (generic engine) from its initial state to t_end with
+/// `kind` at rtol (atol = rtol/100), sampling the invariants `samples` times.
+Drift run_invariants(const Model& model, double t_end, IntegratorKind kind, double rtol, int samples = 50);
+
+/// Every model file under models/ (modal files excluded), sorted.
+std::vector<std::string> model_files();
+
+/// Writes `text` to a fresh temporary file with the given name and returns its path.
+std::string write_temp(const std::string& name, const std::string& text);
+
+}  // namespace kanegen::test
