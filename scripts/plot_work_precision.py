@@ -102,7 +102,7 @@ DEFAULT_INTEGRATOR = "cvode-bdf"  # kanegen simulate's default
 
 def time_to_reach(points, target):
     """points: (error, wall) in sweep order. Same rule as kanegen bench
-    (runtime/work_precision.cpp): the first point reaching the target,
+    (sim/work_precision.cpp): the first point reaching the target,
     log-log interpolated from the point before it; a later cheaper point wins."""
     best = None
     for k, (e2, t2) in enumerate(points):
@@ -175,7 +175,7 @@ def report(argv):
              "Numbers are wall-clock times of one machine" + (f" ({a.machine})" if a.machine else "") +
              ": ratios between configurations carry over to other machines better than absolute times; "
              "differences below ~20 % are within the noise of a shared machine.\n")
-    L.append("What is measured (details: `runtime/work_precision.hpp`): every engine (generated code, "
+    L.append("What is measured (details: `sim/work_precision.hpp`): every engine (generated code, "
              "generic numeric path) x integrator x tolerance (rtol = tol, atol = 1e-2 tol; RK4: fixed steps) "
              "integrates the model from its initial state. Wall time: `integrate()` only, median of the "
              "timed repeats after a warm-up. Error: largest over 51 equally spaced output times of the state "

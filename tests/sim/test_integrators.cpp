@@ -1,4 +1,4 @@
-// Tests for runtime/integrators.{hpp,cpp}: accuracy against exact solutions,
+// Tests for sim/integrators.{hpp,cpp}: accuracy against exact solutions,
 // output placement, RK4 order, stiffness handling, failures, projection.
 #include <catch2/catch.hpp>
 

@@ -1,4 +1,4 @@
-// Tests for runtime/work_precision.{hpp,cpp} (`kanegen bench`): the attitude
+// Tests for sim/work_precision.{hpp,cpp} (`kanegen bench`): the attitude
 // error metric, the interpolation of the time to reach a target, the choice
 // of invariants, and a small end-to-end sweep on the pendulum.
 #include <catch2/catch.hpp>
