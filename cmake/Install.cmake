@@ -8,7 +8,7 @@ include(CMakePackageConfigHelpers)
 install(TARGETS kanegen EXPORT kanegenTargets RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(TARGETS kanegen_model kanegen_dynamics kanegen_engine kanegen_sim kanegen_warnings
         EXPORT kanegenTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
-foreach(dir model dynamics engine sim apps/aot)
+foreach(dir model dynamics engine sim apps/aot apps/common)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/kanegen/${dir}
           FILES_MATCHING PATTERN "*.hpp" PATTERN "*.h")
 endforeach()

@@ -264,9 +264,7 @@ class CvodeStepper final : public Stepper {
       // (flexible modes) they are driven to tiny steps (stiff_appendage, 5 s:
       // 400k steps at orders up to 5, 1.9k at order 2). cvode-bdf2 caps the
       // order at 2; stability-limit detection did not help there (530k
-      // steps), so it is off by default.
-      check_flag(CVodeSetStabLimDet(m, opt.bdf_stability_limit_detection ? SUNTRUE : SUNFALSE),
-                 "CVodeSetStabLimDet");
+      // steps, docs/extreme.md), so it stays off (CVODE's default).
       if (opt.max_order > 0) check_flag(CVodeSetMaxOrd(m, opt.max_order), "CVodeSetMaxOrd");
     } else {
       NLS_.reset(check_alloc(SUNNonlinSol_FixedPoint(y, 0, ctx), "SUNNonlinSol_FixedPoint"));

@@ -46,7 +46,6 @@ struct IntegratorOptions {
   double h = 1e-3;         ///< rk4 step; for adaptive methods: ignored
   long max_steps = 10'000'000;  ///< total steps before giving up
   int max_order = 0;       ///< cvode-bdf / cvode-adams: cap on the method order (0: CVODE's default, 5 / 12)
-  bool bdf_stability_limit_detection = false;  ///< cvode-bdf: CVodeSetStabLimDet
 };
 
 struct IntegratorStats {

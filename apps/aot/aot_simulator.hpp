@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 
+#include "apps/common/simulation_cli.hpp"
 #include "engine/generated_api.h"
 #include "engine/generated_engine.hpp"
 #include "engine/model_checks.hpp"
@@ -31,25 +32,17 @@ namespace kanegen {
 /// Exit status as the kanegen CLI: 0 success, 2 refused input, 1 failure while running.
 inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* api, const std::string& model_path,
                               const std::string& program) {
-  std::string model_file = model_path, state_path, output, integrator = "cvode-bdf";
-  double t_end = 10.0, rtol = 1e-8, atol = 1e-10, dt_out = 0.01, h = 1e-3;
-  bool eval = false, no_progress = false;
+  std::string model_file = model_path, state_path;
+  cli::SimulationCli sim;
+  bool eval = false;
 
   CLI::App app{fmt::format("{}: simulator of model '{}' with its generated equations of motion compiled in", program,
                            api && api->model_name ? api->model_name : "?")};
-  app.add_option("--t-end", t_end, "final time [s]")->capture_default_str();
-  app.add_option("-o,--output", output, "output CSV file (interface.md)");
+  cli::add_simulation_options(&app, sim, false);
   app.add_option("--state", state_path, "initial STATE.json (default: the model's initial state)")
       ->check(CLI::ExistingFile);
-  app.add_option("--integrator", integrator, "cvode-bdf | cvode-adams | arkode-erk | arkode-dirk | rk4")
-      ->capture_default_str();
-  app.add_option("--rtol", rtol, "relative tolerance (adaptive integrators)")->capture_default_str();
-  app.add_option("--atol", atol, "absolute tolerance (adaptive integrators)")->capture_default_str();
-  app.add_option("--dt-out", dt_out, "output interval [s]")->capture_default_str();
-  app.add_option("--h", h, "fixed step of rk4 [s]")->capture_default_str();
   app.add_option("--model", model_file, "model file the code was generated from")->capture_default_str();
   app.add_flag("--eval", eval, "print the eval JSON at the state instead of simulating");
-  app.add_flag("--no-progress", no_progress, "no progress bar on stderr");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -74,27 +67,13 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
       std::cout << eval_report(engine, state).dump(1) << '\n';
       return 0;
     }
-    if (output.empty()) throw InputError(Diagnostic{"-o", 0, "", "an output CSV file is required (or --eval)"});
-    SimulationOptions opt;
-    opt.t_end = t_end;
-    opt.dt_out = dt_out;
+    const SimulationOptions opt = cli::simulation_options(sim, state);
     try {
-      opt.integrator.kind = integrator_from_string(integrator);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(Diagnostic{"--integrator", 0, "", e.what()});
-    }
-    opt.integrator.rtol = rtol;
-    opt.integrator.atol = atol;
-    opt.integrator.h = h;
-    opt.progress = !no_progress;
-    if (!(t_end > state.t)) throw InputError(Diagnostic{"--t-end", 0, "", "must be after the initial time"});
-    if (!(dt_out > 0)) throw InputError(Diagnostic{"--dt-out", 0, "", "must be positive"});
-    try {
-      const SimulationResult r = simulate_to_file(engine, state, opt, output);
+      const SimulationResult r = simulate_to_file(engine, state, opt, sim.output);
       fmt::print(stderr, "{} [generated engine, compiled in], {} rows to {}, max quaternion drift {:.2e}\n",
-                 r.stats.summary(), r.rows, output, r.max_quaternion_drift);
+                 r.stats.summary(), r.rows, sim.output, r.max_quaternion_drift);
     } catch (const IntegrationError& e) {
-      fmt::print(stderr, "{}: integration failed at t = {:.17g}: {}\nno output written\n", program, e.t, e.what());
+      fmt::print(stderr, "{}: {}\nno output written\n", program, cli::describe_failure(model, e));
       return 1;
     }
     return 0;
