@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -60,7 +61,7 @@ std::string parameters(const EmittedFunction& f) {
   std::vector<std::string> ps;
   for (Arg a : f.args) {
     if (a == Arg::t)
-      ps.push_back(fmt::format("const {} t", T));
+      ps.push_back("const double t");
     else if (a == Arg::out)
       ps.push_back(fmt::format("{}* {}", T, f.out_name));
     else
@@ -139,6 +140,7 @@ AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, 
   replace_all(h, "U_NAMES", join(m.u_names, ", "));
   replace_all(h, "OP_COUNTS", op_counts(m));
   replace_all(h, "CONSTANTS", m.constants);
+  replace_all(h, "SUPPORT", m.support_code);
   replace_all(h, "FUNCTIONS", functions);
   out.header = std::move(h);
 
@@ -191,6 +193,9 @@ AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, 
   j["nu"] = m.nu;
   j["nbodies"] = m.nbodies;
   j["udot_form"] = m.udot_form;
+  j["takes_time"] = std::any_of(m.functions.begin(), m.functions.end(), [](const EmittedFunction& f) {
+    return std::find(f.args.begin(), f.args.end(), Arg::t) != f.args.end();
+  });
   nlohmann::ordered_json fs = nlohmann::ordered_json::array();
   for (const auto& f : m.functions)
     fs.push_back({{"name", f.name}, {"ops", f.ops.total()}, {"out_size", f.out_size}});

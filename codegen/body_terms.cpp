@@ -11,6 +11,210 @@ static const char* kAxis[3] = {"x", "y", "z"};
 
 static int levi(int a, int b, int c) { return (a - b) * (b - c) * (c - a) / 2; }
 
+namespace {
+
+/// The integrated part's velocity terms (dynamics/body_inertia.hpp).
+template <class PffFn>
+void add_integrated_velocity_terms(KaneContext& ctx, int j, const SV3& S, const SM3& J, const std::vector<SV3>& Bc,
+                                   const std::vector<ex> (&Q)[3][3], const PffFn& Pff) {
+  Alg& A = ctx.A;
+  SymBodyWorkspace& s = ctx.body[j];
+  const int m = static_cast<int>(Bc.size());
+  {
+    const SV3& w = s.w_B;
+    SV3 Bed;
+    for (int a = 0; a < 3; ++a) {
+      ex sum = 0;
+      for (int i = 0; i < m; ++i) sum += Bc[i][a] * s.eta_dot[i];
+      Bed[a] = A.let(sum);
+    }
+    const SV3 hv = A.add(A.cross(w, A.cross(w, S)), A.scale(2, A.cross(w, Bed)));
+    SV3 hw = A.cross(w, A.mul(J, w));
+    if (m > 0) {
+      SM3 G;  // G[a][c] = Q[c][a] . eta_dot
+      for (int a = 0; a < 3; ++a)
+        for (int cc = 0; cc < 3; ++cc) {
+          ex sum = 0;
+          for (int i = 0; i < m; ++i) sum += Q[cc][a][i] * s.eta_dot[i];
+          G(a, cc) = A.let(sum);
+        }
+      const ex trG = A.let(G(0, 0) + G(1, 1) + G(2, 2));
+      const SV3 Gw = A.mul(G, w);
+      for (int a = 0; a < 3; ++a) hw[a] = A.let(hw[a] + 2 * (trG * w[a] - Gw[a]));
+      const ex w2 = A.dot(w, w);
+      for (int i = 0; i < m; ++i) {
+        ex sum = 0;
+        for (int a = 0; a < 3; ++a) {
+          sum -= w2 * Q[a][a][i];
+          for (int cc = 0; cc < 3; ++cc) {
+            sum += w[a] * w[cc] * Q[cc][a][i];
+            for (int bb = 0; bb < 3; ++bb)
+              if (int e = levi(a, bb, cc)) {
+                ex pe = 0;
+                for (int l = 0; l < m; ++l) pe += Pff(a, cc, i, l) * s.eta_dot[l];
+                sum += 2 * e * w[bb] * pe;
+              }
+          }
+        }
+        s.h_body[6 + i] = A.let(sum);
+      }
+    }
+    for (int a = 0; a < 3; ++a) s.h_body[a] = hv[a], s.h_body[3 + a] = hw[a];
+  }
+}
+
+/// A rich node's terms, one by one (dynamics/body_inertia.hpp, add_node_terms).
+void add_node_terms(KaneContext& ctx, int j, int k, const SV3& g_B, bool with_velocity) {
+  Alg& A = ctx.A;
+  const Body& b = ctx.model.bodies[j];
+  const FlexibleData& flex = *b.flex;
+  const ModalNode& node = flex.nodes[k];
+  SymBodyWorkspace& s = ctx.body[j];
+  SMat& M = s.M_body;
+  const int m = flex.modes();
+  const std::string nn = fmt::format("{}_node{}", b.name, node.id);
+  ctx.C.group = b.name;
+  ctx.P.section(fmt::format("body {}: node {} (rotary inertia, foreshortening)", b.name, node.id));
+  const SV3& w = s.w_B;
+  if (node.mass != 0.0) {
+    const ex mk = ctx.c(node.mass, nn + "_mass", "kg", "node mass");
+    // s_k = rho + Phi eta + 1/2 gamma(eta); Phi~ = Phi + G(eta), row a of G = (Gamma^a eta)^T
+    std::vector<SV3> Pt(m);
+    SV3 sk = ctx.cvec(node.rho_B, nn + "_rho", "m", "node position (undeformed)");
+    SV3 gamma_dd;
+    for (int i = 0; i < m; ++i) {
+      Pt[i] = ctx.cvec(flex.Phi.block(3 * k, i, 3, 1), fmt::format("{}_Phi{}", nn, i + 1), "m",
+                       fmt::format("translational shape of mode {} at the node", i + 1));
+      for (int a = 0; a < 3; ++a) sk[a] = sk[a] + Pt[i][a] * s.eta[i];
+    }
+    for (int a = 0; a < 3 && flex.has_second_order(k); ++a) {
+      const MatX& G = flex.Gamma[k][a];
+      if (G.size() == 0) continue;
+      auto Gc = [&](int i, int l) {
+        return ctx.c(G(std::min(i, l), std::max(i, l)),
+                     fmt::format("{}_Gamma{}_{}_{}", nn, kAxis[a], std::min(i, l) + 1, std::max(i, l) + 1), "1/m",
+                     "second-order (foreshortening) coefficient");
+      };
+      ex quad = 0, dd = 0;
+      for (int i = 0; i < m; ++i) {
+        ex row = 0, row_dot = 0;
+        for (int l = 0; l < m; ++l) {
+          row += Gc(i, l) * s.eta[l];
+          if (with_velocity) row_dot += Gc(i, l) * s.eta_dot[l];
+        }
+        const ex gi = A.let(row);
+        quad += gi * s.eta[i];
+        Pt[i][a] = A.let(Pt[i][a] + gi);
+        if (with_velocity) dd += A.let(row_dot) * s.eta_dot[i];
+      }
+      sk[a] = sk[a] + quad / 2;
+      gamma_dd[a] = A.let(dd);
+    }
+    sk = A.let(sk, ctx.name("s_B", j) + fmt::format("_node{}", node.id));
+    const SM3 sx = Alg::skew(sk);
+    for (int a = 0; a < 3; ++a) {
+      M(a, a) = M(a, a) + mk;
+      for (int c = 0; c < 3; ++c) {
+        M(a, 3 + c) = M(a, 3 + c) - mk * sx(a, c);
+        M(3 + a, c) = M(3 + a, c) + mk * sx(a, c);
+        M(3 + a, 3 + c) = M(3 + a, 3 + c) + mk * ((a == c ? A.dot(sk, sk) : ex(0)) - sk[a] * sk[c]);
+      }
+    }
+    for (int i = 0; i < m; ++i) {
+      const SV3 sxP = A.cross(sk, Pt[i]);
+      for (int a = 0; a < 3; ++a) {
+        M(a, 6 + i) = M(6 + i, a) = M(a, 6 + i) + mk * Pt[i][a];
+        M(3 + a, 6 + i) = M(6 + i, 3 + a) = M(3 + a, 6 + i) + mk * sxP[a];
+      }
+      for (int l = i; l < m; ++l) M(6 + i, 6 + l) = M(6 + l, 6 + i) = M(6 + i, 6 + l) + mk * A.dot(Pt[i], Pt[l]);
+    }
+    if (!ctx.model.g_N.isZero()) {
+      const SV3 sg = A.cross(sk, g_B);
+      for (int a = 0; a < 3; ++a) {
+        s.g_body[a] = s.g_body[a] + mk * g_B[a];
+        s.g_body[3 + a] = s.g_body[3 + a] + mk * sg[a];
+      }
+      for (int i = 0; i < m; ++i) s.g_body[6 + i] = s.g_body[6 + i] + mk * A.dot(Pt[i], g_B);
+    }
+    if (with_velocity) {
+      SV3 v_rel;
+      for (int a = 0; a < 3; ++a) {
+        ex sum = 0;
+        for (int i = 0; i < m; ++i) sum += Pt[i][a] * s.eta_dot[i];
+        v_rel[a] = A.let(sum);
+      }
+      SV3 bk = A.add(A.cross(w, A.cross(w, sk)), A.scale(2, A.cross(w, v_rel)));
+      bk = A.add(bk, gamma_dd);
+      const SV3 sb = A.cross(sk, bk);
+      for (int a = 0; a < 3; ++a) {
+        s.h_body[a] = s.h_body[a] + mk * bk[a];
+        s.h_body[3 + a] = s.h_body[3 + a] + mk * sb[a];
+      }
+      for (int i = 0; i < m; ++i) s.h_body[6 + i] = s.h_body[6 + i] + mk * A.dot(Pt[i], bk);
+    }
+  }
+  if (!node.J_B.isZero(0.0)) {
+    // node frame C(Psi eta): J' = C J C^T; w_k = w + H eta_dot, H = (I + g^x) Psi / (1 + g.g), g = Psi eta / 2
+    std::vector<SV3> Psi(m), H(m), JH(m);
+    SV3 g, g_dot;
+    for (int i = 0; i < m; ++i) {
+      Psi[i] = ctx.cvec(flex.Psi.block(3 * k, i, 3, 1), fmt::format("{}_Psi{}", nn, i + 1), "rad",
+                        fmt::format("rotational shape of mode {} at the node", i + 1));
+      for (int a = 0; a < 3; ++a) {
+        g[a] = g[a] + Psi[i][a] * s.eta[i] / 2;
+        g_dot[a] = g_dot[a] + Psi[i][a] * s.eta_dot[i] / 2;
+      }
+    }
+    g = A.let(g);
+    const ex denom = A.let(1 + A.dot(g, g));
+    const ex two_over = A.let(2 / denom), inv = A.let(1 / denom);
+    const SM3 G = Alg::skew(g);
+    SM3 C;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) {
+        ex gg = 0;
+        for (int t = 0; t < 3; ++t) gg += G(r, t) * G(t, c);
+        C(r, c) = A.let((r == c ? 1 : 0) + two_over * (G(r, c) + gg));
+      }
+    const SM3 Jn = ctx.cmat(node.J_B, nn + "_J", "kg m^2", "node rotary inertia (B axes at eta = 0)", true);
+    const SM3 CJ = A.mul(C, Jn);
+    SM3 Jp;
+    for (int r = 0; r < 3; ++r)
+      for (int c = r; c < 3; ++c) {
+        ex sum = 0;
+        for (int t = 0; t < 3; ++t) sum += CJ(r, t) * C(c, t);
+        Jp(r, c) = Jp(c, r) = A.let(sum);
+      }
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) M(3 + r, 3 + c) = M(3 + r, 3 + c) + Jp(r, c);
+    for (int i = 0; i < m; ++i) {
+      const SV3 gx = A.cross(g, Psi[i]);
+      for (int a = 0; a < 3; ++a) H[i][a] = A.let((Psi[i][a] + gx[a]) * inv);
+      JH[i] = A.mul(Jp, H[i]);
+      for (int a = 0; a < 3; ++a) M(3 + a, 6 + i) = M(6 + i, 3 + a) = M(3 + a, 6 + i) + JH[i][a];
+    }
+    for (int i = 0; i < m; ++i)
+      for (int l = i; l < m; ++l) M(6 + i, 6 + l) = M(6 + l, 6 + i) = M(6 + i, 6 + l) + A.dot(H[i], JH[l]);
+    if (with_velocity) {
+      SV3 w_rel;
+      for (int a = 0; a < 3; ++a) {
+        ex sum = 0;
+        for (int i = 0; i < m; ++i) sum += H[i][a] * s.eta_dot[i];
+        w_rel[a] = A.let(sum);
+      }
+      const SV3 w_k = A.add(w, w_rel);
+      const ex f = A.let(-2 * A.dot(g, A.let(g_dot)) * inv);
+      const SV3 beta = A.add(A.cross(w, w_rel), A.scale(f, w_rel));
+      const SV3 torque = A.add(A.mul(Jp, beta), A.cross(w_k, A.mul(Jp, w_k)));
+      for (int a = 0; a < 3; ++a) s.h_body[3 + a] = s.h_body[3 + a] + torque[a];
+      for (int i = 0; i < m; ++i) s.h_body[6 + i] = s.h_body[6 + i] + A.dot(H[i], torque);
+    }
+  }
+}
+
+
+}  // namespace
+
 void compute_body_terms(KaneContext& ctx, bool with_velocity) {
   Alg& A = ctx.A;
   const Model& model = ctx.model;
@@ -96,54 +300,16 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
     }
     // Gravity: g_B = R_NB^T g_N; [m g_B; S x g_B; B^T g_B]
     s.g_body.assign(6 + m, ex(0));
+    SV3 g_B;
     if (!gN.isZero()) {
-      const SV3 g_B = A.mul_t(s.R_NB, g_N, ctx.name("g_B", static_cast<int>(j)));
+      g_B = A.mul_t(s.R_NB, g_N, ctx.name("g_B", static_cast<int>(j)));
       const SV3 mg = A.scale(mass, g_B), Sg = A.cross(S, g_B);
       for (int a = 0; a < 3; ++a) s.g_body[a] = mg[a], s.g_body[3 + a] = Sg[a];
       for (int i = 0; i < m; ++i) s.g_body[6 + i] = A.dot(Bc[i], g_B);
     }
-    if (!with_velocity) continue;
-    // Velocity terms.
     s.h_body.assign(6 + m, ex(0));
-    const SV3& w = s.w_B;
-    SV3 Bed;
-    for (int a = 0; a < 3; ++a) {
-      ex sum = 0;
-      for (int i = 0; i < m; ++i) sum += Bc[i][a] * s.eta_dot[i];
-      Bed[a] = A.let(sum);
-    }
-    const SV3 hv = A.add(A.cross(w, A.cross(w, S)), A.scale(2, A.cross(w, Bed)));
-    SV3 hw = A.cross(w, A.mul(J, w));
-    if (m > 0) {
-      SM3 G;  // G[a][c] = Q[c][a] . eta_dot
-      for (int a = 0; a < 3; ++a)
-        for (int cc = 0; cc < 3; ++cc) {
-          ex sum = 0;
-          for (int i = 0; i < m; ++i) sum += Q[cc][a][i] * s.eta_dot[i];
-          G(a, cc) = A.let(sum);
-        }
-      const ex trG = A.let(G(0, 0) + G(1, 1) + G(2, 2));
-      const SV3 Gw = A.mul(G, w);
-      for (int a = 0; a < 3; ++a) hw[a] = A.let(hw[a] + 2 * (trG * w[a] - Gw[a]));
-      const ex w2 = A.dot(w, w);
-      for (int i = 0; i < m; ++i) {
-        ex sum = 0;
-        for (int a = 0; a < 3; ++a) {
-          sum -= w2 * Q[a][a][i];
-          for (int cc = 0; cc < 3; ++cc) {
-            sum += w[a] * w[cc] * Q[cc][a][i];
-            for (int bb = 0; bb < 3; ++bb)
-              if (int e = levi(a, bb, cc)) {
-                ex pe = 0;
-                for (int l = 0; l < m; ++l) pe += Pff(a, cc, i, l) * s.eta_dot[l];
-                sum += 2 * e * w[bb] * pe;
-              }
-          }
-        }
-        s.h_body[6 + i] = A.let(sum);
-      }
-    }
-    for (int a = 0; a < 3; ++a) s.h_body[a] = hv[a], s.h_body[3 + a] = hw[a];
+    if (with_velocity) add_integrated_velocity_terms(ctx, static_cast<int>(j), S, J, Bc, Q, Pff);
+    for (int k : b.rich_nodes) add_node_terms(ctx, static_cast<int>(j), k, g_B, with_velocity);
   }
 }
 

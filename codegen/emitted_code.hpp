@@ -23,7 +23,7 @@ namespace kanegen::codegen {
 /// KanegenArgs (engine/generated_api.h) by these names; `out` is the
 /// function's output array.
 enum class Arg {
-  t,        ///< const T t: time (only for models with prescribed motion)
+  t,        ///< const double t: time (only for models with prescribed motion)
   q,        ///< const T* q
   u,        ///< const T* u
   tau,      ///< const T* tau: generalized inputs
@@ -53,6 +53,7 @@ struct EmittedModel {
   int nq = 0, nu = 0, nbodies = 0;
   std::vector<std::string> q_names, u_names;
   std::string constants;        ///< namespace-scope constant declarations, grouped by body
+  std::string support_code;     ///< helper functions the bodies call (e.g. prescribed motion), or empty
   std::string udot_form;        ///< "composite" or "articulated"
   OpCount udot_composite_ops, udot_articulated_ops;
   std::vector<EmittedFunction> functions;

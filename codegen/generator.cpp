@@ -51,9 +51,11 @@ EmittedFunction function(std::string name, std::string title, std::vector<Arg> a
 
 /// The exact Jacobian of x_dot = [q_dot; u_dot] by forward-mode dual numbers
 /// over qdot() and udot() (the Dual type is part of the header template).
-EmittedFunction jacobian_function(int nq, int nu, const OpCount& qdot_ops, const OpCount& udot_ops) {
+EmittedFunction jacobian_function(int nq, int nu, bool timed, const OpCount& qdot_ops, const OpCount& udot_ops) {
+  std::vector<Arg> args{Arg::q, Arg::u, Arg::tau, Arg::out};
+  if (timed) args.insert(args.begin(), Arg::t);
   EmittedFunction f = function("jacobian", "Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major",
-                               {Arg::q, Arg::u, Arg::tau, Arg::out}, "J", (nq + nu) * (nq + nu), true);
+                               args, "J", (nq + nu) * (nq + nu), true);
   f.templated = false;
   f.note =
       "// Forward-mode differentiation of qdot() and udot() with dual numbers, one\n"
@@ -70,7 +72,8 @@ EmittedFunction jacobian_function(int nq, int nu, const OpCount& qdot_ops, const
       "    for (int i = 0; i < nq; ++i) { qd[i] = D(q[i]); if (i == c) qd[i].d[0] = 1.0; }\n"
       "    for (int i = 0; i < nu; ++i) { ud[i] = D(u[i]); td[i] = D(tau[i]); if (nq + i == c) ud[i].d[0] = 1.0; }\n"
       "    qdot(qd, ud, qdot_out);\n"
-      "    const int status = udot(qd, ud, td, udot_out);\n"
+      + std::string(timed ? "    const int status = udot(t, qd, ud, td, udot_out);\n"
+                          : "    const int status = udot(qd, ud, td, udot_out);\n") +
       "    if (status != 0) return status;\n"
       "    for (int i = 0; i < nq; ++i) J[c * nx + i] = qdot_out[i].d[0];\n"
       "    for (int i = 0; i < nu; ++i) J[c * nx + nq + i] = udot_out[i].d[0];\n"
@@ -80,6 +83,44 @@ EmittedFunction jacobian_function(int nq, int nu, const OpCount& qdot_ops, const
   const long per_pass = 3 * (qdot_ops.total() + udot_ops.total());
   f.ops.mul = per_pass * (nq + nu);
   return f;
+}
+
+/// The prescribed-motion functions of time the emitted code calls (the same
+/// formulas as model/prescribed_motion.cpp, which the generic engine uses).
+std::string motion_support_code() {
+  return R"(
+// ---- prescribed motion: f(t), f'(t), f''(t) of a joint coordinate ------------
+inline void motion_polynomial(double t, const double* c, int n, double& f, double& fd, double& fdd) {
+  f = fd = fdd = 0.0;
+  for (int i = n - 1; i >= 0; --i) {
+    fdd = fdd * t + 2.0 * fd;
+    fd = fd * t + f;
+    f = f * t + c[i];
+  }
+}
+inline void motion_sine(double t, double offset, double amplitude, double frequency_hz, double phase, double& f,
+                        double& fd, double& fdd) {
+  const double w = 6.283185307179586476925 * frequency_hz, a = w * t + phase;
+  f = offset + amplitude * std::sin(a);
+  fd = amplitude * w * std::cos(a);
+  fdd = -amplitude * w * w * std::sin(a);
+}
+// The smooth spin-up of Kane, Ryan and Banerjee (1987) to `rate` over `duration`.
+inline void motion_spinup(double t, double rate, double duration, double start, double& f, double& fd,
+                          double& fdd) {
+  constexpr double two_pi = 6.283185307179586476925;
+  if (t < 0.0) {
+    f = start, fd = 0.0, fdd = 0.0;
+  } else if (t < duration) {
+    const double a = two_pi * t / duration;
+    f = start + rate * (t * t / (2.0 * duration) + (duration / (two_pi * two_pi)) * (std::cos(a) - 1.0));
+    fd = (rate / duration) * (t - (duration / two_pi) * std::sin(a));
+    fdd = (rate / duration) * (1.0 - std::cos(a));
+  } else {
+    f = start + rate * (t - duration / 2.0), fd = rate, fdd = 0.0;
+  }
+}
+)";
 }
 
 }  // namespace
@@ -116,6 +157,13 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   out.q_names = model_in.q_names;
   out.u_names = model_in.u_names;
   auto& fns = out.functions;
+  // Functions take t only when the scene has prescribed motion.
+  const bool timed = dyn.has_prescribed();
+  auto at_t = [timed](std::vector<Arg> args) {
+    if (timed) args.insert(args.begin(), Arg::t);
+    return args;
+  };
+  if (timed) out.support_code = motion_support_code();
 
   {
     Program p;
@@ -133,7 +181,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     const SMat M = compute_mass_matrix(ctx);
     for (int r = 0; r < dyn.nu; ++r)
       for (int c = 0; c < dyn.nu; ++c) p.assign(fmt::format("M[{}]", r * dyn.nu + c), M(r, c));
-    EmittedFunction f = function("mass_matrix", "M(q), row-major", {Arg::q, Arg::out}, "M", dyn.nu * dyn.nu);
+    EmittedFunction f = function("mass_matrix", "M(q), row-major", at_t({Arg::q, Arg::out}), "M", dyn.nu * dyn.nu);
     finish(p, C, f);
     fns.push_back(std::move(f));
   }
@@ -143,7 +191,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     prepare(ctx, true);
     const auto F = compute_forcing(ctx);
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("F[{}]", r), F[r]);
-    EmittedFunction f = function("forcing", "F(q, u, tau)", {Arg::q, Arg::u, Arg::tau, Arg::out}, "F", dyn.nu);
+    EmittedFunction f = function("forcing", "F(q, u, tau)", at_t({Arg::q, Arg::u, Arg::tau, Arg::out}), "F", dyn.nu);
     finish(p, C, f);
     fns.push_back(std::move(f));
   }
@@ -170,7 +218,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("udot[{}]", r), ud[r]);
     EmittedFunction f = function("udot",
                                  "u_dot: M u_dot = F (form chosen by operation count, see the counts above)",
-                                 {Arg::q, Arg::u, Arg::tau, Arg::out}, "udot", dyn.nu, true);
+                                 at_t({Arg::q, Arg::u, Arg::tau, Arg::out}), "udot", dyn.nu, true);
     f.note = "// Returns 0, or k if the pivot of speed k (1-based) is not positive (M singular).\n";
     finish(p, C, f);
     (std::string(form) == "composite" ? out.udot_composite_ops : out.udot_articulated_ops) = f.ops;
@@ -191,7 +239,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     prepare(ctx, true);
     p.assign("TV[0]", compute_kinetic_energy(ctx));
     p.assign("TV[1]", compute_potential_energy(ctx));
-    EmittedFunction f = function("energy", "energy: T, V", {Arg::q, Arg::u, Arg::out}, "TV", 2);
+    EmittedFunction f = function("energy", "energy: T, V", at_t({Arg::q, Arg::u, Arg::out}), "TV", 2);
     finish(p, C, f);
     fns.push_back(std::move(f));
   }
@@ -202,7 +250,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     const auto pH = compute_momentum(ctx);
     for (int i = 0; i < 6; ++i) p.assign(fmt::format("pH[{}]", i), pH[i]);
     EmittedFunction f =
-        function("momentum", "momentum: p_N[3], H_N[3] about N's origin", {Arg::q, Arg::u, Arg::out}, "pH", 6);
+        function("momentum", "momentum: p_N[3], H_N[3] about N's origin", at_t({Arg::q, Arg::u, Arg::out}), "pH", 6);
     finish(p, C, f);
     fns.push_back(std::move(f));
   }
@@ -215,11 +263,11 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     for (std::size_t i = 0; i < W.size(); ++i) p.assign(fmt::format("wrenches[{}]", i), W[i]);
     EmittedFunction f =
         function("reactions", "reactions on each body from its parent: [force; torque about O_B], body axes",
-                 {Arg::q, Arg::u, Arg::udot_in, Arg::out}, "wrenches", 6 * out.nbodies);
+                 at_t({Arg::q, Arg::u, Arg::udot_in, Arg::out}), "wrenches", 6 * out.nbodies);
     finish(p, C, f);
     fns.push_back(std::move(f));
   }
-  fns.push_back(jacobian_function(dyn.nq, dyn.nu, qdot_ops, udot_ops));
+  fns.push_back(jacobian_function(dyn.nq, dyn.nu, timed, qdot_ops, udot_ops));
 
   // Constants, grouped per body with a comment block.
   for (const std::string& g : C.groups()) {

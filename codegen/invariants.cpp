@@ -42,7 +42,7 @@ ex compute_potential_energy(KaneContext& ctx) {
       for (int a = 0; a < 3; ++a) V -= g_N[a] * (s.M_body(0, 0) * s.r_NO_N[a] + RS[a]);
     }
     ctx.C.group = b.name;
-    if (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic) {
+    if ((b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic) && !b.joint.prescribed()) {
       const ex kk = ctx.c(b.joint.stiffness, b.name + "_k", "N m/rad or N/m", "joint spring stiffness");
       const ex rest = ctx.c(b.joint.rest, b.name + "_rest", "rad or m", "spring rest value");
       const ex dq = ctx.A.let(ctx.x.q[b.q_joint] - rest);

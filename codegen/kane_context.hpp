@@ -19,6 +19,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,7 @@ struct KaneContext {
   const StateSymbols& x;
   Alg A;
   std::vector<SymBodyWorkspace> body;
+  std::map<int, std::array<ex, 3>> motion_symbols;  ///< body -> f, f_dot, f_ddot (see motion())
 
   /// A named model constant (constants.hpp) of the current group.
   ex c(double v, const std::string& name, const std::string& unit, const std::string& what) {
@@ -63,6 +65,10 @@ struct KaneContext {
            bool symmetric = false);
   /// Name of a quantity of body j for the emitted code, e.g. "w_B_ant2".
   std::string name(const std::string& quantity, int j) const { return quantity + "_" + model.bodies[j].name; }
+  /// The prescribed coordinate of body j's joint and its two derivatives at t
+  /// (symbols f_<body>, f_dot_<body>, f_ddot_<body>, defined by a prelude of
+  /// the Program that calls the motion's helper of the emitted support code).
+  std::array<ex, 3> motion(int j);
 };
 
 // ---- passes (one file each, see the header comment) ----------------------

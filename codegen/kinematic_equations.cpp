@@ -10,7 +10,7 @@ using namespace GiNaC;
 std::vector<ex> compute_qdot(KaneContext& ctx) {
   std::vector<ex> qd(ctx.model.nq, ex(0));
   for (const Body& b : ctx.model.bodies) {
-    switch (b.joint.type) {
+    switch (b.joint.prescribed() ? JointType::fixed : b.joint.type) {  // a prescribed joint has no q
       case JointType::revolute:
       case JointType::prismatic: qd[b.q_joint] = ctx.x.u[b.u_joint]; break;
       case JointType::fixed: break;

@@ -29,6 +29,48 @@ SM3 KaneContext::cmat(const Mat3& m, const std::string& n, const std::string& un
   return r;
 }
 
+std::array<ex, 3> KaneContext::motion(int j) {
+  if (auto it = motion_symbols.find(j); it != motion_symbols.end()) return it->second;
+  const Body& b = model.bodies[j];
+  const PrescribedMotion& m = *b.joint.motion;
+  const std::string f = "f_" + b.name, fd = "f_dot_" + b.name, fdd = "f_ddot_" + b.name;
+  C.group = b.name;
+  const char* unit = b.joint.type == JointType::revolute ? "rad" : "m";
+  auto arg = [&](double v, const std::string& what_name, const std::string& u, const std::string& what) {
+    OpCount unused;
+    return print_cpp(c(v, b.name + "_motion_" + what_name, u, what), unused);
+  };
+  std::string text = fmt::format("double {}, {}, {}; ", f, fd, fdd);
+  switch (m.kind) {
+    case MotionKind::polynomial: {
+      std::string coeffs;
+      for (std::size_t i = 0; i < m.coefficients.size(); ++i)
+        coeffs += (i ? ", " : "") + arg(m.coefficients[i], fmt::format("c{}", i), fmt::format("{}/s^{}", unit, i),
+                                         fmt::format("prescribed motion: polynomial coefficient {}", i));
+      text += fmt::format("const double c_{}[] = {{{}}}; motion_polynomial(t, c_{}, {}, {}, {}, {});", b.name, coeffs,
+                          b.name, m.coefficients.size(), f, fd, fdd);
+      break;
+    }
+    case MotionKind::sine:
+      text += fmt::format("motion_sine(t, {}, {}, {}, {}, {}, {}, {});",
+                          arg(m.offset, "offset", unit, "prescribed motion: sine offset"),
+                          arg(m.amplitude, "amplitude", unit, "prescribed motion: sine amplitude"),
+                          arg(m.frequency_hz, "frequency", "Hz", "prescribed motion: sine frequency"),
+                          arg(m.phase, "phase", "rad", "prescribed motion: sine phase"), f, fd, fdd);
+      break;
+    case MotionKind::spinup:
+      text += fmt::format("motion_spinup(t, {}, {}, {}, {}, {}, {});",
+                          arg(m.rate, "rate", std::string(unit) + "/s", "prescribed motion: spin-up final rate"),
+                          arg(m.duration, "duration", "s", "prescribed motion: spin-up duration"),
+                          arg(m.start, "start", unit, "prescribed motion: spin-up start value"), f, fd, fdd);
+      break;
+  }
+  P.prelude(text, {f, fd, fdd});
+  const std::array<ex, 3> syms = {GiNaC::symbol(f), GiNaC::symbol(fd), GiNaC::symbol(fdd)};
+  motion_symbols[j] = syms;
+  return syms;
+}
+
 void compute_kinematics(KaneContext& ctx, bool with_velocity) {
   Alg& A = ctx.A;
   const Model& model = ctx.model;
@@ -54,7 +96,7 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     // Joint frame.
     SM3 R_PJ = ctx.cmat(b.joint.R_PJ, n + "_R_PJ", "", "joint frame orientation in the parent");
     SV3 p_PJ;
-    SV3 w_J, w_J_dot_R, v_node;
+    SV3 w_J, w_J_dot_R, v_node, a_node_R;
     std::vector<SV3> H_cols, Phi_cols;  // per parent mode
     const int m_P = has_parent ? model.bodies[b.parent].n_modes() : 0;
     if (b.joint.node >= 0) {
@@ -88,11 +130,46 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
         }
       R_PJ = A.mul(Cg, R_PJ);
       const SV3 rho = ctx.cvec(pf.nodes[node].rho_B, nn + "_rho", "m", "attachment node position in the parent");
+      // Foreshortening: p_PJ gains 1/2 eta^T Gamma^a eta; the node's shape
+      // becomes Phi~ = Phi + G(eta), row a of G = (Gamma^a eta)^T.
+      std::vector<SV3> Gcols(m_P);  // G(eta) by column
+      SV3 half_gamma;
+      if (pf.has_second_order(node))
+        for (int a = 0; a < 3; ++a) {
+          const MatX& G = pf.Gamma[node][a];
+          if (G.size() == 0) continue;
+          ex quad = 0;
+          for (int i = 0; i < m_P; ++i) {
+            ex row = 0;
+            for (int l = 0; l < m_P; ++l)
+              row += ctx.c(G(std::min(i, l), std::max(i, l)),
+                           fmt::format("{}_Gamma{}_{}_{}", nn, kAxis[a], std::min(i, l) + 1, std::max(i, l) + 1), "1/m",
+                           "second-order (foreshortening) coefficient of the attachment node") *
+                     p->eta[l];
+            Gcols[i][a] = A.let(row);
+            quad += row * p->eta[i];
+          }
+          half_gamma[a] = A.let(quad / 2);
+        }
       for (int a = 0; a < 3; ++a) {
-        ex sum = rho[a];
+        ex sum = rho[a] + half_gamma[a];
         for (int mode = 0; mode < m_P; ++mode) sum += Phi_cols[mode][a] * p->eta[mode];
         p_PJ[a] = A.let(sum);
       }
+      for (int mode = 0; mode < m_P; ++mode) Phi_cols[mode] = A.add(Phi_cols[mode], Gcols[mode]);
+      if (with_velocity && pf.has_second_order(node))
+        for (int a = 0; a < 3; ++a) {  // [eta_dot^T Gamma^a eta_dot]_a
+          const MatX& G = pf.Gamma[node][a];
+          if (G.size() == 0) continue;
+          ex sum = 0;
+          for (int i = 0; i < m_P; ++i)
+            for (int l = 0; l < m_P; ++l)
+              sum += ctx.c(G(std::min(i, l), std::max(i, l)),
+                           fmt::format("{}_Gamma{}_{}_{}", nn, kAxis[a], std::min(i, l) + 1, std::max(i, l) + 1), "1/m",
+                           "second-order (foreshortening) coefficient of the attachment node") *
+                     p->eta_dot[i] * p->eta_dot[l];
+          a_node_R[a] = A.let(sum);
+        }
       // H = (I + g^x) Psi / (1 + g.g): w_J = H eta_dot_P
       const ex inv = A.let(1 / denom);
       for (int mode = 0; mode < m_P; ++mode) {
@@ -124,13 +201,20 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
       p_PJ = ctx.cvec(b.joint.p_PJ, n + "_p_PJ", "m", "joint frame origin in the parent");
     }
 
-    // Joint motion.
+    // Joint motion; a prescribed joint's coordinate and rate are its motion at t.
     SM3 R_JB = SM3::identity();
     SV3 e, e_dot, w_rel;
     const SV3 axis = ctx.cvec(b.joint.axis_J, n + "_axis", "", "joint axis");
+    ex q_j = 0, u_j = 0, f_ddot = 0;
+    if (b.joint.prescribed()) {
+      const auto f = ctx.motion(j);
+      q_j = f[0], u_j = f[1], f_ddot = f[2];
+    } else if (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic) {
+      q_j = ctx.x.q[b.q_joint], u_j = ctx.x.u[b.u_joint];
+    }
     switch (b.joint.type) {
       case JointType::revolute: {
-        const ex cq = A.let(cos(ctx.x.q[b.q_joint])), sq = A.let(sin(ctx.x.q[b.q_joint]));
+        const ex cq = A.let(cos(q_j)), sq = A.let(sin(q_j));
         // Rot(a, th) = a a^T + cos th (I - a a^T) + sin th a^x
         const Eigen::Matrix3d aa = b.joint.axis_J * b.joint.axis_J.transpose();
         const SM3 Ax = Alg::skew(axis);
@@ -144,13 +228,13 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
                                      "I - axis outer product");
             R_JB(r, cc) = A.let(aa_rc + cq * one_minus + sq * Ax(r, cc));
           }
-        if (with_velocity) w_rel = A.scale(ctx.x.u[b.u_joint], A.mul(R_PJ, axis));
+        if (with_velocity) w_rel = A.scale(u_j, A.mul(R_PJ, axis));
         break;
       }
       case JointType::prismatic: {
         const SV3 a_P = A.mul(R_PJ, axis);
-        e = A.scale(ctx.x.q[b.q_joint], a_P);
-        if (with_velocity) e_dot = A.scale(ctx.x.u[b.u_joint], a_P);
+        e = A.scale(q_j, a_P);
+        if (with_velocity) e_dot = A.scale(u_j, a_P);
         break;
       }
       case JointType::fixed: break;
@@ -209,7 +293,12 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     a = A.add(a, A.cross(w_J, A.cross(w_J, e)));
     a = A.add(a, A.cross(w_J, e_dot));
     a = A.add(a, A.cross(w_BP, e_dot));
+    a = A.add(a, a_node_R);
     s.a_R_B = A.mul(R_BP, a, ctx.name("a_R_B", j));
+    if (b.joint.prescribed()) {  // the known acceleration along the joint's column (axis in B = axis in J)
+      SV3& target = b.joint.type == JointType::revolute ? s.alpha_R_B : s.a_R_B;
+      target = A.add(target, A.scale(f_ddot, axis), ctx.name(b.joint.type == JointType::revolute ? "alpha_R_B" : "a_R_B", j));
+    }
   }
 }
 

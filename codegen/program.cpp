@@ -42,6 +42,12 @@ void Program::statement(const std::string& text, const ex& dep) { stmts_.push_ba
 
 void Program::section(const std::string& title) { temps_.push_back({symbol(), ex(0), title}); }
 
+void Program::prelude(const std::string& text, const std::vector<std::string>& defines) {
+  for (const auto& p : preludes_)
+    if (p.text == text) return;
+  preludes_.push_back({text, defines});
+}
+
 static void collect_symbols(const ex& e, std::set<std::string>& names) {
   if (is_a<symbol>(e)) {
     names.insert(ex_to<symbol>(e).get_name());
@@ -62,6 +68,11 @@ std::string Program::emit(const std::string& indent, OpCount& ops) const {
     }
   }
   std::string out;
+  for (const Prelude& p : preludes_) {
+    bool used = false;
+    for (const auto& d : p.defines) used = used || needed.count(d);
+    if (used) out += indent + p.text + "\n";
+  }
   const std::string* pending = nullptr;  // a section marker not yet printed
   for (std::size_t k = 0; k < temps_.size(); ++k) {
     if (!temps_[k].section.empty()) {

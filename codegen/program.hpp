@@ -37,6 +37,10 @@ class Program {
   void statement(const std::string& text, const ex& dep);
   /// A comment marker for the temporaries bound after it.
   void section(const std::string& title);
+  /// A statement emitted before every temporary, verbatim, that defines the
+  /// symbols `defines` (e.g. the prescribed motion of a joint at t); emitted
+  /// only when one of them is needed.
+  void prelude(const std::string& text, const std::vector<std::string>& defines);
 
   /// C++ body: temporaries that some output needs (dead ones dropped), in
   /// order, as `const T name = ...;`, then the outputs. Counts operations.
@@ -60,6 +64,11 @@ class Program {
     ex value;
   };
   std::vector<Stmt> stmts_;
+  struct Prelude {
+    std::string text;
+    std::vector<std::string> defines;
+  };
+  std::vector<Prelude> preludes_;
 };
 
 }  // namespace kanegen::codegen

@@ -12,7 +12,7 @@ using namespace GiNaC;
 std::vector<int> own_columns(const Model& model, int j) {
   const Body& b = model.bodies[j];
   std::vector<int> cols;
-  for (int k = 0; k < joint_nu(b.joint.type) + b.n_modes(); ++k) cols.push_back(b.u_joint + k);
+  for (int k = 0; k < joint_nu(b.joint) + b.n_modes(); ++k) cols.push_back(b.u_joint + k);
   return cols;
 }
 
@@ -22,7 +22,7 @@ std::vector<std::vector<ex>> motion_subspace(KaneContext& ctx, int j) {
   std::vector<std::vector<ex>> S;
   ctx.C.group = b.name;
   const SV3 axis = ctx.cvec(b.joint.axis_J, b.name + "_axis", "", "joint axis");
-  switch (b.joint.type) {
+  switch (b.joint.prescribed() ? JointType::fixed : b.joint.type) {  // a prescribed joint has no column
     case JointType::revolute: {
       std::vector<ex> col(6 + m, ex(0));
       for (int a = 0; a < 3; ++a) col[3 + a] = axis[a];
@@ -104,14 +104,14 @@ ex applied_force(KaneContext& ctx, int j, int own) {
   const int r = b.u_joint + own;
   ex f = ctx.x.tau[r];
   ctx.C.group = b.name;
-  if (own < joint_nu(b.joint.type) && (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic)) {
+  if (own < joint_nu(b.joint) && (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic)) {
     const ex kk = ctx.c(b.joint.stiffness, b.name + "_k", "N m/rad or N/m", "joint spring stiffness");
     const ex cc = ctx.c(b.joint.damping, b.name + "_c", "N m s/rad or N s/m", "joint damping");
     const ex rest = ctx.c(b.joint.rest, b.name + "_rest", "rad or m", "spring rest value");
     f -= kk * (ctx.x.q[b.q_joint] - rest) + cc * ctx.x.u[b.u_joint];
   }
-  if (own >= joint_nu(b.joint.type)) {
-    const int i = own - joint_nu(b.joint.type);
+  if (own >= joint_nu(b.joint)) {
+    const int i = own - joint_nu(b.joint);
     const ex K = ctx.c(b.flex->K(i), fmt::format("{}_K{}", b.name, i + 1), "N m", "modal stiffness");
     const ex D = ctx.c(b.flex->D(i), fmt::format("{}_D{}", b.name, i + 1), "N m s", "modal damping");
     f -= K * ctx.x.q[b.q_eta + i] + D * ctx.x.u[b.u_eta + i];

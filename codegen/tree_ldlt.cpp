@@ -15,7 +15,7 @@ std::vector<ex> solve_tree_ldlt(KaneContext& ctx, SMat H, std::vector<ex> b, std
   // lambda: parent of each dof in the dof tree
   std::vector<int> lambda(n, -1);
   for (const Body& bd : ctx.model.bodies) {
-    const int nown = joint_nu(bd.joint.type) + bd.n_modes();
+    const int nown = joint_nu(bd.joint) + bd.n_modes();
     if (nown == 0) continue;
     int prev = -1;
     if (bd.parent >= 0) {

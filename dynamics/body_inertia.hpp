@@ -11,9 +11,23 @@
 //   h_w   = w x (J_O w) + 2 (tr(G) w - G w),     G = Sum m_k (Phi_k eta_dot) s_k^T
 //   h_eta = Sum m_k Phi_k^T (w x (w x s_k) + 2 w x Phi_k eta_dot)
 // so that the generalized inertia force of the body is -(M_body z_dot + h).
+//
+// Nodes with rotary inertia or foreshortening ("rich" nodes) are added one by
+// one (add_node_terms): a point mass at s_k = rho_k + Phi_k eta + 1/2
+// gamma_k(eta), velocity v_O + w x s_k + Phi~_k eta_dot (Phi~_k = Phi_k +
+// G_k(eta)), acceleration A_k z_dot + b_k with A_k = [I, -s_k^x, Phi~_k] and
+// b_k = w x (w x s_k) + 2 w x Phi~_k eta_dot + [eta_dot^T Gamma_k^a eta_dot]_a;
+// and a rotary inertia J_k carried by the node frame C(Psi_k eta): J'_k = C J_k
+// C^T, angular velocity w_k = w + H_k eta_dot, H_k = (I + g^x) Psi_k / (1 + g.g),
+// g = Psi_k eta / 2, angular acceleration Omega_k z_dot + beta_k with
+// Omega_k = [0, I, H_k], beta_k = w x H_k eta_dot - (2 g.g_dot / (1 + g.g)) H_k eta_dot.
+// They add m_k A_k^T A_k + Omega_k^T J'_k Omega_k to M_body,
+// m_k A_k^T b_k + Omega_k^T (J'_k beta_k + w_k x J'_k w_k) to h and
+// m_k A_k^T g_B to g: exact, nothing truncated in eta (dynamics.md).
 #pragma once
 
 #include "model/modal_integrals.hpp"
+#include "model/model.hpp"
 #include "model/rotation.hpp"
 
 namespace kanegen {
@@ -91,6 +105,96 @@ void compute_body_inertia(const BodyMassIntegrals& I, const VecS& eta, const Vec
   h_body.template segment<3>(3) = w.cross(J_O * w) + h_w_extra;
   g_body.template head<3>() = S(I.mass) * g_B;
   g_body.template segment<3>(3) = S_B.cross(g_B);
+}
+
+/// First mass moment about O of the integrated part (rigid part and plain nodes).
+template <class S, class VecS>
+V3<S> integrated_first_moment(const BodyMassIntegrals& I, const VecS& eta) {
+  V3<S> S_B = I.S0.cast<S>();
+  if (I.m) S_B.noalias() += as_scalar<S>(I.B) * eta;
+  return S_B;
+}
+
+/// Adds node k of `flex` (a rich node) to M_body, h_body, g_body and to the
+/// first moment S_B (header comment). Phi_t, H, JH: 3 x m scratch; tmp: m scratch.
+template <class S, class VecS, class MatS, class Mat3m>
+void add_node_terms(const FlexibleData& flex, int k, const VecS& eta, const VecS& eta_dot, const V3<S>& w,
+                    const V3<S>& g_B, MatS& M_body, VecS& h_body, VecS& g_body, V3<S>& S_B, Mat3m& Phi_t, Mat3m& H,
+                    Mat3m& JH, VecS& tmp) {
+  const int m = flex.modes();
+  const ModalNode& node = flex.nodes[k];
+  const M3<S> I3 = M3<S>::Identity();
+  if (node.mass != 0.0) {
+    const S mk = S(node.mass);
+    V3<S> s_k = node.rho_B.cast<S>();
+    Phi_t = as_scalar<S>(flex.Phi.template middleRows<3>(3 * k));
+    if (m) s_k.noalias() += Phi_t * eta;
+    V3<S> gamma_dd = V3<S>::Zero();  // [eta_dot^T Gamma^a eta_dot]_a
+    if (flex.has_second_order(k))
+      for (int a = 0; a < 3; ++a) {
+        const MatX& G = flex.Gamma[k][a];
+        if (G.size() == 0) continue;
+        tmp.noalias() = as_scalar<S>(G) * eta;
+        s_k(a) += S(0.5) * eta.dot(tmp);
+        Phi_t.row(a) += tmp.transpose();
+        tmp.noalias() = as_scalar<S>(G) * eta_dot;
+        gamma_dd(a) = eta_dot.dot(tmp);
+      }
+    const M3<S> sx = skew<S>(s_k);
+    M_body.template block<3, 3>(0, 0) += mk * I3;
+    M_body.template block<3, 3>(0, 3) -= mk * sx;
+    M_body.template block<3, 3>(3, 0) += mk * sx;
+    M_body.template block<3, 3>(3, 3) += mk * (s_k.squaredNorm() * I3 - s_k * s_k.transpose());
+    V3<S> v_rel = V3<S>::Zero();
+    if (m) {
+      M_body.block(0, 6, 3, m) += mk * Phi_t;
+      M_body.block(6, 0, m, 3) += mk * Phi_t.transpose();
+      JH.noalias() = sx * Phi_t;  // JH as scratch: s_k^x Phi~_k
+      M_body.block(3, 6, 3, m) += mk * JH;
+      M_body.block(6, 3, m, 3) += mk * JH.transpose();
+      M_body.block(6, 6, m, m).noalias() += (mk * Phi_t.transpose()) * Phi_t;
+      v_rel.noalias() = Phi_t * eta_dot;
+    }
+    const V3<S> b = w.cross(w.cross(s_k)) + S(2) * w.cross(v_rel) + gamma_dd;
+    h_body.template head<3>() += mk * b;
+    h_body.template segment<3>(3) += mk * s_k.cross(b);
+    g_body.template head<3>() += mk * g_B;
+    g_body.template segment<3>(3) += mk * s_k.cross(g_B);
+    if (m) {
+      h_body.tail(m).noalias() += mk * Phi_t.transpose() * b;
+      g_body.tail(m).noalias() += mk * Phi_t.transpose() * g_B;
+    }
+    S_B += mk * s_k;
+  }
+  if (!node.J_B.isZero(0.0)) {
+    const auto Psi_k = as_scalar<S>(flex.Psi.template middleRows<3>(3 * k));
+    V3<S> theta = V3<S>::Zero(), g_dot = V3<S>::Zero();
+    if (m) {
+      theta.noalias() = Psi_k * eta;
+      g_dot.noalias() = Psi_k * eta_dot;
+      g_dot /= S(2);
+    }
+    const V3<S> g = theta / S(2);
+    const S denom = S(1) + g.dot(g);
+    const M3<S> C = rodrigues_R<S>(theta);
+    const M3<S> Jp = C * node.J_B.cast<S>() * C.transpose();
+    V3<S> w_rel = V3<S>::Zero();
+    M_body.template block<3, 3>(3, 3) += Jp;
+    if (m) {
+      H.noalias() = (I3 + skew<S>(g)) * Psi_k;
+      H /= denom;
+      JH.noalias() = Jp * H;
+      M_body.block(3, 6, 3, m) += JH;
+      M_body.block(6, 3, m, 3) += JH.transpose();
+      M_body.block(6, 6, m, m).noalias() += H.transpose() * JH;
+      w_rel.noalias() = H * eta_dot;
+    }
+    const V3<S> w_k = w + w_rel;
+    const V3<S> beta = w.cross(w_rel) - (S(2) * g.dot(g_dot) / denom) * w_rel;
+    const V3<S> torque = Jp * beta + w_k.cross(Jp * w_k);
+    h_body.template segment<3>(3) += torque;
+    if (m) h_body.tail(m).noalias() += H.transpose() * torque;
+  }
 }
 
 }  // namespace kanegen

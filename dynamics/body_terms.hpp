@@ -13,8 +13,12 @@ void compute_body_terms(const Model& model, Workspace<S>& ws) {
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
     BodyWorkspace<S>& s = ws.body[i];
     const V3<S> g_B = s.R_NB.transpose() * g_N;
-    compute_body_inertia<S>(model.bodies[i].integrals, s.eta, s.eta_dot, s.w_B, g_B, s.M_body, s.h_body, s.g_body,
-                            s.Q);
+    const Body& b = model.bodies[i];
+    compute_body_inertia<S>(b.integrals, s.eta, s.eta_dot, s.w_B, g_B, s.M_body, s.h_body, s.g_body, s.Q);
+    s.S_B = integrated_first_moment<S>(b.integrals, s.eta);
+    for (int k : b.rich_nodes)
+      add_node_terms<S>(*b.flex, k, s.eta, s.eta_dot, s.w_B, g_B, s.M_body, s.h_body, s.g_body, s.S_B, s.node_Phi,
+                        s.node_H, s.node_JH, s.node_m);
   }
 }
 

@@ -43,11 +43,9 @@ Energy<S> compute_energy(const Model& model, Workspace<S>& ws, const VecQ& q) {
     BodyWorkspace<S>& s = ws.body[i];
     detail::body_momentum(s);
     E.T += S(0.5) * s.z.dot(s.Mz);
-    V3<S> S_B = b.integrals.S0.cast<S>();
-    if (b.n_modes()) S_B.noalias() += as_scalar<S>(b.integrals.B) * s.eta;
-    E.V -= g_N.dot(S(b.integrals.mass) * s.r_NO_N + s.R_NB * S_B);
+    E.V -= g_N.dot(S(b.total_mass) * s.r_NO_N + s.R_NB * s.S_B);
     const Joint& j = b.joint;
-    if (j.type == JointType::revolute || j.type == JointType::prismatic) {
+    if ((j.type == JointType::revolute || j.type == JointType::prismatic) && !j.prescribed()) {
       const S dq = S(q(b.q_joint)) - S(j.rest);
       E.V += S(0.5 * j.stiffness) * dq * dq;
     }

@@ -12,7 +12,7 @@ namespace kanegen {
 template <class S, class VecQ, class VecU, class VecQd>
 void compute_qdot(const Model& model, const VecQ& q, const VecU& u, VecQd& qdot) {
   for (const Body& b : model.bodies) {
-    switch (b.joint.type) {
+    switch (b.joint.prescribed() ? JointType::fixed : b.joint.type) {  // a prescribed joint has no q
       case JointType::revolute:
       case JointType::prismatic: qdot(b.q_joint) = S(u(b.u_joint)); break;
       case JointType::fixed: break;

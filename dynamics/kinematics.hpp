@@ -14,7 +14,15 @@
 //             + w_J_dot_R x e + w_J x (w_J x e) + w_J x e_dot + (w_J + w_rel) x e_dot
 // At a node k with rotational shapes Psi_k: R_PJ = C(Psi_k eta_P) R_J0 (Rodrigues,
 // g = Psi_k eta_P / 2), w_J = (I + g^x) Psi_k eta_dot_P / (1 + g.g) and
-// w_J_dot_R = -(2 g.g_dot / (1 + g.g)) w_J.
+// w_J_dot_R = -(2 g.g_dot / (1 + g.g)) w_J. The node's displaced position is
+// p_PJ = rho_k + Phi_k eta_P + 1/2 gamma_k(eta_P) (foreshortening), so its
+// velocity is v_node = Phi~_k eta_dot_P with Phi~_k = Phi_k + G_k(eta_P)
+// (row a of G_k: (Gamma_k^a eta_P)^T) and its acceleration gains the
+// remainder [eta_dot_P^T Gamma_k^a eta_dot_P]_a.
+// A prescribed joint (motion:) moves as a degree of freedom would with
+// q = f(t), u = f_dot(t) but has no partial-velocity column: its known
+// acceleration f_ddot times that column (the axis, angular for a revolute
+// joint, linear for a prismatic one) joins the remainder accelerations.
 #pragma once
 
 #include <cmath>
@@ -26,7 +34,7 @@
 namespace kanegen {
 
 template <class S, class VecQ, class VecU>
-void compute_kinematics(const Model& model, Workspace<S>& ws, const VecQ& q, const VecU& u) {
+void compute_kinematics(const Model& model, Workspace<S>& ws, double t, const VecQ& q, const VecU& u) {
   using std::sqrt;
   const M3<S> I3 = M3<S>::Identity();
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
@@ -51,8 +59,10 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, const VecQ& q, con
     V3<S> p_PJ = b.joint.p_PJ.cast<S>();
     V3<S> w_J = V3<S>::Zero();        // angular velocity of J relative to P, P components
     V3<S> w_J_dot_R = V3<S>::Zero();  // its remainder rate
-    V3<S> v_node = V3<S>::Zero();     // Phi_k eta_dot_P
+    V3<S> v_node = V3<S>::Zero();     // Phi~_k eta_dot_P
+    V3<S> a_node_R = V3<S>::Zero();   // [eta_dot_P^T Gamma_k^a eta_dot_P]_a
     auto& H = s.H_node;
+    auto& Phi_t = s.Phi_node;         // Phi~_k = Phi_k + G_k(eta_P)
     const int m_P = has_parent ? model.bodies[b.parent].n_modes() : 0;
     const FlexibleData* pf_ptr = b.joint.node >= 0 ? &*model.bodies[b.parent].flex : nullptr;
     if (b.joint.node >= 0) {
@@ -65,15 +75,36 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, const VecQ& q, con
       const S denom = S(1) + g.dot(g);
       R_PJ = rodrigues_R<S>(theta) * R_PJ;
       p_PJ = pf.nodes[k].rho_B.cast<S>() + Phi_k * p->eta;
+      Phi_t = Phi_k;
+      if (pf.has_second_order(k)) {
+        auto& Gx = s.Gx_node;  // scratch, m_P
+        for (int a = 0; a < 3; ++a) {
+          const MatX& G = pf.Gamma[k][a];
+          if (G.size() == 0) continue;
+          Gx.noalias() = as_scalar<S>(G) * p->eta;
+          p_PJ(a) += S(0.5) * p->eta.dot(Gx);
+          Phi_t.row(a) += Gx.transpose();
+          Gx.noalias() = as_scalar<S>(G) * p->eta_dot;
+          a_node_R(a) = p->eta_dot.dot(Gx);
+        }
+      }
       H.noalias() = (I3 + skew<S>(g)) * Psi_k;
       H /= denom;
       w_J = H * p->eta_dot;
       const V3<S> g_dot = Psi_k * p->eta_dot / S(2);
       w_J_dot_R = -(S(2) * g.dot(g_dot) / denom) * w_J;
-      v_node = Phi_k * p->eta_dot;
+      v_node = Phi_t * p->eta_dot;
     }
 
-    // Joint motion.
+    // Joint motion; a prescribed joint's coordinate, rate and acceleration
+    // come from its motion at t.
+    S q_j = S(0), u_j = S(0), f_ddot = S(0);
+    if (b.joint.prescribed()) {
+      const MotionValue mv = b.joint.motion->at(t);
+      q_j = S(mv.f), u_j = S(mv.f_dot), f_ddot = S(mv.f_ddot);
+    } else if (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic) {
+      q_j = S(q(b.q_joint)), u_j = S(u(b.u_joint));
+    }
     M3<S> R_JB = I3;
     V3<S> e = V3<S>::Zero();      // O_B - origin of J, P components
     V3<S> e_dot = V3<S>::Zero();  // its rate seen in J, P components
@@ -81,12 +112,12 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, const VecQ& q, con
     const V3<S> a_J = b.joint.axis_J.cast<S>();
     switch (b.joint.type) {
       case JointType::revolute:
-        R_JB = axis_angle_R<S>(b.joint.axis_J, S(q(b.q_joint)));
-        w_rel = R_PJ * a_J * S(u(b.u_joint));
+        R_JB = axis_angle_R<S>(b.joint.axis_J, q_j);
+        w_rel = R_PJ * a_J * u_j;
         break;
       case JointType::prismatic:
-        e = R_PJ * a_J * S(q(b.q_joint));
-        e_dot = R_PJ * a_J * S(u(b.u_joint));
+        e = R_PJ * a_J * q_j;
+        e_dot = R_PJ * a_J * u_j;
         break;
       case JointType::fixed: break;
       case JointType::free: {
@@ -115,7 +146,11 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, const VecQ& q, con
     s.v_O_B = R_BP * (v_P + w_P.cross(d) + v_rel);
     s.alpha_R_B = R_BP * (alR_P + w_P.cross(w_BP) + w_J_dot_R + w_J.cross(w_rel));
     s.a_R_B = R_BP * (aR_P + alR_P.cross(d) + w_P.cross(w_P.cross(d)) + S(2) * w_P.cross(v_rel) +
-                      w_J_dot_R.cross(e) + w_J.cross(w_J.cross(e)) + w_J.cross(e_dot) + w_BP.cross(e_dot));
+                      w_J_dot_R.cross(e) + w_J.cross(w_J.cross(e)) + w_J.cross(e_dot) + w_BP.cross(e_dot) + a_node_R);
+    if (b.joint.prescribed()) {  // the known acceleration along the joint's column (axis in B = axis in J)
+      if (b.joint.type == JointType::revolute) s.alpha_R_B += a_J * f_ddot;
+      else s.a_R_B += a_J * f_ddot;
+    }
     if (has_parent) {
       s.R_NB = p->R_NB * s.R_PB;
       s.r_NO_N = p->r_NO_N + p->R_NB * d;
@@ -136,20 +171,20 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, const VecQ& q, con
       s.P.block(3, 0, 3, k_P).noalias() = R_BP * W_P;
       if (b.joint.node >= 0) {  // ... plus the node's motion driven by the parent's modes
         const int c0 = k_P - m_P;
-        s.P.block(0, c0, 3, m_P).noalias() += R_BP * as_scalar<S>(pf_ptr->Phi.template middleRows<3>(3 * b.joint.node));
+        s.P.block(0, c0, 3, m_P).noalias() += R_BP * Phi_t;
         s.P.block(0, c0, 3, m_P).noalias() -= (R_BP * skew<S>(e)) * H;
         s.P.block(3, c0, 3, m_P).noalias() += R_BP * H;
       }
     }
     // ... then the joint's own columns (axis in B equals axis in J for both joints) ...
-    switch (b.joint.type) {
+    switch (b.joint.prescribed() ? JointType::fixed : b.joint.type) {
       case JointType::revolute: s.P.block(3, k_P, 3, 1) = a_J; break;
       case JointType::prismatic: s.P.block(0, k_P, 3, 1) = a_J; break;
       case JointType::fixed: break;
       case JointType::free: s.P.block(0, k_P, 6, 6).setIdentity(); break;
     }
     // ... and the body's own modal speeds.
-    const int c_eta = k_P + joint_nu(b.joint.type);
+    const int c_eta = k_P + joint_nu(b.joint);
     for (int k = 0; k < m; ++k) s.P(6 + k, c_eta + k) = S(1);
   }
 }

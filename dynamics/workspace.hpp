@@ -40,6 +40,14 @@ struct BodyWorkspace {
   MatS MP;           ///< (6+m) x k scratch: M_body * P
   Eigen::Matrix<S, 6, 1> wrench_B;  ///< reaction on the body from its parent [force; torque about O_B], B
   Eigen::Matrix<S, 3, Eigen::Dynamic> H_node;  ///< 3 x m_parent: w_J = H eta_dot_parent (at a node)
+  Eigen::Matrix<S, 3, Eigen::Dynamic> Phi_node;  ///< 3 x m_parent: v_node = Phi~ eta_dot_parent (at a node)
+  VecS Gx_node;      ///< m_parent scratch: Gamma_k^a times eta or eta_dot (at a node)
+  V3<S> S_B;         ///< first mass moment about O_B of the whole body (rigid part and every node), B
+  // Scratch of the node-by-node terms (body_inertia.hpp, add_node_terms):
+  Eigen::Matrix<S, 3, Eigen::Dynamic> node_Phi;  ///< 3 x m: Phi~_k = Phi_k + G_k(eta)
+  Eigen::Matrix<S, 3, Eigen::Dynamic> node_H;    ///< 3 x m: node frame's angular velocity per eta_dot
+  Eigen::Matrix<S, 3, Eigen::Dynamic> node_JH;   ///< 3 x m: J'_k H
+  VecS node_m;       ///< m scratch
   VecS Q[3][3];      ///< m each: Sum m_k s_k[a] Phi_k[b,:] (body_inertia.hpp scratch)
 };
 
@@ -67,6 +75,12 @@ struct Workspace {
       w.MP = MatS::Zero(6 + m, k);
       const int m_parent = b.parent >= 0 ? model.bodies[b.parent].n_modes() : 0;
       w.H_node = Eigen::Matrix<S, 3, Eigen::Dynamic>::Zero(3, b.joint.node >= 0 ? m_parent : 0);
+      w.Phi_node = Eigen::Matrix<S, 3, Eigen::Dynamic>::Zero(3, b.joint.node >= 0 ? m_parent : 0);
+      w.Gx_node = VecS::Zero(b.joint.node >= 0 ? m_parent : 0);
+      w.node_Phi = Eigen::Matrix<S, 3, Eigen::Dynamic>::Zero(3, m);
+      w.node_H = Eigen::Matrix<S, 3, Eigen::Dynamic>::Zero(3, m);
+      w.node_JH = Eigen::Matrix<S, 3, Eigen::Dynamic>::Zero(3, m);
+      w.node_m = VecS::Zero(m);
       for (auto& row : w.Q)
         for (auto& v : row) v = VecS::Zero(m);
     }

@@ -16,8 +16,7 @@ GenericEngine::GenericEngine(const Model& model)
     : Engine(model), ws_(model), llt_(model.nu), zero_u_(VecX::Zero(model.nu)) {}
 
 void GenericEngine::update(double t, const VecX& q, const VecX& u) {
-  (void)t;
-  compute_kinematics(model(), ws_, q, u);
+  compute_kinematics(model(), ws_, t, q, u);
   compute_body_terms(model(), ws_);
 }
 

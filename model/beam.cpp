@@ -1,15 +1,25 @@
-// Euler–Bernoulli cantilever, lumped masses (beam.hpp).
+// Euler–Bernoulli cantilever, lumped masses and rotary inertias (beam.hpp).
 //
 // Nodes k = 0..n at s_k = k h along the beam direction d (h = L/n); node 0 is
-// clamped at the body origin. Element mass mu h is lumped half to each end, so
-// the nodes carry exactly the beam's mass (node 0 rigidly). Per free node the
-// degrees of freedom are the transverse displacements w1, w2 along
-// t1 = n1 x d, t2 = n2 x d (n1, n2 the normal axes in cyclic order), the
-// bending rotations th1, th2 about n1, n2 (th_i = w_i'), and, with EA, the
-// axial displacement. The lumped nodes have no rotary inertia, so the
-// rotations are condensed statically (exact for this mass model); torsion
-// carries no inertia and therefore no modes (GJ is accepted, it only
-// stiffens). Shapes are mass-normalized: sum_k m_k t_k.t_k = 1.
+// clamped at the body origin. Each element's mass mu h, rotary inertias
+// rhoI_p h and polar inertia rhoJ h are lumped half to each end, so the nodes
+// carry exactly the beam's mass and inertia (node 0 rigidly). Degrees of
+// freedom per free node: in each bending plane p (normal axis n_p,
+// deflection along t_p = n_p x d) the deflection w_p and the slope
+// th_p = w_p' (a rotation about n_p), with the Hermite-cubic element
+// stiffness of EI_p; with GJ the twist phi about d (linear elements); with EA
+// the axial displacement (linear elements). Where a plane has no rotary
+// inertia its slopes carry no inertia and are condensed statically (exact for
+// this mass model); torsion needs a polar inertia to have modes.
+//
+// Each problem K x = lambda M x (M diagonal) is solved as the symmetric
+// problem of M^-1/2 K M^-1/2, so the shapes come out mass-normalized:
+// Sum_k m_k t_k.t_k + r_k.J_k r_k = 1.
+//
+// Foreshortening (dynamics.md): mode i's deflection w_i(s) in its plane is the
+// cubic Hermite interpolation of its nodal deflections and slopes, and node k
+// gets Gamma_k^d_ij = -Integral_0^{s_k} w_i'(s).w_j'(s) ds along d, integrated
+// exactly per element (3-point Gauss-Legendre: the integrand is a quartic).
 #include "model/beam.hpp"
 
 #include <algorithm>
@@ -22,73 +32,102 @@ namespace kanegen {
 
 namespace {
 
+enum class Kind { bend0, bend1, torsion, axial };
+
 struct BeamMode {
-  double lambda;   // omega^2
-  int kind;        // 0, 1: bending with deflection along t1, t2; 2: axial
-  VecX w;          // n translations (free nodes 1..n), mass-normalized
-  VecX th;         // n bending rotations (empty for axial)
+  double lambda;  // omega^2
+  Kind kind;
+  VecX x;         // n values (free nodes 1..n): deflection, twist or axial displacement
+  VecX th;        // n bending slopes (bending modes only)
 };
 
-/// Modes of one decoupled problem: bending in one plane (stiffness EI) or,
-/// with bending = false, axial (stiffness EA). Node masses m(1..n).
-void solve_plane(bool bending, double EIorEA, double h, int n, const VecX& m, int kind, std::vector<BeamMode>& out) {
-  MatX Ktt = MatX::Zero(n, n);
-  MatX Ktr = MatX::Zero(n, n), Krr = MatX::Zero(n, n);
-  if (bending) {
-    const double c = EIorEA / (h * h * h);
-    const double ke[4][4] = {{12, 6 * h, -12, 6 * h},
-                             {6 * h, 4 * h * h, -6 * h, 2 * h * h},
-                             {-12, -6 * h, 12, -6 * h},
-                             {6 * h, 2 * h * h, -6 * h, 4 * h * h}};
-    for (int e = 0; e < n; ++e) {
-      // element from node e to e + 1, dofs (w_e, th_e, w_e+1, th_e+1); node 0 clamped.
-      // Free node k has index k - 1 in both the w and the th block.
-      const int idx[4] = {e - 1, e - 1, e, e};
-      const bool rot[4] = {false, true, false, true};
-      for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b) {
-          if (idx[a] < 0 || idx[b] < 0) continue;
-          const double v = c * ke[a][b];
-          if (!rot[a] && !rot[b]) Ktt(idx[a], idx[b]) += v;
-          if (!rot[a] && rot[b]) Ktr(idx[a], idx[b]) += v;
-          if (rot[a] && rot[b]) Krr(idx[a], idx[b]) += v;
-        }
-    }
-  } else {
-    const double c = EIorEA / h;
-    for (int e = 0; e < n; ++e) {
-      Ktt(e, e) += c;
-      if (e > 0) {
-        Ktt(e - 1, e - 1) += c;
-        Ktt(e - 1, e) -= c;
-        Ktt(e, e - 1) -= c;
-      }
-    }
-  }
-  MatX G;  // th = -G w (static condensation: the lumped nodes have no rotary inertia)
-  MatX Kc = Ktt;
-  if (bending) {
-    const Eigen::LLT<MatX> Lrr(Krr);
-    if (Lrr.info() != Eigen::Success) throw std::runtime_error("singular rotational stiffness");
-    G = Lrr.solve(Ktr.transpose());
-    Kc -= Ktr * G;
-  }
-  const VecX s = m.cwiseSqrt().cwiseInverse();
-  MatX A = s.asDiagonal() * Kc * s.asDiagonal();
+/// K x = lambda M x for diagonal M > 0: eigenpairs, x mass-normalized, sign
+/// fixed (largest |entry| of the first block positive).
+void solve_diagonal_mass(const MatX& K, const VecX& Mdiag, int sign_block, std::vector<std::pair<double, VecX>>& out) {
+  const VecX s = Mdiag.cwiseSqrt().cwiseInverse();
+  MatX A = s.asDiagonal() * K * s.asDiagonal();
   A = 0.5 * (A + A.transpose());
   Eigen::SelfAdjointEigenSolver<MatX> es(A);
   if (es.info() != Eigen::Success) throw std::runtime_error("eigenvalue problem failed");
-  for (int j = 0; j < n; ++j) {
-    BeamMode md;
-    md.lambda = std::max(es.eigenvalues()(j), 0.0);
-    md.kind = kind;
-    md.w = s.asDiagonal() * es.eigenvectors().col(j);
-    Eigen::Index imax = 0;  // deterministic sign: largest translation positive
-    md.w.cwiseAbs().maxCoeff(&imax);
-    if (md.w(imax) < 0) md.w = -md.w;
-    if (bending) md.th = -G * md.w;
-    out.push_back(std::move(md));
+  for (Eigen::Index j = 0; j < A.rows(); ++j) {
+    VecX x = s.asDiagonal() * es.eigenvectors().col(j);
+    Eigen::Index imax = 0;
+    x.head(sign_block).cwiseAbs().maxCoeff(&imax);
+    if (x(imax) < 0) x = -x;
+    out.emplace_back(std::max(es.eigenvalues()(j), 0.0), x);
   }
+}
+
+/// Bending in one plane: stiffness EI, node masses m (free nodes), slope
+/// inertias Jr (free nodes; all zero: slopes condensed).
+void solve_bending(double EI, double h, int n, const VecX& m, const VecX& Jr, Kind kind, std::vector<BeamMode>& out) {
+  // Free dofs: w_1..w_n (block 0), th_1..th_n (block 1).
+  MatX K = MatX::Zero(2 * n, 2 * n);
+  const double c = EI / (h * h * h);
+  const double ke[4][4] = {{12, 6 * h, -12, 6 * h},
+                           {6 * h, 4 * h * h, -6 * h, 2 * h * h},
+                           {-12, -6 * h, 12, -6 * h},
+                           {6 * h, 2 * h * h, -6 * h, 4 * h * h}};
+  for (int e = 0; e < n; ++e) {
+    // element from node e to e + 1, dofs (w_e, th_e, w_e+1, th_e+1); node 0 clamped.
+    const int node[4] = {e, e, e + 1, e + 1};
+    const bool rot[4] = {false, true, false, true};
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) {
+        if (node[a] == 0 || node[b] == 0) continue;
+        const int ia = (rot[a] ? n : 0) + node[a] - 1, ib = (rot[b] ? n : 0) + node[b] - 1;
+        K(ia, ib) += c * ke[a][b];
+      }
+  }
+  std::vector<std::pair<double, VecX>> pairs;
+  if (Jr.minCoeff() > 0) {
+    VecX M(2 * n);
+    M << m, Jr;
+    solve_diagonal_mass(K, M, n, pairs);
+    for (auto& [lambda, x] : pairs) out.push_back({lambda, kind, x.head(n), x.tail(n)});
+    return;
+  }
+  // th = -G w: the slopes carry no inertia (static condensation, exact here).
+  const MatX Ktt = K.topLeftCorner(n, n), Ktr = K.topRightCorner(n, n), Krr = K.bottomRightCorner(n, n);
+  const Eigen::LLT<MatX> Lrr(Krr);
+  if (Lrr.info() != Eigen::Success) throw std::runtime_error("singular rotational stiffness");
+  const MatX G = Lrr.solve(Ktr.transpose());
+  solve_diagonal_mass(Ktt - Ktr * G, m, n, pairs);
+  for (auto& [lambda, x] : pairs) out.push_back({lambda, kind, x, -G * x});
+}
+
+/// Torsion or axial: linear elements of stiffness k_per_length / h, masses M (free nodes).
+void solve_linear(double stiffness, double h, int n, const VecX& M, Kind kind, std::vector<BeamMode>& out) {
+  MatX K = MatX::Zero(n, n);
+  const double c = stiffness / h;
+  for (int e = 0; e < n; ++e) {  // element e .. e+1; free node k has index k - 1
+    K(e, e) += c;
+    if (e > 0) {
+      K(e - 1, e - 1) += c;
+      K(e - 1, e) -= c;
+      K(e, e - 1) -= c;
+    }
+  }
+  std::vector<std::pair<double, VecX>> pairs;
+  solve_diagonal_mass(K, M, n, pairs);
+  for (auto& [lambda, x] : pairs) out.push_back({lambda, kind, x, VecX()});
+}
+
+/// Integral over one element of w_i'(s) w_j'(s) ds for Hermite cubics given
+/// by end values (wa, ta, wb, tb) of each.
+double element_slope_product(double h, const double (&di)[4], const double (&dj)[4]) {
+  // dw/ds = (1/h) [N1' wa + h N2' ta + N3' wb + h N4' tb] (' = d/dxi)
+  static const double xg[3] = {0.5 - 0.5 * std::sqrt(0.6), 0.5, 0.5 + 0.5 * std::sqrt(0.6)};
+  static const double wg[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+  double sum = 0.0;
+  for (int g = 0; g < 3; ++g) {
+    const double x = xg[g];
+    const double dN[4] = {-6 * x + 6 * x * x, h * (1 - 4 * x + 3 * x * x), 6 * x - 6 * x * x, h * (-2 * x + 3 * x * x)};
+    double a = 0, b = 0;
+    for (int k = 0; k < 4; ++k) a += dN[k] * di[k], b += dN[k] * dj[k];
+    sum += wg[g] * a * b;
+  }
+  return sum / h;  // (1/h)^2 from the derivatives, h from ds = h dxi
 }
 
 }  // namespace
@@ -96,10 +135,13 @@ void solve_plane(bool bending, double EIorEA, double h, int n, const VecX& m, in
 FlexibleData beam_modal_data(const BeamSpec& spec) {
   const int n = spec.elements;
   if (!(spec.length > 0) || !(spec.mass_per_length > 0) || n < 1 || spec.modes < 1 || !(spec.EI[0] > 0) ||
-      !(spec.EI[1] > 0) || spec.axis < 0 || spec.axis > 2 || (spec.sign != 1 && spec.sign != -1))
+      !(spec.EI[1] > 0) || spec.axis < 0 || spec.axis > 2 || (spec.sign != 1 && spec.sign != -1) ||
+      !(spec.rotary_inertia[0] >= 0) || !(spec.rotary_inertia[1] >= 0))
     throw std::invalid_argument("invalid beam specification");
+  const double polar = spec.polar_inertia.value_or(spec.rotary_inertia[0] + spec.rotary_inertia[1]);
+  const bool torsion = spec.GJ.has_value() && polar > 0;
   const bool axial = spec.EA.has_value();
-  const int available = (axial ? 3 : 2) * n;
+  const int available = 2 * n + (torsion ? n : 0) + (axial ? n : 0);
   if (spec.modes > available)
     throw std::invalid_argument("asks for " + std::to_string(spec.modes) + " modes but " + std::to_string(n) +
                                 " elements give only " + std::to_string(available) +
@@ -107,20 +149,21 @@ FlexibleData beam_modal_data(const BeamSpec& spec) {
 
   const double L = spec.length, h = L / n, mu = spec.mass_per_length;
   const Vec3 d = spec.sign * Vec3::Unit(spec.axis);
-  const Vec3 n1 = Vec3::Unit((spec.axis + 1) % 3), n2 = Vec3::Unit((spec.axis + 2) % 3);
-  const Vec3 t[2] = {n1.cross(d), n2.cross(d)};  // deflection whose slope is a rotation about n1, n2
-  const Vec3 nrm[2] = {n1, n2};
+  const Vec3 nrm[2] = {Vec3::Unit((spec.axis + 1) % 3), Vec3::Unit((spec.axis + 2) % 3)};
+  const Vec3 t[2] = {nrm[0].cross(d), nrm[1].cross(d)};  // deflection whose slope is a rotation about n_p
 
-  // node masses (node 0 included: it is part of the body's mass)
-  VecX mass(n + 1);
-  for (int k = 0; k <= n; ++k) mass(k) = (k == 0 || k == n) ? 0.5 * mu * h : mu * h;
-  const VecX mfree = mass.tail(n);
-
+  // Lumped node data (node 0 included: it is part of the body's mass).
+  VecX w(n + 1);  // share of an element
+  for (int k = 0; k <= n; ++k) w(k) = (k == 0 || k == n) ? 0.5 : 1.0;
+  const VecX mass = mu * h * w;
   std::vector<BeamMode> all;
-  solve_plane(true, spec.EI[0], h, n, mfree, 0, all);
-  solve_plane(true, spec.EI[1], h, n, mfree, 1, all);
-  if (axial) solve_plane(false, *spec.EA, h, n, mfree, 2, all);
+  for (int p = 0; p < 2; ++p)
+    solve_bending(spec.EI[p], h, n, mass.tail(n), spec.rotary_inertia[p] * h * w.tail(n), p == 0 ? Kind::bend0 : Kind::bend1,
+                  all);
+  if (torsion) solve_linear(*spec.GJ, h, n, polar * h * w.tail(n), Kind::torsion, all);
+  if (axial) solve_linear(*spec.EA, h, n, mass.tail(n), Kind::axial, all);
   std::stable_sort(all.begin(), all.end(), [](const BeamMode& a, const BeamMode& b) { return a.lambda < b.lambda; });
+  all.resize(spec.modes);
 
   const int m = spec.modes;
   FlexibleData flex;
@@ -130,6 +173,9 @@ FlexibleData beam_modal_data(const BeamSpec& spec) {
     node.id = k + 1;
     node.rho_B = (k * h) * d;
     node.mass = mass(k);
+    node.J_B = h * w(k) *
+               (spec.rotary_inertia[0] * nrm[0] * nrm[0].transpose() + spec.rotary_inertia[1] * nrm[1] * nrm[1].transpose() +
+                polar * d * d.transpose());
     flex.nodes.push_back(node);
   }
   flex.Phi = MatX::Zero(3 * (n + 1), m);
@@ -140,13 +186,42 @@ FlexibleData beam_modal_data(const BeamSpec& spec) {
     const BeamMode& md = all[j];
     flex.frequency_hz(j) = std::sqrt(md.lambda) / kTwoPi;
     for (int k = 1; k <= n; ++k) {
-      if (md.kind == 2) {
-        flex.Phi.block<3, 1>(3 * k, j) = md.w(k - 1) * d;
-      } else {
-        flex.Phi.block<3, 1>(3 * k, j) = md.w(k - 1) * t[md.kind];
-        flex.Psi.block<3, 1>(3 * k, j) = md.th(k - 1) * nrm[md.kind];
+      switch (md.kind) {
+        case Kind::bend0:
+        case Kind::bend1: {
+          const int p = md.kind == Kind::bend0 ? 0 : 1;
+          flex.Phi.block<3, 1>(3 * k, j) = md.x(k - 1) * t[p];
+          flex.Psi.block<3, 1>(3 * k, j) = md.th(k - 1) * nrm[p];
+          break;
+        }
+        case Kind::torsion: flex.Psi.block<3, 1>(3 * k, j) = md.x(k - 1) * d; break;
+        case Kind::axial: flex.Phi.block<3, 1>(3 * k, j) = md.x(k - 1) * d; break;
       }
     }
+  }
+
+  // Foreshortening: Gamma_k^d = -Integral_0^{s_k} w_i'.w_j' ds, along d.
+  flex.Gamma.assign(n + 1, {});
+  MatX acc = MatX::Zero(m, m);  // integral up to the current node
+  auto ends = [&](const BeamMode& md, int e, double (&v)[4]) {  // (w, th) at nodes e, e + 1
+    v[0] = e == 0 ? 0.0 : md.x(e - 1);
+    v[1] = e == 0 ? 0.0 : md.th(e - 1);
+    v[2] = md.x(e);
+    v[3] = md.th(e);
+  };
+  for (int e = 0; e < n; ++e) {
+    for (int i = 0; i < m; ++i) {
+      if (all[i].kind != Kind::bend0 && all[i].kind != Kind::bend1) continue;
+      for (int j = i; j < m; ++j) {
+        if (all[j].kind != all[i].kind) continue;  // w_i' . w_j' = 0 across planes
+        double di[4], dj[4];
+        ends(all[i], e, di);
+        ends(all[j], e, dj);
+        acc(i, j) += element_slope_product(h, di, dj);
+        acc(j, i) = acc(i, j);
+      }
+    }
+    if (!acc.isZero(0.0)) flex.Gamma[e + 1][spec.axis] = -spec.sign * acc;
   }
   flex.damping_ratio = VecX::Zero(m);
   flex.K = VecX::Zero(m);

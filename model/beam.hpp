@@ -1,6 +1,8 @@
 // Built-in flexible body: a uniform Euler–Bernoulli cantilever clamped at the
-// body origin (model-format.md, `flexible: beam:`), discretized by finite
-// elements with lumped nodal masses; its lowest modes become FlexibleData.
+// body origin (model-format.md `flexible: beam:`, extended in docs/models.md),
+// discretized by finite elements with lumped nodal masses and rotary
+// inertias; its lowest modes and, for foreshortening, the second-order node
+// displacements Gamma_k (dynamics.md) become FlexibleData.
 #pragma once
 
 #include <array>
@@ -19,14 +21,24 @@ struct BeamSpec {
                                      ///< order: x -> [y, z], y -> [z, x], z -> [x, y]
   std::optional<double> GJ;          ///< torsional stiffness, optional
   std::optional<double> EA;          ///< axial stiffness, optional
+  /// Rotary inertia per length of the cross-section about the two normal axes
+  /// (rho I, kg m; same order as EI); 0: Euler–Bernoulli (the bending slopes
+  /// are condensed statically).
+  std::array<double, 2> rotary_inertia{0.0, 0.0};
+  /// Polar inertia per length (rho J, kg m) for torsion; when not given, the
+  /// perpendicular-axis sum of rotary_inertia. Torsion modes need GJ and a
+  /// polar inertia > 0.
+  std::optional<double> polar_inertia;
   int elements = 0;                  ///< >= 1
   int modes = 0;                     ///< >= 1, lowest modes kept
 };
 
-/// Nodes (element ends; node 1 at the clamped origin), mass-normalized modes
-/// and frequencies of the cantilever. damping_ratio, K and D are left zero
-/// for the caller. Throws std::invalid_argument if the spec cannot give
-/// `modes` modes (e.g. more modes than finite degrees of freedom).
+/// Nodes (element ends; node 1 at the clamped origin, carried rigidly), their
+/// masses and rotary inertias, the mass-normalized modes (bending in both
+/// planes, torsion with GJ, axial with EA), their frequencies, and the
+/// second-order data Gamma_k along the beam (for every node but the root).
+/// damping_ratio, K and D are left zero for the caller. Throws
+/// std::invalid_argument if the spec cannot give `modes` modes.
 FlexibleData beam_modal_data(const BeamSpec& spec);
 
 }  // namespace kanegen

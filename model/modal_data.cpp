@@ -9,6 +9,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "model/output_file.hpp"
 #include "model/yaml_check.hpp"
 
 namespace kanegen {
@@ -27,6 +28,7 @@ struct RawMode {
   double frequency = 0.0;
   bool ok = true;
   Eigen::VectorXd t, r;  // 3 * nodes
+  double scale = 1.0;    // normalization factor applied to t and r
 };
 
 }  // namespace
@@ -44,7 +46,7 @@ FlexibleData load_modal_file(const std::string& path, const std::vector<int>& ke
     return flex;
   }
   if (!ck.expect_map(root, 1, "")) return flex;
-  ck.check_keys(root, "", {"nodes", "modes", "mass_normalized"});
+  ck.check_keys(root, "", {"nodes", "modes", "mass_normalized", "second_order"});
 
   // ---- nodes
   const YAML::Node nodes = root["nodes"];
@@ -225,58 +227,169 @@ FlexibleData load_modal_file(const std::string& path, const std::vector<int>& ke
     for (std::size_t i = 0; i < modes.size(); ++i) {
       RawMode& mode = modes[i];
       if (!mode.ok) continue;
+      // modal mass: translations with the node masses, rotations with the node inertias
       double mm = 0.0;
-      for (int k = 0; k < nn; ++k) mm += flex.nodes[k].mass * mode.t.segment<3>(3 * k).squaredNorm();
+      for (int k = 0; k < nn; ++k) {
+        const Eigen::Vector3d r = mode.r.segment<3>(3 * k);
+        mm += flex.nodes[k].mass * mode.t.segment<3>(3 * k).squaredNorm() + r.dot(flex.nodes[k].J_B * r);
+      }
       const std::string f = fmt::format("modes[{}].shapes", i);
       if (mass_normalized) {
         if (std::abs(mm - 1.0) > 1e-6) {
           ck.error(mode.shapes_line, f,
-                   fmt::format("modal mass sum_k m_k t_k.t_k = {} is not 1 (to within 1e-6); expected "
+                   fmt::format("modal mass sum_k (m_k t_k.t_k + r_k.J_k r_k) = {} is not 1 (to within 1e-6); expected "
                                "mass-normalized shapes, or set 'mass_normalized: false' to normalize them on load",
                                num(mm)));
           mode.ok = false;
         }
       } else if (!(mm > 0.0)) {
         ck.error(mode.shapes_line, f,
-                 "zero modal mass (the mode moves no node mass); expected a mode with sum_k m_k t_k.t_k > 0");
+                 "zero modal mass (the mode moves no node mass or inertia); expected a mode with "
+                 "sum_k (m_k t_k.t_k + r_k.J_k r_k) > 0");
         mode.ok = false;
       } else {
-        const double s = 1.0 / std::sqrt(mm);
-        mode.t *= s;
-        mode.r *= s;
+        mode.scale = 1.0 / std::sqrt(mm);
+        mode.t *= mode.scale;
+        mode.r *= mode.scale;
       }
     }
   }
 
-  // ---- selection
-  std::vector<int> sel;
-  if (keep.empty()) {
-    for (std::size_t i = 0; i < modes.size(); ++i) sel.push_back(static_cast<int>(i));
-  } else {
-    for (int k : keep) {
-      if (k < 1 || k > static_cast<int>(modes.size())) {
-        ck.error(0, "modes",
-                 fmt::format("mode {} requested, but the file has {} modes; expected 1-based mode numbers in 1..{}",
-                             k, modes.size(), modes.size()));
-      } else {
-        sel.push_back(k - 1);
+  // ---- second order (foreshortening): node id -> {x, y, z: M x M symmetric}
+  const int M = static_cast<int>(modes.size());
+  flex.Gamma.assign(nn, {});
+  const YAML::Node so = root["second_order"];
+  bool so_ok = true;
+  if (so.IsDefined() && nodes_ok && M > 0) {
+    if (!ck.expect_map(so, 1, "second_order")) {
+      so_ok = false;
+    } else {
+      for (auto it = so.begin(); it != so.end(); ++it) {
+        const int kl = line_of(it->first) ? line_of(it->first) : line_of(so);
+        auto id = ck.integer(it->first, kl, "second_order");
+        if (!id) {
+          so_ok = false;
+          continue;
+        }
+        const std::string f = fmt::format("second_order.{}", *id);
+        auto found = index_of_id.find(static_cast<int>(*id));
+        if (found == index_of_id.end()) {
+          ck.error(kl, f, fmt::format("no node with id {} in nodes; expected second-order data only for listed nodes",
+                                      *id));
+          so_ok = false;
+          continue;
+        }
+        const YAML::Node axes = it->second;
+        if (!ck.expect_map(axes, kl, f)) {
+          so_ok = false;
+          continue;
+        }
+        ck.check_keys(axes, f, {"x", "y", "z"});
+        auto& G = flex.Gamma[found->second];
+        for (int a = 0; a < 3; ++a) {
+          const char* axis = a == 0 ? "x" : a == 1 ? "y" : "z";
+          const YAML::Node mat = axes[axis];
+          if (!mat.IsDefined()) continue;
+          const std::string fa = f + "." + axis;
+          const int al = line_of(mat) ? line_of(mat) : kl;
+          if (!mat.IsSequence() || static_cast<int>(mat.size()) != M) {
+            ck.error(mat, al, fa,
+                     fmt::format("got {}; expected a {} x {} matrix (one row and column per mode of the file)",
+                                 yamlcheck::describe(mat), M, M));
+            so_ok = false;
+            continue;
+          }
+          Eigen::MatrixXd Gm(M, M);
+          bool rows_ok = true;
+          for (int r = 0; r < M; ++r) {
+            auto row = ck.vector(mat[r], al, fmt::format("{}[{}]", fa, r), M);
+            if (row)
+              Gm.row(r) = row->transpose();
+            else
+              rows_ok = false;
+          }
+          if (!rows_ok) {
+            so_ok = false;
+            continue;
+          }
+          const double scale = Gm.cwiseAbs().maxCoeff();
+          const double asym = (Gm - Gm.transpose()).cwiseAbs().maxCoeff();
+          if (asym > 1e-9 * scale) {
+            ck.error(mat, al, fa,
+                     fmt::format("not symmetric (largest |G - G^T| entry {}); expected a symmetric matrix", num(asym)));
+            so_ok = false;
+            continue;
+          }
+          Gm = 0.5 * (Gm + Gm.transpose());
+          // Shapes normalized on load: Gamma_ij scales with modes i's and j's factors.
+          for (int r = 0; r < M; ++r)
+            for (int c = 0; c < M; ++c) Gm(r, c) *= modes[r].scale * modes[c].scale;
+          G[a] = Gm;
+        }
       }
     }
   }
-  const int m = static_cast<int>(sel.size());
-  flex.Phi = Eigen::MatrixXd::Zero(3 * nn, m);
-  flex.Psi = Eigen::MatrixXd::Zero(3 * nn, m);
-  flex.frequency_hz = Eigen::VectorXd::Zero(m);
-  for (int j = 0; j < m; ++j) {
-    const RawMode& mode = modes[sel[j]];
-    flex.Phi.col(j) = mode.t;
-    flex.Psi.col(j) = mode.r;
-    flex.frequency_hz(j) = mode.frequency;
+  if (!so_ok) flex.Gamma.assign(nn, {});
+
+  // ---- all modes, then the selection
+  flex.Phi = Eigen::MatrixXd::Zero(3 * nn, M);
+  flex.Psi = Eigen::MatrixXd::Zero(3 * nn, M);
+  flex.frequency_hz = Eigen::VectorXd::Zero(M);
+  for (int j = 0; j < M; ++j) {
+    flex.Phi.col(j) = modes[j].t;
+    flex.Psi.col(j) = modes[j].r;
+    flex.frequency_hz(j) = modes[j].frequency;
   }
-  flex.damping_ratio = Eigen::VectorXd::Zero(m);
-  flex.K = Eigen::VectorXd::Zero(m);
-  flex.D = Eigen::VectorXd::Zero(m);
-  return flex;
+  flex.damping_ratio = Eigen::VectorXd::Zero(M);
+  flex.K = Eigen::VectorXd::Zero(M);
+  flex.D = Eigen::VectorXd::Zero(M);
+  if (keep.empty()) return flex;
+  std::vector<int> sel;
+  for (int k : keep) {
+    if (k < 1 || k > M)
+      ck.error(0, "modes",
+               fmt::format("mode {} requested, but the file has {} modes; expected 1-based mode numbers in 1..{}", k,
+                           M, M));
+    else
+      sel.push_back(k - 1);
+  }
+  return select_modes(flex, sel);
+}
+
+FlexibleData select_modes(const FlexibleData& in, const std::vector<int>& sel) {
+  FlexibleData s = in;
+  const int m = static_cast<int>(sel.size());
+  s.Phi.resize(in.Phi.rows(), m);
+  s.Psi.resize(in.Psi.rows(), m);
+  s.frequency_hz.resize(m);
+  s.damping_ratio = Eigen::VectorXd::Zero(m);
+  s.K = Eigen::VectorXd::Zero(m);
+  s.D = Eigen::VectorXd::Zero(m);
+  for (int c = 0; c < m; ++c) {
+    s.Phi.col(c) = in.Phi.col(sel[c]);
+    s.Psi.col(c) = in.Psi.col(sel[c]);
+    s.frequency_hz(c) = in.frequency_hz(sel[c]);
+  }
+  for (std::size_t k = 0; k < in.Gamma.size(); ++k)
+    for (int a = 0; a < 3; ++a) {
+      const Eigen::MatrixXd& G = in.Gamma[k][a];
+      if (G.size() == 0) continue;
+      Eigen::MatrixXd g(m, m);
+      for (int r = 0; r < m; ++r)
+        for (int c = 0; c < m; ++c) g(r, c) = G(sel[r], sel[c]);
+      s.Gamma[k][a] = g.isZero(0.0) ? Eigen::MatrixXd() : g;
+    }
+  return s;
+}
+
+Eigen::VectorXd modal_masses(const FlexibleData& f) {
+  Eigen::VectorXd Y = Eigen::VectorXd::Zero(f.modes());
+  for (int c = 0; c < f.modes(); ++c)
+    for (std::size_t k = 0; k < f.nodes.size(); ++k) {
+      const Eigen::Vector3d r = f.Psi.block<3, 1>(3 * k, c);
+      Y(c) += f.nodes[k].mass * f.Phi.block<3, 1>(3 * k, c).squaredNorm() + r.dot(f.nodes[k].J_B * r);
+    }
+  return Y;
 }
 
 static std::string lossless(double x) { return fmt::format("{}", x); }
@@ -314,10 +427,25 @@ void write_modal_file(const FlexibleData& flex, const std::string& path) {
     }
   }
   out += "mass_normalized: true\n";
-  std::ofstream f(path, std::ios::binary);
-  if (!f) throw std::runtime_error(fmt::format("{}: cannot open for writing", path));
-  f << out;
-  if (!f) throw std::runtime_error(fmt::format("{}: write failed", path));
+  bool any = false;
+  for (std::size_t k = 0; k < flex.nodes.size(); ++k) {
+    if (!flex.has_second_order(static_cast<int>(k))) continue;
+    if (!any) out += "second_order:\n";
+    any = true;
+    out += fmt::format("  {}:\n", flex.nodes[k].id);
+    for (int a = 0; a < 3; ++a) {
+      const Eigen::MatrixXd& G = flex.Gamma[k][a];
+      if (G.size() == 0) continue;
+      std::string rows;
+      for (Eigen::Index r = 0; r < G.rows(); ++r) {
+        std::string row;
+        for (Eigen::Index c = 0; c < G.cols(); ++c) row += (c ? ", " : "") + lossless(G(r, c));
+        rows += (r ? ", [" : "[") + row + "]";
+      }
+      out += fmt::format("    {}: [{}]\n", a == 0 ? "x" : a == 1 ? "y" : "z", rows);
+    }
+  }
+  write_file_atomically(path, out);
 }
 
 }  // namespace kanegen

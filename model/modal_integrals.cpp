@@ -23,12 +23,13 @@ BodyMassIntegrals compute_mass_integrals(const RigidPart& rigid, const FlexibleD
     for (auto& M : row) M = Eigen::MatrixXd::Zero(m, m);
   if (!flex) return I;
   for (std::size_t k = 0; k < flex->nodes.size(); ++k) {
+    if (flex->node_is_rich(static_cast<int>(k))) continue;  // handled node by node (body_inertia.hpp)
     const ModalNode& node = flex->nodes[k];
     const double mk = node.mass;
     const Eigen::MatrixXd Phi_k = flex->Phi.middleRows(3 * k, 3);  // 3 x m
     I.mass += mk;
     I.S0 += mk * node.rho_B;
-    I.J0 += node.J_B + point_inertia(mk, node.rho_B);
+    I.J0 += point_inertia(mk, node.rho_B);  // a plain node has no rotary inertia
     I.B += mk * Phi_k;
     I.Y += mk * Phi_k.transpose() * Phi_k;
     for (int a = 0; a < 3; ++a)

@@ -1,12 +1,14 @@
-// Mass integrals of one body (its rigid part plus the nodes of its modal
-// model), precomputed once at load so that evaluating the body's inertia
-// terms costs O(m^2) for m modes, independently of the number of nodes.
+// Mass integrals of one body (its rigid part plus the plain nodes of its
+// modal model: those without rotary inertia or foreshortening, whose terms
+// are polynomials in eta), precomputed once at load so that evaluating them
+// costs O(m^2) for m modes, independently of the number of nodes. The other
+// ("rich") nodes are handled one by one (dynamics/body_inertia.hpp).
 //
-// With node k at s_k(eta) = rho_k + Phi_k eta (B components), mass m_k and
-// rotary inertia J_k, and the rigid part (m_r, c, I_c):
+// With plain node k at s_k(eta) = rho_k + Phi_k eta (B components), mass m_k,
+// and the rigid part (m_r, c, I_c):
 //   mass   = m_r + Sum m_k
 //   S0     = m_r c + Sum m_k rho_k                        first moment at eta = 0
-//   J0     = I_c + m_r(|c|^2 I - c c^T) + Sum J_k         inertia about O of the
+//   J0     = I_c + m_r(|c|^2 I - c c^T)                   inertia about O of the
 //            + Sum m_k (|rho_k|^2 I - rho_k rho_k^T)      undeformed body
 //   B      = Sum m_k Phi_k                   (3 x m)      translational participation
 //   Y      = Sum m_k Phi_k^T Phi_k           (m x m)      modal mass

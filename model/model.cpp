@@ -16,8 +16,9 @@ const char* to_string(JointType t) {
   return "?";
 }
 
-int joint_nq(JointType t) {
-  switch (t) {
+int joint_nq(const Joint& j) {
+  if (j.prescribed()) return 0;
+  switch (j.type) {
     case JointType::revolute:
     case JointType::prismatic: return 1;
     case JointType::fixed: return 0;
@@ -26,7 +27,7 @@ int joint_nq(JointType t) {
   return 0;
 }
 
-int joint_nu(JointType t) { return t == JointType::free ? 6 : joint_nq(t); }
+int joint_nu(const Joint& j) { return j.type == JointType::free ? 6 : joint_nq(j); }
 
 int FlexibleData::node_index(int id) const {
   for (std::size_t k = 0; k < nodes.size(); ++k)
@@ -78,6 +79,7 @@ void snap_roundoff_residues(Body& b) {
 void finalize_model(Model& model) {
   model.q_names.clear();
   model.u_names.clear();
+  model.prescribed_names.clear();
   int nq = 0, nu = 0;
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
     Body& b = model.bodies[i];
@@ -86,7 +88,9 @@ void finalize_model(Model& model) {
     b.q_joint = nq;
     b.u_joint = nu;
     const std::string& n = b.name;
-    switch (b.joint.type) {
+    if (b.joint.prescribed())
+      model.prescribed_names.push_back(n + (b.joint.type == JointType::revolute ? ".angle" : ".disp"));
+    switch (b.joint.prescribed() ? JointType::fixed : b.joint.type) {
       case JointType::revolute:
         model.q_names.push_back(n + ".angle");
         model.u_names.push_back(n + ".angle");
@@ -101,8 +105,8 @@ void finalize_model(Model& model) {
         for (const char* s : {".vx", ".vy", ".vz", ".wx", ".wy", ".wz"}) model.u_names.push_back(n + s);
         break;
     }
-    nq += joint_nq(b.joint.type);
-    nu += joint_nu(b.joint.type);
+    nq += joint_nq(b.joint);
+    nu += joint_nu(b.joint);
     b.q_eta = nq;
     b.u_eta = nu;
     for (int k = 1; k <= b.n_modes(); ++k) {
@@ -118,10 +122,17 @@ void finalize_model(Model& model) {
     Body& b = model.bodies[i];
     if (b.parent >= 0) model.bodies[b.parent].children.push_back(static_cast<int>(i));
     std::vector<int> chain = b.parent >= 0 ? model.bodies[b.parent].chain_u : std::vector<int>{};
-    for (int k = 0; k < joint_nu(b.joint.type) + b.n_modes(); ++k) chain.push_back(b.u_joint + k);
+    for (int k = 0; k < joint_nu(b.joint) + b.n_modes(); ++k) chain.push_back(b.u_joint + k);
     std::sort(chain.begin(), chain.end());
     b.chain_u = std::move(chain);
     b.integrals = compute_mass_integrals(b.rigid, b.flex ? &*b.flex : nullptr);
+    b.rich_nodes.clear();
+    b.total_mass = b.rigid.mass;
+    if (b.flex)
+      for (int k = 0; k < static_cast<int>(b.flex->nodes.size()); ++k) {
+        if (b.flex->node_is_rich(k)) b.rich_nodes.push_back(k);
+        b.total_mass += b.flex->nodes[k].mass;
+      }
   }
   if (model.q0.size() != nq) {
     model.q0 = VecX::Zero(nq);

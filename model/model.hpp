@@ -11,11 +11,13 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "model/modal_integrals.hpp"
+#include "model/prescribed_motion.hpp"
 
 namespace kanegen {
 
@@ -27,9 +29,6 @@ using MatX = Eigen::MatrixXd;
 enum class JointType { revolute, prismatic, fixed, free };
 
 const char* to_string(JointType t);
-/// Number of generalized coordinates / speeds the joint contributes.
-int joint_nq(JointType t);
-int joint_nu(JointType t);
 
 struct Joint {
   JointType type = JointType::fixed;
@@ -40,7 +39,16 @@ struct Joint {
   double stiffness = 0.0;           ///< spring on the joint coordinate
   double damping = 0.0;             ///< damper on the joint coordinate
   double rest = 0.0;                ///< spring rest value
+  /// Prescribed motion (revolute, prismatic): the coordinate is a known
+  /// function of time, not a degree of freedom (no q, no u, no input).
+  std::optional<PrescribedMotion> motion;
+  bool prescribed() const { return motion.has_value(); }
 };
+
+/// Number of generalized coordinates / speeds the joint contributes (0 for a
+/// prescribed joint).
+int joint_nq(const Joint& j);
+int joint_nu(const Joint& j);
 
 /// Rigid part of a body: moves with B. Mass may be zero.
 struct RigidPart {
@@ -54,11 +62,14 @@ struct ModalNode {
   int id = 0;                       ///< id in the modal data file
   Vec3 rho_B = Vec3::Zero();        ///< undeformed position from O, B components
   double mass = 0.0;
-  Mat3 J_B = Mat3::Zero();          ///< rotary inertia (turns with B)
+  Mat3 J_B = Mat3::Zero();          ///< rotary inertia in B axes at eta = 0 (turns with the node frame)
 };
 
 /// Modal description of a flexible body, modes already selected and
-/// mass-normalized (Sum_k m_k t_k.t_k = 1 for each kept mode).
+/// mass-normalized (Sum_k m_k t_k.t_k + r_k^T J_k r_k = 1 for each kept mode).
+/// Node k's displaced position is rho_k + Phi_k eta + 1/2 gamma_k(eta), with
+/// gamma_k = [eta^T Gamma_k[0] eta, eta^T Gamma_k[1] eta, eta^T Gamma_k[2] eta]
+/// (foreshortening, dynamics.md), and its node frame is C(Psi_k eta).
 struct FlexibleData {
   std::string source;               ///< modal file path or "beam" (for messages)
   std::vector<ModalNode> nodes;
@@ -68,8 +79,18 @@ struct FlexibleData {
   VecX damping_ratio;               ///< m modal damping ratios
   VecX K;                           ///< m diagonal modal stiffness (2 pi f)^2 Y_ii
   VecX D;                           ///< m diagonal modal damping 2 zeta (2 pi f) Y_ii
+  /// Per node: Gamma_k along B's x, y, z (m x m, symmetric); a node without
+  /// second-order data (or a body with foreshortening off) has 0 x 0 matrices.
+  std::vector<std::array<MatX, 3>> Gamma;
   int modes() const { return static_cast<int>(Phi.cols()); }
   int node_index(int id) const;     ///< -1 if no node with that id
+  /// Whether node k has second-order (foreshortening) data.
+  bool has_second_order(int k) const {
+    return k < static_cast<int>(Gamma.size()) && (Gamma[k][0].size() || Gamma[k][1].size() || Gamma[k][2].size());
+  }
+  /// Whether node k is handled element by element (rotary inertia or
+  /// foreshortening); the others enter the body through its mass integrals.
+  bool node_is_rich(int k) const { return has_second_order(k) || !nodes[k].J_B.isZero(0.0); }
 };
 
 struct Body {
@@ -79,7 +100,11 @@ struct Body {
   Joint joint;
   RigidPart rigid;
   std::optional<FlexibleData> flex;
-  BodyMassIntegrals integrals;      ///< mass data of rigid part + nodes (modal_integrals.hpp)
+  BodyMassIntegrals integrals;      ///< mass data of the rigid part and the plain nodes (modal_integrals.hpp)
+  /// Nodes handled one by one (FlexibleData::node_is_rich: rotary inertia or
+  /// foreshortening), ascending; the other nodes are in `integrals`.
+  std::vector<int> rich_nodes;
+  double total_mass = 0.0;          ///< rigid part and every node
 
   // Layout in the state vectors.
   int q_joint = 0;                  ///< first joint coordinate in q
@@ -116,7 +141,12 @@ struct Model {
   int body_index(const std::string& name) const;  ///< -1 if absent
   int q_index(const std::string& name) const;     ///< -1 if absent
   int u_index(const std::string& name) const;     ///< -1 if absent
+  /// Coordinates of the prescribed joints, named as the joint coordinate
+  /// would be ("hub.angle", "cart.disp"), in body order.
+  std::vector<std::string> prescribed_names;
+
   bool has_flexible() const;
+  bool has_prescribed() const { return !prescribed_names.empty(); }
 };
 
 /// Relative size below which a model constant is a round-off residue of an

@@ -85,6 +85,13 @@ std::string model_fingerprint(const Model& model) {
     w.num(j.stiffness);
     w.num(j.damping);
     w.num(j.rest);
+    if (j.motion) {
+      const PrescribedMotion& mo = *j.motion;
+      w.key(" motion");
+      w.str(to_string(mo.kind));
+      for (double c : mo.coefficients) w.num(c);
+      for (double x : {mo.offset, mo.amplitude, mo.frequency_hz, mo.phase, mo.rate, mo.duration, mo.start}) w.num(x);
+    }
     w.key(" mass");
     w.num(b.rigid.mass);
     w.key(" com");
@@ -116,6 +123,14 @@ std::string model_fingerprint(const Model& model) {
       w.mat(f.K);
       w.key(" D");
       w.mat(f.D);
+      for (std::size_t k = 0; k < f.Gamma.size(); ++k)
+        for (int a = 0; a < 3; ++a)
+          if (f.Gamma[k][a].size()) {
+            w.key(" Gamma");
+            w.integer(static_cast<long long>(k));
+            w.integer(a);
+            w.mat(f.Gamma[k][a]);
+          }
     }
   }
   w.out += '\n';

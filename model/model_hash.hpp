@@ -4,9 +4,9 @@
 // given, and the JIT cache is keyed by it.
 //
 // The fingerprint covers everything that changes the generated equations or
-// the outputs: names, topology, joints, mass data, flexible data (nodes,
-// shapes, frequencies, damping, modal stiffness), gravity, state layout and
-// the requested outputs. It leaves out what generated code does not depend
+// the outputs: names, topology, joints (with their prescribed motion), mass
+// data, flexible data (nodes, shapes, second-order data, frequencies, damping,
+// modal stiffness), gravity, state layout and the requested outputs. It leaves out what generated code does not depend
 // on: the description, the source path and the initial state. Numbers are
 // printed with 17 significant digits (-0 printed as 0), so equal models give
 // equal text on every platform.

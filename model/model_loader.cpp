@@ -300,7 +300,7 @@ class Loader {
     const std::string f = fmt::format("bodies[{}].joint", i);
     if (!ck_.expect_map(j, bi.line, f)) return;
     const int l = kl ? kl : line_of(j);
-    ck_.check_keys(j, f, {"type", "axis", "position", "node", "rotation", "stiffness", "damping", "rest"});
+    ck_.check_keys(j, f, {"type", "axis", "position", "node", "rotation", "stiffness", "damping", "rest", "motion"});
 
     const YAML::Node type = j["type"];
     if (!type.IsDefined()) {
@@ -359,6 +359,24 @@ class Loader {
       }
     }
 
+    // prescribed motion
+    const YAML::Node motion = j["motion"];
+    if (motion.IsDefined()) {
+      if (bi.type_known && !one_dof) {
+        ck_.error(motion, l, f + ".motion",
+                  fmt::format("not allowed on a {} joint; expected motion only on revolute and prismatic joints",
+                              tname));
+      } else {
+        for (const char* key : {"stiffness", "damping", "rest"})
+          if (j[key].IsDefined())
+            ck_.error(j[key], l, f + "." + key,
+                      fmt::format("not allowed with motion: (a prescribed coordinate is no degree of freedom); "
+                                  "expected either motion or {}",
+                                  key));
+        if (auto m = read_motion(motion, key_line(j, "motion"), f + ".motion")) joint.motion = *m;
+      }
+    }
+
     // position / node
     const YAML::Node position = j["position"];
     const YAML::Node node = j["node"];
@@ -377,6 +395,77 @@ class Loader {
     if (rot.IsDefined()) {
       if (auto R = read_rotation(rot, key_line(j, "rotation"), f + ".rotation")) joint.R_PJ = *R;
     }
+  }
+
+  /// motion: {polynomial: [...]} | {sine: {...}} | {spinup: {...}}
+  std::optional<PrescribedMotion> read_motion(const YAML::Node& n, int kl, const std::string& f) {
+    const std::vector<std::string> kinds = {"polynomial", "sine", "spinup"};
+    const int l = kl ? kl : line_of(n);
+    if (!ck_.expect_map(n, l, f)) return std::nullopt;
+    ck_.check_keys(n, f, kinds);
+    std::vector<std::string> given;
+    for (const auto& k : kinds)
+      if (n[k].IsDefined()) given.push_back(k);
+    if (given.size() != 1) {
+      if (given.empty() && n.size() > 0) return std::nullopt;  // only unknown keys: already reported
+      ck_.error(l, f,
+                given.empty() ? "empty; expected exactly one of polynomial, sine, spinup"
+                              : fmt::format("{} given; expected exactly one of polynomial, sine, spinup",
+                                            join(given, " and ")));
+      return std::nullopt;
+    }
+    PrescribedMotion m;
+    const YAML::Node v = n[given[0]];
+    const std::string fv = f + "." + given[0];
+    const int vl = key_line(n, given[0]) ? key_line(n, given[0]) : l;
+    bool ok = true;
+    if (given[0] == "polynomial") {
+      m.kind = MotionKind::polynomial;
+      if (!v.IsSequence() || v.size() < 1 || v.size() > 8) {
+        ck_.error(v, vl, fv, fmt::format("got {}; expected a list of 1 to 8 coefficients [c0, c1, ...]", describe(v)));
+        return std::nullopt;
+      }
+      for (std::size_t k = 0; k < v.size(); ++k) {
+        if (auto c = ck_.number(v[k], vl, fmt::format("{}[{}]", fv, k)))
+          m.coefficients.push_back(*c);
+        else
+          ok = false;
+      }
+    } else {
+      if (!ck_.expect_map(v, vl, fv)) return std::nullopt;
+      const bool sine = given[0] == "sine";
+      m.kind = sine ? MotionKind::sine : MotionKind::spinup;
+      const std::vector<std::string> keys = sine ? std::vector<std::string>{"offset", "amplitude", "frequency", "phase"}
+                                                 : std::vector<std::string>{"rate", "duration", "start"};
+      ck_.check_keys(v, fv, keys);
+      auto field = [&](const char* key, bool required, double& out, const char* expected, bool positive) {
+        const YAML::Node x = v[key];
+        if (!x.IsDefined()) {
+          if (required) {
+            ck_.error(vl, fv + "." + key, fmt::format("missing; expected {}", expected));
+            ok = false;
+          }
+          return;
+        }
+        auto val = positive ? ck_.positive(x, vl, fv + "." + key, expected) : ck_.number(x, vl, fv + "." + key);
+        if (val)
+          out = *val;
+        else
+          ok = false;
+      };
+      if (sine) {
+        field("offset", false, m.offset, "the offset", false);
+        field("amplitude", true, m.amplitude, "the amplitude (rad or m)", false);
+        field("frequency", true, m.frequency_hz, "a frequency in Hz", true);
+        field("phase", false, m.phase, "the phase in rad", false);
+      } else {
+        field("rate", true, m.rate, "the final rate (rad/s or m/s)", false);
+        field("duration", true, m.duration, "a duration in s", true);
+        field("start", false, m.start, "the start value", false);
+      }
+    }
+    if (!ok) return std::nullopt;
+    return m;
   }
 
   void read_node(const YAML::Node& node, int i, const std::string& f) {
@@ -486,7 +575,11 @@ class Loader {
     const std::string f = fmt::format("bodies[{}].flexible", i);
     if (!ck_.expect_map(n, bi.line, f)) return;
     const int l = kl ? kl : line_of(n);
-    ck_.check_keys(n, f, {"modal", "beam", "damping_ratio", "modes"});
+    ck_.check_keys(n, f, {"modal", "beam", "damping_ratio", "modes", "foreshortening"});
+    bool foreshortening = true;
+    if (n["foreshortening"].IsDefined()) {
+      if (auto b = ck_.boolean(n["foreshortening"], l, f + ".foreshortening")) foreshortening = *b;
+    }
 
     // modes subset (validated before the data, range checked after)
     std::vector<int> keep;
@@ -569,17 +662,9 @@ class Loader {
         }
       }
       if (in_range) {
-        const int m = static_cast<int>(keep.size());
-        FlexibleData s = *data;
-        s.Phi.resize(data->Phi.rows(), m);
-        s.Psi.resize(data->Psi.rows(), m);
-        s.frequency_hz.resize(m);
-        for (int c = 0; c < m; ++c) {
-          s.Phi.col(c) = data->Phi.col(keep[c] - 1);
-          s.Psi.col(c) = data->Psi.col(keep[c] - 1);
-          s.frequency_hz(c) = data->frequency_hz(keep[c] - 1);
-        }
-        data = std::move(s);
+        std::vector<int> sel;
+        for (int k : keep) sel.push_back(k - 1);
+        data = select_modes(*data, sel);
       } else {
         data.reset();
       }
@@ -619,16 +704,15 @@ class Loader {
 
     if (!data || !zeta_ok) return;
     FlexibleData& fd_ = *data;
-    const int nn = static_cast<int>(fd_.nodes.size());
+    if (!foreshortening) fd_.Gamma.assign(fd_.nodes.size(), {});
     fd_.damping_ratio = zeta;
     fd_.K = Eigen::VectorXd::Zero(m);
     fd_.D = Eigen::VectorXd::Zero(m);
+    const Eigen::VectorXd Y = modal_masses(fd_);  // with the nodes' rotary inertia (dynamics.md)
     for (int c = 0; c < m; ++c) {
-      double Y = 0.0;
-      for (int k = 0; k < nn; ++k) Y += fd_.nodes[k].mass * fd_.Phi.block<3, 1>(3 * k, c).squaredNorm();
       const double w = 2.0 * kPi * fd_.frequency_hz(c);
-      fd_.K(c) = w * w * Y;
-      fd_.D(c) = 2.0 * zeta(c) * w * Y;
+      fd_.K(c) = w * w * Y(c);
+      fd_.D(c) = 2.0 * zeta(c) * w * Y(c);
     }
     bi.body.flex = std::move(fd_);
     bi.flex_known = true;
@@ -637,7 +721,8 @@ class Loader {
   std::optional<BeamSpec> read_beam(const YAML::Node& n, const std::string& f, int kl) {
     if (!ck_.expect_map(n, kl, f)) return std::nullopt;
     const int l = kl ? kl : line_of(n);
-    ck_.check_keys(n, f, {"length", "direction", "mass_per_length", "EI", "GJ", "EA", "elements", "modes"});
+    ck_.check_keys(n, f, {"length", "direction", "mass_per_length", "EI", "GJ", "EA", "elements", "modes",
+                          "rotary_inertia_per_length", "polar_inertia_per_length"});
     BeamSpec spec;
     bool ok = true;
     auto required = [&](const char* key, const char* expected) -> YAML::Node {
@@ -698,6 +783,26 @@ class Loader {
       else
         ok = false;
     }
+    if (const YAML::Node v = n["rotary_inertia_per_length"]; v.IsDefined()) {
+      if (auto e = ck_.vector(v, l, f + ".rotary_inertia_per_length", 2)) {
+        for (int k = 0; k < 2; ++k) {
+          if (!((*e)(k) >= 0)) {
+            ck_.error(v, l, fmt::format("{}.rotary_inertia_per_length[{}]", f, k),
+                      fmt::format("{} is negative; expected a rotary inertia per length >= 0 (kg m)", num((*e)(k))));
+            ok = false;
+          }
+          spec.rotary_inertia[k] = (*e)(k);
+        }
+      } else {
+        ok = false;
+      }
+    }
+    if (const YAML::Node v = n["polar_inertia_per_length"]; v.IsDefined()) {
+      if (auto x = ck_.nonneg(v, l, f + ".polar_inertia_per_length", "a polar inertia per length (kg m)"))
+        spec.polar_inertia = *x;
+      else
+        ok = false;
+    }
     for (const char* key : {"elements", "modes"}) {
       const YAML::Node v = required(key, std::string(key) == "elements" ? "the number of finite elements (>= 1)"
                                                                          : "the number of modes kept (>= 1)");
@@ -726,7 +831,7 @@ class Loader {
     certain = !bi.name.empty() && bi.type_known && (!bi.has_flex_block || bi.flex_known);
     if (bi.name.empty()) return names;
     const std::string& n = bi.name;
-    if (bi.type_known) {
+    if (bi.type_known && !bi.body.joint.prescribed()) {
       switch (bi.body.joint.type) {
         case JointType::revolute: names.push_back(n + ".angle"); break;
         case JointType::prismatic: names.push_back(n + ".disp"); break;
@@ -742,6 +847,15 @@ class Loader {
     if (bi.body.flex)
       for (int k = 1; k <= bi.body.flex->modes(); ++k) names.push_back(n + ".eta" + std::to_string(k));
     return names;
+  }
+
+  /// Whether `name` is the coordinate of a prescribed joint (e.g. "hub.angle").
+  bool prescribed_coordinate(const std::string& name) const {
+    for (const BodyInfo& bi : info_)
+      if (!bi.name.empty() && bi.type_known && bi.body.joint.prescribed() &&
+          name == bi.name + (bi.body.joint.type == JointType::revolute ? ".angle" : ".disp"))
+        return true;
+    return false;
   }
 
   void read_initial(const YAML::Node& n) {
@@ -773,6 +887,13 @@ class Loader {
         const std::string fk = f + "." + name;
         auto x = ck_.number(it->second, kl, fk);
         if (std::find(known.begin(), known.end(), name) == known.end()) {
+          if (prescribed_coordinate(name)) {
+            ck_.error(kl, fk,
+                      fmt::format("'{}' is prescribed by its joint's motion: (a known function of time); expected "
+                                  "no initial value for it",
+                                  name));
+            continue;
+          }
           bool uncertain = false;
           for (const auto& p : uncertain_prefix)
             if (name.rfind(p, 0) == 0) uncertain = true;

@@ -186,6 +186,16 @@ class Checker {
     }
   }
 
+  std::optional<bool> boolean(const YAML::Node& n, int fallback, const std::string& field) {
+    if (n.IsScalar()) {
+      const std::string& v = n.Scalar();
+      if (v == "true" || v == "True" || v == "TRUE") return true;
+      if (v == "false" || v == "False" || v == "FALSE") return false;
+    }
+    error(n, fallback, field, fmt::format("got {}; expected true or false", describe(n)));
+    return std::nullopt;
+  }
+
   std::optional<std::string> string(const YAML::Node& n, int fallback, const std::string& field) {
     if (!n.IsScalar()) {
       error(n, fallback, field, fmt::format("got {}; expected a string", describe(n)));

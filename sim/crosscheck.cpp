@@ -38,8 +38,10 @@ CrosscheckResult crosscheck(Engine& tested, Engine& reference, int samples, unsi
   auto note = [&](const std::string& k, double v) { r.worst[k] = std::max(r.worst[k], std::isnan(v) ? 1e300 : v); };
   for (int s = 0; s < samples; ++s) {
     VecX q = model.q0, u(model.nu), tau(model.nu);
+    // Prescribed motion: times before, during and after a spin-up.
+    const double t = model.has_prescribed() ? 10.0 + 11.0 * U(rng) : 0.0;
     for (const Body& b : model.bodies) {
-      switch (b.joint.type) {
+      switch (b.joint.prescribed() ? JointType::fixed : b.joint.type) {
         case JointType::revolute: q(b.q_joint) = M_PI * U(rng); break;
         case JointType::prismatic: q(b.q_joint) = U(rng); break;
         case JointType::fixed: break;
@@ -58,22 +60,22 @@ CrosscheckResult crosscheck(Engine& tested, Engine& reference, int samples, unsi
     tested.qdot(q, u, qd_t);
     reference.qdot(q, u, qd_r);
     note("qdot", rel(qd_t, qd_r));
-    tested.mass_matrix(q, M_t);
-    reference.mass_matrix(q, M_r);
+    tested.mass_matrix(t, q, M_t);
+    reference.mass_matrix(t, q, M_r);
     note("M", rel(M_t, M_r));
-    tested.forcing(q, u, tau, F_t);
-    reference.forcing(q, u, tau, F_r);
+    tested.forcing(t, q, u, tau, F_t);
+    reference.forcing(t, q, u, tau, F_r);
     note("F", rel(F_t, F_r));
-    tested.udot(q, u, tau, ud_t);
-    reference.udot(q, u, tau, ud_r);
+    tested.udot(t, q, u, tau, ud_t);
+    reference.udot(t, q, u, tau, ud_r);
     note("udot (relative)", rel(ud_t, ud_r));
     note("udot (residual)", (M_r * ud_t - F_r).norm() / (M_r.norm() * ud_t.norm() + F_r.norm()));
     if (model.outputs.energy) {
-      const EnergyValues a = tested.energy(q, u), b = reference.energy(q, u);
+      const EnergyValues a = tested.energy(t, q, u), b = reference.energy(t, q, u);
       note("energy", rel(Eigen::Vector2d(a.T, a.V), Eigen::Vector2d(b.T, b.V)));
     }
     if (model.outputs.momentum) {
-      const MomentumValues a = tested.momentum(q, u), b = reference.momentum(q, u);
+      const MomentumValues a = tested.momentum(t, q, u), b = reference.momentum(t, q, u);
       Eigen::Matrix<double, 6, 1> x, y;
       x << a.p_N, a.H_N;
       y << b.p_N, b.H_N;
@@ -81,8 +83,8 @@ CrosscheckResult crosscheck(Engine& tested, Engine& reference, int samples, unsi
     }
     if (model.outputs.reactions) {
       std::vector<Reaction> a, b;
-      tested.reactions(q, u, ud_r, a);
-      reference.reactions(q, u, ud_r, b);
+      tested.reactions(t, q, u, ud_r, a);
+      reference.reactions(t, q, u, ud_r, b);
       MatX x(6, a.size()), y(6, b.size());
       for (std::size_t i = 0; i < a.size(); ++i) {
         x.col(i) << a[i].force_B, a[i].torque_B;

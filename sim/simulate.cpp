@@ -164,6 +164,7 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
 std::vector<std::string> csv_columns(const Model& model) {
   std::vector<std::string> cols{"t"};
   cols.insert(cols.end(), model.q_names.begin(), model.q_names.end());
+  cols.insert(cols.end(), model.prescribed_names.begin(), model.prescribed_names.end());
   cols.insert(cols.end(), model.u_names.begin(), model.u_names.end());
   if (model.outputs.energy) cols.insert(cols.end(), {"T", "V"});
   if (model.outputs.momentum) cols.insert(cols.end(), {"Hx", "Hy", "Hz"});
@@ -226,7 +227,10 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     }
     q = x.head(nq);
     u = x.tail(nu);
-    row.assign(x.data(), x.data() + nq + nu);
+    row.assign(x.data(), x.data() + nq);
+    for (const Body& b : model.bodies)  // the prescribed coordinates, after the q's
+      if (b.joint.prescribed()) row.push_back(b.joint.motion->at(t).f);
+    row.insert(row.end(), x.data() + nq, x.data() + nq + nu);
     try {
       if (model.outputs.energy) {
         const EnergyValues E = engine.energy(t, q, u);

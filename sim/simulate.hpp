@@ -34,8 +34,9 @@ struct SimulationResult {
 OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failure, bool use_jacobian = true,
                             bool stabilize_quaternions = true);
 
-/// Column names of the CSV: t, q names, u names, then T V / Hx Hy Hz /
-/// <body>.fx .fy .fz .tx .ty .tz as the model's outputs ask.
+/// Column names of the CSV: t, q names, the prescribed coordinates (named as
+/// the joint coordinate would be, e.g. hub.angle), u names, then T V /
+/// Hx Hy Hz / <body>.fx .fy .fz .tx .ty .tz as the model's outputs ask.
 std::vector<std::string> csv_columns(const Model& model);
 
 /// Integrates from `initial` to options.t_end writing CSV rows to `csv`.

@@ -236,6 +236,21 @@ TEST_CASE("model hash: stable for the same model, sensitive to every parameter",
     g.bodies[i].flex->nodes[0].mass += 1e-12;
     CHECK(model_hash(g) != hf);
   }
+  // Second-order (foreshortening) data and prescribed motion count too.
+  const Model sp = load_model(test::source_path("tests/reference/v_spinup/v_spinup.yaml"));
+  const std::string hs = model_hash(sp);
+  Model g = sp;
+  g.bodies[1].flex->Gamma[2][0](0, 0) *= 1.0 + 1e-12;
+  CHECK(model_hash(g) != hs);
+  g = sp;
+  g.bodies[1].flex->Gamma.assign(g.bodies[1].flex->nodes.size(), {});  // foreshortening off
+  CHECK(model_hash(g) != hs);
+  g = sp;
+  g.bodies[0].joint.motion->rate += 1e-12;
+  CHECK(model_hash(g) != hs);
+  g = sp;
+  g.bodies[0].joint.motion->kind = MotionKind::sine;
+  CHECK(model_hash(g) != hs);
 }
 
 TEST_CASE("generated engine refuses a table that does not match the model", "[jit]") {

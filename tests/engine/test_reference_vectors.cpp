@@ -114,7 +114,7 @@ void check_all(const std::string& engine_name) {
       ++cases;
     }
   }
-  CHECK(cases == 14);
+  CHECK(cases == 18);
 }
 
 TEST_CASE("generic engine reproduces every reference vector", "[reference][generic]") { check_all("generic"); }

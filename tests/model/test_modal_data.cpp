@@ -37,9 +37,13 @@ void check_single(const std::string& path, int line, const std::string& field, c
   CHECK_THAT(ds[0].message, Contains(text));
 }
 
+/// Sum_k m_k t_k.t_k + r_k.J_k r_k (dynamics.md: rotary inertia included).
 double modal_mass(const FlexibleData& f, int c) {
   double s = 0;
-  for (std::size_t k = 0; k < f.nodes.size(); ++k) s += f.nodes[k].mass * f.Phi.block<3, 1>(3 * k, c).squaredNorm();
+  for (std::size_t k = 0; k < f.nodes.size(); ++k) {
+    const Vec3 r = f.Psi.block<3, 1>(3 * k, c);
+    s += f.nodes[k].mass * f.Phi.block<3, 1>(3 * k, c).squaredNorm() + r.dot(f.nodes[k].J_B * r);
+  }
   return s;
 }
 
@@ -108,9 +112,13 @@ TEST_CASE("modal: normalization on load when mass_normalized is false", "[modal]
   REQUIRE(g.modes() == 2);
   REQUIRE(g.nodes.size() == 4);
   for (int c = 0; c < 2; ++c) CHECK(modal_mass(g, c) == Approx(1.0).epsilon(1e-14));
-  // both translations and rotations scaled by 1/sqrt(sum m t.t) of the file's shapes
+  // both translations and rotations scaled by 1/sqrt(sum m t.t + r.J r) of the file's shapes
+  Eigen::Matrix3d J2, J7;
+  J2 << 0.002, 0.0001, 0.0, 0.0001, 0.003, -0.0002, 0.0, -0.0002, 0.0025;
+  J7 = Eigen::Vector3d(0.001, 0.0012, 0.0011).asDiagonal();
+  const Eigen::Vector3d r2(0.1, -0.2, 0.6), r7(-0.1, 0.4, 1.3);
   const double mm1 = 0.4 * (0.01 * 0.01 + 0.3 * 0.3 + 0.05 * 0.05) + 0.3 * (0.02 * 0.02 + 0.8 * 0.8 + 0.1 * 0.1) +
-                     0.25 * (0.03 * 0.03 + 1.2 * 1.2 + 0.2 * 0.2);
+                     0.25 * (0.03 * 0.03 + 1.2 * 1.2 + 0.2 * 0.2) + r2.dot(J2 * r2) + r7.dot(J7 * r7);
   const double s = 1.0 / std::sqrt(mm1);
   CHECK(g.Phi(3 * 3 + 1, 0) == Approx(1.2 * s).epsilon(1e-15));
   CHECK(g.Psi(3 * 3 + 2, 0) == Approx(1.3 * s).epsilon(1e-15));

@@ -249,7 +249,7 @@ std::vector<std::string> reference_models() {
 
 TEST_CASE("loader: reference models load with the documented q/u layout", "[loader]") {
   const auto names = reference_models();
-  REQUIRE(names.size() == 7);
+  REQUIRE(names.size() == 9);
   for (const auto& n : names) {
     const std::string dir = std::string(KANEGEN_SOURCE_DIR) + "/tests/reference/" + n + "/";
     INFO(n);
@@ -282,8 +282,12 @@ TEST_CASE("loader: reference v_flex details (modal subset, normalization, K, D, 
   CHECK(f.damping_ratio(0) == 0.01);
   CHECK(f.damping_ratio(1) == 0.03);
   for (int c = 0; c < 2; ++c) {
+    // the modal mass includes the nodes' rotary inertia (dynamics.md, "Forces")
     double Y = 0;
-    for (std::size_t k = 0; k < f.nodes.size(); ++k) Y += f.nodes[k].mass * f.Phi.block<3, 1>(3 * k, c).squaredNorm();
+    for (std::size_t k = 0; k < f.nodes.size(); ++k) {
+      const Vec3 r = f.Psi.block<3, 1>(3 * k, c);
+      Y += f.nodes[k].mass * f.Phi.block<3, 1>(3 * k, c).squaredNorm() + r.dot(f.nodes[k].J_B * r);
+    }
     CHECK(Y == Approx(1.0).epsilon(1e-14));
     const double w = 2 * M_PI * f.frequency_hz(c);
     CHECK(f.K(c) == Approx(w * w * Y).epsilon(1e-14));
