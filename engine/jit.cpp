@@ -167,8 +167,18 @@ std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out
     steps.push_back(std::move(st));
     objects.push_back(obj);
   };
-  add("table", 0, "-O2", jacobian_left_out ? std::vector<std::string>{"-DKANEGEN_OMIT_jacobian"} : std::vector<std::string>{});
+  auto wanted = [&](const std::string& name) {
+    if (!o.only_set) return true;
+    for (const char* required : {"qdot", "mass_matrix", "forcing", "udot"})
+      if (name == required) return true;
+    return std::find(o.only.begin(), o.only.end(), name) != o.only.end();
+  };
+  std::vector<std::string> omitted;
+  for (const ManifestFunction& f : manifest.functions)
+    if (!wanted(f.name) || (f.name == "jacobian" && jacobian_left_out)) omitted.push_back("-DKANEGEN_OMIT_" + f.name);
+  add("table", 0, "-O2", omitted);
   for (const ManifestFunction& f : manifest.functions) {
+    if (!wanted(f.name)) continue;
     if (f.name == "jacobian") {
       if (jacobian_left_out) continue;
       add(f.name, f.ops, udot_ops <= 1500 ? "-O2" : "-O1", {});
@@ -370,7 +380,12 @@ JitOptions resolved(const JitOptions& opts) {
 
 std::string jit_cache_key(const Model& model, const std::string& generator_hash, const JitOptions& opts) {
   const JitOptions o = resolved(opts);
-  const std::string flags = join_quoted(split_words(o.compiler)) + "\n" + join_quoted(split_words(o.flags));
+  std::string flags = join_quoted(split_words(o.compiler)) + "\n" + join_quoted(split_words(o.flags));
+  if (o.only_set) {
+    std::vector<std::string> only = o.only;
+    std::sort(only.begin(), only.end());
+    flags += "\nonly " + join_quoted(only);
+  }
   return fnv1a64_hex(fmt::format("{}\n{}\n{}\n{}\n{}", model_hash(model), KANEGEN_VERSION,
                                  KANEGEN_GENERATED_API_VERSION, generator_hash, flags));
 }

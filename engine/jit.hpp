@@ -12,6 +12,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "engine/generated_engine.hpp"
 #include "model/model.hpp"
@@ -34,6 +35,11 @@ struct JitOptions {
   std::string flags;        ///< empty: default_jit_flags()
   std::string include_dir;  ///< where engine/generated_api.h is; empty: resources.hpp's include_dir()
   bool verbose = false;     ///< announce compiles on stderr (also done whenever stderr is a terminal)
+  /// Compile only these functions of the table besides the four every engine
+  /// needs (qdot, mass_matrix, forcing, udot); empty: all of them. E.g. {} vs
+  /// {"reactions"}: a build without the Jacobian and the invariants compiles faster.
+  std::vector<std::string> only;
+  bool only_set = false;    ///< whether `only` restricts the build (an empty list then means the four alone)
 };
 
 /// $KANEGEN_CACHE_DIR, else $XDG_CACHE_HOME/kanegen, else ~/.cache/kanegen.

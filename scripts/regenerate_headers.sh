@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 KANEGEN=${KANEGEN:-./build/bin/kanegen}
 mkdir -p generated
-find models -name '*.yaml' ! -name '*.modal.yaml' | sort | while read -r m; do
+find models -name '*.yaml' ! -name '*.modal.yaml' ! -path 'models/spinup/*' | sort | while read -r m; do
   name=$(basename "$m" .yaml)
   "$KANEGEN" generate "$m" -o "generated/$name.hpp"
 done

@@ -47,7 +47,8 @@ struct Drift {
 /// `kind` at rtol (atol = rtol/100), sampling the invariants `samples` times.
 Drift run_invariants(const Model& model, double t_end, IntegratorKind kind, double rtol, int samples = 50);
 
-/// Every model file under models/ (modal files excluded), sorted.
+/// Every model file under models/ (modal files and the generated benchmark
+/// models of models/spinup/ excluded), sorted.
 std::vector<std::string> model_files();
 
 /// Writes `text` to a fresh temporary file with the given name and returns its path.
