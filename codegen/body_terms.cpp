@@ -229,7 +229,7 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
     const std::string& n = b.name;
     const int m = I.m;
     ctx.P.section(fmt::format("body {}: mass and velocity terms", n));
-    const ex mass = ctx.c(I.mass, n + "_mass", "kg", "mass (rigid part and nodes)");
+    const ex mass = ctx.c(I.mass, n + "_mass", "kg", "mass (rigid part and plain nodes)");
     const SV3 S0 = ctx.cvec(I.S0, n + "_S0", "kg m", "first mass moment about O (undeformed)");
     const SM3 J0 = ctx.cmat(I.J0, n + "_J0", "kg m^2", "inertia about O (undeformed)", true);
     // Modal integrals.

@@ -20,7 +20,7 @@ std::string body_comment(const Model& model, const Body& b) {
   const std::string parent = b.parent < 0 ? "ground" : model.bodies[b.parent].name;
   std::string s = fmt::format("// body {}: {} joint to {}", b.name, to_string(b.joint.type), parent);
   if (b.joint.node >= 0) s += fmt::format(" at node {}", model.bodies[b.parent].flex->nodes[b.joint.node].id);
-  s += fmt::format(", mass {:.6g} kg", b.integrals.mass);
+  s += fmt::format(", mass {:.6g} kg", b.total_mass);
   // the file name only: the bytes must not depend on where the model was read from
   if (b.flex)
     s += fmt::format(", flexible: {} modes from {}", b.n_modes(),

@@ -35,9 +35,9 @@ inline constexpr char model_name[] = "boom_fea";
 inline constexpr char model_hash[] = "3653f23d2c0aaef5";
 
 // ---- model constants (SI units) ---------------------------------------------
-// body boom: fixed joint to hub, mass 0.2 kg, flexible: 2 modes from boom.modal.yaml
+// body boom: fixed joint to hub, mass 4.8 kg, flexible: 2 modes from boom.modal.yaml
 inline constexpr double boom_p_PJ_x = 0.3;  // joint frame origin in the parent x [m]
-inline constexpr double boom_mass = 0.19999999999999998;  // mass (rigid part and nodes) [kg]
+inline constexpr double boom_mass = 0.19999999999999998;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double boom_node2_mass = 0.39999999999999997;  // node mass [kg]
 inline constexpr double boom_node2_rho_x = 0.3333333333333333;  // node position (undeformed) x [m]
 inline constexpr double boom_node2_Phi1_z = -0.01066879043876091;  // translational shape of mode 1 at the node z [m]
@@ -122,7 +122,7 @@ inline constexpr double instrument_node13_Psi2_z = 0.3139013575182017;  // rotat
 inline constexpr double instrument_node13_rho_x = 4;  // attachment node position in the parent x [m]
 inline constexpr double instrument_node13_Gammax_1_1 = -0.24087891412311357;  // second-order (foreshortening) coefficient of the attachment node [1/m]
 inline constexpr double instrument_node13_Gammax_2_2 = -0.24087891412309156;  // second-order (foreshortening) coefficient of the attachment node [1/m]
-inline constexpr double instrument_mass = 12;  // mass (rigid part and nodes) [kg]
+inline constexpr double instrument_mass = 12;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double instrument_S0_x = 1.7999999999999998;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double instrument_S0_z = 0.6000000000000001;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double instrument_J0_xx = 0.43000000000000005;  // inertia about O (undeformed) [kg m^2]
@@ -134,7 +134,7 @@ inline constexpr double instrument_J0_zz = 0.62;  // inertia about O (undeformed
 inline constexpr double instrument_k = 10;  // joint spring stiffness [N m/rad or N/m]
 
 // body hub: revolute joint to ground, mass 40 kg
-inline constexpr double hub_mass = 40;  // mass (rigid part and nodes) [kg]
+inline constexpr double hub_mass = 40;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double hub_J0_xx = 1.5;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double hub_J0_yy = 1.5;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double hub_J0_zz = 2;  // inertia about O (undeformed) [kg m^2]

@@ -45,7 +45,7 @@ inline constexpr double yoke_a_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body panel_a: revolute joint to yoke_a, mass 4 kg
 inline constexpr double panel_a_p_PJ_x = 0.5;  // joint frame origin in the parent x [m]
-inline constexpr double panel_a_mass = 4;  // mass (rigid part and nodes) [kg]
+inline constexpr double panel_a_mass = 4;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double panel_a_S0_x = 3.2;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double panel_a_J0_xx = 0.2134;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double panel_a_J0_yy = 3.4134000000000007;  // inertia about O (undeformed) [kg m^2]
@@ -62,7 +62,7 @@ inline constexpr double yoke_b_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body panel_b: revolute joint to yoke_b, mass 4 kg
 inline constexpr double panel_b_p_PJ_x = 0.5;  // joint frame origin in the parent x [m]
-inline constexpr double panel_b_mass = 4;  // mass (rigid part and nodes) [kg]
+inline constexpr double panel_b_mass = 4;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double panel_b_S0_x = 3.2;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double panel_b_S0_y = 0.4;  // first mass moment about O (undeformed) y [kg m]
 inline constexpr double panel_b_J0_xx = 0.25340000000000007;  // inertia about O (undeformed) [kg m^2]
@@ -77,7 +77,7 @@ inline constexpr double gimbal_p_PJ_z = 0.2;  // joint frame origin in the paren
 inline constexpr double gimbal_p_PJ_x = 0.8;  // joint frame origin in the parent x [m]
 
 // body hub: free joint to ground, mass 50 kg
-inline constexpr double hub_mass = 51.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double hub_mass = 51.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double hub_S0_x = 0.49999999999999994;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double hub_S0_y = 0.3500000000000001;  // first mass moment about O (undeformed) y [kg m]
 inline constexpr double hub_S0_z = 1.8;  // first mass moment about O (undeformed) z [kg m]
@@ -87,7 +87,7 @@ inline constexpr double hub_J0_xz = -0.065;  // inertia about O (undeformed) [kg
 inline constexpr double hub_J0_yy = 5.111;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double hub_J0_yz = -0.16000000000000003;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double hub_J0_zz = 4.82;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double hub_mass_2 = 50;  // mass (rigid part and nodes) [kg]
+inline constexpr double hub_mass_2 = 50;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double hub_S0_x_2 = 0.5;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double hub_S0_z_2 = 1.5;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double hub_J0_xx_2 = 4.065;  // inertia about O (undeformed) [kg m^2]
@@ -96,7 +96,7 @@ inline constexpr double hub_J0_yz_2 = 0.11;  // inertia about O (undeformed) [kg
 inline constexpr double hub_J0_zz_2 = 3.525;  // inertia about O (undeformed) [kg m^2]
 
 // body dish: revolute joint to gimbal, mass 3 kg
-inline constexpr double dish_mass = 3;  // mass (rigid part and nodes) [kg]
+inline constexpr double dish_mass = 3;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double dish_S0_x = 0.30000000000000004;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double dish_S0_z = 0.44999999999999996;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double dish_J0_xx = 0.1875;  // inertia about O (undeformed) [kg m^2]
@@ -109,7 +109,7 @@ inline constexpr double dish_J0_zz = 0.18;  // inertia about O (undeformed) [kg 
 // body mast: fixed joint to hub, mass 1.5 kg
 inline constexpr double mast_p_PJ_y = 0.5;  // joint frame origin in the parent y [m]
 inline constexpr double mast_p_PJ_z = 0.2;  // joint frame origin in the parent z [m]
-inline constexpr double mast_mass = 1.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double mast_mass = 1.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double mast_S0_x = 0.6000000000000001;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double mast_J0_xx = 0.001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double mast_J0_yy = 0.32000000000000006;  // inertia about O (undeformed) [kg m^2]

@@ -45,7 +45,7 @@ inline constexpr double l2_c = 0.05;  // joint damping [N m s/rad or N s/m]
 
 // body l3: prismatic joint to l2, mass 0.8 kg
 inline constexpr double l3_p_PJ_z = -0.4;  // joint frame origin in the parent z [m]
-inline constexpr double l3_mass = 0.8;  // mass (rigid part and nodes) [kg]
+inline constexpr double l3_mass = 0.8;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double l3_S0_z = -0.12;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double l3_J0_xx = 0.024;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double l3_J0_yy = 0.024;  // inertia about O (undeformed) [kg m^2]
@@ -69,7 +69,7 @@ inline constexpr double l4_axis_aa_yz = 0.48;  // axis outer product
 inline constexpr double l4_axis_Iaa_yz = -0.48;  // I - axis outer product
 inline constexpr double l4_axis_aa_zz = 0.6400000000000001;  // axis outer product
 inline constexpr double l4_axis_Iaa_zz = 0.3599999999999999;  // I - axis outer product
-inline constexpr double l4_mass = 0.6;  // mass (rigid part and nodes) [kg]
+inline constexpr double l4_mass = 0.6;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double l4_S0_z = -0.105;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double l4_J0_xx = 0.024574999999999996;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double l4_J0_xz = 0.0004;  // inertia about O (undeformed) [kg m^2]
@@ -78,7 +78,7 @@ inline constexpr double l4_J0_zz = 0.0003;  // inertia about O (undeformed) [kg 
 
 // body l5: revolute joint to l4, mass 0.4 kg
 inline constexpr double l5_p_PJ_z = -0.35;  // joint frame origin in the parent z [m]
-inline constexpr double l5_mass = 0.4;  // mass (rigid part and nodes) [kg]
+inline constexpr double l5_mass = 0.4;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double l5_S0_z = -0.06;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double l5_J0_xx = 0.012;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double l5_J0_yy = 0.012;  // inertia about O (undeformed) [kg m^2]
@@ -90,7 +90,7 @@ inline constexpr double l5_c = 0.02;  // joint damping [N m s/rad or N s/m]
 inline constexpr double gravity_z = -9.81;  // gravity in N z [m/s^2]
 
 // body l1: revolute joint to ground, mass 1.2 kg
-inline constexpr double l1_mass = 1.2;  // mass (rigid part and nodes) [kg]
+inline constexpr double l1_mass = 1.2;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double l1_S0_z = -0.24;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double l1_J0_xx = 0.064;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double l1_J0_yy = 0.064;  // inertia about O (undeformed) [kg m^2]

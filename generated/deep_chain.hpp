@@ -36,7 +36,7 @@ inline constexpr char model_hash[] = "542f98b41d32c83d";
 // ---- model constants (SI units) ---------------------------------------------
 // body link1: revolute joint to base, mass 0.5 kg
 inline constexpr double link1_p_PJ_x = 0.2;  // joint frame origin in the parent x [m]
-inline constexpr double link1_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link1_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link1_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link1_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link1_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -45,7 +45,7 @@ inline constexpr double link1_k = 2;  // joint spring stiffness [N m/rad or N/m]
 
 // body link2: revolute joint to link1, mass 0.5 kg
 inline constexpr double link2_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link2_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link2_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link2_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link2_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link2_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -54,7 +54,7 @@ inline constexpr double link2_k = 2;  // joint spring stiffness [N m/rad or N/m]
 
 // body link3: revolute joint to link2, mass 0.5 kg
 inline constexpr double link3_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link3_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link3_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link3_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link3_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link3_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -67,7 +67,7 @@ inline constexpr double link4_R_PJ_yz = -0.19866933079506124;  // joint frame or
 inline constexpr double link4_R_PJ_zy = 0.19866933079506124;  // joint frame orientation in the parent
 inline constexpr double link4_R_PJ_zz = 0.9800665778412416;  // joint frame orientation in the parent
 inline constexpr double link4_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link4_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link4_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link4_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link4_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link4_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -76,7 +76,7 @@ inline constexpr double link4_k = 2;  // joint spring stiffness [N m/rad or N/m]
 
 // body link5: revolute joint to link4, mass 0.5 kg
 inline constexpr double link5_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link5_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link5_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link5_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link5_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link5_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -85,7 +85,7 @@ inline constexpr double link5_k = 2;  // joint spring stiffness [N m/rad or N/m]
 
 // body link6: revolute joint to link5, mass 0.5 kg
 inline constexpr double link6_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link6_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link6_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link6_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link6_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link6_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -94,7 +94,7 @@ inline constexpr double link6_k = 2;  // joint spring stiffness [N m/rad or N/m]
 
 // body link7: revolute joint to link6, mass 0.5 kg
 inline constexpr double link7_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link7_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link7_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link7_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link7_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link7_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -107,7 +107,7 @@ inline constexpr double link8_R_PJ_yz = -0.19866933079506124;  // joint frame or
 inline constexpr double link8_R_PJ_zy = 0.19866933079506124;  // joint frame orientation in the parent
 inline constexpr double link8_R_PJ_zz = 0.9800665778412416;  // joint frame orientation in the parent
 inline constexpr double link8_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link8_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link8_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link8_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link8_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link8_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -116,7 +116,7 @@ inline constexpr double link8_k = 2;  // joint spring stiffness [N m/rad or N/m]
 
 // body link9: revolute joint to link8, mass 0.5 kg
 inline constexpr double link9_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link9_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link9_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link9_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link9_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link9_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -125,7 +125,7 @@ inline constexpr double link9_k = 2;  // joint spring stiffness [N m/rad or N/m]
 
 // body link10: revolute joint to link9, mass 0.5 kg
 inline constexpr double link10_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link10_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link10_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link10_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link10_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link10_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -134,7 +134,7 @@ inline constexpr double link10_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link11: revolute joint to link10, mass 0.5 kg
 inline constexpr double link11_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link11_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link11_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link11_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link11_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link11_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -147,7 +147,7 @@ inline constexpr double link12_R_PJ_yz = -0.19866933079506124;  // joint frame o
 inline constexpr double link12_R_PJ_zy = 0.19866933079506124;  // joint frame orientation in the parent
 inline constexpr double link12_R_PJ_zz = 0.9800665778412416;  // joint frame orientation in the parent
 inline constexpr double link12_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link12_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link12_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link12_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link12_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link12_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -156,7 +156,7 @@ inline constexpr double link12_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link13: revolute joint to link12, mass 0.5 kg
 inline constexpr double link13_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link13_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link13_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link13_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link13_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link13_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -165,7 +165,7 @@ inline constexpr double link13_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link14: revolute joint to link13, mass 0.5 kg
 inline constexpr double link14_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link14_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link14_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link14_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link14_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link14_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -174,7 +174,7 @@ inline constexpr double link14_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link15: revolute joint to link14, mass 0.5 kg
 inline constexpr double link15_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link15_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link15_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link15_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link15_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link15_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -187,7 +187,7 @@ inline constexpr double link16_R_PJ_yz = -0.19866933079506124;  // joint frame o
 inline constexpr double link16_R_PJ_zy = 0.19866933079506124;  // joint frame orientation in the parent
 inline constexpr double link16_R_PJ_zz = 0.9800665778412416;  // joint frame orientation in the parent
 inline constexpr double link16_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link16_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link16_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link16_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link16_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link16_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -196,7 +196,7 @@ inline constexpr double link16_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link17: revolute joint to link16, mass 0.5 kg
 inline constexpr double link17_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link17_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link17_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link17_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link17_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link17_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -205,7 +205,7 @@ inline constexpr double link17_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link18: revolute joint to link17, mass 0.5 kg
 inline constexpr double link18_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link18_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link18_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link18_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link18_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link18_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -214,7 +214,7 @@ inline constexpr double link18_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link19: revolute joint to link18, mass 0.5 kg
 inline constexpr double link19_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link19_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link19_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link19_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link19_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link19_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -227,7 +227,7 @@ inline constexpr double link20_R_PJ_yz = -0.19866933079506124;  // joint frame o
 inline constexpr double link20_R_PJ_zy = 0.19866933079506124;  // joint frame orientation in the parent
 inline constexpr double link20_R_PJ_zz = 0.9800665778412416;  // joint frame orientation in the parent
 inline constexpr double link20_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link20_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link20_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link20_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link20_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link20_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -236,7 +236,7 @@ inline constexpr double link20_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link21: revolute joint to link20, mass 0.5 kg
 inline constexpr double link21_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link21_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link21_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link21_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link21_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link21_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -245,7 +245,7 @@ inline constexpr double link21_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link22: revolute joint to link21, mass 0.5 kg
 inline constexpr double link22_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link22_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link22_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link22_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link22_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link22_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -254,7 +254,7 @@ inline constexpr double link22_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link23: revolute joint to link22, mass 0.5 kg
 inline constexpr double link23_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link23_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link23_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link23_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link23_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link23_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -267,7 +267,7 @@ inline constexpr double link24_R_PJ_yz = -0.19866933079506124;  // joint frame o
 inline constexpr double link24_R_PJ_zy = 0.19866933079506124;  // joint frame orientation in the parent
 inline constexpr double link24_R_PJ_zz = 0.9800665778412416;  // joint frame orientation in the parent
 inline constexpr double link24_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link24_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link24_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link24_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link24_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link24_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -276,7 +276,7 @@ inline constexpr double link24_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link25: revolute joint to link24, mass 0.5 kg
 inline constexpr double link25_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link25_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link25_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link25_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link25_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link25_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -285,7 +285,7 @@ inline constexpr double link25_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link26: revolute joint to link25, mass 0.5 kg
 inline constexpr double link26_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link26_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link26_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link26_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link26_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link26_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -294,7 +294,7 @@ inline constexpr double link26_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link27: revolute joint to link26, mass 0.5 kg
 inline constexpr double link27_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link27_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link27_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link27_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link27_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link27_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -307,7 +307,7 @@ inline constexpr double link28_R_PJ_yz = -0.19866933079506124;  // joint frame o
 inline constexpr double link28_R_PJ_zy = 0.19866933079506124;  // joint frame orientation in the parent
 inline constexpr double link28_R_PJ_zz = 0.9800665778412416;  // joint frame orientation in the parent
 inline constexpr double link28_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link28_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link28_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link28_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link28_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link28_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -316,7 +316,7 @@ inline constexpr double link28_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link29: revolute joint to link28, mass 0.5 kg
 inline constexpr double link29_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link29_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link29_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link29_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link29_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link29_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -325,7 +325,7 @@ inline constexpr double link29_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link30: revolute joint to link29, mass 0.5 kg
 inline constexpr double link30_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link30_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link30_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link30_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link30_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link30_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -334,7 +334,7 @@ inline constexpr double link30_k = 2;  // joint spring stiffness [N m/rad or N/m
 
 // body link31: revolute joint to link30, mass 0.5 kg
 inline constexpr double link31_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link31_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link31_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link31_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link31_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link31_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -347,7 +347,7 @@ inline constexpr double link32_R_PJ_yz = -0.19866933079506124;  // joint frame o
 inline constexpr double link32_R_PJ_zy = 0.19866933079506124;  // joint frame orientation in the parent
 inline constexpr double link32_R_PJ_zz = 0.9800665778412416;  // joint frame orientation in the parent
 inline constexpr double link32_p_PJ_x = 0.25;  // joint frame origin in the parent x [m]
-inline constexpr double link32_mass = 0.5;  // mass (rigid part and nodes) [kg]
+inline constexpr double link32_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link32_S0_x = 0.0625;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link32_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link32_J0_yy = 0.0104125;  // inertia about O (undeformed) [kg m^2]
@@ -355,7 +355,7 @@ inline constexpr double link32_J0_zz = 0.0104125;  // inertia about O (undeforme
 inline constexpr double link32_k = 2;  // joint spring stiffness [N m/rad or N/m]
 
 // body base: free joint to ground, mass 20 kg
-inline constexpr double base_mass = 20;  // mass (rigid part and nodes) [kg]
+inline constexpr double base_mass = 20;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double base_S0_x = 0.2;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double base_S0_z = 0.4;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double base_J0_xx = 0.508;  // inertia about O (undeformed) [kg m^2]

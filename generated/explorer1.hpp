@@ -35,9 +35,9 @@ inline constexpr char model_name[] = "explorer1";
 inline constexpr char model_hash[] = "3429d7ec6c54342c";
 
 // ---- model constants (SI units) ---------------------------------------------
-// body ant1: fixed joint to bus, mass 0.0025 kg, flexible: 2 modes from beam
+// body ant1: fixed joint to bus, mass 0.05 kg, flexible: 2 modes from beam
 inline constexpr double ant1_p_PJ_x = 0.076;  // joint frame origin in the parent x [m]
-inline constexpr double ant1_mass = 0.0025000000000000005;  // mass (rigid part and nodes) [kg]
+inline constexpr double ant1_mass = 0.0025000000000000005;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double ant1_node2_mass = 0.005000000000000001;  // node mass [kg]
 inline constexpr double ant1_node2_rho_x = 0.05600000000000001;  // node position (undeformed) x [m]
 inline constexpr double ant1_node2_Phi1_z = -0.1490304534777333;  // translational shape of mode 1 at the node z [m]
@@ -103,9 +103,9 @@ inline constexpr double ant1_D1 = 4.021321350338369;  // modal damping [N m s]
 inline constexpr double ant1_K2 = 47.76666624568325;  // modal stiffness [N m]
 inline constexpr double ant1_D2 = 0.691134330254859;  // modal damping [N m s]
 
-// body ant2: fixed joint to bus, mass 0.0025 kg, flexible: 2 modes from beam
+// body ant2: fixed joint to bus, mass 0.05 kg, flexible: 2 modes from beam
 inline constexpr double ant2_p_PJ_y = 0.076;  // joint frame origin in the parent y [m]
-inline constexpr double ant2_mass = 0.0025000000000000005;  // mass (rigid part and nodes) [kg]
+inline constexpr double ant2_mass = 0.0025000000000000005;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double ant2_node2_mass = 0.005000000000000001;  // node mass [kg]
 inline constexpr double ant2_node2_rho_x = 0.05600000000000001;  // node position (undeformed) x [m]
 inline constexpr double ant2_node2_Phi1_z = -0.1490304534777333;  // translational shape of mode 1 at the node z [m]
@@ -171,9 +171,9 @@ inline constexpr double ant2_D1 = 4.021321350338369;  // modal damping [N m s]
 inline constexpr double ant2_K2 = 47.76666624568325;  // modal stiffness [N m]
 inline constexpr double ant2_D2 = 0.691134330254859;  // modal damping [N m s]
 
-// body ant3: fixed joint to bus, mass 0.0025 kg, flexible: 2 modes from beam
+// body ant3: fixed joint to bus, mass 0.05 kg, flexible: 2 modes from beam
 inline constexpr double ant3_p_PJ_x = -0.076;  // joint frame origin in the parent x [m]
-inline constexpr double ant3_mass = 0.0025000000000000005;  // mass (rigid part and nodes) [kg]
+inline constexpr double ant3_mass = 0.0025000000000000005;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double ant3_node2_mass = 0.005000000000000001;  // node mass [kg]
 inline constexpr double ant3_node2_rho_x = 0.05600000000000001;  // node position (undeformed) x [m]
 inline constexpr double ant3_node2_Phi1_z = -0.1490304534777333;  // translational shape of mode 1 at the node z [m]
@@ -239,9 +239,9 @@ inline constexpr double ant3_D1 = 4.021321350338369;  // modal damping [N m s]
 inline constexpr double ant3_K2 = 47.76666624568325;  // modal stiffness [N m]
 inline constexpr double ant3_D2 = 0.691134330254859;  // modal damping [N m s]
 
-// body ant4: fixed joint to bus, mass 0.0025 kg, flexible: 2 modes from beam
+// body ant4: fixed joint to bus, mass 0.05 kg, flexible: 2 modes from beam
 inline constexpr double ant4_p_PJ_y = -0.076;  // joint frame origin in the parent y [m]
-inline constexpr double ant4_mass = 0.0025000000000000005;  // mass (rigid part and nodes) [kg]
+inline constexpr double ant4_mass = 0.0025000000000000005;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double ant4_node2_mass = 0.005000000000000001;  // node mass [kg]
 inline constexpr double ant4_node2_rho_x = 0.05600000000000001;  // node position (undeformed) x [m]
 inline constexpr double ant4_node2_Phi1_z = -0.1490304534777333;  // translational shape of mode 1 at the node z [m]
@@ -308,7 +308,7 @@ inline constexpr double ant4_K2 = 47.76666624568325;  // modal stiffness [N m]
 inline constexpr double ant4_D2 = 0.691134330254859;  // modal damping [N m s]
 
 // body bus: free joint to ground, mass 13.77 kg
-inline constexpr double bus_mass = 13.77;  // mass (rigid part and nodes) [kg]
+inline constexpr double bus_mass = 13.77;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double bus_J0_xx = 4.7486166;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double bus_J0_yy = 4.7486166;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double bus_J0_zz = 0.0397678;  // inertia about O (undeformed) [kg m^2]

@@ -37,7 +37,7 @@ inline constexpr char model_hash[] = "7c8ebf78f50d6ee5";
 // ---- model constants (SI units) ---------------------------------------------
 // body ant1: revolute joint to bus, mass 0.05 kg
 inline constexpr double ant1_p_PJ_x = 0.076;  // joint frame origin in the parent x [m]
-inline constexpr double ant1_mass = 0.05;  // mass (rigid part and nodes) [kg]
+inline constexpr double ant1_mass = 0.05;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double ant1_S0_x = 0.014000000000000002;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double ant1_J0_xx = 2.5e-08;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double ant1_J0_yy = 0.005226670000000001;  // inertia about O (undeformed) [kg m^2]
@@ -47,7 +47,7 @@ inline constexpr double ant1_c = 0.007;  // joint damping [N m s/rad or N s/m]
 
 // body ant2: revolute joint to bus, mass 0.05 kg
 inline constexpr double ant2_p_PJ_y = 0.076;  // joint frame origin in the parent y [m]
-inline constexpr double ant2_mass = 0.05;  // mass (rigid part and nodes) [kg]
+inline constexpr double ant2_mass = 0.05;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double ant2_S0_x = 0.014000000000000002;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double ant2_J0_xx = 2.5e-08;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double ant2_J0_yy = 0.005226670000000001;  // inertia about O (undeformed) [kg m^2]
@@ -57,7 +57,7 @@ inline constexpr double ant2_c = 0.007;  // joint damping [N m s/rad or N s/m]
 
 // body ant3: revolute joint to bus, mass 0.05 kg
 inline constexpr double ant3_p_PJ_x = -0.076;  // joint frame origin in the parent x [m]
-inline constexpr double ant3_mass = 0.05;  // mass (rigid part and nodes) [kg]
+inline constexpr double ant3_mass = 0.05;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double ant3_S0_x = 0.014000000000000002;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double ant3_J0_xx = 2.5e-08;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double ant3_J0_yy = 0.005226670000000001;  // inertia about O (undeformed) [kg m^2]
@@ -67,7 +67,7 @@ inline constexpr double ant3_c = 0.007;  // joint damping [N m s/rad or N s/m]
 
 // body ant4: revolute joint to bus, mass 0.05 kg
 inline constexpr double ant4_p_PJ_y = -0.076;  // joint frame origin in the parent y [m]
-inline constexpr double ant4_mass = 0.05;  // mass (rigid part and nodes) [kg]
+inline constexpr double ant4_mass = 0.05;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double ant4_S0_x = 0.014000000000000002;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double ant4_J0_xx = 2.5e-08;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double ant4_J0_yy = 0.005226670000000001;  // inertia about O (undeformed) [kg m^2]
@@ -76,7 +76,7 @@ inline constexpr double ant4_k = 0.0005;  // joint spring stiffness [N m/rad or 
 inline constexpr double ant4_c = 0.007;  // joint damping [N m s/rad or N s/m]
 
 // body bus: free joint to ground, mass 13.77 kg
-inline constexpr double bus_mass = 13.77;  // mass (rigid part and nodes) [kg]
+inline constexpr double bus_mass = 13.77;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double bus_J0_xx = 4.7486166;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double bus_J0_yy = 4.7486166;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double bus_J0_zz = 0.0397678;  // inertia about O (undeformed) [kg m^2]

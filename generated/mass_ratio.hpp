@@ -37,7 +37,7 @@ inline constexpr char model_hash[] = "6724ac3de81dcd8f";
 // body arm: revolute joint to station, mass 200 kg
 inline constexpr double arm_p_PJ_x = 3;  // joint frame origin in the parent x [m]
 inline constexpr double arm_p_PJ_z = 2;  // joint frame origin in the parent z [m]
-inline constexpr double arm_mass = 200;  // mass (rigid part and nodes) [kg]
+inline constexpr double arm_mass = 200;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double arm_S0_x = 800;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double arm_J0_xx = 2;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double arm_J0_yy = 4267;  // inertia about O (undeformed) [kg m^2]
@@ -46,7 +46,7 @@ inline constexpr double arm_k = 500;  // joint spring stiffness [N m/rad or N/m]
 
 // body sensor: revolute joint to arm, mass 0.01 kg
 inline constexpr double sensor_p_PJ_x = 8;  // joint frame origin in the parent x [m]
-inline constexpr double sensor_mass = 0.01;  // mass (rigid part and nodes) [kg]
+inline constexpr double sensor_mass = 0.01;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double sensor_S0_x = 0.0005;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double sensor_J0_xx = 1e-06;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double sensor_J0_yy = 2.7000000000000006e-05;  // inertia about O (undeformed) [kg m^2]
@@ -54,7 +54,7 @@ inline constexpr double sensor_J0_zz = 2.7000000000000006e-05;  // inertia about
 inline constexpr double sensor_k = 0.002;  // joint spring stiffness [N m/rad or N/m]
 
 // body station: free joint to ground, mass 10000 kg
-inline constexpr double station_mass = 10000;  // mass (rigid part and nodes) [kg]
+inline constexpr double station_mass = 10000;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double station_S0_x = 1000;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double station_S0_y = -500;  // first mass moment about O (undeformed) y [kg m]
 inline constexpr double station_S0_z = 2000;  // first mass moment about O (undeformed) z [kg m]

@@ -36,13 +36,13 @@ inline constexpr char model_hash[] = "1da78b109d9b0307";
 // ---- model constants (SI units) ---------------------------------------------
 // body outer: revolute joint to bus, mass 0.001 kg
 inline constexpr double outer_p_PJ_z = 0.8;  // joint frame origin in the parent z [m]
-inline constexpr double outer_mass = 0.001;  // mass (rigid part and nodes) [kg]
+inline constexpr double outer_mass = 0.001;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double outer_J0_xx = 4.5e-07;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double outer_J0_yy = 4.5e-07;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double outer_J0_zz = 9e-07;  // inertia about O (undeformed) [kg m^2]
 
 // body bus: free joint to ground, mass 300 kg
-inline constexpr double bus_mass = 300;  // mass (rigid part and nodes) [kg]
+inline constexpr double bus_mass = 300;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double bus_S0_x = 6;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double bus_S0_z = -15;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double bus_J0_xx = 50.75;  // inertia about O (undeformed) [kg m^2]
@@ -52,13 +52,13 @@ inline constexpr double bus_J0_yz = 0.2;  // inertia about O (undeformed) [kg m^
 inline constexpr double bus_J0_zz = 40.12;  // inertia about O (undeformed) [kg m^2]
 
 // body middle: revolute joint to outer, mass 0.001 kg
-inline constexpr double middle_mass = 0.001;  // mass (rigid part and nodes) [kg]
+inline constexpr double middle_mass = 0.001;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double middle_J0_xx = 4.5e-07;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double middle_J0_yy = 9e-07;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double middle_J0_zz = 4.5e-07;  // inertia about O (undeformed) [kg m^2]
 
 // body platform: revolute joint to middle, mass 5 kg
-inline constexpr double platform_mass = 5;  // mass (rigid part and nodes) [kg]
+inline constexpr double platform_mass = 5;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double platform_S0_z = 0.25;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double platform_J0_xx = 0.1125;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double platform_J0_yy = 0.1325;  // inertia about O (undeformed) [kg m^2]

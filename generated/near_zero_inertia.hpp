@@ -41,7 +41,7 @@ inline constexpr double probe_R_PJ_yx = 0.29552020666133955;  // joint frame ori
 inline constexpr double probe_R_PJ_yy = 0.955336489125606;  // joint frame orientation in the parent
 inline constexpr double probe_p_PJ_x = 0.3;  // joint frame origin in the parent x [m]
 inline constexpr double probe_p_PJ_y = 0.1;  // joint frame origin in the parent y [m]
-inline constexpr double probe_mass = 0.001;  // mass (rigid part and nodes) [kg]
+inline constexpr double probe_mass = 0.001;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double probe_S0_x = 5e-05;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double probe_J0_xx = 1e-09;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double probe_J0_yy = 3.3300000000000007e-06;  // inertia about O (undeformed) [kg m^2]
@@ -49,7 +49,7 @@ inline constexpr double probe_J0_zz = 3.3300000000000007e-06;  // inertia about 
 inline constexpr double probe_k = 1e-06;  // joint spring stiffness [N m/rad or N/m]
 
 // body bus: free joint to ground, mass 20 kg
-inline constexpr double bus_mass = 20;  // mass (rigid part and nodes) [kg]
+inline constexpr double bus_mass = 20;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double bus_S0_x = 0.2;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double bus_S0_y = 0.4;  // first mass moment about O (undeformed) y [kg m]
 inline constexpr double bus_S0_z = -0.2;  // first mass moment about O (undeformed) z [kg m]

@@ -35,9 +35,9 @@ inline constexpr char model_name[] = "spacecraft_arrays";
 inline constexpr char model_hash[] = "b245168020086c2c";
 
 // ---- model constants (SI units) ---------------------------------------------
-// body wing_a: revolute joint to bus, mass 4.25 kg, flexible: 4 modes from beam
+// body wing_a: revolute joint to bus, mass 33 kg, flexible: 4 modes from beam
 inline constexpr double wing_a_p_PJ_y = 0.8;  // joint frame origin in the parent y [m]
-inline constexpr double wing_a_mass = 4.25;  // mass (rigid part and nodes) [kg]
+inline constexpr double wing_a_mass = 4.25;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double wing_a_S0_y = 0.44999999999999996;  // first mass moment about O (undeformed) y [kg m]
 inline constexpr double wing_a_J0_xx = 0.1675;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double wing_a_J0_yy = 10;  // inertia about O (undeformed) [kg m^2]
@@ -208,9 +208,9 @@ inline constexpr double wing_a_D3 = 0.06264217231021402;  // modal damping [N m 
 inline constexpr double wing_a_K4 = 264.0524639339671;  // modal stiffness [N m]
 inline constexpr double wing_a_D4 = 0.16249691195034047;  // modal damping [N m s]
 
-// body wing_b: revolute joint to bus, mass 4.25 kg, flexible: 4 modes from beam
+// body wing_b: revolute joint to bus, mass 33 kg, flexible: 4 modes from beam
 inline constexpr double wing_b_p_PJ_y = -0.8;  // joint frame origin in the parent y [m]
-inline constexpr double wing_b_mass = 4.25;  // mass (rigid part and nodes) [kg]
+inline constexpr double wing_b_mass = 4.25;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double wing_b_S0_y = 0.44999999999999996;  // first mass moment about O (undeformed) y [kg m]
 inline constexpr double wing_b_J0_xx = 0.1675;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double wing_b_J0_yy = 10;  // inertia about O (undeformed) [kg m^2]
@@ -381,10 +381,10 @@ inline constexpr double wing_b_D3 = 0.06264217231021402;  // modal damping [N m 
 inline constexpr double wing_b_K4 = 264.0524639339671;  // modal stiffness [N m]
 inline constexpr double wing_b_D4 = 0.16249691195034047;  // modal damping [N m s]
 
-// body boom: fixed joint to bus, mass 0.2 kg, flexible: 4 modes from beam
+// body boom: fixed joint to bus, mass 4.8 kg, flexible: 4 modes from beam
 inline constexpr double boom_p_PJ_x = 0.8;  // joint frame origin in the parent x [m]
 inline constexpr double boom_p_PJ_z = 0.5;  // joint frame origin in the parent z [m]
-inline constexpr double boom_mass = 0.19999999999999998;  // mass (rigid part and nodes) [kg]
+inline constexpr double boom_mass = 0.19999999999999998;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double boom_node2_mass = 0.39999999999999997;  // node mass [kg]
 inline constexpr double boom_node2_rho_x = 0.3333333333333333;  // node position (undeformed) x [m]
 inline constexpr double boom_node2_Phi1_z = -0.01066879043876091;  // translational shape of mode 1 at the node z [m]
@@ -553,7 +553,7 @@ inline constexpr double instrument_node13_Gammax_2_2 = -0.24087891412309156;  //
 inline constexpr double instrument_node13_Gammax_2_4 = -0.3777640068142919;  // second-order (foreshortening) coefficient of the attachment node [1/m]
 inline constexpr double instrument_node13_Gammax_3_3 = -1.6542733773553446;  // second-order (foreshortening) coefficient of the attachment node [1/m]
 inline constexpr double instrument_node13_Gammax_4_4 = -1.6542733773553917;  // second-order (foreshortening) coefficient of the attachment node [1/m]
-inline constexpr double instrument_mass = 12;  // mass (rigid part and nodes) [kg]
+inline constexpr double instrument_mass = 12;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double instrument_S0_x = 1.7999999999999998;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double instrument_S0_z = 0.6000000000000001;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double instrument_J0_xx = 0.43000000000000005;  // inertia about O (undeformed) [kg m^2]
@@ -565,7 +565,7 @@ inline constexpr double instrument_J0_zz = 0.62;  // inertia about O (undeformed
 inline constexpr double instrument_k = 10;  // joint spring stiffness [N m/rad or N/m]
 
 // body bus: free joint to ground, mass 800 kg
-inline constexpr double bus_mass = 800;  // mass (rigid part and nodes) [kg]
+inline constexpr double bus_mass = 800;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double bus_S0_x = 16;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double bus_S0_y = -8;  // first mass moment about O (undeformed) y [kg m]
 inline constexpr double bus_S0_z = 40;  // first mass moment about O (undeformed) z [kg m]

@@ -34,10 +34,10 @@ inline constexpr char model_name[] = "stiff_appendage";
 inline constexpr char model_hash[] = "c98d123b912e6e4e";
 
 // ---- model constants (SI units) ---------------------------------------------
-// body mast: fixed joint to bus, mass 0.2 kg, flexible: 4 modes from beam
+// body mast: fixed joint to bus, mass 4 kg, flexible: 4 modes from beam
 inline constexpr double mast_p_PJ_x = 0.5;  // joint frame origin in the parent x [m]
 inline constexpr double mast_p_PJ_z = 0.3;  // joint frame origin in the parent z [m]
-inline constexpr double mast_mass = 0.2;  // mass (rigid part and nodes) [kg]
+inline constexpr double mast_mass = 0.2;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double mast_node2_mass = 0.4;  // node mass [kg]
 inline constexpr double mast_node2_rho_x = 0.1;  // node position (undeformed) x [m]
 inline constexpr double mast_node2_Phi1_z = -0.016662111234694577;  // translational shape of mode 1 at the node z [m]
@@ -167,7 +167,7 @@ inline constexpr double mast_K4 = 2352232463.9255414;  // modal stiffness [N m]
 inline constexpr double mast_D4 = 969.996384307806;  // modal damping [N m s]
 
 // body bus: free joint to ground, mass 200 kg
-inline constexpr double bus_mass = 200;  // mass (rigid part and nodes) [kg]
+inline constexpr double bus_mass = 200;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double bus_S0_x = 4;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double bus_S0_y = -2;  // first mass moment about O (undeformed) y [kg m]
 inline constexpr double bus_S0_z = 6;  // first mass moment about O (undeformed) z [kg m]

@@ -413,7 +413,7 @@ std::vector<RunRecord> bench_model(const std::string& model_path, const BenchOpt
   if (!(t_end > s0.t)) throw InputError(Diagnostic{"--t-end", 0, "", "must be after the initial time"});
   const double dt_out = (t_end - s0.t) / std::max(1, opt.n_outputs);
   double total_mass = 0;
-  for (const Body& b : model.bodies) total_mass += b.integrals.mass;
+  for (const Body& b : model.bodies) total_mass += b.total_mass;
 
   fmt::print(stderr, "bench {}: t_end {} s, nq {}, nu {}\n", model.name, t_end, model.nq, model.nu);
   GenericEngine reference_engine(model);
