@@ -1,9 +1,32 @@
 #include "engine/model_checks.hpp"
 
+#include <fmt/format.h>
+
+#include <cmath>
+
 #include "engine/generic_engine.hpp"
 #include "model/state_io.hpp"
 
 namespace kanegen {
+
+namespace {
+
+/// The first speed whose pivot fails in a Cholesky factorization of M in
+/// speed order (relative to M's largest diagonal entry), or -1.
+int first_singular_speed(const MatX& M) {
+  const int n = static_cast<int>(M.rows());
+  const double scale = n ? M.diagonal().cwiseAbs().maxCoeff() : 0.0;
+  MatX L = MatX::Zero(n, n);
+  for (int j = 0; j < n; ++j) {
+    double d = M(j, j) - L.row(j).head(j).squaredNorm();
+    if (!(d > 1e-14 * scale)) return j;
+    L(j, j) = std::sqrt(d);
+    for (int i = j + 1; i < n; ++i) L(i, j) = (M(i, j) - L.row(i).head(j).dot(L.row(j).head(j))) / L(j, j);
+  }
+  return -1;
+}
+
+}  // namespace
 
 void check_mass_matrix_at_initial_state(const Model& model) {
   GenericEngine engine(model);
@@ -13,10 +36,35 @@ void check_mass_matrix_at_initial_state(const Model& model) {
   try {
     factorize_mass_matrix(M, llt);
   } catch (const SingularMassMatrix& e) {
-    throw InputError(Diagnostic{model.source_path, 0, "bodies",
-                                std::string(e.what()) +
-                                    " at the initial state; expected every degree of freedom to move some mass "
-                                    "(check massless bodies and zero inertias)"});
+    // Name the speed, its body (with the body's line) and the bodies it moves.
+    const int k = first_singular_speed(M);
+    int body = -1;
+    for (std::size_t i = 0; i < model.bodies.size() && k >= 0; ++i) {
+      const Body& b = model.bodies[i];
+      if (k >= b.u_joint && k < b.u_joint + joint_nu(b.joint) + b.n_modes()) body = static_cast<int>(i);
+    }
+    if (body < 0)
+      throw InputError(Diagnostic{model.source_path, 0, "bodies",
+                                  std::string(e.what()) +
+                                      " at the initial state; expected every degree of freedom to move some mass "
+                                      "(check massless bodies and zero inertias)"});
+    const Body& b = model.bodies[body];
+    std::vector<std::string> moved{b.name};
+    for (std::size_t i = body + 1; i < model.bodies.size(); ++i)
+      for (int p = model.bodies[i].parent; p >= 0; p = model.bodies[p].parent)
+        if (p == body) {
+          moved.push_back(model.bodies[i].name);
+          break;
+        }
+    std::string list;
+    for (std::size_t i = 0; i < moved.size() && i < 8; ++i) list += (i ? ", " : "") + moved[i];
+    if (moved.size() > 8) list += fmt::format(" and {} more", moved.size() - 8);
+    throw InputError(Diagnostic{
+        model.source_path, b.line, fmt::format("bodies[{}] ({})", body, b.name),
+        fmt::format("the mass matrix is singular at the initial state: speed '{}' moves no mass or inertia that the "
+                    "other speeds do not already move (it moves {}); expected every degree of freedom to move some "
+                    "mass: give these bodies mass or inertia about the joint axis, or make the joint fixed",
+                    model.u_names[k], list)});
   }
 }
 

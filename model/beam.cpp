@@ -12,9 +12,11 @@
 // inertia its slopes carry no inertia and are condensed statically (exact for
 // this mass model); torsion needs a polar inertia to have modes.
 //
-// Each problem K x = lambda M x (M diagonal) is solved as the symmetric
-// problem of M^-1/2 K M^-1/2, so the shapes come out mass-normalized:
-// Sum_k m_k t_k.t_k + r_k.J_k r_k = 1.
+// Each problem K x = lambda M x (K sparse, M diagonal) is solved for its
+// lowest modes through the symmetric operator M^1/2 K^-1 M^1/2 (lowest_modes),
+// so the shapes come out mass-normalized: Sum_k m_k t_k.t_k + r_k.J_k r_k = 1;
+// large problems by Lanczos iteration, in time and memory linear in the
+// number of elements (2,000 elements: well under a second).
 //
 // Foreshortening (dynamics.md): mode i's deflection w_i(s) in its plane is the
 // cubic Hermite interpolation of its nodal deflections and slopes, and node k
@@ -27,6 +29,11 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include <Eigen/SparseCholesky>
+#include <Spectra/SymEigsSolver.h>
+#include <functional>
+#include <limits>
 
 namespace kanegen {
 
@@ -41,28 +48,87 @@ struct BeamMode {
   VecX th;        // n bending slopes (bending modes only)
 };
 
-/// K x = lambda M x for diagonal M > 0: eigenpairs, x mass-normalized, sign
-/// fixed (largest |entry| of the first block positive).
-void solve_diagonal_mass(const MatX& K, const VecX& Mdiag, int sign_block, std::vector<std::pair<double, VecX>>& out) {
-  const VecX s = Mdiag.cwiseSqrt().cwiseInverse();
-  MatX A = s.asDiagonal() * K * s.asDiagonal();
-  A = 0.5 * (A + A.transpose());
-  Eigen::SelfAdjointEigenSolver<MatX> es(A);
-  if (es.info() != Eigen::Success) throw std::runtime_error("eigenvalue problem failed");
-  for (Eigen::Index j = 0; j < A.rows(); ++j) {
-    VecX x = s.asDiagonal() * es.eigenvectors().col(j);
+/// Problems up to this many degrees of freedom are solved densely (all
+/// modes); larger ones by Lanczos (Spectra) for the lowest modes only, with
+/// a sparse factorization of K: time and memory linear in the size.
+constexpr int kDenseLimit = 300;
+
+/// The lowest `wanted` eigenpairs of K x = lambda M x, K sparse symmetric
+/// positive definite (the clamped beam), M diagonal >= 0 (a zero mass: a
+/// degree of freedom without inertia, condensed statically). Solved as the
+/// symmetric problem A v = nu v, A = M_D^1/2 (K^-1)_DD M_D^1/2 on the
+/// degrees of freedom D with mass (nu = 1/lambda), so x_D = M_D^-1/2 v is
+/// mass-normalized; the massless ones follow from x = lambda K^-1 M x.
+/// Sign fixed: the largest |entry| of the first `sign_block` entries positive.
+std::vector<std::pair<double, VecX>> lowest_modes(const Eigen::SparseMatrix<double>& K, const VecX& M, int wanted,
+                                                  int sign_block) {
+  const int n = static_cast<int>(K.rows());
+  std::vector<int> D;
+  for (int i = 0; i < n; ++i)
+    if (M(i) > 0) D.push_back(i);
+  const int nd = static_cast<int>(D.size());
+  wanted = std::min(wanted, nd);
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(K);
+  if (ldlt.info() != Eigen::Success) throw std::runtime_error("the stiffness matrix is singular");
+  VecX sqrtM(nd);
+  for (int i = 0; i < nd; ++i) sqrtM(i) = std::sqrt(M(D[i]));
+  auto apply = [&](const double* x, double* y) {  // y = A x
+    VecX f = VecX::Zero(n);
+    for (int i = 0; i < nd; ++i) f(D[i]) = sqrtM(i) * x[i];
+    const VecX z = ldlt.solve(f);
+    for (int i = 0; i < nd; ++i) y[i] = sqrtM(i) * z(D[i]);
+  };
+  std::vector<std::pair<double, VecX>> out;  // (nu, v)
+  if (nd <= kDenseLimit) {
+    MatX A(nd, nd);
+    VecX e = VecX::Zero(nd);
+    for (int j = 0; j < nd; ++j) {
+      e(j) = 1.0;
+      apply(e.data(), A.col(j).data());
+      e(j) = 0.0;
+    }
+    A = 0.5 * (A + A.transpose());
+    Eigen::SelfAdjointEigenSolver<MatX> es(A);
+    if (es.info() != Eigen::Success) throw std::runtime_error("eigenvalue problem failed");
+    for (int j = nd - 1; j >= nd - wanted; --j) out.emplace_back(es.eigenvalues()(j), es.eigenvectors().col(j));
+  } else {
+    struct Op {
+      using Scalar = double;
+      int size;
+      std::function<void(const double*, double*)> f;
+      Eigen::Index rows() const { return size; }
+      Eigen::Index cols() const { return size; }
+      void perform_op(const double* x, double* y) const { f(x, y); }
+    } op{nd, apply};
+    Spectra::SymEigsSolver<Op> eigs(op, wanted, std::min(nd, 2 * wanted + 20));
+    eigs.init();
+    eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-12);
+    if (eigs.info() != Spectra::CompInfo::Successful) throw std::runtime_error("the Lanczos iteration did not converge");
+    const VecX nu = eigs.eigenvalues();
+    const MatX V = eigs.eigenvectors();
+    for (int j = 0; j < wanted; ++j) out.emplace_back(nu(j), V.col(j));
+  }
+  std::vector<std::pair<double, VecX>> modes;
+  for (auto& [nu, v] : out) {
+    const double lambda = nu > 0 ? 1.0 / nu : std::numeric_limits<double>::infinity();
+    VecX Mx = VecX::Zero(n);
+    for (int i = 0; i < nd; ++i) Mx(D[i]) = sqrtM(i) * v(i);  // M x with x_D = v / sqrt(M_D)
+    VecX x = lambda * ldlt.solve(Mx);
+    for (int i = 0; i < nd; ++i) x(D[i]) = v(i) / sqrtM(i);  // exact on D
     Eigen::Index imax = 0;
     x.head(sign_block).cwiseAbs().maxCoeff(&imax);
     if (x(imax) < 0) x = -x;
-    out.emplace_back(std::max(es.eigenvalues()(j), 0.0), x);
+    modes.emplace_back(lambda, std::move(x));
   }
+  return modes;
 }
 
-/// Bending in one plane: stiffness EI, node masses m (free nodes), slope
-/// inertias Jr (free nodes; all zero: slopes condensed).
-void solve_bending(double EI, double h, int n, const VecX& m, const VecX& Jr, Kind kind, std::vector<BeamMode>& out) {
-  // Free dofs: w_1..w_n (block 0), th_1..th_n (block 1).
-  MatX K = MatX::Zero(2 * n, 2 * n);
+/// Bending in one plane: stiffness EI, node masses m and slope inertias Jr
+/// (free nodes 1..n; Jr zero: slopes condensed). Degrees of freedom
+/// w_1..w_n, th_1..th_n.
+void solve_bending(double EI, double h, int n, const VecX& m, const VecX& Jr, Kind kind, int wanted,
+                   std::vector<BeamMode>& out) {
+  std::vector<Eigen::Triplet<double>> t;
   const double c = EI / (h * h * h);
   const double ke[4][4] = {{12, 6 * h, -12, 6 * h},
                            {6 * h, 4 * h * h, -6 * h, 2 * h * h},
@@ -75,42 +141,31 @@ void solve_bending(double EI, double h, int n, const VecX& m, const VecX& Jr, Ki
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b) {
         if (node[a] == 0 || node[b] == 0) continue;
-        const int ia = (rot[a] ? n : 0) + node[a] - 1, ib = (rot[b] ? n : 0) + node[b] - 1;
-        K(ia, ib) += c * ke[a][b];
+        t.emplace_back((rot[a] ? n : 0) + node[a] - 1, (rot[b] ? n : 0) + node[b] - 1, c * ke[a][b]);
       }
   }
-  std::vector<std::pair<double, VecX>> pairs;
-  if (Jr.minCoeff() > 0) {
-    VecX M(2 * n);
-    M << m, Jr;
-    solve_diagonal_mass(K, M, n, pairs);
-    for (auto& [lambda, x] : pairs) out.push_back({lambda, kind, x.head(n), x.tail(n)});
-    return;
-  }
-  // th = -G w: the slopes carry no inertia (static condensation, exact here).
-  const MatX Ktt = K.topLeftCorner(n, n), Ktr = K.topRightCorner(n, n), Krr = K.bottomRightCorner(n, n);
-  const Eigen::LLT<MatX> Lrr(Krr);
-  if (Lrr.info() != Eigen::Success) throw std::runtime_error("singular rotational stiffness");
-  const MatX G = Lrr.solve(Ktr.transpose());
-  solve_diagonal_mass(Ktt - Ktr * G, m, n, pairs);
-  for (auto& [lambda, x] : pairs) out.push_back({lambda, kind, x, -G * x});
+  Eigen::SparseMatrix<double> K(2 * n, 2 * n);
+  K.setFromTriplets(t.begin(), t.end());
+  VecX M(2 * n);
+  M << m, Jr;
+  for (auto& [lambda, x] : lowest_modes(K, M, wanted, n)) out.push_back({lambda, kind, x.head(n), x.tail(n)});
 }
 
-/// Torsion or axial: linear elements of stiffness k_per_length / h, masses M (free nodes).
-void solve_linear(double stiffness, double h, int n, const VecX& M, Kind kind, std::vector<BeamMode>& out) {
-  MatX K = MatX::Zero(n, n);
+/// Torsion or axial: linear elements of stiffness k / h, inertias M (free nodes).
+void solve_linear(double stiffness, double h, int n, const VecX& M, Kind kind, int wanted, std::vector<BeamMode>& out) {
+  std::vector<Eigen::Triplet<double>> t;
   const double c = stiffness / h;
   for (int e = 0; e < n; ++e) {  // element e .. e+1; free node k has index k - 1
-    K(e, e) += c;
+    t.emplace_back(e, e, c);
     if (e > 0) {
-      K(e - 1, e - 1) += c;
-      K(e - 1, e) -= c;
-      K(e, e - 1) -= c;
+      t.emplace_back(e - 1, e - 1, c);
+      t.emplace_back(e - 1, e, -c);
+      t.emplace_back(e, e - 1, -c);
     }
   }
-  std::vector<std::pair<double, VecX>> pairs;
-  solve_diagonal_mass(K, M, n, pairs);
-  for (auto& [lambda, x] : pairs) out.push_back({lambda, kind, x, VecX()});
+  Eigen::SparseMatrix<double> K(n, n);
+  K.setFromTriplets(t.begin(), t.end());
+  for (auto& [lambda, x] : lowest_modes(K, M, wanted, n)) out.push_back({lambda, kind, x, VecX()});
 }
 
 /// Integral over one element of w_i'(s) w_j'(s) ds for Hermite cubics given
@@ -141,7 +196,8 @@ FlexibleData beam_modal_data(const BeamSpec& spec) {
   const double polar = spec.polar_inertia.value_or(spec.rotary_inertia[0] + spec.rotary_inertia[1]);
   const bool torsion = spec.GJ.has_value() && polar > 0;
   const bool axial = spec.EA.has_value();
-  const int available = 2 * n + (torsion ? n : 0) + (axial ? n : 0);
+  const int slopes = (spec.rotary_inertia[0] > 0 ? n : 0) + (spec.rotary_inertia[1] > 0 ? n : 0);
+  const int available = 2 * n + slopes + (torsion ? n : 0) + (axial ? n : 0);
   if (spec.modes > available)
     throw std::invalid_argument("asks for " + std::to_string(spec.modes) + " modes but " + std::to_string(n) +
                                 " elements give only " + std::to_string(available) +
@@ -157,11 +213,12 @@ FlexibleData beam_modal_data(const BeamSpec& spec) {
   for (int k = 0; k <= n; ++k) w(k) = (k == 0 || k == n) ? 0.5 : 1.0;
   const VecX mass = mu * h * w;
   std::vector<BeamMode> all;
+  // Each family contributes at most the `modes` lowest of its own; the lowest overall are kept.
   for (int p = 0; p < 2; ++p)
-    solve_bending(spec.EI[p], h, n, mass.tail(n), spec.rotary_inertia[p] * h * w.tail(n), p == 0 ? Kind::bend0 : Kind::bend1,
-                  all);
-  if (torsion) solve_linear(*spec.GJ, h, n, polar * h * w.tail(n), Kind::torsion, all);
-  if (axial) solve_linear(*spec.EA, h, n, mass.tail(n), Kind::axial, all);
+    solve_bending(spec.EI[p], h, n, mass.tail(n), spec.rotary_inertia[p] * h * w.tail(n),
+                  p == 0 ? Kind::bend0 : Kind::bend1, spec.modes, all);
+  if (torsion) solve_linear(*spec.GJ, h, n, polar * h * w.tail(n), Kind::torsion, spec.modes, all);
+  if (axial) solve_linear(*spec.EA, h, n, mass.tail(n), Kind::axial, spec.modes, all);
   std::stable_sort(all.begin(), all.end(), [](const BeamMode& a, const BeamMode& b) { return a.lambda < b.lambda; });
   all.resize(spec.modes);
 

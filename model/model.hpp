@@ -95,6 +95,7 @@ struct FlexibleData {
 
 struct Body {
   std::string name;
+  int line = 0;                     ///< line of the body's entry in the model file (0: built in code)
   int parent = -1;                  ///< index of the parent body, -1 for ground
   std::vector<int> children;
   Joint joint;

@@ -112,7 +112,22 @@ class Loader {
         model_.name = *s;
     }
     if (root["description"].IsDefined()) {
-      if (auto s = ck_.string(root["description"], 1, "description")) model_.description = *s;
+      if (auto s = ck_.string(root["description"], 1, "description")) {
+        // One line of printable text: it is copied into the generated header's comment.
+        const auto bad = std::find_if(s->begin(), s->end(), [](char c) {
+          const auto u = static_cast<unsigned char>(c);
+          return u < 0x20 || u == 0x7F;
+        });
+        if (bad != s->end())
+          ck_.error(root["description"], 1, "description",
+                    fmt::format("control character 0x{:02x} (e.g. an escaped line break); expected one line of text",
+                                static_cast<unsigned>(static_cast<unsigned char>(*bad))));
+        else if (s->size() > 1000)
+          ck_.error(root["description"], 1, "description",
+                    fmt::format("{} characters; expected at most 1000", s->size()));
+        else
+          model_.description = *s;
+      }
     }
     if (root["gravity"].IsDefined()) {
       if (auto g = ck_.vec3(root["gravity"], 1, "gravity")) model_.g_N = *g;
@@ -946,6 +961,7 @@ class Loader {
   Model build() {
     for (BodyInfo& bi : info_) {
       bi.body.parent = bi.parent;
+      bi.body.line = bi.line;
       snap_roundoff_residues(bi.body);
       model_.bodies.push_back(std::move(bi.body));
     }

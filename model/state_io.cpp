@@ -4,10 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <nlohmann/json.hpp>
-#include <set>
-#include <sstream>
+#include <map>
+
+#include "model/input_text.hpp"
+#include "model/json_lines.hpp"
 
 namespace kanegen {
 
@@ -43,107 +43,132 @@ std::string hint(const std::string& name, const std::vector<std::string>& names)
   return list.empty() ? "(none)" : s;
 }
 
-/// 1-based line of byte offset `pos` in text.
-int line_at(const std::string& text, std::size_t pos) {
-  pos = std::min(pos, text.size());
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(pos), '\n'));
+void sort_by_line(std::vector<Diagnostic>& ds) {
+  std::stable_sort(ds.begin(), ds.end(), [](const Diagnostic& a, const Diagnostic& b) { return a.line < b.line; });
 }
 
 }  // namespace
 
 State load_state(const Model& model, const std::string& path) {
   std::vector<Diagnostic> diags;
-  auto err = [&](const std::string& field, const std::string& msg) {
-    diags.push_back(Diagnostic{path, 0, field, msg});
+  const std::optional<std::string> text = read_input_text(path, kMaxStateFileBytes, diags);
+  if (!text) throw InputError(diags);
+  const JsonValue root = parse_json_with_lines(*text, path);
+  auto err = [&](int line, const std::string& field, const std::string& msg) {
+    diags.push_back(Diagnostic{path, line, field, msg});
   };
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(Diagnostic{path, 0, "", "cannot open file; expected a readable STATE.json"});
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string text = ss.str();
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    // e.byte is 1-based position of the fault
-    const int line = e.byte > 0 ? line_at(text, e.byte - 1) : 0;
-    std::string what = e.what();
-    throw InputError(Diagnostic{path, line, "", fmt::format("malformed JSON: {}", what)});
+  if (root.kind != JsonValue::Kind::object) {
+    err(root.line, "", fmt::format("got {}; expected a JSON object {{\"t\", \"q\", \"u\", \"tau\"}}",
+                                   root.kind_name()));
+    throw InputError(diags);
   }
-  if (!j.is_object()) throw InputError(Diagnostic{path, 0, "", "expected a JSON object {\"t\", \"q\", \"u\", \"tau\"}"});
+  /// The members of an object, each key once: a repeated key is refused with both lines.
+  auto unique_members = [&](const JsonValue& obj, const std::string& prefix) {
+    std::vector<const JsonValue::Member*> out;
+    for (const auto& m : obj.members) {
+      const std::string field = prefix.empty() ? m.key : prefix + "." + m.key;
+      auto same = std::find_if(out.begin(), out.end(), [&](const JsonValue::Member* o) { return o->key == m.key; });
+      if (same != out.end()) {
+        err(m.key_line, field,
+            fmt::format("given twice (also on line {}); expected each name once", (*same)->key_line));
+        continue;
+      }
+      out.push_back(&m);
+    }
+    return out;
+  };
+  auto number = [&](const JsonValue::Member& m, const std::string& field, double& out) {
+    if (m.value.kind != JsonValue::Kind::number) {
+      err(m.value.line, field, fmt::format("got {}; expected a number", m.value.kind_name()));
+      return false;
+    }
+    if (!std::isfinite(m.value.number)) {
+      err(m.value.line, field,
+          fmt::format("{} is out of the range of a double; expected a finite number", m.value.text));
+      return false;
+    }
+    out = m.value.number;
+    return true;
+  };
 
   State s = initial_state(model);
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string& key = it.key();
-    if (key != "t" && key != "q" && key != "u" && key != "tau")
-      err(key, fmt::format("unknown key '{}'; expected only t, q, u, tau", key));
-  }
-  if (j.contains("t")) {
-    if (!j["t"].is_number())
-      err("t", fmt::format("got {}; expected a number", j["t"].dump()));
-    else
-      s.t = j["t"].get<double>();
+  const auto top = unique_members(root, "");
+  const JsonValue::Member* sections[3] = {nullptr, nullptr, nullptr};
+  for (const auto* m : top) {
+    if (m->key == "t") {
+      number(*m, "t", s.t);
+    } else if (m->key == "q" || m->key == "u" || m->key == "tau") {
+      sections[m->key == "q" ? 0 : m->key == "u" ? 1 : 2] = m;
+    } else {
+      err(m->key_line, m->key, fmt::format("unknown key '{}'; expected only t, q, u, tau", m->key));
+    }
   }
 
-  std::set<std::string> given_q;
-  struct Section {
-    const char* key;
-    const std::vector<std::string>* names;
-    VecX* target;
-  };
-  for (const Section& sec : {Section{"q", &model.q_names, &s.q}, Section{"u", &model.u_names, &s.u},
-                             Section{"tau", &model.u_names, &s.tau}}) {
-    if (!j.contains(sec.key)) continue;
-    const auto& obj = j[sec.key];
-    if (!obj.is_object()) {
-      err(sec.key, fmt::format("got {}; expected an object {{name: number}}", obj.type_name()));
+  std::map<std::string, int> given_q;  // name -> line
+  const char* keys[3] = {"q", "u", "tau"};
+  const std::vector<std::string>* names[3] = {&model.q_names, &model.u_names, &model.u_names};
+  VecX* targets[3] = {&s.q, &s.u, &s.tau};
+  for (int k = 0; k < 3; ++k) {
+    const JsonValue::Member* sec = sections[k];
+    if (!sec) continue;
+    if (sec->value.kind != JsonValue::Kind::object) {
+      err(sec->value.line, keys[k],
+          fmt::format("got {}; expected an object {{name: number}}", sec->value.kind_name()));
       continue;
     }
-    for (auto it = obj.begin(); it != obj.end(); ++it) {
-      const std::string field = std::string(sec.key) + "." + it.key();
-      const int k = find_name(*sec.names, it.key());
-      if (k < 0) {
-        err(field, fmt::format("unknown name '{}'; expected one of: {}", it.key(), hint(it.key(), *sec.names)));
+    for (const auto* m : unique_members(sec->value, keys[k])) {
+      const std::string field = std::string(keys[k]) + "." + m->key;
+      const int idx = find_name(*names[k], m->key);
+      if (idx < 0) {
+        const bool prescribed =
+            k == 0 && std::find(model.prescribed_names.begin(), model.prescribed_names.end(), m->key) !=
+                          model.prescribed_names.end();
+        err(m->key_line, field,
+            prescribed ? fmt::format("'{}' is prescribed by its joint's motion: (a known function of time); "
+                                     "expected no value for it",
+                                     m->key)
+                       : fmt::format("unknown name '{}'; expected one of: {}", m->key, hint(m->key, *names[k])));
         continue;
       }
-      if (!it.value().is_number()) {
-        err(field, fmt::format("got {}; expected a number", it.value().dump()));
-        continue;
-      }
-      const double x = it.value().get<double>();
-      if (!std::isfinite(x)) {
-        err(field, "not finite; expected a finite number");
-        continue;
-      }
-      (*sec.target)(k) = x;
-      if (std::string(sec.key) == "q") given_q.insert(it.key());
+      double x = 0;
+      if (!number(*m, field, x)) continue;
+      (*targets[k])(idx) = x;
+      if (k == 0) given_q[m->key] = m->key_line;
     }
   }
 
-  // Quaternions: all four components or none; any non-zero norm is normalized.
+  // Quaternions: all four components or none; any non-zero norm is
+  // normalized, robustly (scaled by the largest component first, so that
+  // tiny and huge components neither underflow nor overflow).
   for (const Body& b : model.bodies) {
     if (b.joint.type != JointType::free) continue;
     const char* comp[4] = {".qw", ".qx", ".qy", ".qz"};
     std::vector<std::string> have, lack;
     for (const char* c : comp) (given_q.count(b.name + c) ? have : lack).push_back(b.name + c);
     if (have.empty()) continue;
+    const int line = given_q[have[0]];
     if (!lack.empty()) {
       std::string l;
       for (std::size_t i = 0; i < lack.size(); ++i) l += (i ? ", " : "") + lack[i];
-      err("q." + have[0], fmt::format("quaternion of '{}' given in part ({} missing); expected all of {}.qw, "
-                                      ".qx, .qy, .qz or none",
-                                      b.name, l, b.name));
+      err(line, "q." + have[0],
+          fmt::format("quaternion of '{}' given in part ({} missing); expected all of {}.qw, .qx, .qy, .qz or none",
+                      b.name, l, b.name));
       continue;
     }
     auto q = s.q.segment<4>(b.q_joint + 3);
-    const double n = q.norm();
-    if (!(n > 0.0)) {
-      err("q." + b.name + ".qw", fmt::format("quaternion of '{}' is zero; expected a non-zero quaternion", b.name));
+    const double scale = q.cwiseAbs().maxCoeff();
+    if (!(scale > 0.0)) {
+      err(line, "q." + b.name + ".qw",
+          fmt::format("quaternion of '{}' is zero; expected a non-zero quaternion", b.name));
       continue;
     }
-    q /= n;
+    q /= scale;
+    q /= q.norm();
   }
-  if (!diags.empty()) throw InputError(diags);
+  if (!diags.empty()) {
+    sort_by_line(diags);
+    throw InputError(diags);
+  }
   return s;
 }
 

@@ -5,11 +5,13 @@
 #pragma once
 
 #include <fmt/format.h>
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <initializer_list>
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "model/diagnostics.hpp"
+#include "model/input_text.hpp"
 
 namespace kanegen::yamlcheck {
 
@@ -173,17 +176,24 @@ class Checker {
     return x;
   }
 
+  /// A decimal integer (one rule everywhere: "010" is ten, as in YAML 1.2;
+  /// hex, octal and other forms are refused).
   std::optional<long long> integer(const YAML::Node& n, int fallback, const std::string& field) {
     if (!n.IsScalar()) {
       error(n, fallback, field, fmt::format("got {}; expected an integer", describe(n)));
       return std::nullopt;
     }
-    try {
-      return n.as<long long>();
-    } catch (const YAML::Exception&) {
-      error(n, fallback, field, fmt::format("'{}' is not an integer; expected an integer", n.Scalar()));
+    const std::string& v = n.Scalar();
+    long long x = 0;
+    const char* b = v.data() + (v.size() > 1 && v[0] == '+' ? 1 : 0);
+    const auto r = std::from_chars(b, v.data() + v.size(), x, 10);
+    if (v.empty() || r.ptr != v.data() + v.size() || r.ec != std::errc()) {
+      error(n, fallback, field,
+            fmt::format("'{}' is not an integer{}; expected a decimal integer", v,
+                        r.ec == std::errc::result_out_of_range ? " in range" : ""));
       return std::nullopt;
     }
+    return x;
   }
 
   std::optional<bool> boolean(const YAML::Node& n, int fallback, const std::string& field) {
@@ -334,23 +344,57 @@ inline void sort_diagnostics(std::vector<Diagnostic>& ds) {
   });
 }
 
-/// Parses a YAML file; a missing file or a syntax error is recorded and an
-/// undefined node returned.
+/// Line of the first line at column 0 that starts a second document ("---"
+/// after content, or content after "..."), or 0.
+inline int second_document_line(const std::string& text) {
+  bool content = false, ended = false;
+  int line = 0;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    const std::string l = text.substr(pos, end - pos);
+    ++line;
+    const std::size_t first = l.find_first_not_of(" \t");
+    const bool blank = first == std::string::npos || l[first] == '#';
+    if (l.rfind("---", 0) == 0 && (l.size() == 3 || l[3] == ' ' || l[3] == '\t')) {
+      if (content || ended) return line;
+      // "--- x": content on the marker's line
+      const std::size_t c = l.find_first_not_of(" \t", 3);
+      if (c != std::string::npos && l[c] != '#') content = true;
+    } else if (l.rfind("...", 0) == 0 && (l.size() == 3 || l[3] == ' ' || l[3] == '\t')) {
+      ended = true;
+    } else if (!blank && l[0] != '%') {
+      if (ended) return line;
+      content = true;
+    }
+    pos = end + 1;
+  }
+  return 0;
+}
+
+/// Parses a YAML file (read and checked by read_input_text: size, UTF-8,
+/// control characters, nesting, line breaks); a missing file, a syntax error,
+/// or a second document is recorded and an undefined node returned.
 inline YAML::Node parse_file(const std::string& path, std::vector<Diagnostic>& diags, bool& ok) {
   ok = false;
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    diags.push_back(Diagnostic{path, 0, "",
-                               std::filesystem::exists(path, ec) ? "cannot open file (not a regular file); expected a YAML file"
-                                                                 : "cannot open file (no such file); expected a YAML file"});
+  const std::optional<std::string> text = read_input_text(path, kMaxModelFileBytes, diags);
+  if (!text) return YAML::Node();
+  if (const int l = second_document_line(*text)) {
+    diags.push_back(Diagnostic{path, l, "",
+                               "a second YAML document (after '---' or '...'); expected one document per file"});
     return YAML::Node();
   }
   try {
-    YAML::Node root = YAML::LoadFile(path);
+    std::vector<YAML::Node> docs = YAML::LoadAll(*text);
+    if (docs.size() > 1) {
+      diags.push_back(Diagnostic{path, 0, "", "more than one YAML document; expected one document per file"});
+      return YAML::Node();
+    }
     ok = true;
-    return root;
-  } catch (const YAML::BadFile&) {
-    diags.push_back(Diagnostic{path, 0, "", "cannot open file; expected a readable YAML file"});
+    return docs.empty() ? YAML::Node() : docs[0];
+  } catch (const YAML::DeepRecursion& e) {
+    diags.push_back(Diagnostic{path, e.mark.is_null() ? 0 : e.mark.line + 1, "",
+                               "nested too deeply; expected a flatter document"});
   } catch (const YAML::ParserException& e) {
     diags.push_back(Diagnostic{path, e.mark.is_null() ? 0 : e.mark.line + 1, "",
                                fmt::format("YAML syntax error: {}", e.msg)});

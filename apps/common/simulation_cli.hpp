@@ -22,6 +22,7 @@ namespace kanegen::cli {
 struct SimulationCli {
   std::string output, integrator = "cvode-bdf";
   double t_end = 10.0, rtol = 1e-8, atol = 1e-10, dt_out = 0.01, h = 1e-3;
+  long max_steps = 100'000'000;
   bool no_progress = false;
 };
 
@@ -46,6 +47,7 @@ inline void add_simulation_options(CLI::App* c, SimulationCli& o, bool t_end_req
   c->add_option("--atol", o.atol, "absolute tolerance (adaptive integrators), > 0")->capture_default_str();
   c->add_option("--dt-out", o.dt_out, "output interval [s], > 0")->capture_default_str();
   c->add_option("--h", o.h, "fixed step of rk4 [s], > 0")->capture_default_str();
+  c->add_option("--max-steps", o.max_steps, "steps allowed in all before the run fails, >= 1")->capture_default_str();
   c->add_flag("--no-progress", o.no_progress, "no progress bar on stderr");
 }
 
@@ -72,6 +74,7 @@ inline SimulationOptions simulation_options(const SimulationCli& o, const State&
   if (!(std::isfinite(o.atol) && o.atol > 0))
     fault("--atol", fmt::format("got {}; expected a positive, finite absolute tolerance", o.atol));
   if (!(std::isfinite(o.h) && o.h > 0)) fault("--h", fmt::format("got {}; expected a positive, finite step", o.h));
+  if (o.max_steps < 1) fault("--max-steps", fmt::format("got {}; expected at least 1", o.max_steps));
   if (faults.empty()) {
     const double rows = std::floor((o.t_end - t0) / o.dt_out) + 2;
     if (!(rows <= kMaxOutputRows))
@@ -91,6 +94,7 @@ inline SimulationOptions simulation_options(const SimulationCli& o, const State&
   opt.integrator.rtol = o.rtol;
   opt.integrator.atol = o.atol;
   opt.integrator.h = o.h;
+  opt.integrator.max_steps = o.max_steps;
   opt.progress = !o.no_progress;
   return opt;
 }
