@@ -25,6 +25,7 @@
 #include "engine/manifest.hpp"
 #include "engine/resources.hpp"
 #include "model/model_hash.hpp"
+#include "model/signal_cleanup.hpp"
 
 #ifndef KANEGEN_VERSION
 #define KANEGEN_VERSION "unknown"
@@ -251,14 +252,18 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
   if (ec) throw std::runtime_error(fmt::format("kanegen: cannot create cache directory {}: {}", dir.string(), ec.message()));
   jit_cache::remove_stale_temps(dir.string());
   const fs::path tmp = jit_cache::make_temp_dir(dir.string());
+  // Removed on every exit path, and by the signal handler on SIGINT/SIGTERM/SIGHUP
+  // (a SIGKILL leaves it to the next build's remove_stale_temps).
   struct Cleanup {
     fs::path p;
+    int slot;
     bool keep = false;
     ~Cleanup() {
+      unregister_cleanup(slot);
       std::error_code e;
       if (!keep) fs::remove_all(p, e);
     }
-  } cleanup{tmp};
+  } cleanup{tmp, register_cleanup(tmp.string())};
 
   write_file(tmp / "model.hpp", sources.header);
   write_file(tmp / "manifest.json", sources.manifest);

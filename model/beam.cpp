@@ -266,7 +266,7 @@ FlexibleData beam_modal_data(const BeamSpec& spec) {
     v[2] = md.x(e);
     v[3] = md.th(e);
   };
-  for (int e = 0; e < n; ++e) {
+  for (int e = 0; spec.second_order && e < n; ++e) {
     for (int i = 0; i < m; ++i) {
       if (all[i].kind != Kind::bend0 && all[i].kind != Kind::bend1) continue;
       for (int j = i; j < m; ++j) {

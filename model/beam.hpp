@@ -31,6 +31,7 @@ struct BeamSpec {
   std::optional<double> polar_inertia;
   int elements = 0;                  ///< >= 1
   int modes = 0;                     ///< >= 1, lowest modes kept
+  bool second_order = true;          ///< compute Gamma (foreshortening); elements x modes^2 entries
 };
 
 /// Nodes (element ends; node 1 at the clamped origin, carried rigidly), their

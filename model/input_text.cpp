@@ -37,6 +37,8 @@ int utf8_length(const std::string& s, std::size_t i) {
 
 std::optional<Diagnostic> check_input_text(const std::string& text, const std::string& path) {
   int line = 1, depth = 0;
+  std::size_t line_start = 0;  // offset of the current line
+  auto column = [&](std::size_t i) { return fmt::format("column {}", i - line_start + 1); };
   char quote = 0;  // inside a quoted scalar/string: its quote character
   bool comment = false;
   for (std::size_t i = 0; i < text.size();) {
@@ -44,14 +46,15 @@ std::optional<Diagnostic> check_input_text(const std::string& text, const std::s
     const auto uc = static_cast<unsigned char>(c);
     const int len = utf8_length(text, i);
     if (len == 0)
-      return Diagnostic{path, line, "",
+      return Diagnostic{path, line, column(i),
                         fmt::format("invalid UTF-8 (byte 0x{:02x}); expected a UTF-8 text file", static_cast<unsigned>(uc))};
     if (len == 1 && ((uc < 0x20 && c != '\t' && c != '\n') || uc == 0x7F))
-      return Diagnostic{path, line, "",
+      return Diagnostic{path, line, column(i),
                         fmt::format("control character 0x{:02x}; expected printable text (tab and line breaks only)",
                                     static_cast<unsigned>(uc))};
     if (c == '\n') {
       ++line;
+      line_start = i + 1;
       comment = false;
       if (quote == '\'' || quote == '"') {
         // a multi-line quoted scalar continues; brackets inside do not nest
@@ -73,7 +76,7 @@ std::optional<Diagnostic> check_input_text(const std::string& text, const std::s
         comment = true;
       } else if (c == '[' || c == '{') {
         if (++depth > kMaxNestingDepth)
-          return Diagnostic{path, line, "",
+          return Diagnostic{path, line, column(i),
                             fmt::format("brackets nested deeper than {} levels; expected a flatter document",
                                         kMaxNestingDepth)};
       } else if ((c == ']' || c == '}') && depth > 0) {

@@ -18,7 +18,10 @@
 namespace kanegen {
 
 /// Limits of the inputs (docs/limits.md).
-inline constexpr std::size_t kMaxModelFileBytes = 64u << 20;  ///< a model or modal file
+/// yaml-cpp holds about 0.6 kB per number it reads: these two bound the
+/// memory of a load to about 0.5 GB and 2 GB (docs/limits.md).
+inline constexpr std::size_t kMaxModelFileBytes = 4u << 20;   ///< a model file
+inline constexpr std::size_t kMaxModalFileBytes = 16u << 20;  ///< a modal data file
 inline constexpr std::size_t kMaxStateFileBytes = 1u << 20;   ///< a STATE.json
 inline constexpr int kMaxNestingDepth = 32;                   ///< brackets [ { nested
 

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -39,7 +40,13 @@ class Parser {
 
  private:
   [[noreturn]] void fail(const std::string& what) {
-    throw InputError(Diagnostic{path_, line_, "", "malformed JSON: " + what});
+    throw InputError(Diagnostic{path_, line_, fmt::format("column {}", column()), "malformed JSON: " + what});
+  }
+  /// 1-based column (in bytes) of the current position.
+  std::size_t column() const {
+    const std::size_t at = std::min(i_, s_.size());
+    const std::size_t nl = at == 0 ? std::string::npos : s_.rfind('\n', at - 1);
+    return nl == std::string::npos ? at + 1 : at - nl;
   }
   void skip_ws() {
     while (i_ < s_.size()) {

@@ -38,14 +38,14 @@ FlexibleData load_modal_file(const std::string& path, const std::vector<int>& ke
   FlexibleData flex;
   flex.source = path;
   bool parsed = false;
-  const YAML::Node root = yamlcheck::parse_file(path, diagnostics, parsed);
+  const YAML::Node root = yamlcheck::parse_file(path, kMaxModalFileBytes, diagnostics, parsed);
   if (!parsed) return flex;
   Checker ck(path, diagnostics);
   if (!root.IsDefined() || root.IsNull()) {
-    ck.error(1, "", "empty file; expected modal data (a mapping with nodes, modes, mass_normalized)");
+    ck.error(1, "(document)", "empty file; expected modal data (a mapping with nodes, modes, mass_normalized)");
     return flex;
   }
-  if (!ck.expect_map(root, 1, "")) return flex;
+  if (!ck.expect_map(root, 1, "(document)")) return flex;
   ck.check_keys(root, "", {"nodes", "modes", "mass_normalized", "second_order"});
 
   // ---- nodes
@@ -60,6 +60,10 @@ FlexibleData load_modal_file(const std::string& path, const std::vector<int>& ke
   } else if (nodes.size() == 0) {
     ck.error(nodes, 1, "nodes", "empty; expected at least one node");
     nodes_ok = false;
+  } else if (nodes.size() > kMaxModalNodes) {
+    ck.error(nodes, 1, "nodes",
+             fmt::format("{} nodes; expected at most {} (docs/limits.md)", nodes.size(), kMaxModalNodes));
+    nodes_ok = false;
   } else {
     for (std::size_t k = 0; k < nodes.size(); ++k) {
       const YAML::Node nd = nodes[k];
@@ -68,6 +72,7 @@ FlexibleData load_modal_file(const std::string& path, const std::vector<int>& ke
       ModalNode node;
       if (!ck.expect_map(nd, l, f)) {
         nodes_ok = false;
+        flex.nodes.push_back(node);  // keep flex.nodes[k] aligned with nodes[k]
         continue;
       }
       ck.check_keys(nd, f, {"id", "position", "mass", "inertia"});
@@ -136,6 +141,11 @@ FlexibleData load_modal_file(const std::string& path, const std::vector<int>& ke
   } else if (!ck.expect_seq(ms, 1, "modes")) {
   } else if (ms.size() == 0) {
     ck.error(ms, 1, "modes", "empty; expected at least one mode");
+  } else if (ms.size() > kMaxFileModes || 3.0 * static_cast<double>(nn) * static_cast<double>(ms.size()) > kMaxShapeEntries) {
+    ck.error(ms, 1, "modes",
+             fmt::format("{} modes of {} nodes; expected at most {} modes and at most {:.0e} shape entries "
+                         "(3 x nodes x modes; docs/limits.md)",
+                         ms.size(), nn, kMaxFileModes, kMaxShapeEntries));
   } else {
     for (std::size_t i = 0; i < ms.size(); ++i) {
       const YAML::Node md = ms[i];
@@ -262,6 +272,12 @@ FlexibleData load_modal_file(const std::string& path, const std::vector<int>& ke
   bool so_ok = true;
   if (so.IsDefined() && nodes_ok && M > 0) {
     if (!ck.expect_map(so, 1, "second_order")) {
+      so_ok = false;
+    } else if (3.0 * static_cast<double>(so.size()) * M * M > kMaxSecondOrderEntries) {
+      ck.error(so, 1, "second_order",
+               fmt::format("{} nodes x 3 axes x {}^2 modes is more than {:.0e} entries; expected fewer nodes or "
+                           "modes (docs/limits.md)",
+                           so.size(), M, kMaxSecondOrderEntries));
       so_ok = false;
     } else {
       for (auto it = so.begin(); it != so.end(); ++it) {

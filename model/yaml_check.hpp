@@ -13,6 +13,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <initializer_list>
 #include <optional>
@@ -122,11 +123,11 @@ class Checker {
     for (auto it = n.begin(); it != n.end(); ++it) {
       const YAML::Node& k = it->first;
       if (!k.IsScalar()) {
-        error(k, line_of(n), field, "a key must be a plain name");
+        error(k, line_of(n), field.empty() ? "(document)" : field, "a key must be a plain name");
         continue;
       }
       const std::string key = k.Scalar();
-      const std::string f = field.empty() ? key : field + "." + key;
+      const std::string f = field.empty() ? (key.empty() ? std::string("''") : key) : field + "." + key;
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
         std::string msg = fmt::format("unknown key '{}'", key);
         const std::string hint = did_you_mean(key, allowed);
@@ -148,7 +149,16 @@ class Checker {
     try {
       x = n.as<double>();
     } catch (const YAML::Exception&) {
-      error(n, fallback, field, fmt::format("'{}' is not a number; expected a number", n.Scalar()));
+      // yaml-cpp refuses a decimal that overflows double as "not a number";
+      // say which it is
+      char* end = nullptr;
+      const std::string& text = n.Scalar();
+      const double y = std::strtod(text.c_str(), &end);
+      const bool overflows = end && end != text.c_str() && *end == '\0' && std::isinf(y) &&
+                             text.find_first_of("iI") == std::string::npos;
+      error(n, fallback, field,
+            overflows ? fmt::format("'{}' is beyond double precision (|x| > 1.8e308); expected a finite number", text)
+                      : fmt::format("'{}' is not a number; expected a number", text));
       return std::nullopt;
     }
     if (!std::isfinite(x)) {
@@ -287,6 +297,11 @@ class Checker {
       if (!v) return std::nullopt;
       const auto& a = *v;
       I << a(0), a(3), a(4), a(3), a(1), a(5), a(4), a(5), a(2);
+    } else if (n.IsSequence() && n.size() == 3 && n[0].IsScalar() && n[1].IsScalar() && n[2].IsScalar()) {
+      error(n, fallback, field,
+            "got a list of 3 numbers; expected [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] (a diagonal inertia is "
+            "[Ixx, Iyy, Izz, 0, 0, 0]) or a 3x3 list");
+      return std::nullopt;
     } else if (n.IsSequence() && n.size() == 3) {
       auto M = mat3(n, fallback, field);
       if (!M) return std::nullopt;
@@ -372,34 +387,40 @@ inline int second_document_line(const std::string& text) {
   return 0;
 }
 
+/// "column N" of a parser mark, or "(document)" when it has none.
+inline std::string mark_column(const YAML::Mark& m) {
+  return m.is_null() ? std::string("(document)") : fmt::format("column {}", m.column + 1);
+}
+
 /// Parses a YAML file (read and checked by read_input_text: size, UTF-8,
 /// control characters, nesting, line breaks); a missing file, a syntax error,
 /// or a second document is recorded and an undefined node returned.
-inline YAML::Node parse_file(const std::string& path, std::vector<Diagnostic>& diags, bool& ok) {
+inline YAML::Node parse_file(const std::string& path, std::size_t max_bytes, std::vector<Diagnostic>& diags,
+                             bool& ok) {
   ok = false;
-  const std::optional<std::string> text = read_input_text(path, kMaxModelFileBytes, diags);
+  const std::optional<std::string> text = read_input_text(path, max_bytes, diags);
   if (!text) return YAML::Node();
   if (const int l = second_document_line(*text)) {
-    diags.push_back(Diagnostic{path, l, "",
+    diags.push_back(Diagnostic{path, l, "(document)",
                                "a second YAML document (after '---' or '...'); expected one document per file"});
     return YAML::Node();
   }
   try {
     std::vector<YAML::Node> docs = YAML::LoadAll(*text);
     if (docs.size() > 1) {
-      diags.push_back(Diagnostic{path, 0, "", "more than one YAML document; expected one document per file"});
+      diags.push_back(Diagnostic{path, 1, "(document)", "more than one YAML document; expected one document per file"});
       return YAML::Node();
     }
     ok = true;
     return docs.empty() ? YAML::Node() : docs[0];
   } catch (const YAML::DeepRecursion& e) {
-    diags.push_back(Diagnostic{path, e.mark.is_null() ? 0 : e.mark.line + 1, "",
+    diags.push_back(Diagnostic{path, e.mark.is_null() ? 1 : e.mark.line + 1, mark_column(e.mark),
                                "nested too deeply; expected a flatter document"});
   } catch (const YAML::ParserException& e) {
-    diags.push_back(Diagnostic{path, e.mark.is_null() ? 0 : e.mark.line + 1, "",
+    diags.push_back(Diagnostic{path, e.mark.is_null() ? 1 : e.mark.line + 1, mark_column(e.mark),
                                fmt::format("YAML syntax error: {}", e.msg)});
   } catch (const YAML::Exception& e) {
-    diags.push_back(Diagnostic{path, e.mark.is_null() ? 0 : e.mark.line + 1, "",
+    diags.push_back(Diagnostic{path, e.mark.is_null() ? 1 : e.mark.line + 1, mark_column(e.mark),
                                fmt::format("cannot read YAML: {}", e.msg)});
   }
   return YAML::Node();

@@ -38,6 +38,22 @@ class InputError(Exception):
 
 
 # ---------------------------------------------------------------- rotations
+
+def save_atomically(fig, path, **kw):
+    """The PNG appears complete or not at all: written beside the target, then renamed."""
+    import os
+    import tempfile
+    d = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".kanegen-", suffix=".png", dir=d)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, format="png", **kw)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
 def quat_to_R(w, x, y, z):
     """R(quat) of dynamics.md (child -> parent components); arrays broadcast. Normalizes."""
     n = np.sqrt(w * w + x * x + y * y + z * z)
@@ -134,7 +150,7 @@ def finish(fig, ax_list, path, written):
     for ax in ax_list:
         ax.grid(True, alpha=0.4)
     fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
+    save_atomically(fig, path, dpi=DPI)
     plt.close(fig)
     written.append(path)
 

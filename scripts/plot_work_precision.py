@@ -39,6 +39,22 @@ STYLES = {"generated": "-", "generic": "--"}
 TARGETS = (1e-4, 1e-6, 1e-8)
 
 
+
+def save_atomically(fig, path, **kw):
+    """The PNG appears complete or not at all: written beside the target, then renamed."""
+    import os
+    import tempfile
+    d = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".kanegen-", suffix=".png", dir=d)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, format="png", **kw)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
 def read(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
@@ -92,7 +108,7 @@ def main():
         ax.text(0.01, 0.01, f"{failed} failed/skipped runs not shown", transform=ax.transAxes, fontsize=8,
                 color="0.4")
     fig.tight_layout()
-    fig.savefig(a.output, dpi=110)
+    save_atomically(fig, a.output, dpi=110)
 
 
 # ---- report mode -------------------------------------------------------------------

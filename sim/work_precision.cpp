@@ -20,6 +20,7 @@
 #include "engine/resources.hpp"
 #include "model/diagnostics.hpp"
 #include "model/model_loader.hpp"
+#include "model/output_file.hpp"
 #include "model/state_io.hpp"
 #include "sim/integrators.hpp"
 #include "sim/simulate.hpp"
@@ -571,14 +572,15 @@ std::vector<RunRecord> bench_model(const std::string& model_path, const BenchOpt
   fs::create_directories(opt.out_dir);
   const std::string csv_path = (fs::path(opt.out_dir) / (model.name + "_work_precision.csv")).string();
   {
-    std::ofstream csv(csv_path);
+    OutputFile file(csv_path);  // complete or untouched
+    std::ostream& csv = file.stream();
     csv << "model,engine,integrator,tolerance_or_step,wall_s,steps,rhs_evals,jac_evals,error,energy_drift,H_drift,"
            "status,p_drift,message\n";
     for (const RunRecord& r : records)
       csv << fmt::format("{},{},{},{:.6g},{},{},{},{},{},{},{},{},{},{}\n", r.model, r.engine, r.integrator,
                          r.tolerance_or_step, num(r.wall_s), r.steps, r.rhs_evals, r.jac_evals, num(r.error),
                          num(r.energy_drift), num(r.H_drift), r.status, num(r.p_drift), csv_quote(r.message));
-    if (!csv) throw std::runtime_error("cannot write " + csv_path);
+    file.commit();
   }
   fmt::print(stderr, "  wrote {}\n", csv_path);
 
@@ -773,9 +775,7 @@ int run_bench(std::vector<std::string> models, BenchOptions opt, const std::stri
   }
   fs::create_directories(opt.out_dir);
   const std::string summary = (fs::path(opt.out_dir) / "summary.md").string();
-  std::ofstream out(summary);
-  out << md;
-  if (!out) throw std::runtime_error("cannot write " + summary);
+  write_file_atomically(summary, md);
   fmt::print(stderr, "bench: wrote {}\n", summary);
   return status;
 }

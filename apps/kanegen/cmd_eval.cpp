@@ -1,4 +1,6 @@
 // kanegen eval MODEL [--state S.json] [--engine E]: the dynamics at one state, as JSON.
+#include <fmt/format.h>
+
 #include <iostream>
 
 #include "apps/kanegen/cli_common.hpp"
@@ -21,7 +23,11 @@ int run(const Options& o) {
   try {
     j = eval_report(*engine, state);
   } catch (const SingularMassMatrix& e) {
-    throw InputError(Diagnostic{o.state.empty() ? o.model : o.state, 0, "q", e.what()});
+    // the model's own initial state was checked on load: q came from the STATE file
+    throw InputError(Diagnostic{o.state.empty() ? o.model : o.state, state.q_line > 0 ? state.q_line : 1, "q",
+                                fmt::format("{} at these coordinates; expected coordinates where every degree of "
+                                            "freedom moves some mass",
+                                            e.what())});
   }
   std::cout << j.dump(1) << '\n';
   return 0;
