@@ -5,6 +5,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
+
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +14,7 @@
 #include <streambuf>
 #include <vector>
 
+#include "model/diagnostics.hpp"
 #include "model/signal_cleanup.hpp"
 
 namespace kanegen {
@@ -85,6 +88,15 @@ void check_output_path(const std::string& path) {
   if (stat(dir.c_str(), &ds) != 0) throw OutputRefused(path, "directory " + dir + " does not exist");
   if (!S_ISDIR(ds.st_mode)) throw OutputRefused(path, dir + " is not a directory");
   if (access(dir.c_str(), W_OK | X_OK) != 0) throw OutputRefused(path, "directory " + dir + " is not writable");
+}
+
+void check_output_option(const std::string& option, const std::string& path) {
+  try {
+    check_output_path(path);
+  } catch (const OutputRefused& e) {
+    const std::string why = std::string(e.what()).substr(e.path.size() + 2);
+    throw InputError(Diagnostic{option, 0, "", fmt::format("cannot write '{}': {}", path, why)});
+  }
 }
 
 struct OutputFile::Impl {

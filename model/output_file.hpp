@@ -59,4 +59,8 @@ void write_file_atomically(const std::string& path, const std::string& content);
 /// and is writable, and the path is absent or a regular file.
 void check_output_path(const std::string& path);
 
+/// check_output_path for the value of a command-line option: a refusal is an
+/// InputError "OPTION: cannot write 'PATH': why" (exit 2).
+void check_output_option(const std::string& option, const std::string& path);
+
 }  // namespace kanegen

@@ -52,7 +52,7 @@ inline void add_simulation_options(CLI::App* c, SimulationCli& o, bool t_end_req
 }
 
 /// The SimulationOptions of `o` for a run from `initial`; throws InputError
-/// (one diagnostic per bad option) or OutputRefused.
+/// (one diagnostic per bad option, an unwritable -o among them).
 inline SimulationOptions simulation_options(const SimulationCli& o, const State& initial) {
   std::vector<Diagnostic> faults;
   auto fault = [&](const char* option, const std::string& what) { faults.push_back(Diagnostic{option, 0, "", what}); };
@@ -88,7 +88,7 @@ inline SimulationOptions simulation_options(const SimulationCli& o, const State&
   }
   if (o.output.empty()) fault("-o", "an output CSV file is required");
   if (!faults.empty()) throw InputError(faults);
-  check_output_path(o.output);
+  check_output_option("-o", o.output);
   opt.t_end = o.t_end;
   opt.dt_out = o.dt_out;
   opt.integrator.rtol = o.rtol;

@@ -22,8 +22,10 @@ struct Options {
 int run(const Options& o) {
   // Every output's place is checked before any work, so that a bad path is
   // refused up front and nothing is half-written.
-  for (const std::string* p : {&o.output, &o.entry, &o.manifest, &o.depfile})
-    if (!p->empty()) check_output_path(*p);
+  const std::pair<const char*, const std::string*> outputs[] = {
+      {"-o", &o.output}, {"--entry", &o.entry}, {"--manifest", &o.manifest}, {"--depfile", &o.depfile}};
+  for (const auto& [option, path] : outputs)
+    if (!path->empty()) check_output_option(option, *path);
   const Model model = load_checked(o.model);
   codegen::GeneratorOptions opt;
   opt.udot_form = o.form;

@@ -22,7 +22,7 @@ struct Options {
 };
 
 int run(const Options& o) {
-  check_output_path(o.output);
+  check_output_option("-o", o.output);
   const Model model = load_model(o.model);
   const int i = model.body_index(o.body);
   if (i < 0 || !model.bodies[i].flex)

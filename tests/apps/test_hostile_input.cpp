@@ -255,6 +255,15 @@ TEST_CASE("hostile: every command-line value is checked against its domain up fr
   CHECK_FALSE(fs::exists(d / "target.csv"));
   // generate onto a directory, and next to a user's own x.hpp.tmp
   CHECK(run(fmt::format("generate {} -o {}", m, d.string())).status == 2);
+  // every output option is checked before any work, and named
+  const Run dep = run(fmt::format("generate {} -o {} --depfile {}", m, (d / "p.hpp").string(),
+                                  (d / "missing" / "p.d").string()));
+  CHECK(dep.status == 2);
+  CHECK(dep.out.rfind("--depfile: cannot write", 0) == 0);
+  CHECK_FALSE(fs::exists(d / "p.hpp"));
+  const Run modes = run(fmt::format("modes {} --body boom -o {}", model("models/boom_fea.yaml"), d.string()));
+  CHECK(modes.status == 2);
+  CHECK(modes.out.rfind("-o: cannot write", 0) == 0);
   write(d / "x.hpp.tmp", "mine");
   CHECK(run(fmt::format("generate {} -o {}", m, (d / "x.hpp").string())).status == 0);
   std::ifstream mine(d / "x.hpp.tmp");
@@ -310,6 +319,27 @@ TEST_CASE("hostile: a full disk leaves no file and exits 1", "[hostile][disk]") 
   const Run g = run(fmt::format("generate {} -o {}", model("models/spacecraft_arrays.yaml"), (d / "h.hpp").string()));
   CHECK(g.status == 1);
   CHECK(fs::is_empty(d));
+  const fs::path w = scratch("fulldisk-model");
+  const std::string beam = write(w / "beam.yaml",
+                                 "name: beam\nbodies:\n  - name: b\n    parent: ground\n    joint: {type: fixed}\n"
+                                 "    flexible:\n      beam: {length: 2, direction: x, mass_per_length: 0.5, "
+                                 "EI: [20, 30], elements: 200, modes: 20}\n");
+  const Run m = run(fmt::format("modes {} --body b -o {}", beam, (d / "b.modal.yaml").string()));
+  INFO(m.out);
+  CHECK(m.status == 1);
+  CHECK(fs::is_empty(d));
+  // a depfile on a disk with no room left: exit 1, no 0-byte file
+  {
+    std::ofstream filler(d / "filler", std::ios::binary);
+    const std::string block(4096, 'x');
+    for (int i = 0; i < 64 && filler.write(block.data(), block.size()); ++i) {
+    }
+  }
+  const Run dep = run(fmt::format("generate {} -o {} --depfile {}", model("models/pendulum.yaml"),
+                                  (w / "p.hpp").string(), (d / "p.d").string()));
+  INFO(dep.out);
+  CHECK(dep.status == 1);
+  CHECK_FALSE(fs::exists(d / "p.d"));
 }
 
 TEST_CASE("hostile: the limits are checked before allocating, and what is allowed runs quickly", "[hostile][limits]") {
