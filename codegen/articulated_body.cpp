@@ -53,7 +53,7 @@ static SMat spd_inverse(KaneContext& ctx, const SMat& D, std::vector<ex>& pivots
 // IA_j delta_j + pA_j. Inward: U = IA S, D = S^T U, r = tau' - S^T pA,
 // Ia = IA - U D^-1 U^T, pa = pA + U D^-1 r, passed to the parent through
 // Xe^T; outward: udot_j = D^-1 (r - U^T Xe_j delta_p).
-std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivots) {
+std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivots, std::vector<ex>& pivot_scales) {
   const int nb = static_cast<int>(ctx.model.bodies.size());
   std::vector<std::vector<ex>> pA = compute_bias_forces(ctx);
   for (auto& v : pA)
@@ -67,8 +67,10 @@ std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivo
   };
   std::vector<Joint> J(nb);
   pivots.assign(ctx.model.nu, ex(1));  // by speed; bodies are visited leaves first
+  pivot_scales.assign(ctx.model.nu, ex(0));
   for (int j = nb - 1; j >= 0; --j) {
     const Body& b = ctx.model.bodies[j];
+    ctx.P.section(fmt::format("body {}: articulated inertia and bias force (inward)", b.name));
     const auto S = motion_subspace(ctx, j);
     const int k = static_cast<int>(S.size());
     const int n = IA[j].rows;
@@ -91,7 +93,18 @@ std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivo
     std::vector<ex> joint_pivots;
     jt.Dinv = spd_inverse(ctx, D, joint_pivots);
     const auto own = own_columns(ctx.model, j);
-    for (int c = 0; c < k; ++c) pivots[own[c]] = joint_pivots[c];
+    for (int c = 0; c < k; ++c) {
+      pivots[own[c]] = joint_pivots[c];
+      // scale: the trace of the 3x3 block of I^A the column moves (same units
+      // as the pivot); modal columns are judged against 0
+      for (int blk = 0; blk < 2; ++blk) {
+        bool moves = false;
+        for (int r = 3 * blk; r < 3 * blk + 3; ++r) moves = moves || !S[c][r].is_zero();
+        if (moves && pivot_scales[own[c]].is_zero())
+          pivot_scales[own[c]] = ctx.A.let(I(3 * blk, 3 * blk) + I(3 * blk + 1, 3 * blk + 1) + I(3 * blk + 2, 3 * blk + 2));
+      }
+      if (pivot_scales[own[c]].is_zero()) pivot_scales[own[c]] = joint_pivots[c];
+    }
     if (b.parent < 0) continue;
     // Ia = IA - U Dinv U^T (rows/cols 0-5 are all the parent sees), pa = pA + U Dinv r
     std::vector<std::vector<ex>> UD(k, std::vector<ex>(6));  // (U Dinv) by column, rows 0-5
@@ -103,8 +116,24 @@ std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivo
       }
     SMat Ia(6, 6);
     std::vector<ex> pa(6);
+    // A joint whose one column is a coordinate vector e_k (the generator's
+    // frames make revolute and prismatic joints so): Ia e_k = U - U D^-1 D = 0
+    // exactly, so row and column k of Ia are zero.
+    int unit_col = -1;
+    if (k == 1) {
+      int nonzero = 0;
+      for (int r = 0; r < 6; ++r)
+        if (!S[0][r].is_zero()) ++nonzero, unit_col = r;
+      for (int r = 6; r < n; ++r)
+        if (!S[0][r].is_zero()) nonzero = 2;
+      if (nonzero != 1 || !(S[0][unit_col] - 1).is_zero()) unit_col = -1;
+    }
     for (int r = 0; r < 6; ++r) {
       for (int c = r; c < 6; ++c) {
+        if (r == unit_col || c == unit_col) {
+          Ia(r, c) = Ia(c, r) = 0;
+          continue;
+        }
         ex sum = I(r, c);
         for (int t = 0; t < k; ++t) sum -= UD[t][r] * jt.U[t][c];
         Ia(r, c) = Ia(c, r) = ctx.A.let(sum);
@@ -115,6 +144,17 @@ std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivo
     }
     // Parent: IA_p += Xe^T Ia Xe, pA_p += Xe^T pa, Xe = [X6 | N] acting on the parent's (6 + m_p).
     const int np = IA[b.parent].rows;
+    if (ctx.body[j].P_node.empty()) {  // the 6 x 6 block formula (spatial_transforms.cpp)
+      const SMat T = transform_inertia_to_parent(ctx, j, Ia);
+      for (int a = 0; a < 6; ++a)
+        for (int bb = a; bb < 6; ++bb) {
+          const ex v = ctx.A.let(IA[b.parent](a, bb) + T(a, bb));
+          IA[b.parent](a, bb) = IA[b.parent](bb, a) = v;
+        }
+      const auto pt = transform_wrench_to_parent(ctx, j, pa);
+      for (int r = 0; r < np; ++r) pA[b.parent][r] = ctx.A.let(pA[b.parent][r] + pt[r]);
+      continue;
+    }
     std::vector<std::vector<ex>> XtIa(6);  // XtIa[c] = Xe^T Ia[:, c]  (np entries)
     for (int c = 0; c < 6; ++c) {
       std::vector<ex> col(6);
@@ -139,6 +179,7 @@ std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivo
   std::vector<std::vector<ex>> delta(nb);
   for (int j = 0; j < nb; ++j) {
     const Body& b = ctx.model.bodies[j];
+    ctx.P.section(fmt::format("body {}: accelerations (outward)", b.name));
     const int n = IA[j].rows;
     std::vector<ex> dl = transform_motion_from_parent(ctx, j, b.parent >= 0 ? &delta[b.parent] : nullptr);
     const auto S = motion_subspace(ctx, j);

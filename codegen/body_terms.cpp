@@ -64,7 +64,7 @@ void add_integrated_velocity_terms(KaneContext& ctx, int j, const SV3& S, const 
 }
 
 /// A rich node's terms, one by one (dynamics/body_inertia.hpp, add_node_terms).
-void add_node_terms(KaneContext& ctx, int j, int k, const SV3& g_B, bool with_velocity) {
+void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV3& g_B, bool with_velocity) {
   Alg& A = ctx.A;
   const Body& b = ctx.model.bodies[j];
   const FlexibleData& flex = *b.flex;
@@ -128,7 +128,7 @@ void add_node_terms(KaneContext& ctx, int j, int k, const SV3& g_B, bool with_ve
       }
       for (int l = i; l < m; ++l) M(6 + i, 6 + l) = M(6 + l, 6 + i) = M(6 + i, 6 + l) + mk * A.dot(Pt[i], Pt[l]);
     }
-    if (!ctx.model.g_N.isZero()) {
+    if (gravity_terms) {
       const SV3 sg = A.cross(sk, g_B);
       for (int a = 0; a < 3; ++a) {
         s.g_body[a] = s.g_body[a] + mk * g_B[a];
@@ -301,7 +301,8 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
     // Gravity: g_B = R_NB^T g_N; [m g_B; S x g_B; B^T g_B]
     s.g_body.assign(6 + m, ex(0));
     SV3 g_B;
-    if (!gN.isZero()) {
+    const bool gravity_terms = !gN.isZero() && !(with_velocity && ctx.gravity_in_base_acceleration);
+    if (gravity_terms) {
       g_B = A.mul_t(s.R_NB, g_N, ctx.name("g_B", static_cast<int>(j)));
       const SV3 mg = A.scale(mass, g_B), Sg = A.cross(S, g_B);
       for (int a = 0; a < 3; ++a) s.g_body[a] = mg[a], s.g_body[3 + a] = Sg[a];
@@ -309,7 +310,7 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
     }
     s.h_body.assign(6 + m, ex(0));
     if (with_velocity) add_integrated_velocity_terms(ctx, static_cast<int>(j), S, J, Bc, Q, Pff);
-    for (int k : b.rich_nodes) add_node_terms(ctx, static_cast<int>(j), k, g_B, with_velocity);
+    for (int k : b.rich_nodes) add_node_terms(ctx, static_cast<int>(j), k, gravity_terms, g_B, with_velocity);
   }
 }
 

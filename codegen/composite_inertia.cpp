@@ -19,34 +19,35 @@ SMat compute_mass_matrix(KaneContext& ctx) {
   for (int j = 0; j < nb; ++j) Ic[j] = ctx.body[j].M_body;
   for (int j = nb - 1; j >= 0; --j) {
     const int p = ctx.model.bodies[j].parent;
+    ctx.P.section(fmt::format("body {}: composite inertia (inward)", ctx.model.bodies[j].name));
     SMat& I = Ic[j];
     for (auto& e : I.a) e = ctx.A.let(e);
     if (p < 0) continue;
     const SymBodyWorkspace& s = ctx.body[j];
-    // Rigid part: m' = m, S' = R S + m d, J' = R J R^T - d^x S'^x... as the 6x6 spatial transform
+    // Rigid form [m, -S^x; S^x, J]: m' = m, S' = R S + m d, J' = R J R^T - d^x S'^x... done as
+    // a turn by R_JB, a shift by d = O_B - O_P in J components, and a turn by R_PJ.
     const ex mass = I(0, 0);
     const SV3 S{{I(5, 1), I(3, 2), I(4, 0)}};  // from I(3..5, 0..2) = S^x
     SM3 J;
     for (int a = 0; a < 3; ++a)
       for (int cc = 0; cc < 3; ++cc) J(a, cc) = I(3 + a, 3 + cc);
-    const SV3 RS = ctx.A.mul(s.R_PB, S);
-    const SV3 Sp = ctx.A.add(RS, ctx.A.scale(mass, s.p_PO_P));
-    const SM3 RJ = ctx.A.mul(s.R_PB, J);
-    SM3 RJRt;
+    const SV3 S1 = ctx.A.mul(s.R_JB, S);
+    const SM3 J1 = rotate_symmetric(ctx, s.R_JB, J);
+    // J2 = J1 - d^x S1^x - S1^x d^x - m d^x d^x, S2 = S1 + m d (J components)
+    const SM3 dx = Alg::skew(s.p_BP_J), S1x = Alg::skew(S1);
+    SM3 J2;
     for (int a = 0; a < 3; ++a)
       for (int cc = a; cc < 3; ++cc) {
-        ex sum = 0;
-        for (int t = 0; t < 3; ++t) sum += RJ(a, t) * s.R_PB(cc, t);
-        RJRt(a, cc) = RJRt(cc, a) = ctx.A.let(sum);
+        ex sum = J1(a, cc);
+        for (int t = 0; t < 3; ++t) sum -= dx(a, t) * S1x(t, cc) + S1x(a, t) * dx(t, cc) + mass * dx(a, t) * dx(t, cc);
+        J2(a, cc) = J2(cc, a) = ctx.A.let(sum);
       }
-    // J_p = R J R^T - d^x RS^x - RS^x d^x - m d^x d^x, symmetric
-    const SM3 dx = Alg::skew(s.p_PO_P), RSx = Alg::skew(RS);
+    const SV3 Sp = ctx.A.mul(s.R_PJ, ctx.A.add(S1, ctx.A.scale(mass, s.p_BP_J)));
+    const SM3 Jp = rotate_symmetric(ctx, s.R_PJ, J2);
     SMat& Ip = Ic[p];
     for (int a = 0; a < 3; ++a)
       for (int cc = a; cc < 3; ++cc) {
-        ex sum = RJRt(a, cc);
-        for (int t = 0; t < 3; ++t) sum -= dx(a, t) * RSx(t, cc) + RSx(a, t) * dx(t, cc) + mass * dx(a, t) * dx(t, cc);
-        const ex v = ctx.A.let(Ip(3 + a, 3 + cc) + sum);
+        const ex v = ctx.A.let(Ip(3 + a, 3 + cc) + Jp(a, cc));
         Ip(3 + a, 3 + cc) = v;
         Ip(3 + cc, 3 + a) = v;
       }
@@ -83,6 +84,7 @@ SMat compute_mass_matrix(KaneContext& ctx) {
   }
   // Columns: f = Icj S_j[:, s]; M(own_j, s) = S_j^T f; then walk to the root.
   for (int j = 0; j < nb; ++j) {
+    ctx.P.section(fmt::format("body {}: its columns of M (walked to the root)", ctx.model.bodies[j].name));
     const auto S = motion_subspace(ctx, j);
     const auto cols = own_columns(ctx.model, j);
     const SMat& I = Ic[j];

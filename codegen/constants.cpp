@@ -3,8 +3,25 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+
+#include "codegen/printer.hpp"
 
 namespace kanegen::codegen {
+
+namespace {
+
+/// The double v as an exact GiNaC rational.
+GiNaC::ex exact(double v) {
+  int e = 0;
+  const double m = std::frexp(v, &e);  // v = m 2^e, 0.5 <= |m| < 1
+  const auto mantissa = static_cast<long long>(std::ldexp(m, 53));
+  return GiNaC::numeric(static_cast<long>(mantissa)) * GiNaC::pow(GiNaC::numeric(2), e - 53);
+}
+
+}  // namespace
 
 GiNaC::ex Constants::value(double v, const std::string& name, const std::string& unit, const std::string& what) {
   if (v == 0.0) return 0;
@@ -21,17 +38,117 @@ GiNaC::ex Constants::value(double v, const std::string& name, const std::string&
   }
   Entry e{v, unit, what, group, GiNaC::symbol(key)};
   const GiNaC::ex s = e.sym;
+  values_[s] = exact(v);
   by_name_.emplace(key, std::move(e));
   order_.push_back(key);
   return s;
 }
 
+bool Constants::is_constant(const GiNaC::ex& e) const {
+  if (GiNaC::is_a<GiNaC::numeric>(e)) return true;
+  if (GiNaC::is_a<GiNaC::symbol>(e)) return values_.count(e) > 0;
+  if (GiNaC::is_a<GiNaC::function>(e)) return false;  // sin, cos of constants: left to the compiler
+  for (std::size_t i = 0; i < e.nops(); ++i)
+    if (!is_constant(e.op(i))) return false;
+  return true;
+}
+
+double Constants::evaluate(const GiNaC::ex& e) const {
+  // exact rational arithmetic, rounded once: the value does not depend on the
+  // order in which GiNaC keeps the terms
+  const GiNaC::ex v = e.subs(values_);
+  if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real())
+    throw std::logic_error("constant folding: not a real number");
+  return GiNaC::ex_to<GiNaC::numeric>(v).to_double();
+}
+
+GiNaC::ex Constants::derived(const GiNaC::ex& e) {
+  // GiNaC may hold the same quantity as -(a b) in one run and (-a) b in the
+  // next (its term order follows hash values): a derived constant is free of
+  // a numeric factor, and a sum is taken with the sign that makes it
+  // positive, so both forms give the same constant
+  if (GiNaC::is_a<GiNaC::mul>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(e.nops() - 1))) {
+    const GiNaC::ex n = e.op(e.nops() - 1);
+    return n * derived_unsigned(e / n);
+  }
+  if (GiNaC::is_a<GiNaC::add>(e) && evaluate(e) < 0.0) return -derived_unsigned(-e);
+  return derived_unsigned(e);
+}
+
+GiNaC::ex Constants::derived_unsigned(const GiNaC::ex& e) {
+  if (GiNaC::is_a<GiNaC::numeric>(e) || GiNaC::is_a<GiNaC::symbol>(e)) return e;
+  if (auto it = derived_.find(e); it != derived_.end()) return it->second;
+  const double v = evaluate(e);
+  GiNaC::ex r;
+  if (v == 0.0 || v == 1.0 || v == -1.0) {
+    r = GiNaC::numeric(static_cast<long>(v));
+  } else {
+    OpCount unused;
+    std::string text = print_cpp(e, unused);
+    // named by a hash of its (canonical) text, kept in one group sorted by
+    // name: the same model gives the same bytes whatever order they arise in
+    std::uint64_t h = 1469598103934665603ULL;  // FNV-1a
+    for (const unsigned char ch : text) h = (h ^ ch) * 1099511628211ULL;
+    if (text.size() > 100) text = text.substr(0, 97) + "...";
+    const std::string saved = group;
+    group = kDerivedGroup;
+    r = value(v, fmt::format("k{:08x}", static_cast<std::uint32_t>(h ^ (h >> 32))), "", "= " + text);
+    group = saved;
+
+  }
+  derived_.emplace(e, r);
+  return r;
+}
+
+GiNaC::ex Constants::fold(const GiNaC::ex& e) {
+  using namespace GiNaC;
+
+  if (is_a<numeric>(e) || is_a<symbol>(e)) return e;
+  if (is_constant(e)) return derived(e);
+  if (is_a<add>(e) || is_a<mul>(e)) {
+    const bool sum = is_a<add>(e);
+    ex constant_part = sum ? ex(0) : ex(1), rest = sum ? ex(0) : ex(1);
+    int constant_terms = 0;
+    // operands in the order of their text (GiNaC's own order depends on
+    // hash values), so that derived constants are created in the same order
+    // every run
+    std::vector<std::pair<std::string, ex>> ops;
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      OpCount unused;
+      ops.emplace_back(print_cpp(e.op(i), unused), e.op(i));
+    }
+    std::sort(ops.begin(), ops.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [text, op] : ops) {
+      const ex t = fold(op);
+      if (is_constant(t)) {
+        constant_part = sum ? constant_part + t : constant_part * t;
+        if (!is_a<numeric>(t)) ++constant_terms;
+      } else {
+        rest = sum ? rest + t : rest * t;
+      }
+    }
+    // a lone constant symbol (times a number) stays as it is (derived() keeps it)
+    const ex c = constant_terms > 0 ? derived(constant_part) : constant_part;
+    return sum ? c + rest : c * rest;
+  }
+  if (is_a<power>(e)) return pow(fold(e.op(0)), e.op(1));
+  if (is_a<function>(e)) {
+    ex r = e;
+    for (std::size_t i = 0; i < e.nops(); ++i) r = r.subs(e.op(i) == fold(e.op(i)));
+    return r;
+  }
+  return e;
+}
+
 std::vector<std::string> Constants::groups() const {
   std::vector<std::string> g;
+  bool derived = false;
   for (const auto& n : order_) {
     const std::string& gr = by_name_.at(n).group;
-    if (std::find(g.begin(), g.end(), gr) == g.end()) g.push_back(gr);
+    if (gr == kDerivedGroup) derived = true;
+    else if (std::find(g.begin(), g.end(), gr) == g.end()) g.push_back(gr);
   }
+  if (derived) g.push_back(kDerivedGroup);  // last, whenever they arose
   return g;
 }
 
@@ -43,7 +160,9 @@ std::set<std::string> Constants::names() const {
 
 std::string Constants::emit(const std::string& grp, const std::string& indent) const {
   std::string out;
-  for (const auto& n : order_) {
+  std::vector<std::string> names = order_;
+  if (grp == kDerivedGroup) std::sort(names.begin(), names.end());
+  for (const auto& n : names) {
     const Entry& e = by_name_.at(n);
     if (e.group != grp) continue;
     std::string comment = e.what;

@@ -14,9 +14,17 @@
 
 namespace kanegen::codegen {
 
+/// The group of the constants fold() derives (emitted last, sorted by name).
+inline constexpr const char* kDerivedGroup = "derived";
+
 class Constants {
  public:
   GiNaC::ex value(double v, const std::string& name, const std::string& unit, const std::string& what);
+  /// e with every subexpression made only of constants (and numbers) replaced
+  /// by one derived constant `kNNN = value;  // = expression` (constant sums
+  /// and products are evaluated here, not at run time). Sums and products that
+  /// mix constants and state keep one derived constant for their constant part.
+  GiNaC::ex fold(const GiNaC::ex& e);
   /// Declarations of one group, in creation order.
   std::string emit(const std::string& group, const std::string& indent) const;
   /// Groups in order of first use.
@@ -32,8 +40,15 @@ class Constants {
     std::string unit, what, group;
     GiNaC::symbol sym;
   };
+  bool is_constant(const GiNaC::ex& e) const;
+  double evaluate(const GiNaC::ex& e) const;
+  GiNaC::ex derived(const GiNaC::ex& e);
+  GiNaC::ex derived_unsigned(const GiNaC::ex& e);
   std::map<std::string, Entry> by_name_;
   std::vector<std::string> order_;
+  std::map<GiNaC::ex, GiNaC::ex, GiNaC::ex_is_less> derived_;  ///< folded expression -> its constant
+  GiNaC::exmap values_;                                         ///< constant symbol -> value
+
 };
 
 }  // namespace kanegen::codegen

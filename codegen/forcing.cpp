@@ -15,6 +15,7 @@ std::vector<ex> compute_forcing(KaneContext& ctx) {
   std::vector<ex> F(ctx.model.nu, ex(0));
   for (int j = nb - 1; j >= 0; --j) {
     const Body& b = ctx.model.bodies[j];
+    ctx.P.section(fmt::format("body {}: generalized forces (inward)", b.name));
     const auto S = motion_subspace(ctx, j);
     const auto cols = own_columns(ctx.model, j);
     for (std::size_t k = 0; k < cols.size(); ++k) F[cols[k]] = ctx.A.let(applied_force(ctx, j, static_cast<int>(k)) + dot(S[k], W[j]));

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "codegen/kane_context.hpp"
+#include "codegen/joint_frames.hpp"
 #include "codegen/merge_fixed.hpp"
 #include "kanegen_generator_hash.h"
 #include "model/model_hash.hpp"
@@ -129,7 +130,7 @@ const char* generator_hash() { return KANEGEN_GENERATOR_HASH; }
 
 std::string generator_identity(const GeneratorOptions& options) {
   return std::string(generator_hash()) + (options.udot_form == "auto" ? "" : "-" + options.udot_form) +
-         (options.merge_fixed ? "" : "-unmerged");
+         (options.merge_fixed ? "" : "-unmerged") + (options.joint_frames ? "" : "-model-frames");
 }
 
 const EmittedFunction* EmittedModel::find(const std::string& name) const {
@@ -142,7 +143,9 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   if (options.udot_form != "auto" && options.udot_form != "composite" && options.udot_form != "articulated")
     throw std::invalid_argument("udot form must be auto, composite or articulated");
   const Model merged = options.merge_fixed ? merge_fixed_bodies(model_in) : model_in;
-  const Model& dyn = merged;  // used for M, F, u_dot, energy, momentum
+  auto frames = [&](const Model& m) { return options.joint_frames ? choose_joint_frames(m) : keep_joint_frames(m); };
+  const FramedModel framed = frames(merged);
+  const Model& dyn = framed.model;  // used for M, F, u_dot, energy, momentum
   Constants C;
   const StateSymbols x(dyn);
   EmittedModel out;
@@ -168,6 +171,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   {
     Program p;
     KaneContext ctx(dyn, p, C, x);
+    ctx.angle_offset = framed.angle_offset;
     const auto qd = compute_qdot(ctx);
     for (int i = 0; i < dyn.nq; ++i) p.assign(fmt::format("qdot[{}]", i), qd[i]);
     EmittedFunction f = function("qdot", "q_dot = W(q) u", {Arg::q, Arg::u, Arg::out}, "qdot", dyn.nq);
@@ -177,6 +181,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   {
     Program p;
     KaneContext ctx(dyn, p, C, x);
+    ctx.angle_offset = framed.angle_offset;
     prepare(ctx, false);
     const SMat M = compute_mass_matrix(ctx);
     for (int r = 0; r < dyn.nu; ++r)
@@ -188,6 +193,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   {
     Program p;
     KaneContext ctx(dyn, p, C, x);
+    ctx.angle_offset = framed.angle_offset;
     prepare(ctx, true);
     const auto F = compute_forcing(ctx);
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("F[{}]", r), F[r]);
@@ -202,19 +208,25 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   for (const char* form : {"composite", "articulated"}) {
     Program p;
     KaneContext ctx(dyn, p, C, x);
+    ctx.angle_offset = framed.angle_offset;
     prepare(ctx, true);
-    std::vector<ex> pivots, ud;
+    std::vector<ex> pivots, scales, ud;
     if (std::string(form) == "composite") {
       const SMat M = compute_mass_matrix(ctx);
       const auto F = compute_forcing(ctx);
-      ud = solve_tree_ldlt(ctx, M, F, pivots);
+      ud = solve_tree_ldlt(ctx, M, F, pivots, scales);
     } else {
-      ud = compute_udot_articulated(ctx, pivots);
+      ud = compute_udot_articulated(ctx, pivots, scales);
     }
     OpCount dummy;
-    for (std::size_t r = 0; r < pivots.size(); ++r)
-      if (!(GiNaC::is_a<GiNaC::numeric>(pivots[r]) && GiNaC::ex_to<GiNaC::numeric>(pivots[r]).is_positive()))
-        p.statement(fmt::format("if (!({} > 0.0)) return {};", print_cpp(pivots[r], dummy), r + 1), pivots[r]);
+    for (std::size_t r = 0; r < pivots.size(); ++r) {
+      if (GiNaC::is_a<GiNaC::numeric>(pivots[r]) && GiNaC::ex_to<GiNaC::numeric>(pivots[r]).is_positive()) continue;
+      const bool scaled = r < scales.size() && !(scales[r] - pivots[r]).is_zero();
+      const std::string test = scaled ? fmt::format("{} > {}*{}", print_cpp(pivots[r], dummy), kPivotRatio,
+                                                    print_cpp(scales[r], dummy))
+                                      : fmt::format("{} > 0.0", print_cpp(pivots[r], dummy));
+      p.statement(fmt::format("if (!({})) return {};", test, r + 1), scaled ? pivots[r] + scales[r] : pivots[r]);
+    }
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("udot[{}]", r), ud[r]);
     EmittedFunction f = function("udot",
                                  "u_dot: M u_dot = F (form chosen by operation count, see the counts above)",
@@ -236,6 +248,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   if (outs.energy) {
     Program p;
     KaneContext ctx(dyn, p, C, x);
+    ctx.angle_offset = framed.angle_offset;
     prepare(ctx, true);
     p.assign("TV[0]", compute_kinetic_energy(ctx));
     p.assign("TV[1]", compute_potential_energy(ctx));
@@ -246,6 +259,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   if (outs.momentum) {
     Program p;
     KaneContext ctx(dyn, p, C, x);
+    ctx.angle_offset = framed.angle_offset;
     prepare(ctx, true);
     const auto pH = compute_momentum(ctx);
     for (int i = 0; i < 6; ++i) p.assign(fmt::format("pH[{}]", i), pH[i]);
@@ -255,12 +269,23 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     fns.push_back(std::move(f));
   }
   if (outs.reactions) {  // on the unmerged tree: every body, fixed ones included
-    const StateSymbols xr(model_in);
+    const FramedModel fr = frames(model_in);
+    const StateSymbols xr(fr.model);
     Program p;
-    KaneContext ctx(model_in, p, C, xr);
+    KaneContext ctx(fr.model, p, C, xr);
+    ctx.angle_offset = fr.angle_offset;
     prepare(ctx, true);
     const auto W = compute_reactions(ctx, xr.udot);
-    for (std::size_t i = 0; i < W.size(); ++i) p.assign(fmt::format("wrenches[{}]", i), W[i]);
+    // back to the model's body axes: [R_BB' f; R_BB' t]
+    for (int j = 0; j < out.nbodies; ++j) {
+      const SM3 Q = ctx.cmat(fr.R_BBp[j], fr.model.bodies[j].name + "_R_BBp", "",
+                             "the model's body axes from the generator's (joint_frames.hpp)");
+      for (int half = 0; half < 2; ++half) {
+        const SV3 w{{W[6 * j + 3 * half], W[6 * j + 3 * half + 1], W[6 * j + 3 * half + 2]}};
+        const SV3 wB = ctx.A.mul(Q, w);
+        for (int a = 0; a < 3; ++a) p.assign(fmt::format("wrenches[{}]", 6 * j + 3 * half + a), wB[a]);
+      }
+    }
     EmittedFunction f =
         function("reactions", "reactions on each body from its parent: [force; torque about O_B], body axes",
                  at_t({Arg::q, Arg::u, Arg::udot_in, Arg::out}), "wrenches", 6 * out.nbodies);
@@ -272,7 +297,9 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   // Constants, grouped per body with a comment block.
   for (const std::string& g : C.groups()) {
     const int bi = model_in.body_index(g);
-    out.constants += bi >= 0 ? body_comment(model_in, model_in.bodies[bi]) : std::string("// model\n");
+    out.constants += bi >= 0                 ? body_comment(model_in, model_in.bodies[bi])
+                     : g == kDerivedGroup ? std::string("// derived: constant subexpressions, evaluated here exactly\n")
+                                          : std::string("// model\n");
     out.constants += C.emit(g, "") + "\n";
   }
   return out;

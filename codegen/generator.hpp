@@ -14,6 +14,7 @@ namespace kanegen::codegen {
 struct GeneratorOptions {
   bool merge_fixed = true;         ///< merge rigid bodies on fixed joints into their parents
   std::string udot_form = "auto";  ///< "auto" (fewer operations), "composite" or "articulated"
+  bool joint_frames = true;        ///< re-choose body frames along the joint axes (joint_frames.hpp)
 };
 
 EmittedModel generate(const Model& model, const GeneratorOptions& options = {});

@@ -31,7 +31,9 @@ namespace kanegen::codegen {
 
 struct SymBodyWorkspace {
   SM3 R_PB, R_NB;                 ///< orientation of B in its parent, in N
+  SM3 R_PJ, R_JB;                 ///< R_PB = R_PJ R_JB: joint frame in the parent (with a node's turn), B in J
   SV3 p_PO_P;                     ///< O_B from the parent's origin, parent components
+  SV3 p_BP_J;                     ///< O_B from the parent's origin, J components
   SV3 r_NO_N;                     ///< O_B from N's origin, N components
   SV3 w_B, v_O_B;                 ///< angular velocity, velocity of O_B (B components)
   SV3 a_R_B, alpha_R_B;           ///< remainder accelerations (B components)
@@ -46,7 +48,9 @@ struct SymBodyWorkspace {
 /// One Model's symbolic formulation in one Program.
 struct KaneContext {
   KaneContext(const Model& model, Program& program, Constants& constants, const StateSymbols& x)
-      : model(model), P(program), C(constants), x(x), A(program), body(model.bodies.size()) {}
+      : model(model), P(program), C(constants), x(x), A(program), body(model.bodies.size()) {
+    program.fold = [&constants](const ex& e) { return constants.fold(e); };
+  }
 
   const Model& model;
   Program& P;
@@ -55,6 +59,12 @@ struct KaneContext {
   Alg A;
   std::vector<SymBodyWorkspace> body;
   std::map<int, std::array<ex, 3>> motion_symbols;  ///< body -> f, f_dot, f_ddot (see motion())
+  /// Per body: a revolute joint turns by q + angle_offset[j] (joint_frames.hpp); empty: no offsets.
+  std::vector<double> angle_offset;
+  /// Gravity as a fictitious acceleration -g of the ground (Featherstone): with
+  /// velocities, every body's remainder acceleration carries -g and no body has
+  /// a gravity term g_body, so no R_NB is needed for the dynamics.
+  bool gravity_in_base_acceleration = true;
 
   /// A named model constant (constants.hpp) of the current group.
   ex c(double v, const std::string& name, const std::string& unit, const std::string& what) {
@@ -93,6 +103,13 @@ std::vector<std::vector<ex>> motion_subspace(KaneContext& ctx, int j);
 std::vector<ex> transform_motion_from_parent(KaneContext& ctx, int j, const std::vector<ex>* dp);
 /// Xe_j^T applied to a 6-vector wrench of body j: the parent's (6 + m_p) contribution.
 std::vector<ex> transform_wrench_to_parent(KaneContext& ctx, int j, const std::vector<ex>& W6);
+/// R J R^T of a symmetric J (symmetric result, each product bound).
+SM3 rotate_symmetric(KaneContext& ctx, const SM3& R, const SM3& J);
+/// R B R^T.
+SM3 rotate_matrix(KaneContext& ctx, const SM3& R, const SM3& B);
+/// Xe^T I Xe for a symmetric 6 x 6 I of body j whose joint is not at a node of
+/// a flexible parent: the parent's 6 x 6 (turn by R_JB, shift, turn by R_PJ).
+SMat transform_inertia_to_parent(KaneContext& ctx, int j, const SMat& I);
 /// y_j = g_j - h_j - M_body z_R for every body (generalized gravity and
 /// velocity forces with the remainder accelerations' inertia forces).
 std::vector<std::vector<ex>> compute_bias_forces(KaneContext& ctx);
@@ -103,10 +120,18 @@ std::vector<ex> compute_forcing(KaneContext& ctx);
 SMat compute_mass_matrix(KaneContext& ctx);
 /// Solves M x = b by L^T D L along the dof tree; returns x and binds the pivots D_ii
 /// in `pivots` (index = speed).
-std::vector<ex> solve_tree_ldlt(KaneContext& ctx, SMat M, std::vector<ex> b, std::vector<ex>& pivots);
+/// A pivot of the generated factorization below this fraction of its
+/// diagonal entry counts as zero (as the generic engine's cond(M) > 1e14).
+inline constexpr const char* kPivotRatio = "1e-14";
+
+/// pivot_scales[k]: M's diagonal entry k, against which pivot k is judged
+/// (a pivot below kPivotRatio of it means dof k is, to round-off, a
+/// combination of its descendants': M is singular there).
+std::vector<ex> solve_tree_ldlt(KaneContext& ctx, SMat M, std::vector<ex> b, std::vector<ex>& pivots,
+                                std::vector<ex>& pivot_scales);
 /// u_dot by the articulated-body recursion (O(n)); `pivots[r]` is the pivot
 /// of speed r in its joint's D matrix factorization.
-std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivots);
+std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivots, std::vector<ex>& pivot_scales);
 /// 6 entries per body: reaction [force; torque about O_B] (B components).
 std::vector<ex> compute_reactions(KaneContext& ctx, const std::vector<ex>& udot);
 ex compute_kinetic_energy(KaneContext& ctx);

@@ -91,7 +91,13 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     const SymBodyWorkspace* p = has_parent ? &ctx.body[b.parent] : nullptr;
     const SV3 zero;
     const SV3 w_P = has_parent ? p->w_B : zero, v_P = has_parent ? p->v_O_B : zero;
-    const SV3 aR_P = has_parent ? p->a_R_B : zero, alR_P = has_parent ? p->alpha_R_B : zero;
+    SV3 minus_g;
+    if (!has_parent && with_velocity && ctx.gravity_in_base_acceleration && !model.g_N.isZero()) {
+      ctx.C.group = "model";
+      minus_g = ctx.cvec(-model.g_N, "minus_gravity", "m/s^2", "-gravity in N: the ground's fictitious acceleration");
+      ctx.C.group = b.name;
+    }
+    const SV3 aR_P = has_parent ? p->a_R_B : minus_g, alR_P = has_parent ? p->alpha_R_B : zero;
 
     // Joint frame.
     SM3 R_PJ = ctx.cmat(b.joint.R_PJ, n + "_R_PJ", "", "joint frame orientation in the parent");
@@ -202,8 +208,12 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     }
 
     // Joint motion; a prescribed joint's coordinate and rate are its motion at t.
+    // Everything relative to the joint is formed in J components, where the
+    // generator's frames make the joint axis a coordinate axis (joint_frames.hpp),
+    // and turned into B components by R_JB^T once.
     SM3 R_JB = SM3::identity();
-    SV3 e, e_dot, w_rel;
+    SV3 e_J;                   // O_B - O_J, J components
+    SV3 e_dot_B, w_rel_B;      // rates of e and of B relative to J, B components
     const SV3 axis = ctx.cvec(b.joint.axis_J, n + "_axis", "", "joint axis");
     ex q_j = 0, u_j = 0, f_ddot = 0;
     if (b.joint.prescribed()) {
@@ -214,7 +224,10 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     }
     switch (b.joint.type) {
       case JointType::revolute: {
-        const ex cq = A.let(cos(q_j)), sq = A.let(sin(q_j));
+        const double offset = i < ctx.angle_offset.size() ? ctx.angle_offset[i] : 0.0;
+        const ex angle = q_j + ctx.c(offset, n + "_angle_offset", "rad",
+                                     "joint angle offset of the generator's body frame (joint_frames.hpp)");
+        const ex cq = A.let(cos(angle)), sq = A.let(sin(angle));
         // Rot(a, th) = a a^T + cos th (I - a a^T) + sin th a^x
         const Eigen::Matrix3d aa = b.joint.axis_J * b.joint.axis_J.transpose();
         const SM3 Ax = Alg::skew(axis);
@@ -228,15 +241,13 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
                                      "I - axis outer product");
             R_JB(r, cc) = A.let(aa_rc + cq * one_minus + sq * Ax(r, cc));
           }
-        if (with_velocity) w_rel = A.scale(u_j, A.mul(R_PJ, axis));
+        if (with_velocity) w_rel_B = A.scale(u_j, axis);  // R_JB^T a = a
         break;
       }
-      case JointType::prismatic: {
-        const SV3 a_P = A.mul(R_PJ, axis);
-        e = A.scale(q_j, a_P);
-        if (with_velocity) e_dot = A.scale(u_j, a_P);
+      case JointType::prismatic:
+        e_J = A.scale(q_j, axis);
+        if (with_velocity) e_dot_B = A.scale(u_j, axis);
         break;
-      }
       case JointType::fixed: break;
       case JointType::free: {
         const auto& q = ctx.x.q;
@@ -251,19 +262,44 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
         R_JB(0, 0) = A.let(1 - 2 * (yy + zz)), R_JB(0, 1) = A.let(2 * (xy - wz)), R_JB(0, 2) = A.let(2 * (xz + wy));
         R_JB(1, 0) = A.let(2 * (xy + wz)), R_JB(1, 1) = A.let(1 - 2 * (xx + zz)), R_JB(1, 2) = A.let(2 * (yz - wx));
         R_JB(2, 0) = A.let(2 * (xz - wy)), R_JB(2, 1) = A.let(2 * (yz + wx)), R_JB(2, 2) = A.let(1 - 2 * (xx + yy));
-        const SV3 xyz{{q[q0], q[q0 + 1], q[q0 + 2]}};
-        e = A.mul(R_PJ, xyz);
+        e_J = SV3{{q[q0], q[q0 + 1], q[q0 + 2]}};
+        if (with_velocity) {
+          const int u0 = b.u_joint;
+          e_dot_B = SV3{{ctx.x.u[u0], ctx.x.u[u0 + 1], ctx.x.u[u0 + 2]}};
+          w_rel_B = SV3{{ctx.x.u[u0 + 3], ctx.x.u[u0 + 4], ctx.x.u[u0 + 5]}};
+        }
         break;
       }
     }
+    s.R_PJ = R_PJ;
+    s.R_JB = R_JB;
+    const SM3 R_JP = R_PJ.transpose(), R_BJ = R_JB.transpose();
+    // O_J from O_P in J components: a model constant unless O_J is a node of a flexible parent
+    const SV3 p_J = b.joint.node >= 0 ? A.mul(R_JP, p_PJ)
+                                      : ctx.cvec(b.joint.R_PJ.transpose() * b.joint.p_PJ, n + "_p_J", "m",
+                                                 "joint origin from the parent's origin, joint axes");
+    s.p_BP_J = A.add(p_J, e_J);
     s.R_PB = A.mul(R_PJ, R_JB, ctx.name("R_PB", j));
-    s.p_PO_P = A.add(p_PJ, e, ctx.name("p_PO_P", j));
-    const SM3 R_BP = s.R_PB.transpose();
-    if (b.joint.type == JointType::free && with_velocity) {
-      const int u0 = b.u_joint;
-      const SV3 v{{ctx.x.u[u0], ctx.x.u[u0 + 1], ctx.x.u[u0 + 2]}}, w{{ctx.x.u[u0 + 3], ctx.x.u[u0 + 4], ctx.x.u[u0 + 5]}};
-      e_dot = A.mul(s.R_PB, v);
-      w_rel = A.mul(s.R_PB, w);
+    s.p_PO_P = A.add(p_PJ, A.mul(R_PJ, e_J), ctx.name("p_PO_P", j));
+    // The transforms between B and P (spatial_transforms.cpp) turn by R_JB, then
+    // by R_PJ. When R_PJ is dense and R_JB is not the identity, one turn by the
+    // product R_PB is cheaper: then J stands for P (R_PJ = I, R_JB = R_PB).
+    auto nonzeros = [](const SM3& R) {
+      int k = 0;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) k += R(r, c).is_zero() ? 0 : 1;
+      return k;
+    };
+    auto identity = [](const SM3& R) {
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          if (!(R(r, c) - (r == c ? 1 : 0)).is_zero()) return false;
+      return true;
+    };
+    if (nonzeros(R_PJ) > 5 && !identity(R_JB)) {
+      s.R_PJ = SM3::identity();
+      s.R_JB = s.R_PB;
+      s.p_BP_J = s.p_PO_P;
     }
     if (has_parent) {
       s.R_NB = A.mul(p->R_NB, s.R_PB, ctx.name("R_NB", j));
@@ -275,26 +311,35 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     // Node coupling: partials of [v; w] w.r.t. the parent's modal speeds.
     s.P_node.clear();
     for (int mode = 0; mode < static_cast<int>(H_cols.size()); ++mode) {
-      const SV3 lin = A.mul(R_BP, A.sub(Phi_cols[mode], A.cross(e, H_cols[mode])));
-      const SV3 ang = A.mul(R_BP, H_cols[mode]);
+      const SV3 H_J = A.mul(R_JP, H_cols[mode]);
+      const SV3 lin = A.mul(R_BJ, A.sub(A.mul(R_JP, Phi_cols[mode]), A.cross(e_J, H_J)));
+      const SV3 ang = A.mul(R_BJ, H_J);
       s.P_node.push_back({lin[0], lin[1], lin[2], ang[0], ang[1], ang[2]});
     }
     if (!with_velocity) continue;
-    const SV3 w_BP = A.add(w_J, w_rel);
-    const SV3 v_rel = A.add(A.add(v_node, A.cross(w_J, e)), e_dot);
-    s.w_B = A.mul(R_BP, A.add(w_P, w_BP), ctx.name("w_B", j));
-    s.v_O_B = A.mul(R_BP, A.add(A.add(v_P, A.cross(w_P, s.p_PO_P)), v_rel), ctx.name("v_O_B", j));
-    SV3 al = A.add(A.add(alR_P, A.cross(w_P, w_BP)), A.add(w_J_dot_R, A.cross(w_J, w_rel)));
-    s.alpha_R_B = A.mul(R_BP, al, ctx.name("alpha_R_B", j));
-    SV3 a = A.add(aR_P, A.cross(alR_P, s.p_PO_P));
-    a = A.add(a, A.cross(w_P, A.cross(w_P, s.p_PO_P)));
-    a = A.add(a, A.scale(2, A.cross(w_P, v_rel)));
-    a = A.add(a, A.cross(w_J_dot_R, e));
-    a = A.add(a, A.cross(w_J, A.cross(w_J, e)));
-    a = A.add(a, A.cross(w_J, e_dot));
-    a = A.add(a, A.cross(w_BP, e_dot));
-    a = A.add(a, a_node_R);
-    s.a_R_B = A.mul(R_BP, a, ctx.name("a_R_B", j));
+    // The parent's motion at O_J and the node's own, J components.
+    const SV3 wP = A.mul(R_JP, w_P), alP = A.mul(R_JP, alR_P);
+    const SV3 wJ = A.mul(R_JP, w_J), wJdot = A.mul(R_JP, w_J_dot_R);
+    const SV3 vnode = A.mul(R_JP, v_node), anode = A.mul(R_JP, a_node_R);
+    const SV3 w_in = A.add(wP, wJ);
+    const SV3 vP0 = A.add(A.mul(R_JP, v_P), A.cross(wP, p_J));
+    const SV3 aP0 = A.add(A.add(A.mul(R_JP, aR_P), A.cross(alP, p_J)), A.cross(wP, A.cross(wP, p_J)));
+    // w_B = R_BJ (w_P + w_J) + w_rel; v_O_B = R_BJ (v_OJ + v_node + (w_P + w_J) x e) + e_dot
+    const SV3 wt = A.mul(R_BJ, w_in);
+    s.w_B = A.add(wt, w_rel_B, ctx.name("w_B", j));
+    s.v_O_B = A.add(A.mul(R_BJ, A.add(A.add(vP0, vnode), A.cross(w_in, e_J))), e_dot_B, ctx.name("v_O_B", j));
+    // alpha_R = R_BJ (alpha_P + w_P x w_J + w_J_dot) + (R_BJ (w_P + w_J)) x w_rel
+    s.alpha_R_B = A.add(A.mul(R_BJ, A.add(A.add(alP, A.cross(wP, wJ)), wJdot)), A.cross(wt, w_rel_B),
+                        ctx.name("alpha_R_B", j));
+    // a_R = R_BJ [a_OJ + alpha_P x e + w_P x (w_P x e) + 2 w_P x (v_node + w_J x e) + w_J_dot x e
+    //             + w_J x (w_J x e) + a_node] + (2 R_BJ (w_P + w_J) + w_rel) x e_dot
+    SV3 a = A.add(aP0, A.cross(alP, e_J));
+    a = A.add(a, A.cross(wP, A.cross(wP, e_J)));
+    a = A.add(a, A.scale(2, A.cross(wP, A.add(vnode, A.cross(wJ, e_J)))));
+    a = A.add(a, A.cross(wJdot, e_J));
+    a = A.add(a, A.cross(wJ, A.cross(wJ, e_J)));
+    a = A.add(a, anode);
+    s.a_R_B = A.add(A.mul(R_BJ, a), A.cross(A.add(A.scale(2, wt), w_rel_B), e_dot_B), ctx.name("a_R_B", j));
     if (b.joint.prescribed()) {  // the known acceleration along the joint's column (axis in B = axis in J)
       SV3& target = b.joint.type == JointType::revolute ? s.alpha_R_B : s.a_R_B;
       target = A.add(target, A.scale(f_ddot, axis), ctx.name(b.joint.type == JointType::revolute ? "alpha_R_B" : "a_R_B", j));

@@ -15,7 +15,8 @@ static bool trivial(const ex& e) {
   return false;
 }
 
-ex Program::let(const ex& e, const std::string& name) {
+ex Program::let(const ex& e_in, const std::string& name) {
+  const ex e = fold ? fold(e_in) : e_in;
   if (trivial(e)) return e;
   auto it = cse_.find(e);
   if (it != cse_.end()) return it->second;
@@ -36,7 +37,7 @@ ex Program::let(const ex& e, const std::string& name) {
   return s;
 }
 
-void Program::assign(const std::string& lhs, const ex& e) { stmts_.push_back({lhs, "", e}); }
+void Program::assign(const std::string& lhs, const ex& e) { stmts_.push_back({lhs, "", fold ? fold(e) : e}); }
 
 void Program::statement(const std::string& text, const ex& dep) { stmts_.push_back({"", text, dep}); }
 

@@ -13,6 +13,7 @@
 
 #include <ginac/ginac.h>
 
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -26,6 +27,10 @@ using GiNaC::ex;
 
 class Program {
  public:
+  /// Applied to every expression before it is bound or assigned (e.g. the
+  /// folding of constant subexpressions into derived constants, constants.hpp).
+  std::function<ex(const ex&)> fold;
+
   /// Binds e to a temporary (reusing one for an equal expression); numbers,
   /// symbols and a number times a symbol are returned as they are. A new
   /// temporary takes `name` when given (made unique with a suffix).

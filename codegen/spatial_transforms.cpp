@@ -56,10 +56,11 @@ std::vector<ex> transform_motion_from_parent(KaneContext& ctx, int j, const std:
   const SymBodyWorkspace& s = ctx.body[j];
   std::vector<ex> dl(6 + ctx.model.bodies[j].n_modes(), ex(0));
   if (!dp) return dl;
-  const SM3 R_BP = s.R_PB.transpose();
-  const SV3 ap{{(*dp)[0], (*dp)[1], (*dp)[2]}}, alp{{(*dp)[3], (*dp)[4], (*dp)[5]}};
-  const SV3 lin = ctx.A.mul(R_BP, ctx.A.add(ap, ctx.A.cross(alp, s.p_PO_P)));
-  const SV3 ang = ctx.A.mul(R_BP, alp);
+  // [v; w] of the parent at O_B, in J then in B components: two sparse turns
+  const SM3 R_JP = s.R_PJ.transpose(), R_BJ = s.R_JB.transpose();
+  const SV3 w_J = ctx.A.mul(R_JP, SV3{{(*dp)[3], (*dp)[4], (*dp)[5]}});
+  const SV3 v_J = ctx.A.add(ctx.A.mul(R_JP, SV3{{(*dp)[0], (*dp)[1], (*dp)[2]}}), ctx.A.cross(w_J, s.p_BP_J));
+  const SV3 lin = ctx.A.mul(R_BJ, v_J), ang = ctx.A.mul(R_BJ, w_J);
   for (int a = 0; a < 3; ++a) dl[a] = lin[a], dl[3 + a] = ang[a];
   for (int i = 0; i < static_cast<int>(s.P_node.size()); ++i)
     for (int r = 0; r < 6; ++r) dl[r] = dl[r] + s.P_node[i][r] * (*dp)[6 + i];
@@ -70,9 +71,10 @@ std::vector<ex> transform_wrench_to_parent(KaneContext& ctx, int cidx, const std
   const SymBodyWorkspace& s = ctx.body[cidx];
   const int p = ctx.model.bodies[cidx].parent;
   const int m_P = ctx.model.bodies[p].n_modes();
-  const SV3 f{{W6[0], W6[1], W6[2]}}, t{{W6[3], W6[4], W6[5]}};
-  const SV3 fP = ctx.A.mul(s.R_PB, f);
-  const SV3 tP = ctx.A.add(ctx.A.mul(s.R_PB, t), ctx.A.cross(s.p_PO_P, fP));
+  // [f; t about O_B] in J components, moved to the parent's origin, then in P components
+  const SV3 f_J = ctx.A.mul(s.R_JB, SV3{{W6[0], W6[1], W6[2]}});
+  const SV3 t_J = ctx.A.add(ctx.A.mul(s.R_JB, SV3{{W6[3], W6[4], W6[5]}}), ctx.A.cross(s.p_BP_J, f_J));
+  const SV3 fP = ctx.A.mul(s.R_PJ, f_J), tP = ctx.A.mul(s.R_PJ, t_J);
   std::vector<ex> out(6 + m_P, ex(0));
   for (int a = 0; a < 3; ++a) out[a] = fP[a], out[3 + a] = tP[a];
   for (int i = 0; i < static_cast<int>(s.P_node.size()); ++i) {
@@ -83,10 +85,59 @@ std::vector<ex> transform_wrench_to_parent(KaneContext& ctx, int cidx, const std
   return out;
 }
 
+SM3 rotate_symmetric(KaneContext& ctx, const SM3& R, const SM3& J) {
+  SM3 RJ = ctx.A.mul(R, J), out;
+  for (int a = 0; a < 3; ++a)
+    for (int c = a; c < 3; ++c)
+      out(a, c) = out(c, a) = ctx.A.let(RJ(a, 0) * R(c, 0) + RJ(a, 1) * R(c, 1) + RJ(a, 2) * R(c, 2));
+  return out;
+}
+
+SM3 rotate_matrix(KaneContext& ctx, const SM3& R, const SM3& B) { return ctx.A.mul(ctx.A.mul(R, B), R.transpose()); }
+
+SMat transform_inertia_to_parent(KaneContext& ctx, int j, const SMat& I) {
+  const SymBodyWorkspace& s = ctx.body[j];
+  // blocks of I in B components: [A B; B^T C] over [v; w]
+  SM3 Am, Bm, Cm;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) Am(r, c) = I(r, c), Bm(r, c) = I(r, 3 + c), Cm(r, c) = I(3 + r, 3 + c);
+  // turn into J components
+  Am = rotate_symmetric(ctx, s.R_JB, Am);
+  Bm = rotate_matrix(ctx, s.R_JB, Bm);
+  Cm = rotate_symmetric(ctx, s.R_JB, Cm);
+  // move to the parent's origin: X = [I -P; 0 I], P = p^x; X^T I X =
+  // [A, B - A P; B^T + P A, C + P B + (P B)^T - P A P]
+  const SM3 P = Alg::skew(s.p_BP_J);
+  const SM3 AP = ctx.A.mul(Am, P), PB = ctx.A.mul(P, Bm);
+  SM3 B2, C2;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) B2(r, c) = ctx.A.let(Bm(r, c) - AP(r, c));
+  for (int r = 0; r < 3; ++r)
+    for (int c = r; c < 3; ++c) {
+      ex pap = 0;  // (P A P)(r, c) = -(A P)^T... = sum_t P(r, t) (A P)(t, c)
+      for (int t = 0; t < 3; ++t) pap += P(r, t) * AP(t, c);
+      C2(r, c) = C2(c, r) = ctx.A.let(Cm(r, c) + PB(r, c) + PB(c, r) - pap);
+    }
+  // turn into P components
+  Am = rotate_symmetric(ctx, s.R_PJ, Am);
+  B2 = rotate_matrix(ctx, s.R_PJ, B2);
+  C2 = rotate_symmetric(ctx, s.R_PJ, C2);
+  SMat out(6, 6);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      out(r, c) = Am(r, c);
+      out(r, 3 + c) = B2(r, c);
+      out(3 + c, r) = B2(r, c);
+      out(3 + r, 3 + c) = C2(r, c);
+    }
+  return out;
+}
+
 std::vector<std::vector<ex>> compute_bias_forces(KaneContext& ctx) {
   const int nb = static_cast<int>(ctx.model.bodies.size());
   std::vector<std::vector<ex>> y(nb);
   for (int j = 0; j < nb; ++j) {  // y_j = g_j - h_j - M_j z_R
+    ctx.P.section(fmt::format("body {}: bias force", ctx.model.bodies[j].name));
     const SymBodyWorkspace& s = ctx.body[j];
     const int n = 6 + ctx.model.bodies[j].n_modes();
     y[j].resize(n);

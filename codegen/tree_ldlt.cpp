@@ -10,7 +10,8 @@ namespace kanegen::codegen {
 
 using namespace GiNaC;
 
-std::vector<ex> solve_tree_ldlt(KaneContext& ctx, SMat H, std::vector<ex> b, std::vector<ex>& pivots) {
+std::vector<ex> solve_tree_ldlt(KaneContext& ctx, SMat H, std::vector<ex> b, std::vector<ex>& pivots,
+                                std::vector<ex>& pivot_scales) {
   const int n = H.rows;
   // lambda: parent of each dof in the dof tree
   std::vector<int> lambda(n, -1);
@@ -27,6 +28,9 @@ std::vector<ex> solve_tree_ldlt(KaneContext& ctx, SMat H, std::vector<ex> b, std
       prev = bd.u_joint + k;
     }
   }
+  ctx.P.section("M u_dot = F: L^T D L along the dof tree");
+  std::vector<ex> diagonal(n);
+  for (int k = 0; k < n; ++k) diagonal[k] = H(k, k);
   for (int k = n - 1; k >= 0; --k) {
     int i = lambda[k];
     const ex inv = ctx.A.let(1 / H(k, k));
@@ -43,6 +47,7 @@ std::vector<ex> solve_tree_ldlt(KaneContext& ctx, SMat H, std::vector<ex> b, std
   }
   pivots.resize(n);
   for (int k = 0; k < n; ++k) pivots[k] = H(k, k);
+  pivot_scales = diagonal;
   for (int i = n - 1; i >= 0; --i)
     for (int jj = lambda[i]; jj != -1; jj = lambda[jj]) b[jj] = ctx.A.let(b[jj] - H(i, jj) * b[i]);
   for (int i = 0; i < n; ++i) b[i] = ctx.A.let(b[i] / H(i, i));

@@ -17,7 +17,7 @@
 //   qdot               0 (0 add, 0 mul, 0 div, 0 func)
 //   mass_matrix        0 (0 add, 0 mul, 0 div, 0 func)
 //   forcing            8 (4 add, 4 mul, 0 div, 0 func)
-//   udot              28 (10 add, 12 mul, 6 div, 0 func) -- composite form; composite 28, articulated 42
+//   udot              20 (8 add, 12 mul, 0 div, 0 func) -- composite form; composite 20, articulated 20
 //   energy            35 (10 add, 20 mul, 5 div, 0 func)
 //   momentum          31 (11 add, 20 mul, 0 div, 0 func)
 //   reactions         31 (11 add, 20 mul, 0 div, 0 func)
@@ -75,6 +75,28 @@ inline constexpr double beam_K2 = 740.0430389458759;  // modal stiffness [N m]
 inline constexpr double beam_K3 = 19267.017920613365;  // modal stiffness [N m]
 inline constexpr double beam_K4 = 28900.526880924484;  // modal stiffness [N m]
 
+// derived: constant subexpressions, evaluated here exactly
+inline constexpr double k0b6bebb4 = 0.9999999999999996;  // = 1.0/beam_Y_1_1 + kedff471e*kedff471e/kb0f88c66
+inline constexpr double k336a9e00 = -9.714451465470107e-17;  // = kdea33278/k9367c209
+inline constexpr double k5859a259 = 1.0000000000000009;  // = beam_Y_2_2 - beam_Y_2_4*k5c4cfdf0
+inline constexpr double k5c204288 = 1.0000000000000004;  // = beam_Y_1_1 - beam_Y_1_3*ka25a04ea
+inline constexpr double k5c4cfdf0 = -9.714451465470115e-17;  // = beam_Y_2_4*k9f2d7370
+inline constexpr double k91b97e0c = 0.9999999999999991;  // = 1.0/beam_Y_3_3
+inline constexpr double k9367c209 = 1.0000000000000004;  // = -beam_Y_2_2*kdea33278*kdea33278 + beam_Y_4_4
+inline constexpr double k9f2d7370 = 0.9999999999999996;  // = 1.0/beam_Y_4_4
+inline constexpr double ka25a04ea = 1.6653345369377333e-16;  // = beam_Y_1_3*k91b97e0c
+inline constexpr double ka7b4ebbb = 0.9999999999999991;  // = 1.0/beam_Y_2_2 + kdea33278*kdea33278/k9367c209
+inline constexpr double kb0f88c66 = 1.0000000000000009;  // = -beam_Y_1_1*kedff471e*kedff471e + beam_Y_3_3
+inline constexpr double kb5e81d94 = 0.9999999999999991;  // = 1.0/beam_Y_2_2
+inline constexpr double kb8e688b0 = 0.9999999999999996;  // = 1.0/beam_Y_1_1
+inline constexpr double kc841fd61 = 0.9999999999999996;  // = 1.0/k9367c209
+inline constexpr double kccfbf587 = 0.9999999999999991;  // = 1.0/k5859a259
+inline constexpr double kdea33278 = -9.714451465470111e-17;  // = beam_Y_2_4*kb5e81d94
+inline constexpr double ke085ab2a = 0.9999999999999991;  // = 1.0/kb0f88c66
+inline constexpr double kedff471e = 1.665334536937734e-16;  // = beam_Y_1_3*kb8e688b0
+inline constexpr double kee647572 = 0.9999999999999996;  // = 1.0/k5c204288
+inline constexpr double kf2d845e1 = 1.6653345369377326e-16;  // = kedff471e/kb0f88c66
+
 
 // ---- dual numbers for jacobian() ---------------------------------------------
 template <int W>
@@ -98,6 +120,7 @@ template <int W> inline Dual<W> operator*(double a, const Dual<W>& b) { return b
 template <int W> inline Dual<W> operator/(const Dual<W>& a, double b) { return a * (1.0 / b); }
 template <int W> inline Dual<W> operator/(double a, const Dual<W>& b) { Dual<W> r; r.v = a / b.v; const double f = -r.v / b.v; for (int i = 0; i < W; ++i) r.d[i] = f * b.d[i]; return r; }
 template <int W> inline bool operator>(const Dual<W>& a, double b) { return a.v > b; }
+template <int W> inline bool operator>(const Dual<W>& a, const Dual<W>& b) { return a.v > b.v; }
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }
@@ -141,7 +164,7 @@ template <class T>
 void forcing(const T* q, const T* u, const T* tau, T* F) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
-  // ---- body beam: mass and velocity terms
+  // ---- body beam: generalized forces (inward)
   const T t28 = -beam_K1*q[0] + tau[0];
   const T t29 = -beam_K2*q[1] + tau[1];
   const T t30 = -beam_K3*q[2] + tau[2];
@@ -158,33 +181,28 @@ template <class T>
 int udot(const T* q, const T* u, const T* tau, T* udot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
-  // ---- body beam: mass and velocity terms
+  // ---- body beam: generalized forces (inward)
   const T t28 = -beam_K1*q[0] + tau[0];
   const T t29 = -beam_K2*q[1] + tau[1];
   const T t30 = -beam_K3*q[2] + tau[2];
   const T t31 = -beam_K4*q[3] + tau[3];
-  const T t32 = 1.0/beam_Y_4_4;
-  const T t33 = beam_Y_2_4*t32;
-  const T t34 = beam_Y_2_2 - beam_Y_2_4*t33;
-  const T t35 = 1.0/beam_Y_3_3;
-  const T t36 = beam_Y_1_3*t35;
-  const T t37 = beam_Y_1_1 - beam_Y_1_3*t36;
-  const T t40 = t29 - t31*t33;
-  const T t41 = t28 - t30*t36;
-  const T t42 = t41/t37;
-  const T t43 = t40/t34;
-  const T t44 = t30/beam_Y_3_3;
-  const T t45 = t31/beam_Y_4_4;
-  const T t46 = -t36*t42 + t44;
-  const T t47 = -t33*t43 + t45;
-  if (!(t37 > 0.0)) return 1;
-  if (!(t34 > 0.0)) return 2;
+  // ---- M u_dot = F: L^T D L along the dof tree
+  const T t32 = -k5c4cfdf0*t31 + t29;
+  const T t33 = -ka25a04ea*t30 + t28;
+  const T t34 = kee647572*t33;
+  const T t35 = kccfbf587*t32;
+  const T t36 = k91b97e0c*t30;
+  const T t37 = k9f2d7370*t31;
+  const T t38 = -ka25a04ea*t34 + t36;
+  const T t39 = -k5c4cfdf0*t35 + t37;
+  if (!(k5c204288 > 1e-14*beam_Y_1_1)) return 1;
+  if (!(k5859a259 > 1e-14*beam_Y_2_2)) return 2;
   if (!(beam_Y_3_3 > 0.0)) return 3;
   if (!(beam_Y_4_4 > 0.0)) return 4;
-  udot[0] = t42;
-  udot[1] = t43;
-  udot[2] = t46;
-  udot[3] = t47;
+  udot[0] = t34;
+  udot[1] = t35;
+  udot[2] = t38;
+  udot[3] = t39;
   return 0;
 }
 

@@ -15,12 +15,12 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot               0 (0 add, 0 mul, 0 div, 0 func)
-//   mass_matrix      114 (44 add, 68 mul, 0 div, 2 func)
-//   forcing          244 (95 add, 145 mul, 0 div, 4 func)
-//   udot             311 (121 add, 183 mul, 3 div, 4 func) -- composite form; composite 311, articulated 415
-//   energy           170 (63 add, 101 mul, 2 div, 4 func)
-//   momentum         214 (82 add, 128 mul, 0 div, 4 func)
-//   reactions        326 (142 add, 180 mul, 0 div, 4 func)
+//   mass_matrix       51 (20 add, 29 mul, 0 div, 2 func)
+//   forcing          136 (53 add, 79 mul, 0 div, 4 func)
+//   udot             192 (74 add, 113 mul, 1 div, 4 func) -- composite form; composite 192, articulated 270
+//   energy            97 (34 add, 57 mul, 2 div, 4 func)
+//   momentum         156 (57 add, 95 mul, 0 div, 4 func)
+//   reactions        256 (108 add, 144 mul, 0 div, 4 func)
 
 #pragma once
 
@@ -35,49 +35,103 @@ inline constexpr char model_name[] = "double_pendulum";
 inline constexpr char model_hash[] = "3037921e9cab978a";
 
 // ---- model constants (SI units) ---------------------------------------------
+// body link1: revolute joint to ground, mass 1 kg
+inline constexpr double link1_R_PJ_xx = 0.8692335601383587;  // joint frame orientation in the parent
+inline constexpr double link1_R_PJ_xy = -0.49440167670548435;  // joint frame orientation in the parent
+inline constexpr double link1_R_PJ_zx = -0.49440167670548435;  // joint frame orientation in the parent
+inline constexpr double link1_R_PJ_zy = -0.8692335601383587;  // joint frame orientation in the parent
+inline constexpr double link1_S0_x = 0.44450481360328903;  // first mass moment about O (undeformed) x [kg m]
+inline constexpr double link1_S0_y = -0.229816167149975;  // first mass moment about O (undeformed) y [kg m]
+inline constexpr double link1_S0_z = 0.03;  // first mass moment about O (undeformed) z [kg m]
+inline constexpr double link1_J0_xx = 0.0868708832236105;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link1_J0_xy = 0.136348834682609;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link1_J0_xz = -0.010847013520956204;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link1_J0_yy = 0.2653291167763895;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link1_J0_yz = 0.0031784111874005945;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link1_J0_zz = 0.3354;  // inertia about O (undeformed) [kg m^2]
+
 // body link2: revolute joint to link1, mass 0.6 kg
-inline constexpr double link2_R_PJ_xx = 0.9027010963754599;  // joint frame orientation in the parent
-inline constexpr double link2_R_PJ_xy = -0.4261017813090818;  // joint frame orientation in the parent
-inline constexpr double link2_R_PJ_xz = -0.05973275958609334;  // joint frame orientation in the parent
-inline constexpr double link2_R_PJ_yx = 0.38165590209504835;  // joint frame orientation in the parent
-inline constexpr double link2_R_PJ_yy = 0.8570601132100353;  // joint frame orientation in the parent
-inline constexpr double link2_R_PJ_yz = -0.3461022027384634;  // joint frame orientation in the parent
-inline constexpr double link2_R_PJ_zx = 0.1986693307950612;  // joint frame orientation in the parent
-inline constexpr double link2_R_PJ_zy = 0.28962947762551555;  // joint frame orientation in the parent
-inline constexpr double link2_R_PJ_zz = 0.9362933635841992;  // joint frame orientation in the parent
-inline constexpr double link2_p_PJ_y = 0.05;  // joint frame origin in the parent y [m]
-inline constexpr double link2_axis_x = 0.6;  // joint axis x
-inline constexpr double link2_axis_z = 0.8;  // joint axis z
-inline constexpr double link2_axis_aa_xx = 0.36;  // axis outer product
-inline constexpr double link2_axis_Iaa_xx = 0.64;  // I - axis outer product
-inline constexpr double link2_axis_aa_xz = 0.48;  // axis outer product
-inline constexpr double link2_axis_Iaa_xz = -0.48;  // I - axis outer product
-inline constexpr double link2_axis_aa_zz = 0.6400000000000001;  // axis outer product
-inline constexpr double link2_axis_Iaa_zz = 0.3599999999999999;  // I - axis outer product
+inline constexpr double link2_R_PJ_yy = -0.04788822093374167;  // joint frame orientation in the parent
+inline constexpr double link2_R_PJ_yz = -0.9988527010004034;  // joint frame orientation in the parent
+inline constexpr double link2_R_PJ_zy = 0.9988527010004034;  // joint frame orientation in the parent
+inline constexpr double link2_R_PJ_zz = -0.04788822093374167;  // joint frame orientation in the parent
+inline constexpr double link2_p_PJ_x = 0.8692335601383587;  // joint frame origin in the parent x [m]
+inline constexpr double link2_p_PJ_y = -0.49440167670548435;  // joint frame origin in the parent y [m]
+inline constexpr double link2_p_PJ_z = 0.05;  // joint frame origin in the parent z [m]
+inline constexpr double link2_angle_offset = 0.4704898923184695;  // joint angle offset of the generator's body frame (joint_frames.hpp) [rad]
+inline constexpr double link2_p_J_x = 0.8692335601383587;  // joint origin from the parent's origin, joint axes x [m]
+inline constexpr double link2_p_J_y = 0.07361865177410473;  // joint origin from the parent's origin, joint axes y [m]
+inline constexpr double link2_p_J_z = 0.4914400391097142;  // joint origin from the parent's origin, joint axes z [m]
 inline constexpr double link2_mass = 0.6;  // mass (rigid part and plain nodes) [kg]
-inline constexpr double link2_S0_x = 0.24;  // first mass moment about O (undeformed) x [kg m]
-inline constexpr double link2_S0_y = -0.012;  // first mass moment about O (undeformed) y [kg m]
-inline constexpr double link2_S0_z = 0.03;  // first mass moment about O (undeformed) z [kg m]
-inline constexpr double link2_J0_xx = 0.007740000000000008;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link2_J0_xy = 0.0027999999999999995;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link2_J0_xz = -0.010500000000000002;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link2_J0_yy = 0.1385;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link2_J0_yz = 0.0015999999999999999;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link2_J0_zz = 0.13924000000000003;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link2_S0_x = 0.17441330224498364;  // first mass moment about O (undeformed) x [kg m]
+inline constexpr double link2_S0_z = 0.168;  // first mass moment about O (undeformed) z [kg m]
+inline constexpr double link2_J0_xx = 0.06533145562130178;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link2_J0_xy = -0.003766106508875741;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link2_J0_xz = -0.0661071136868038;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link2_J0_yy = 0.13832854437869826;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link2_J0_yz = -0.00159208039997985;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link2_J0_zz = 0.08182000000000002;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link1_R_BBp_xx = 0.8692335601383587;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link1_R_BBp_xy = -0.49440167670548435;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link1_R_BBp_zx = -0.49440167670548435;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link1_R_BBp_zy = -0.8692335601383587;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link2_R_BBp_xx = 0.7981042627383865;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link2_R_BBp_xy = 0.05504167329230252;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link2_R_BBp_xz = 0.6;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link2_R_BBp_yx = -0.06880209161537815;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link2_R_BBp_yy = 0.9976303284229833;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link2_R_BBp_zx = -0.59857819705379;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link2_R_BBp_zy = -0.04128125496922689;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link2_R_BBp_zz = 0.8;  // the model's body axes from the generator's (joint_frames.hpp)
 
 // model
 inline constexpr double gravity_z = -9.81;  // gravity in N z [m/s^2]
+inline constexpr double minus_gravity_z = 9.81;  // -gravity in N: the ground's fictitious acceleration z [m/s^2]
 
-// body link1: revolute joint to ground, mass 1 kg
-inline constexpr double link1_S0_x = 0.5;  // first mass moment about O (undeformed) x [kg m]
-inline constexpr double link1_S0_y = 0.03;  // first mass moment about O (undeformed) y [kg m]
-inline constexpr double link1_S0_z = -0.02;  // first mass moment about O (undeformed) z [kg m]
-inline constexpr double link1_J0_xx = 0.013300000000000024;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link1_J0_xy = -0.011;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link1_J0_xz = 0.007;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link1_J0_yy = 0.33540000000000003;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link1_J0_yz = 0.0026;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link1_J0_zz = 0.3389;  // inertia about O (undeformed) [kg m^2]
+// derived: constant subexpressions, evaluated here exactly
+inline constexpr double k006006a7 = 0.5384120127759056;  // = k1835183a + kcd353d42 + link2_J0_zz
+inline constexpr double k1190128e = 0.22820826203862124;  // = -k59499beb*link2_S0_x + link2_mass
+inline constexpr double k1835183a = 0.0032518235334221364;  // = link2_mass*link2_p_J_y*link2_p_J_y
+inline constexpr double k18351ad3 = 0.021707491864242274;  // = link2_mass*link2_p_J_y*link2_p_J_z
+inline constexpr double k1adb1eba = 0.02708139819115127;  // = k59499beb*link2_J0_xz + link2_S0_z
+inline constexpr double k20edf4c2 = 0.00505244041256677;  // = ka903064d*link2_J0_yz - link2_J0_xy
+inline constexpr double k2d09fd55 = 0.28548000000000007;  // = link2_J0_xx + link2_J0_yy + link2_J0_zz
+inline constexpr double k359ff293 = -4.850080448480802;  // = link1_R_PJ_zx*minus_gravity_z
+inline constexpr double k3a62d85f = 0.14490798722409443;  // = link2_mass*link2_p_J_z*link2_p_J_z
+inline constexpr double k56a6b3da = -0.022165734618012186;  // = k97f57875*link2_R_PJ_zz
+inline constexpr double k56b964fd = -0.4623329800347569;  // = k97f57875*link2_R_PJ_yz
+inline constexpr double k59499beb = 2.1316707680882865;  // = kb7e5959a*link2_S0_x
+inline constexpr double k59fbd54e = 0.08256192657043199;  // = link2_S0_z*link2_p_J_z
+inline constexpr double k59fbd957 = 0.012367933498049596;  // = link2_S0_z*link2_p_J_y
+inline constexpr double k59fbda24 = 0.14603123810324428;  // = link2_S0_z*link2_p_J_x
+inline constexpr double k5a157e01 = 0.003251823533422136;  // = k778d9160*link2_p_J_y
+inline constexpr double k5bfb74db = -8.5271812249573;  // = link1_R_PJ_zy*minus_gravity_z
+inline constexpr double k7153affb = 0.028699967295463154;  // = k9cd2416f*link2_R_PJ_zz
+inline constexpr double k7154599c = 0.5986240309774807;  // = k9cd2416f*link2_R_PJ_yz
+inline constexpr double k72815a3b = 0.03839508166451469;  // = k778d9397*link2_p_J_y
+inline constexpr double k72816788 = 0.45334018924248337;  // = k778d9397*link2_p_J_x
+inline constexpr double k7584c250 = -0.008045221116868602;  // = link2_R_PJ_zz*link2_S0_z
+inline constexpr double k778d903d = 0.2948640234658285;  // = link2_mass*link2_p_J_z
+inline constexpr double k778d9160 = 0.044171191064462836;  // = link2_mass*link2_p_J_y
+inline constexpr double k778d9397 = 0.5215401360830152;  // = link2_mass*link2_p_J_x
+inline constexpr double k872e6b78 = 0.03407542536229187;  // = k18351ad3 + k59fbd957
+inline constexpr double k87a182b3 = 0.0013759690225193123;  // = kbaa7a689*link2_R_PJ_zz
+inline constexpr double k912e4bf7 = 0.011919692238265832;  // = -ka903064d*link2_J0_xz + link2_J0_xx
+inline constexpr double k97f57875 = 0.46286402346582856;  // = k778d903d + link2_S0_z
+inline constexpr double k98569865 = 1.6;  // = 1.0 + link2_mass
+inline constexpr double k9938a779 = 0.13829756515601432;  // = -ka904c900*link2_J0_yz + link2_J0_yy
+inline constexpr double k9cd2416f = -0.599311620600242;  // = link2_R_PJ_yz*link2_mass
+inline constexpr double ka6ba76ae = 0.7633720296074418;  // = 2.0*k59fbd54e + k3a62d85f + kcd353d42
+inline constexpr double ka903064d = -0.8079578793302834;  // = kb7e5959a*link2_J0_xz
+inline constexpr double ka904c900 = -0.019458328036908456;  // = kb7e5959a*link2_J0_yz
+inline constexpr double kb7e5959a = 12.22195062331948;  // = 1.0/link2_J0_zz
+inline constexpr double kbaa7a689 = -0.028732932560245;  // = link2_R_PJ_zz*link2_mass
+inline constexpr double kc16c934c = 0.3132836638983805;  // = 2.0*k59fbd54e + k1835183a + k3a62d85f
+inline constexpr double kc3b8c593 = 0.40233694297716693;  // = k59fbda24 + kcd3534fc
+inline constexpr double kc435ddc0 = -0.0033937912490833535;  // = k59499beb*link2_J0_yz
+inline constexpr double kcd3534fc = 0.2563057048739227;  // = link2_mass*link2_p_J_x*link2_p_J_z
+inline constexpr double kcd353bb1 = 0.03839508166451469;  // = link2_mass*link2_p_J_x*link2_p_J_y
+inline constexpr double kcd353d42 = 0.4533401892424834;  // = link2_mass*link2_p_J_x*link2_p_J_x
 
 
 // ---- dual numbers for jacobian() ---------------------------------------------
@@ -102,6 +156,7 @@ template <int W> inline Dual<W> operator*(double a, const Dual<W>& b) { return b
 template <int W> inline Dual<W> operator/(const Dual<W>& a, double b) { return a * (1.0 / b); }
 template <int W> inline Dual<W> operator/(double a, const Dual<W>& b) { Dual<W> r; r.v = a / b.v; const double f = -r.v / b.v; for (int i = 0; i < W; ++i) r.d[i] = f * b.d[i]; return r; }
 template <int W> inline bool operator>(const Dual<W>& a, double b) { return a.v > b; }
+template <int W> inline bool operator>(const Dual<W>& a, const Dual<W>& b) { return a.v > b.v; }
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }
@@ -121,45 +176,33 @@ void mass_matrix(const T* q, T* M) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q;
   // ---- body link2: outward pass (positions)
-  const T t2 = cos(q[1]);
-  const T t3 = sin(q[1]);
-  const T t4 = link2_axis_Iaa_xx*t2 + link2_axis_aa_xx;
-  const T t5 = -link2_axis_z*t3;
-  const T t6 = link2_axis_Iaa_xz*t2 + link2_axis_aa_xz;
-  const T t7 = link2_axis_z*t3;
-  const T t8 = -link2_axis_x*t3;
-  const T t9 = link2_axis_x*t3;
-  const T t10 = link2_axis_Iaa_zz*t2 + link2_axis_aa_zz;
-  const T R_PB_link2_xx = link2_R_PJ_xx*t4 + link2_R_PJ_xy*t7 + link2_R_PJ_xz*t6;
-  const T R_PB_link2_xy = link2_R_PJ_xx*t5 + link2_R_PJ_xy*t2 + link2_R_PJ_xz*t9;
-  const T R_PB_link2_xz = link2_R_PJ_xx*t6 + link2_R_PJ_xy*t8 + link2_R_PJ_xz*t10;
-  const T R_PB_link2_yx = link2_R_PJ_yx*t4 + link2_R_PJ_yy*t7 + link2_R_PJ_yz*t6;
-  const T R_PB_link2_yy = link2_R_PJ_yx*t5 + link2_R_PJ_yy*t2 + link2_R_PJ_yz*t9;
-  const T R_PB_link2_yz = link2_R_PJ_yx*t6 + link2_R_PJ_yy*t8 + link2_R_PJ_yz*t10;
-  const T R_PB_link2_zx = link2_R_PJ_zx*t4 + link2_R_PJ_zy*t7 + link2_R_PJ_zz*t6;
-  const T R_PB_link2_zy = link2_R_PJ_zx*t5 + link2_R_PJ_zy*t2 + link2_R_PJ_zz*t9;
-  const T R_PB_link2_zz = link2_R_PJ_zx*t6 + link2_R_PJ_zy*t8 + link2_R_PJ_zz*t10;
-  // ---- body link2: mass and velocity terms
-  const T t40 = R_PB_link2_xx*link2_S0_x + R_PB_link2_xy*link2_S0_y + R_PB_link2_xz*link2_S0_z;
-  const T t49 = R_PB_link2_yx*link2_J0_xx + R_PB_link2_yy*link2_J0_xy + R_PB_link2_yz*link2_J0_xz;
-  const T t50 = R_PB_link2_yx*link2_J0_xy + R_PB_link2_yy*link2_J0_yy + R_PB_link2_yz*link2_J0_yz;
-  const T t51 = R_PB_link2_yx*link2_J0_xz + R_PB_link2_yy*link2_J0_yz + R_PB_link2_yz*link2_J0_zz;
-  const T t58 = R_PB_link2_yx*t49 + R_PB_link2_yy*t50 + R_PB_link2_yz*t51;
-  const T t64 = 2.0*t40 + link1_J0_yy + link2_mass + t58;
-  const T t74 = -link2_S0_y*link2_axis_z;
-  const T t75 = link2_S0_x*link2_axis_z - link2_S0_z*link2_axis_x;
-  const T t76 = link2_S0_y*link2_axis_x;
-  const T t77 = link2_J0_xx*link2_axis_x + link2_J0_xz*link2_axis_z;
-  const T t78 = link2_J0_xy*link2_axis_x + link2_J0_yz*link2_axis_z;
-  const T t79 = link2_J0_xz*link2_axis_x + link2_J0_zz*link2_axis_z;
-  const T t80 = link2_axis_x*t77 + link2_axis_z*t79;
-  const T t83 = R_PB_link2_zx*t74 + R_PB_link2_zy*t75 + R_PB_link2_zz*t76;
-  const T t87 = R_PB_link2_yx*t77 + R_PB_link2_yy*t78 + R_PB_link2_yz*t79;
-  const T t90 = -t83 + t87;
-  M[0] = t64;
-  M[1] = t90;
-  M[2] = t90;
-  M[3] = t80;
+  const T t6 = cos(link2_angle_offset + q[1]);
+  const T t7 = sin(link2_angle_offset + q[1]);
+  // ---- body link2: composite inertia (inward)
+  const T t34 = link2_S0_x*t6;
+  const T t35 = link2_S0_x*t7;
+  const T t39 = link2_J0_xx*t7 + link2_J0_xy*t6;
+  const T t40 = link2_J0_xy*t7 + link2_J0_yy*t6;
+  const T t41 = link2_J0_xz*t7 + link2_J0_yz*t6;
+  const T t44 = t39*t7 + t40*t6;
+  const T t48 = 2.0*link2_p_J_x*t34 + ka6ba76ae + t44;
+  const T t49 = -k872e6b78 - link2_p_J_z*t35 + t41;
+  const T t50 = 2.0*link2_p_J_x*t34 + 2.0*link2_p_J_y*t35 + k006006a7;
+  const T t59 = link2_R_PJ_zy*t48 + link2_R_PJ_zz*t49;
+  const T t60 = link2_R_PJ_zy*t49 + link2_R_PJ_zz*t50;
+  const T t63 = link2_R_PJ_zy*t59 + link2_R_PJ_zz*t60;
+  const T t69 = link1_J0_zz + t63;
+  // ---- body link2: its columns of M (walked to the root)
+  const T t76 = -link2_S0_x*t7;
+  const T t78 = link2_p_J_z*t76;
+  const T t79 = link2_p_J_x*t34 - link2_p_J_y*t76;
+  const T t81 = t41 + t78;
+  const T t82 = link2_J0_zz + t79;
+  const T t86 = link2_R_PJ_zy*t81 + link2_R_PJ_zz*t82;
+  M[0] = t69;
+  M[1] = t86;
+  M[2] = t86;
+  M[3] = link2_J0_zz;
 }
 
 // ---- F(q, u, tau) --------------------------------------------------------------
@@ -170,87 +213,68 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   // ---- body link1: outward pass (velocities)
   const T t0 = cos(q[0]);
   const T t1 = sin(q[0]);
+  const T t6 = k359ff293*t0 + k5bfb74db*t1;
+  const T t7 = -k359ff293*t1 + k5bfb74db*t0;
   // ---- body link2: outward pass (velocities)
-  const T t2 = cos(q[1]);
-  const T t3 = sin(q[1]);
-  const T t4 = link2_axis_Iaa_xx*t2 + link2_axis_aa_xx;
-  const T t5 = -link2_axis_z*t3;
-  const T t6 = link2_axis_Iaa_xz*t2 + link2_axis_aa_xz;
-  const T t7 = link2_axis_z*t3;
-  const T t8 = -link2_axis_x*t3;
-  const T t9 = link2_axis_x*t3;
-  const T t10 = link2_axis_Iaa_zz*t2 + link2_axis_aa_zz;
-  const T t11 = link2_R_PJ_xx*link2_axis_x + link2_R_PJ_xz*link2_axis_z;
-  const T t12 = link2_R_PJ_yx*link2_axis_x + link2_R_PJ_yz*link2_axis_z;
-  const T t13 = link2_R_PJ_zx*link2_axis_x + link2_R_PJ_zz*link2_axis_z;
-  const T t14 = t11*u[1];
-  const T t15 = t12*u[1];
-  const T t16 = t13*u[1];
-  const T R_PB_link2_xx = link2_R_PJ_xx*t4 + link2_R_PJ_xy*t7 + link2_R_PJ_xz*t6;
-  const T R_PB_link2_xy = link2_R_PJ_xx*t5 + link2_R_PJ_xy*t2 + link2_R_PJ_xz*t9;
-  const T R_PB_link2_xz = link2_R_PJ_xx*t6 + link2_R_PJ_xy*t8 + link2_R_PJ_xz*t10;
-  const T R_PB_link2_yx = link2_R_PJ_yx*t4 + link2_R_PJ_yy*t7 + link2_R_PJ_yz*t6;
-  const T R_PB_link2_yy = link2_R_PJ_yx*t5 + link2_R_PJ_yy*t2 + link2_R_PJ_yz*t9;
-  const T R_PB_link2_yz = link2_R_PJ_yx*t6 + link2_R_PJ_yy*t8 + link2_R_PJ_yz*t10;
-  const T R_PB_link2_zx = link2_R_PJ_zx*t4 + link2_R_PJ_zy*t7 + link2_R_PJ_zz*t6;
-  const T R_PB_link2_zy = link2_R_PJ_zx*t5 + link2_R_PJ_zy*t2 + link2_R_PJ_zz*t9;
-  const T R_PB_link2_zz = link2_R_PJ_zx*t6 + link2_R_PJ_zy*t8 + link2_R_PJ_zz*t10;
-  const T R_NB_link2_zx = -R_PB_link2_xx*t1 + R_PB_link2_zx*t0;
-  const T R_NB_link2_zy = -R_PB_link2_xy*t1 + R_PB_link2_zy*t0;
-  const T R_NB_link2_zz = -R_PB_link2_xz*t1 + R_PB_link2_zz*t0;
-  const T t32 = t15 + u[0];
-  const T w_B_link2_x = R_PB_link2_xx*t14 + R_PB_link2_yx*t32 + R_PB_link2_zx*t16;
-  const T w_B_link2_y = R_PB_link2_xy*t14 + R_PB_link2_yy*t32 + R_PB_link2_zy*t16;
-  const T w_B_link2_z = R_PB_link2_xz*t14 + R_PB_link2_yz*t32 + R_PB_link2_zz*t16;
-  const T t39 = t16*u[0];
-  const T t40 = -t14*u[0];
-  const T alpha_R_B_link2_x = R_PB_link2_xx*t39 + R_PB_link2_zx*t40;
-  const T alpha_R_B_link2_y = R_PB_link2_xy*t39 + R_PB_link2_zy*t40;
-  const T alpha_R_B_link2_z = R_PB_link2_xz*t39 + R_PB_link2_zz*t40;
-  const T t44 = -u[0]*u[0];
-  const T a_R_B_link2_x = R_PB_link2_xx*t44;
-  const T a_R_B_link2_y = R_PB_link2_xy*t44;
-  const T a_R_B_link2_z = R_PB_link2_xz*t44;
-  // ---- body link1: mass and velocity terms
-  const T g_B_link1_x = -gravity_z*t1;
-  const T g_B_link1_z = gravity_z*t0;
-  const T t51 = g_B_link1_x*link1_S0_z - g_B_link1_z*link1_S0_x;
+  const T t8 = cos(link2_angle_offset + q[1]);
+  const T t9 = sin(link2_angle_offset + q[1]);
+  const T t22 = link2_R_PJ_zy*u[0];
+  const T t23 = link2_R_PJ_zz*u[0];
+  const T t24 = -link2_p_J_y*t23 + link2_p_J_z*t22;
+  const T t25 = link2_p_J_x*t23;
+  const T t26 = -link2_p_J_x*t22;
+  const T t27 = t22*t26 - t23*t25;
+  const T t28 = t23*t24;
+  const T t29 = -t22*t24;
+  const T t30 = link2_R_PJ_yy*t7;
+  const T t31 = link2_R_PJ_yz*t7;
+  const T t32 = t27 + t6;
+  const T t33 = t28 + t30;
+  const T t34 = t29 + t31;
+  const T t35 = t22*t9;
+  const T t36 = t22*t8;
+  const T w_B_link2_z = t23 + u[1];
+  const T t40 = t36*u[1];
+  const T t41 = -t35*u[1];
+  const T t43 = t32*t8 + t33*t9;
+  const T t44 = -t32*t9 + t33*t8;
   // ---- body link2: mass and velocity terms
-  const T g_B_link2_x = R_NB_link2_zx*gravity_z;
-  const T g_B_link2_y = R_NB_link2_zy*gravity_z;
-  const T g_B_link2_z = R_NB_link2_zz*gravity_z;
-  const T t65 = g_B_link2_x*link2_mass;
-  const T t66 = g_B_link2_y*link2_mass;
-  const T t67 = g_B_link2_z*link2_mass;
-  const T t68 = -g_B_link2_y*link2_S0_z + g_B_link2_z*link2_S0_y;
-  const T t69 = g_B_link2_x*link2_S0_z - g_B_link2_z*link2_S0_x;
-  const T t70 = -g_B_link2_x*link2_S0_y + g_B_link2_y*link2_S0_x;
-  const T t71 = -link2_S0_y*w_B_link2_z + link2_S0_z*w_B_link2_y;
-  const T t72 = link2_S0_x*w_B_link2_z - link2_S0_z*w_B_link2_x;
-  const T t73 = -link2_S0_x*w_B_link2_y + link2_S0_y*w_B_link2_x;
-  const T t74 = -t72*w_B_link2_z + t73*w_B_link2_y;
-  const T t75 = t71*w_B_link2_z - t73*w_B_link2_x;
-  const T t76 = -t71*w_B_link2_y + t72*w_B_link2_x;
-  const T t77 = link2_J0_xx*w_B_link2_x + link2_J0_xy*w_B_link2_y + link2_J0_xz*w_B_link2_z;
-  const T t78 = link2_J0_xy*w_B_link2_x + link2_J0_yy*w_B_link2_y + link2_J0_yz*w_B_link2_z;
-  const T t79 = link2_J0_xz*w_B_link2_x + link2_J0_yz*w_B_link2_y + link2_J0_zz*w_B_link2_z;
-  const T t80 = -t78*w_B_link2_z + t79*w_B_link2_y;
-  const T t81 = t77*w_B_link2_z - t79*w_B_link2_x;
-  const T t82 = -t77*w_B_link2_y + t78*w_B_link2_x;
-  const T t87 = -a_R_B_link2_x*link2_mass - alpha_R_B_link2_y*link2_S0_z + alpha_R_B_link2_z*link2_S0_y + t65 - t74;
-  const T t88 = -a_R_B_link2_y*link2_mass + alpha_R_B_link2_x*link2_S0_z - alpha_R_B_link2_z*link2_S0_x + t66 - t75;
-  const T t89 = -a_R_B_link2_z*link2_mass - alpha_R_B_link2_x*link2_S0_y + alpha_R_B_link2_y*link2_S0_x + t67 - t76;
-  const T t90 = a_R_B_link2_y*link2_S0_z - a_R_B_link2_z*link2_S0_y - alpha_R_B_link2_x*link2_J0_xx - alpha_R_B_link2_y*link2_J0_xy - alpha_R_B_link2_z*link2_J0_xz + t68 - t80;
-  const T t91 = -a_R_B_link2_x*link2_S0_z + a_R_B_link2_z*link2_S0_x - alpha_R_B_link2_x*link2_J0_xy - alpha_R_B_link2_y*link2_J0_yy - alpha_R_B_link2_z*link2_J0_yz + t69 - t81;
-  const T t92 = a_R_B_link2_x*link2_S0_y - a_R_B_link2_y*link2_S0_x - alpha_R_B_link2_x*link2_J0_xz - alpha_R_B_link2_y*link2_J0_yz - alpha_R_B_link2_z*link2_J0_zz + t70 - t82;
-  const T t93 = link2_axis_x*t90 + link2_axis_z*t92 + tau[1];
-  const T t96 = R_PB_link2_zx*t87 + R_PB_link2_zy*t88 + R_PB_link2_zz*t89;
-  const T t100 = R_PB_link2_yx*t90 + R_PB_link2_yy*t91 + R_PB_link2_yz*t92;
-  const T t103 = t100 - t96;
-  const T t108 = t103 + t51;
-  const T t110 = t108 + tau[0];
-  F[0] = t110;
-  F[1] = t93;
+  const T t54 = link2_S0_z*t36;
+  const T t55 = link2_S0_x*w_B_link2_z - link2_S0_z*t35;
+  const T t56 = -link2_S0_x*t36;
+  const T t57 = t36*t56 - t55*w_B_link2_z;
+  const T t58 = -t35*t56 + t54*w_B_link2_z;
+  const T t59 = t35*t55 - t36*t54;
+  const T t60 = link2_J0_xx*t35 + link2_J0_xy*t36 + link2_J0_xz*w_B_link2_z;
+  const T t61 = link2_J0_xy*t35 + link2_J0_yy*t36 + link2_J0_yz*w_B_link2_z;
+  const T t62 = link2_J0_xz*t35 + link2_J0_yz*t36 + link2_J0_zz*w_B_link2_z;
+  const T t63 = t36*t62 - t61*w_B_link2_z;
+  const T t64 = -t35*t62 + t60*w_B_link2_z;
+  const T t65 = t35*t61 - t36*t60;
+  // ---- body link1: bias force
+  const T t70 = -link1_S0_x*t7 + link1_S0_y*t6;
+  // ---- body link2: bias force
+  const T t71 = -link2_S0_z*t41 - link2_mass*t43 - t57;
+  const T t72 = link2_S0_z*t40 - link2_mass*t44 - t58;
+  const T t73 = link2_S0_x*t41 - link2_mass*t34 - t59;
+  const T t74 = -link2_J0_xx*t40 - link2_J0_xy*t41 + link2_S0_z*t44 - t63;
+  const T t75 = -link2_J0_xy*t40 - link2_J0_yy*t41 + link2_S0_x*t34 - link2_S0_z*t43 - t64;
+  const T t76 = -link2_J0_xz*t40 - link2_J0_yz*t41 - link2_S0_x*t44 - t65;
+  // ---- body link2: generalized forces (inward)
+  const T t77 = t76 + tau[1];
+  const T t78 = t71*t8 - t72*t9;
+  const T t79 = t71*t9 + t72*t8;
+  const T t81 = -link2_p_J_x*t73 + link2_p_J_z*t78;
+  const T t82 = link2_p_J_x*t79 - link2_p_J_y*t78;
+  const T t84 = t74*t9 + t75*t8;
+  const T t86 = t81 + t84;
+  const T t87 = t76 + t82;
+  const T t91 = link2_R_PJ_zy*t86 + link2_R_PJ_zz*t87;
+  const T t96 = t70 + t91;
+  // ---- body link1: generalized forces (inward)
+  const T t97 = t96 + tau[0];
+  F[0] = t97;
+  F[1] = t77;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
@@ -262,112 +286,98 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body link1: outward pass (velocities)
   const T t0 = cos(q[0]);
   const T t1 = sin(q[0]);
+  const T t6 = k359ff293*t0 + k5bfb74db*t1;
+  const T t7 = -k359ff293*t1 + k5bfb74db*t0;
   // ---- body link2: outward pass (velocities)
-  const T t2 = cos(q[1]);
-  const T t3 = sin(q[1]);
-  const T t4 = link2_axis_Iaa_xx*t2 + link2_axis_aa_xx;
-  const T t5 = -link2_axis_z*t3;
-  const T t6 = link2_axis_Iaa_xz*t2 + link2_axis_aa_xz;
-  const T t7 = link2_axis_z*t3;
-  const T t8 = -link2_axis_x*t3;
-  const T t9 = link2_axis_x*t3;
-  const T t10 = link2_axis_Iaa_zz*t2 + link2_axis_aa_zz;
-  const T t11 = link2_R_PJ_xx*link2_axis_x + link2_R_PJ_xz*link2_axis_z;
-  const T t12 = link2_R_PJ_yx*link2_axis_x + link2_R_PJ_yz*link2_axis_z;
-  const T t13 = link2_R_PJ_zx*link2_axis_x + link2_R_PJ_zz*link2_axis_z;
-  const T t14 = t11*u[1];
-  const T t15 = t12*u[1];
-  const T t16 = t13*u[1];
-  const T R_PB_link2_xx = link2_R_PJ_xx*t4 + link2_R_PJ_xy*t7 + link2_R_PJ_xz*t6;
-  const T R_PB_link2_xy = link2_R_PJ_xx*t5 + link2_R_PJ_xy*t2 + link2_R_PJ_xz*t9;
-  const T R_PB_link2_xz = link2_R_PJ_xx*t6 + link2_R_PJ_xy*t8 + link2_R_PJ_xz*t10;
-  const T R_PB_link2_yx = link2_R_PJ_yx*t4 + link2_R_PJ_yy*t7 + link2_R_PJ_yz*t6;
-  const T R_PB_link2_yy = link2_R_PJ_yx*t5 + link2_R_PJ_yy*t2 + link2_R_PJ_yz*t9;
-  const T R_PB_link2_yz = link2_R_PJ_yx*t6 + link2_R_PJ_yy*t8 + link2_R_PJ_yz*t10;
-  const T R_PB_link2_zx = link2_R_PJ_zx*t4 + link2_R_PJ_zy*t7 + link2_R_PJ_zz*t6;
-  const T R_PB_link2_zy = link2_R_PJ_zx*t5 + link2_R_PJ_zy*t2 + link2_R_PJ_zz*t9;
-  const T R_PB_link2_zz = link2_R_PJ_zx*t6 + link2_R_PJ_zy*t8 + link2_R_PJ_zz*t10;
-  const T R_NB_link2_zx = -R_PB_link2_xx*t1 + R_PB_link2_zx*t0;
-  const T R_NB_link2_zy = -R_PB_link2_xy*t1 + R_PB_link2_zy*t0;
-  const T R_NB_link2_zz = -R_PB_link2_xz*t1 + R_PB_link2_zz*t0;
-  const T t32 = t15 + u[0];
-  const T w_B_link2_x = R_PB_link2_xx*t14 + R_PB_link2_yx*t32 + R_PB_link2_zx*t16;
-  const T w_B_link2_y = R_PB_link2_xy*t14 + R_PB_link2_yy*t32 + R_PB_link2_zy*t16;
-  const T w_B_link2_z = R_PB_link2_xz*t14 + R_PB_link2_yz*t32 + R_PB_link2_zz*t16;
-  const T t39 = t16*u[0];
-  const T t40 = -t14*u[0];
-  const T alpha_R_B_link2_x = R_PB_link2_xx*t39 + R_PB_link2_zx*t40;
-  const T alpha_R_B_link2_y = R_PB_link2_xy*t39 + R_PB_link2_zy*t40;
-  const T alpha_R_B_link2_z = R_PB_link2_xz*t39 + R_PB_link2_zz*t40;
-  const T t44 = -u[0]*u[0];
-  const T a_R_B_link2_x = R_PB_link2_xx*t44;
-  const T a_R_B_link2_y = R_PB_link2_xy*t44;
-  const T a_R_B_link2_z = R_PB_link2_xz*t44;
-  // ---- body link1: mass and velocity terms
-  const T g_B_link1_x = -gravity_z*t1;
-  const T g_B_link1_z = gravity_z*t0;
-  const T t51 = g_B_link1_x*link1_S0_z - g_B_link1_z*link1_S0_x;
+  const T t8 = cos(link2_angle_offset + q[1]);
+  const T t9 = sin(link2_angle_offset + q[1]);
+  const T t22 = link2_R_PJ_zy*u[0];
+  const T t23 = link2_R_PJ_zz*u[0];
+  const T t24 = -link2_p_J_y*t23 + link2_p_J_z*t22;
+  const T t25 = link2_p_J_x*t23;
+  const T t26 = -link2_p_J_x*t22;
+  const T t27 = t22*t26 - t23*t25;
+  const T t28 = t23*t24;
+  const T t29 = -t22*t24;
+  const T t30 = link2_R_PJ_yy*t7;
+  const T t31 = link2_R_PJ_yz*t7;
+  const T t32 = t27 + t6;
+  const T t33 = t28 + t30;
+  const T t34 = t29 + t31;
+  const T t35 = t22*t9;
+  const T t36 = t22*t8;
+  const T w_B_link2_z = t23 + u[1];
+  const T t40 = t36*u[1];
+  const T t41 = -t35*u[1];
+  const T t43 = t32*t8 + t33*t9;
+  const T t44 = -t32*t9 + t33*t8;
   // ---- body link2: mass and velocity terms
-  const T g_B_link2_x = R_NB_link2_zx*gravity_z;
-  const T g_B_link2_y = R_NB_link2_zy*gravity_z;
-  const T g_B_link2_z = R_NB_link2_zz*gravity_z;
-  const T t65 = g_B_link2_x*link2_mass;
-  const T t66 = g_B_link2_y*link2_mass;
-  const T t67 = g_B_link2_z*link2_mass;
-  const T t68 = -g_B_link2_y*link2_S0_z + g_B_link2_z*link2_S0_y;
-  const T t69 = g_B_link2_x*link2_S0_z - g_B_link2_z*link2_S0_x;
-  const T t70 = -g_B_link2_x*link2_S0_y + g_B_link2_y*link2_S0_x;
-  const T t71 = -link2_S0_y*w_B_link2_z + link2_S0_z*w_B_link2_y;
-  const T t72 = link2_S0_x*w_B_link2_z - link2_S0_z*w_B_link2_x;
-  const T t73 = -link2_S0_x*w_B_link2_y + link2_S0_y*w_B_link2_x;
-  const T t74 = -t72*w_B_link2_z + t73*w_B_link2_y;
-  const T t75 = t71*w_B_link2_z - t73*w_B_link2_x;
-  const T t76 = -t71*w_B_link2_y + t72*w_B_link2_x;
-  const T t77 = link2_J0_xx*w_B_link2_x + link2_J0_xy*w_B_link2_y + link2_J0_xz*w_B_link2_z;
-  const T t78 = link2_J0_xy*w_B_link2_x + link2_J0_yy*w_B_link2_y + link2_J0_yz*w_B_link2_z;
-  const T t79 = link2_J0_xz*w_B_link2_x + link2_J0_yz*w_B_link2_y + link2_J0_zz*w_B_link2_z;
-  const T t80 = -t78*w_B_link2_z + t79*w_B_link2_y;
-  const T t81 = t77*w_B_link2_z - t79*w_B_link2_x;
-  const T t82 = -t77*w_B_link2_y + t78*w_B_link2_x;
-  const T t83 = R_PB_link2_xx*link2_S0_x + R_PB_link2_xy*link2_S0_y + R_PB_link2_xz*link2_S0_z;
-  const T t92 = R_PB_link2_yx*link2_J0_xx + R_PB_link2_yy*link2_J0_xy + R_PB_link2_yz*link2_J0_xz;
-  const T t93 = R_PB_link2_yx*link2_J0_xy + R_PB_link2_yy*link2_J0_yy + R_PB_link2_yz*link2_J0_yz;
-  const T t94 = R_PB_link2_yx*link2_J0_xz + R_PB_link2_yy*link2_J0_yz + R_PB_link2_yz*link2_J0_zz;
-  const T t101 = R_PB_link2_yx*t92 + R_PB_link2_yy*t93 + R_PB_link2_yz*t94;
-  const T t107 = 2.0*t83 + link1_J0_yy + link2_mass + t101;
-  const T t117 = -link2_S0_y*link2_axis_z;
-  const T t118 = link2_S0_x*link2_axis_z - link2_S0_z*link2_axis_x;
-  const T t119 = link2_S0_y*link2_axis_x;
-  const T t120 = link2_J0_xx*link2_axis_x + link2_J0_xz*link2_axis_z;
-  const T t121 = link2_J0_xy*link2_axis_x + link2_J0_yz*link2_axis_z;
-  const T t122 = link2_J0_xz*link2_axis_x + link2_J0_zz*link2_axis_z;
-  const T t123 = link2_axis_x*t120 + link2_axis_z*t122;
-  const T t126 = R_PB_link2_zx*t117 + R_PB_link2_zy*t118 + R_PB_link2_zz*t119;
-  const T t130 = R_PB_link2_yx*t120 + R_PB_link2_yy*t121 + R_PB_link2_yz*t122;
-  const T t133 = -t126 + t130;
-  const T t139 = -a_R_B_link2_x*link2_mass - alpha_R_B_link2_y*link2_S0_z + alpha_R_B_link2_z*link2_S0_y + t65 - t74;
-  const T t140 = -a_R_B_link2_y*link2_mass + alpha_R_B_link2_x*link2_S0_z - alpha_R_B_link2_z*link2_S0_x + t66 - t75;
-  const T t141 = -a_R_B_link2_z*link2_mass - alpha_R_B_link2_x*link2_S0_y + alpha_R_B_link2_y*link2_S0_x + t67 - t76;
-  const T t142 = a_R_B_link2_y*link2_S0_z - a_R_B_link2_z*link2_S0_y - alpha_R_B_link2_x*link2_J0_xx - alpha_R_B_link2_y*link2_J0_xy - alpha_R_B_link2_z*link2_J0_xz + t68 - t80;
-  const T t143 = -a_R_B_link2_x*link2_S0_z + a_R_B_link2_z*link2_S0_x - alpha_R_B_link2_x*link2_J0_xy - alpha_R_B_link2_y*link2_J0_yy - alpha_R_B_link2_z*link2_J0_yz + t69 - t81;
-  const T t144 = a_R_B_link2_x*link2_S0_y - a_R_B_link2_y*link2_S0_x - alpha_R_B_link2_x*link2_J0_xz - alpha_R_B_link2_y*link2_J0_yz - alpha_R_B_link2_z*link2_J0_zz + t70 - t82;
-  const T t145 = link2_axis_x*t142 + link2_axis_z*t144 + tau[1];
-  const T t148 = R_PB_link2_zx*t139 + R_PB_link2_zy*t140 + R_PB_link2_zz*t141;
-  const T t152 = R_PB_link2_yx*t142 + R_PB_link2_yy*t143 + R_PB_link2_yz*t144;
-  const T t155 = -t148 + t152;
-  const T t160 = t155 + t51;
-  const T t162 = t160 + tau[0];
-  const T t163 = 1.0/t123;
-  const T t164 = t133*t163;
-  const T t165 = t107 - t133*t164;
-  const T t167 = -t145*t164 + t162;
-  const T t168 = t167/t165;
-  const T t169 = t145/t123;
-  const T t170 = -t164*t168 + t169;
-  if (!(t165 > 0.0)) return 1;
-  if (!(t123 > 0.0)) return 2;
-  udot[0] = t168;
-  udot[1] = t170;
+  const T t54 = link2_S0_z*t36;
+  const T t55 = link2_S0_x*w_B_link2_z - link2_S0_z*t35;
+  const T t56 = -link2_S0_x*t36;
+  const T t57 = t36*t56 - t55*w_B_link2_z;
+  const T t58 = -t35*t56 + t54*w_B_link2_z;
+  const T t59 = t35*t55 - t36*t54;
+  const T t60 = link2_J0_xx*t35 + link2_J0_xy*t36 + link2_J0_xz*w_B_link2_z;
+  const T t61 = link2_J0_xy*t35 + link2_J0_yy*t36 + link2_J0_yz*w_B_link2_z;
+  const T t62 = link2_J0_xz*t35 + link2_J0_yz*t36 + link2_J0_zz*w_B_link2_z;
+  const T t63 = t36*t62 - t61*w_B_link2_z;
+  const T t64 = -t35*t62 + t60*w_B_link2_z;
+  const T t65 = t35*t61 - t36*t60;
+  // ---- body link2: composite inertia (inward)
+  const T t66 = link2_S0_x*t8;
+  const T t67 = link2_S0_x*t9;
+  const T t71 = link2_J0_xx*t9 + link2_J0_xy*t8;
+  const T t72 = link2_J0_xy*t9 + link2_J0_yy*t8;
+  const T t73 = link2_J0_xz*t9 + link2_J0_yz*t8;
+  const T t76 = t71*t9 + t72*t8;
+  const T t80 = 2.0*link2_p_J_x*t66 + ka6ba76ae + t76;
+  const T t81 = -k872e6b78 - link2_p_J_z*t67 + t73;
+  const T t82 = 2.0*link2_p_J_x*t66 + 2.0*link2_p_J_y*t67 + k006006a7;
+  const T t91 = link2_R_PJ_zy*t80 + link2_R_PJ_zz*t81;
+  const T t92 = link2_R_PJ_zy*t81 + link2_R_PJ_zz*t82;
+  const T t95 = link2_R_PJ_zy*t91 + link2_R_PJ_zz*t92;
+  const T t101 = link1_J0_zz + t95;
+  // ---- body link2: its columns of M (walked to the root)
+  const T t108 = -link2_S0_x*t9;
+  const T t110 = link2_p_J_z*t108;
+  const T t111 = link2_p_J_x*t66 - link2_p_J_y*t108;
+  const T t113 = t110 + t73;
+  const T t114 = link2_J0_zz + t111;
+  const T t118 = link2_R_PJ_zy*t113 + link2_R_PJ_zz*t114;
+  // ---- body link1: bias force
+  const T t123 = -link1_S0_x*t7 + link1_S0_y*t6;
+  // ---- body link2: bias force
+  const T t124 = -link2_S0_z*t41 - link2_mass*t43 - t57;
+  const T t125 = link2_S0_z*t40 - link2_mass*t44 - t58;
+  const T t126 = link2_S0_x*t41 - link2_mass*t34 - t59;
+  const T t127 = -link2_J0_xx*t40 - link2_J0_xy*t41 + link2_S0_z*t44 - t63;
+  const T t128 = -link2_J0_xy*t40 - link2_J0_yy*t41 + link2_S0_x*t34 - link2_S0_z*t43 - t64;
+  const T t129 = -link2_J0_xz*t40 - link2_J0_yz*t41 - link2_S0_x*t44 - t65;
+  // ---- body link2: generalized forces (inward)
+  const T t130 = t129 + tau[1];
+  const T t131 = t124*t8 - t125*t9;
+  const T t132 = t124*t9 + t125*t8;
+  const T t134 = -link2_p_J_x*t126 + link2_p_J_z*t131;
+  const T t135 = link2_p_J_x*t132 - link2_p_J_y*t131;
+  const T t137 = t127*t9 + t128*t8;
+  const T t139 = t134 + t137;
+  const T t140 = t129 + t135;
+  const T t144 = link2_R_PJ_zy*t139 + link2_R_PJ_zz*t140;
+  const T t149 = t123 + t144;
+  // ---- body link1: generalized forces (inward)
+  const T t150 = t149 + tau[0];
+  // ---- M u_dot = F: L^T D L along the dof tree
+  const T t151 = kb7e5959a*t118;
+  const T t152 = t101 - t118*t151;
+  const T t154 = -t130*t151 + t150;
+  const T t155 = t154/t152;
+  const T t156 = kb7e5959a*t130;
+  const T t157 = -t151*t155 + t156;
+  if (!(t152 > 1e-14*t101)) return 1;
+  if (!(link2_J0_zz > 0.0)) return 2;
+  udot[0] = t155;
+  udot[1] = t157;
   return 0;
 }
 
@@ -379,59 +389,43 @@ void energy(const T* q, const T* u, T* TV) {
   // ---- body link1: outward pass (velocities)
   const T t0 = cos(q[0]);
   const T t1 = sin(q[0]);
+  const T R_PB_link1_zx = link1_R_PJ_zx*t0 + link1_R_PJ_zy*t1;
+  const T R_PB_link1_zy = -link1_R_PJ_zx*t1 + link1_R_PJ_zy*t0;
   // ---- body link2: outward pass (velocities)
-  const T t2 = cos(q[1]);
-  const T t3 = sin(q[1]);
-  const T t4 = link2_axis_Iaa_xx*t2 + link2_axis_aa_xx;
-  const T t5 = -link2_axis_z*t3;
-  const T t6 = link2_axis_Iaa_xz*t2 + link2_axis_aa_xz;
-  const T t7 = link2_axis_z*t3;
-  const T t8 = -link2_axis_x*t3;
-  const T t9 = link2_axis_x*t3;
-  const T t10 = link2_axis_Iaa_zz*t2 + link2_axis_aa_zz;
-  const T t11 = link2_R_PJ_xx*link2_axis_x + link2_R_PJ_xz*link2_axis_z;
-  const T t12 = link2_R_PJ_yx*link2_axis_x + link2_R_PJ_yz*link2_axis_z;
-  const T t13 = link2_R_PJ_zx*link2_axis_x + link2_R_PJ_zz*link2_axis_z;
-  const T t14 = t11*u[1];
-  const T t15 = t12*u[1];
-  const T t16 = t13*u[1];
-  const T R_PB_link2_xx = link2_R_PJ_xx*t4 + link2_R_PJ_xy*t7 + link2_R_PJ_xz*t6;
-  const T R_PB_link2_xy = link2_R_PJ_xx*t5 + link2_R_PJ_xy*t2 + link2_R_PJ_xz*t9;
-  const T R_PB_link2_xz = link2_R_PJ_xx*t6 + link2_R_PJ_xy*t8 + link2_R_PJ_xz*t10;
-  const T R_PB_link2_yx = link2_R_PJ_yx*t4 + link2_R_PJ_yy*t7 + link2_R_PJ_yz*t6;
-  const T R_PB_link2_yy = link2_R_PJ_yx*t5 + link2_R_PJ_yy*t2 + link2_R_PJ_yz*t9;
-  const T R_PB_link2_yz = link2_R_PJ_yx*t6 + link2_R_PJ_yy*t8 + link2_R_PJ_yz*t10;
-  const T R_PB_link2_zx = link2_R_PJ_zx*t4 + link2_R_PJ_zy*t7 + link2_R_PJ_zz*t6;
-  const T R_PB_link2_zy = link2_R_PJ_zx*t5 + link2_R_PJ_zy*t2 + link2_R_PJ_zz*t9;
-  const T R_PB_link2_zz = link2_R_PJ_zx*t6 + link2_R_PJ_zy*t8 + link2_R_PJ_zz*t10;
-  const T R_NB_link2_zx = -R_PB_link2_xx*t1 + R_PB_link2_zx*t0;
-  const T R_NB_link2_zy = -R_PB_link2_xy*t1 + R_PB_link2_zy*t0;
-  const T R_NB_link2_zz = -R_PB_link2_xz*t1 + R_PB_link2_zz*t0;
-  const T t32 = t15 + u[0];
-  const T w_B_link2_x = R_PB_link2_xx*t14 + R_PB_link2_yx*t32 + R_PB_link2_zx*t16;
-  const T w_B_link2_y = R_PB_link2_xy*t14 + R_PB_link2_yy*t32 + R_PB_link2_zy*t16;
-  const T w_B_link2_z = R_PB_link2_xz*t14 + R_PB_link2_yz*t32 + R_PB_link2_zz*t16;
-  const T v_O_B_link2_x = -R_PB_link2_zx*u[0];
-  const T v_O_B_link2_y = -R_PB_link2_zy*u[0];
-  const T v_O_B_link2_z = -R_PB_link2_zz*u[0];
+  const T t8 = cos(link2_angle_offset + q[1]);
+  const T t9 = sin(link2_angle_offset + q[1]);
+  const T R_PB_link2_yx = link2_R_PJ_yy*t9;
+  const T R_NB_link2_zx = R_PB_link1_zx*t8 + R_PB_link1_zy*R_PB_link2_yx;
+  const T R_NB_link2_zz = R_PB_link1_zy*link2_R_PJ_yz;
+  const T t21 = R_PB_link1_zx*link2_p_PJ_x + R_PB_link1_zy*link2_p_PJ_y;
+  const T t22 = link2_R_PJ_zy*u[0];
+  const T t23 = link2_R_PJ_zz*u[0];
+  const T t24 = -link2_p_J_y*t23 + link2_p_J_z*t22;
+  const T t25 = link2_p_J_x*t23;
+  const T t26 = -link2_p_J_x*t22;
+  const T t35 = t22*t9;
+  const T t36 = t22*t8;
+  const T w_B_link2_z = t23 + u[1];
+  const T t38 = t24*t8 + t25*t9;
+  const T t39 = -t24*t9 + t25*t8;
   // ---- body link1: mass and velocity terms
-  const T t58 = link1_J0_yy*u[0];
+  const T t51 = link1_J0_zz*u[0];
   // ---- body link2: mass and velocity terms
-  const T t83 = t58*u[0];
-  const T t84 = -link2_S0_y*w_B_link2_z + link2_S0_z*w_B_link2_y + link2_mass*v_O_B_link2_x;
-  const T t85 = link2_S0_x*w_B_link2_z - link2_S0_z*w_B_link2_x + link2_mass*v_O_B_link2_y;
-  const T t86 = -link2_S0_x*w_B_link2_y + link2_S0_y*w_B_link2_x + link2_mass*v_O_B_link2_z;
-  const T t87 = link2_J0_xx*w_B_link2_x + link2_J0_xy*w_B_link2_y + link2_J0_xz*w_B_link2_z + link2_S0_y*v_O_B_link2_z - link2_S0_z*v_O_B_link2_y;
-  const T t88 = link2_J0_xy*w_B_link2_x + link2_J0_yy*w_B_link2_y + link2_J0_yz*w_B_link2_z - link2_S0_x*v_O_B_link2_z + link2_S0_z*v_O_B_link2_x;
-  const T t89 = link2_J0_xz*w_B_link2_x + link2_J0_yz*w_B_link2_y + link2_J0_zz*w_B_link2_z + link2_S0_x*v_O_B_link2_y - link2_S0_y*v_O_B_link2_x;
-  const T t90 = t84*v_O_B_link2_x + t85*v_O_B_link2_y + t86*v_O_B_link2_z + t87*w_B_link2_x + t88*w_B_link2_y + t89*w_B_link2_z;
-  const T t91 = t83/2.0 + t90/2.0;
-  const T t93 = -link1_S0_x*t1 + link1_S0_z*t0;
-  const T t94 = -gravity_z*t93;
-  const T t97 = R_NB_link2_zx*link2_S0_x + R_NB_link2_zy*link2_S0_y + R_NB_link2_zz*link2_S0_z;
-  const T t98 = (link2_mass*t1 - t97)*gravity_z + t94;
-  TV[0] = t91;
-  TV[1] = t98;
+  const T t66 = t51*u[0];
+  const T t67 = link2_S0_z*t36 + link2_mass*t38;
+  const T t68 = link2_S0_x*w_B_link2_z - link2_S0_z*t35 + link2_mass*t39;
+  const T t69 = -link2_S0_x*t36 + link2_mass*t26;
+  const T t70 = link2_J0_xx*t35 + link2_J0_xy*t36 + link2_J0_xz*w_B_link2_z - link2_S0_z*t39;
+  const T t71 = link2_J0_xy*t35 + link2_J0_yy*t36 + link2_J0_yz*w_B_link2_z - link2_S0_x*t26 + link2_S0_z*t38;
+  const T t72 = link2_J0_xz*t35 + link2_J0_yz*t36 + link2_J0_zz*w_B_link2_z + link2_S0_x*t39;
+  const T t73 = t26*t69 + t35*t70 + t36*t71 + t38*t67 + t39*t68 + t72*w_B_link2_z;
+  const T t74 = t66/2.0 + t73/2.0;
+  const T t76 = R_PB_link1_zx*link1_S0_x + R_PB_link1_zy*link1_S0_y;
+  const T t77 = -gravity_z*t76;
+  const T t80 = R_NB_link2_zx*link2_S0_x + R_NB_link2_zz*link2_S0_z;
+  const T t81 = -(link2_mass*t21 + t80)*gravity_z + t77;
+  TV[0] = t74;
+  TV[1] = t81;
 }
 
 // ---- momentum: p_N[3], H_N[3] about N's origin ---------------------------------
@@ -442,84 +436,75 @@ void momentum(const T* q, const T* u, T* pH) {
   // ---- body link1: outward pass (velocities)
   const T t0 = cos(q[0]);
   const T t1 = sin(q[0]);
+  const T R_PB_link1_xx = link1_R_PJ_xx*t0 + link1_R_PJ_xy*t1;
+  const T R_PB_link1_xy = -link1_R_PJ_xx*t1 + link1_R_PJ_xy*t0;
+  const T R_PB_link1_zx = link1_R_PJ_zx*t0 + link1_R_PJ_zy*t1;
+  const T R_PB_link1_zy = -link1_R_PJ_zx*t1 + link1_R_PJ_zy*t0;
   // ---- body link2: outward pass (velocities)
-  const T t2 = cos(q[1]);
-  const T t3 = sin(q[1]);
-  const T t4 = link2_axis_Iaa_xx*t2 + link2_axis_aa_xx;
-  const T t5 = -link2_axis_z*t3;
-  const T t6 = link2_axis_Iaa_xz*t2 + link2_axis_aa_xz;
-  const T t7 = link2_axis_z*t3;
-  const T t8 = -link2_axis_x*t3;
-  const T t9 = link2_axis_x*t3;
-  const T t10 = link2_axis_Iaa_zz*t2 + link2_axis_aa_zz;
-  const T t11 = link2_R_PJ_xx*link2_axis_x + link2_R_PJ_xz*link2_axis_z;
-  const T t12 = link2_R_PJ_yx*link2_axis_x + link2_R_PJ_yz*link2_axis_z;
-  const T t13 = link2_R_PJ_zx*link2_axis_x + link2_R_PJ_zz*link2_axis_z;
-  const T t14 = t11*u[1];
-  const T t15 = t12*u[1];
-  const T t16 = t13*u[1];
-  const T R_PB_link2_xx = link2_R_PJ_xx*t4 + link2_R_PJ_xy*t7 + link2_R_PJ_xz*t6;
-  const T R_PB_link2_xy = link2_R_PJ_xx*t5 + link2_R_PJ_xy*t2 + link2_R_PJ_xz*t9;
-  const T R_PB_link2_xz = link2_R_PJ_xx*t6 + link2_R_PJ_xy*t8 + link2_R_PJ_xz*t10;
-  const T R_PB_link2_yx = link2_R_PJ_yx*t4 + link2_R_PJ_yy*t7 + link2_R_PJ_yz*t6;
-  const T R_PB_link2_yy = link2_R_PJ_yx*t5 + link2_R_PJ_yy*t2 + link2_R_PJ_yz*t9;
-  const T R_PB_link2_yz = link2_R_PJ_yx*t6 + link2_R_PJ_yy*t8 + link2_R_PJ_yz*t10;
-  const T R_PB_link2_zx = link2_R_PJ_zx*t4 + link2_R_PJ_zy*t7 + link2_R_PJ_zz*t6;
-  const T R_PB_link2_zy = link2_R_PJ_zx*t5 + link2_R_PJ_zy*t2 + link2_R_PJ_zz*t9;
-  const T R_PB_link2_zz = link2_R_PJ_zx*t6 + link2_R_PJ_zy*t8 + link2_R_PJ_zz*t10;
-  const T R_NB_link2_xx = R_PB_link2_xx*t0 + R_PB_link2_zx*t1;
-  const T R_NB_link2_xy = R_PB_link2_xy*t0 + R_PB_link2_zy*t1;
-  const T R_NB_link2_xz = R_PB_link2_xz*t0 + R_PB_link2_zz*t1;
-  const T R_NB_link2_zx = -R_PB_link2_xx*t1 + R_PB_link2_zx*t0;
-  const T R_NB_link2_zy = -R_PB_link2_xy*t1 + R_PB_link2_zy*t0;
-  const T R_NB_link2_zz = -R_PB_link2_xz*t1 + R_PB_link2_zz*t0;
-  const T t32 = t15 + u[0];
-  const T w_B_link2_x = R_PB_link2_xx*t14 + R_PB_link2_yx*t32 + R_PB_link2_zx*t16;
-  const T w_B_link2_y = R_PB_link2_xy*t14 + R_PB_link2_yy*t32 + R_PB_link2_zy*t16;
-  const T w_B_link2_z = R_PB_link2_xz*t14 + R_PB_link2_yz*t32 + R_PB_link2_zz*t16;
-  const T v_O_B_link2_x = -R_PB_link2_zx*u[0];
-  const T v_O_B_link2_y = -R_PB_link2_zy*u[0];
-  const T v_O_B_link2_z = -R_PB_link2_zz*u[0];
+  const T t8 = cos(link2_angle_offset + q[1]);
+  const T t9 = sin(link2_angle_offset + q[1]);
+  const T R_PB_link2_yx = link2_R_PJ_yy*t9;
+  const T R_PB_link2_yy = link2_R_PJ_yy*t8;
+  const T R_PB_link2_zx = link2_R_PJ_zy*t9;
+  const T R_PB_link2_zy = link2_R_PJ_zy*t8;
+  const T R_NB_link2_xx = R_PB_link1_xx*t8 + R_PB_link1_xy*R_PB_link2_yx;
+  const T R_NB_link2_xy = -R_PB_link1_xx*t9 + R_PB_link1_xy*R_PB_link2_yy;
+  const T R_NB_link2_xz = R_PB_link1_xy*link2_R_PJ_yz;
+  const T R_NB_link2_zx = R_PB_link1_zx*t8 + R_PB_link1_zy*R_PB_link2_yx;
+  const T R_NB_link2_zy = -R_PB_link1_zx*t9 + R_PB_link1_zy*R_PB_link2_yy;
+  const T R_NB_link2_zz = R_PB_link1_zy*link2_R_PJ_yz;
+  const T t20 = R_PB_link1_xx*link2_p_PJ_x + R_PB_link1_xy*link2_p_PJ_y;
+  const T t21 = R_PB_link1_zx*link2_p_PJ_x + R_PB_link1_zy*link2_p_PJ_y;
+  const T t22 = link2_R_PJ_zy*u[0];
+  const T t23 = link2_R_PJ_zz*u[0];
+  const T t24 = -link2_p_J_y*t23 + link2_p_J_z*t22;
+  const T t25 = link2_p_J_x*t23;
+  const T t26 = -link2_p_J_x*t22;
+  const T t35 = t22*t9;
+  const T t36 = t22*t8;
+  const T w_B_link2_z = t23 + u[1];
+  const T t38 = t24*t8 + t25*t9;
+  const T t39 = -t24*t9 + t25*t8;
   // ---- body link1: mass and velocity terms
-  const T t53 = link1_S0_z*u[0];
-  const T t54 = -link1_S0_x*u[0];
-  const T t57 = link1_J0_xy*u[0];
-  const T t58 = link1_J0_yy*u[0];
-  const T t59 = link1_J0_yz*u[0];
+  const T t45 = -link1_S0_y*u[0];
+  const T t46 = link1_S0_x*u[0];
+  const T t49 = link1_J0_xz*u[0];
+  const T t50 = link1_J0_yz*u[0];
+  const T t51 = link1_J0_zz*u[0];
   // ---- body link2: mass and velocity terms
-  const T t83 = t0*t53 + t1*t54;
-  const T t84 = t0*t54 - t1*t53;
-  const T t85 = t0*t57 + t1*t59;
-  const T t86 = t0*t59 - t1*t57;
-  const T t87 = -link2_S0_y*w_B_link2_z + link2_S0_z*w_B_link2_y + link2_mass*v_O_B_link2_x;
-  const T t88 = link2_S0_x*w_B_link2_z - link2_S0_z*w_B_link2_x + link2_mass*v_O_B_link2_y;
-  const T t89 = -link2_S0_x*w_B_link2_y + link2_S0_y*w_B_link2_x + link2_mass*v_O_B_link2_z;
-  const T t90 = link2_J0_xx*w_B_link2_x + link2_J0_xy*w_B_link2_y + link2_J0_xz*w_B_link2_z + link2_S0_y*v_O_B_link2_z - link2_S0_z*v_O_B_link2_y;
-  const T t91 = link2_J0_xy*w_B_link2_x + link2_J0_yy*w_B_link2_y + link2_J0_yz*w_B_link2_z - link2_S0_x*v_O_B_link2_z + link2_S0_z*v_O_B_link2_x;
-  const T t92 = link2_J0_xz*w_B_link2_x + link2_J0_yz*w_B_link2_y + link2_J0_zz*w_B_link2_z + link2_S0_x*v_O_B_link2_y - link2_S0_y*v_O_B_link2_x;
-  const T t93 = R_NB_link2_xx*t87 + R_NB_link2_xy*t88 + R_NB_link2_xz*t89;
-  const T t94 = R_PB_link2_yx*t87 + R_PB_link2_yy*t88 + R_PB_link2_yz*t89;
-  const T t95 = R_NB_link2_zx*t87 + R_NB_link2_zy*t88 + R_NB_link2_zz*t89;
-  const T t96 = R_NB_link2_xx*t90 + R_NB_link2_xy*t91 + R_NB_link2_xz*t92;
-  const T t97 = R_PB_link2_yx*t90 + R_PB_link2_yy*t91 + R_PB_link2_yz*t92;
-  const T t98 = R_NB_link2_zx*t90 + R_NB_link2_zy*t91 + R_NB_link2_zz*t92;
-  const T t99 = link2_p_PJ_y*t95 + t1*t94;
-  const T t100 = -t0*t95 - t1*t93;
-  const T t101 = -link2_p_PJ_y*t93 + t0*t94;
-  const T t102 = t96 + t99;
-  const T t103 = t100 + t97;
-  const T t104 = t101 + t98;
-  const T t105 = t83 + t93;
-  const T t106 = t84 + t95;
-  const T t107 = t102 + t85;
-  const T t108 = t103 + t58;
-  const T t109 = t104 + t86;
-  pH[0] = t105;
-  pH[1] = t94;
-  pH[2] = t106;
-  pH[3] = t107;
-  pH[4] = t108;
-  pH[5] = t109;
+  const T t66 = R_PB_link1_xx*t45 + R_PB_link1_xy*t46;
+  const T t67 = R_PB_link1_zx*t45 + R_PB_link1_zy*t46;
+  const T t68 = R_PB_link1_xx*t49 + R_PB_link1_xy*t50;
+  const T t69 = R_PB_link1_zx*t49 + R_PB_link1_zy*t50;
+  const T t70 = link2_S0_z*t36 + link2_mass*t38;
+  const T t71 = link2_S0_x*w_B_link2_z - link2_S0_z*t35 + link2_mass*t39;
+  const T t72 = -link2_S0_x*t36 + link2_mass*t26;
+  const T t73 = link2_J0_xx*t35 + link2_J0_xy*t36 + link2_J0_xz*w_B_link2_z - link2_S0_z*t39;
+  const T t74 = link2_J0_xy*t35 + link2_J0_yy*t36 + link2_J0_yz*w_B_link2_z - link2_S0_x*t26 + link2_S0_z*t38;
+  const T t75 = link2_J0_xz*t35 + link2_J0_yz*t36 + link2_J0_zz*w_B_link2_z + link2_S0_x*t39;
+  const T t76 = R_NB_link2_xx*t70 + R_NB_link2_xy*t71 + R_NB_link2_xz*t72;
+  const T t77 = R_PB_link2_zx*t70 + R_PB_link2_zy*t71 + link2_R_PJ_zz*t72;
+  const T t78 = R_NB_link2_zx*t70 + R_NB_link2_zy*t71 + R_NB_link2_zz*t72;
+  const T t79 = R_NB_link2_xx*t73 + R_NB_link2_xy*t74 + R_NB_link2_xz*t75;
+  const T t80 = R_PB_link2_zx*t73 + R_PB_link2_zy*t74 + link2_R_PJ_zz*t75;
+  const T t81 = R_NB_link2_zx*t73 + R_NB_link2_zy*t74 + R_NB_link2_zz*t75;
+  const T t82 = link2_p_PJ_z*t78 - t21*t77;
+  const T t83 = -t20*t78 + t21*t76;
+  const T t84 = -link2_p_PJ_z*t76 + t20*t77;
+  const T t85 = t79 + t82;
+  const T t86 = t80 + t83;
+  const T t87 = t81 + t84;
+  const T t88 = t66 + t76;
+  const T t89 = t67 + t78;
+  const T t90 = t68 + t85;
+  const T t91 = t51 + t86;
+  const T t92 = t69 + t87;
+  pH[0] = t88;
+  pH[1] = t77;
+  pH[2] = t89;
+  pH[3] = t90;
+  pH[4] = t91;
+  pH[5] = t92;
 }
 
 // ---- reactions on each body from its parent: [force; torque about O_B], body axes ---
@@ -530,130 +515,115 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   // ---- body link1: outward pass (velocities)
   const T t0 = cos(q[0]);
   const T t1 = sin(q[0]);
+  const T t6 = k359ff293*t0 + k5bfb74db*t1;
+  const T t7 = -k359ff293*t1 + k5bfb74db*t0;
   // ---- body link2: outward pass (velocities)
-  const T t2 = cos(q[1]);
-  const T t3 = sin(q[1]);
-  const T t4 = link2_axis_Iaa_xx*t2 + link2_axis_aa_xx;
-  const T t5 = -link2_axis_z*t3;
-  const T t6 = link2_axis_Iaa_xz*t2 + link2_axis_aa_xz;
-  const T t7 = link2_axis_z*t3;
-  const T t8 = -link2_axis_x*t3;
-  const T t9 = link2_axis_x*t3;
-  const T t10 = link2_axis_Iaa_zz*t2 + link2_axis_aa_zz;
-  const T t11 = link2_R_PJ_xx*link2_axis_x + link2_R_PJ_xz*link2_axis_z;
-  const T t12 = link2_R_PJ_yx*link2_axis_x + link2_R_PJ_yz*link2_axis_z;
-  const T t13 = link2_R_PJ_zx*link2_axis_x + link2_R_PJ_zz*link2_axis_z;
-  const T t14 = t11*u[1];
-  const T t15 = t12*u[1];
-  const T t16 = t13*u[1];
-  const T R_PB_link2_xx = link2_R_PJ_xx*t4 + link2_R_PJ_xy*t7 + link2_R_PJ_xz*t6;
-  const T R_PB_link2_xy = link2_R_PJ_xx*t5 + link2_R_PJ_xy*t2 + link2_R_PJ_xz*t9;
-  const T R_PB_link2_xz = link2_R_PJ_xx*t6 + link2_R_PJ_xy*t8 + link2_R_PJ_xz*t10;
-  const T R_PB_link2_yx = link2_R_PJ_yx*t4 + link2_R_PJ_yy*t7 + link2_R_PJ_yz*t6;
-  const T R_PB_link2_yy = link2_R_PJ_yx*t5 + link2_R_PJ_yy*t2 + link2_R_PJ_yz*t9;
-  const T R_PB_link2_yz = link2_R_PJ_yx*t6 + link2_R_PJ_yy*t8 + link2_R_PJ_yz*t10;
-  const T R_PB_link2_zx = link2_R_PJ_zx*t4 + link2_R_PJ_zy*t7 + link2_R_PJ_zz*t6;
-  const T R_PB_link2_zy = link2_R_PJ_zx*t5 + link2_R_PJ_zy*t2 + link2_R_PJ_zz*t9;
-  const T R_PB_link2_zz = link2_R_PJ_zx*t6 + link2_R_PJ_zy*t8 + link2_R_PJ_zz*t10;
-  const T R_NB_link2_zx = -R_PB_link2_xx*t1 + R_PB_link2_zx*t0;
-  const T R_NB_link2_zy = -R_PB_link2_xy*t1 + R_PB_link2_zy*t0;
-  const T R_NB_link2_zz = -R_PB_link2_xz*t1 + R_PB_link2_zz*t0;
-  const T t32 = t15 + u[0];
-  const T w_B_link2_x = R_PB_link2_xx*t14 + R_PB_link2_yx*t32 + R_PB_link2_zx*t16;
-  const T w_B_link2_y = R_PB_link2_xy*t14 + R_PB_link2_yy*t32 + R_PB_link2_zy*t16;
-  const T w_B_link2_z = R_PB_link2_xz*t14 + R_PB_link2_yz*t32 + R_PB_link2_zz*t16;
-  const T t39 = t16*u[0];
-  const T t40 = -t14*u[0];
-  const T alpha_R_B_link2_x = R_PB_link2_xx*t39 + R_PB_link2_zx*t40;
-  const T alpha_R_B_link2_y = R_PB_link2_xy*t39 + R_PB_link2_zy*t40;
-  const T alpha_R_B_link2_z = R_PB_link2_xz*t39 + R_PB_link2_zz*t40;
-  const T t44 = -u[0]*u[0];
-  const T a_R_B_link2_x = R_PB_link2_xx*t44;
-  const T a_R_B_link2_y = R_PB_link2_xy*t44;
-  const T a_R_B_link2_z = R_PB_link2_xz*t44;
+  const T t8 = cos(link2_angle_offset + q[1]);
+  const T t9 = sin(link2_angle_offset + q[1]);
+  const T t22 = link2_R_PJ_zy*u[0];
+  const T t23 = link2_R_PJ_zz*u[0];
+  const T t24 = -link2_p_J_y*t23 + link2_p_J_z*t22;
+  const T t25 = link2_p_J_x*t23;
+  const T t26 = -link2_p_J_x*t22;
+  const T t27 = t22*t26 - t23*t25;
+  const T t28 = t23*t24;
+  const T t29 = -t22*t24;
+  const T t30 = link2_R_PJ_yy*t7;
+  const T t31 = link2_R_PJ_yz*t7;
+  const T t32 = t27 + t6;
+  const T t33 = t28 + t30;
+  const T t34 = t29 + t31;
+  const T t35 = t22*t9;
+  const T t36 = t22*t8;
+  const T w_B_link2_z = t23 + u[1];
+  const T t40 = t36*u[1];
+  const T t41 = -t35*u[1];
+  const T t43 = t32*t8 + t33*t9;
+  const T t44 = -t32*t9 + t33*t8;
   // ---- body link1: mass and velocity terms
-  const T g_B_link1_x = -gravity_z*t1;
-  const T g_B_link1_z = gravity_z*t0;
-  const T t50 = g_B_link1_z*link1_S0_y;
-  const T t51 = g_B_link1_x*link1_S0_z - g_B_link1_z*link1_S0_x;
-  const T t52 = -g_B_link1_x*link1_S0_y;
-  const T t53 = link1_S0_z*u[0];
-  const T t54 = -link1_S0_x*u[0];
-  const T t55 = t54*u[0];
-  const T t56 = -t53*u[0];
-  const T t57 = link1_J0_xy*u[0];
-  const T t59 = link1_J0_yz*u[0];
-  const T t60 = t59*u[0];
-  const T t61 = -t57*u[0];
+  const T t45 = -link1_S0_y*u[0];
+  const T t46 = link1_S0_x*u[0];
+  const T t47 = -t46*u[0];
+  const T t48 = t45*u[0];
+  const T t49 = link1_J0_xz*u[0];
+  const T t50 = link1_J0_yz*u[0];
+  const T t52 = -t50*u[0];
+  const T t53 = t49*u[0];
   // ---- body link2: mass and velocity terms
-  const T g_B_link2_x = R_NB_link2_zx*gravity_z;
-  const T g_B_link2_y = R_NB_link2_zy*gravity_z;
-  const T g_B_link2_z = R_NB_link2_zz*gravity_z;
-  const T t65 = g_B_link2_x*link2_mass;
-  const T t66 = g_B_link2_y*link2_mass;
-  const T t67 = g_B_link2_z*link2_mass;
-  const T t68 = -g_B_link2_y*link2_S0_z + g_B_link2_z*link2_S0_y;
-  const T t69 = g_B_link2_x*link2_S0_z - g_B_link2_z*link2_S0_x;
-  const T t70 = -g_B_link2_x*link2_S0_y + g_B_link2_y*link2_S0_x;
-  const T t71 = -link2_S0_y*w_B_link2_z + link2_S0_z*w_B_link2_y;
-  const T t72 = link2_S0_x*w_B_link2_z - link2_S0_z*w_B_link2_x;
-  const T t73 = -link2_S0_x*w_B_link2_y + link2_S0_y*w_B_link2_x;
-  const T t74 = -t72*w_B_link2_z + t73*w_B_link2_y;
-  const T t75 = t71*w_B_link2_z - t73*w_B_link2_x;
-  const T t76 = -t71*w_B_link2_y + t72*w_B_link2_x;
-  const T t77 = link2_J0_xx*w_B_link2_x + link2_J0_xy*w_B_link2_y + link2_J0_xz*w_B_link2_z;
-  const T t78 = link2_J0_xy*w_B_link2_x + link2_J0_yy*w_B_link2_y + link2_J0_yz*w_B_link2_z;
-  const T t79 = link2_J0_xz*w_B_link2_x + link2_J0_yz*w_B_link2_y + link2_J0_zz*w_B_link2_z;
-  const T t80 = -t78*w_B_link2_z + t79*w_B_link2_y;
-  const T t81 = t77*w_B_link2_z - t79*w_B_link2_x;
-  const T t82 = -t77*w_B_link2_y + t78*w_B_link2_x;
-  const T t83 = -g_B_link1_x + link1_S0_z*udot_in[0] + t55;
-  const T t84 = -g_B_link1_z - link1_S0_x*udot_in[0] + t56;
-  const T t85 = link1_J0_xy*udot_in[0] - t50 + t60;
-  const T t86 = link1_J0_yy*udot_in[0] - t51;
-  const T t87 = link1_J0_yz*udot_in[0] - t52 + t61;
-  const T t88 = -R_PB_link2_zx*udot_in[0];
-  const T t89 = -R_PB_link2_zy*udot_in[0];
-  const T t90 = -R_PB_link2_zz*udot_in[0];
-  const T t91 = R_PB_link2_yx*udot_in[0];
-  const T t92 = R_PB_link2_yy*udot_in[0];
-  const T t93 = R_PB_link2_yz*udot_in[0];
-  const T t94 = link2_axis_x*udot_in[1] + t91;
-  const T t95 = link2_axis_z*udot_in[1] + t93;
-  const T t96 = (a_R_B_link2_x + t88)*link2_mass + (alpha_R_B_link2_y + t92)*link2_S0_z - (alpha_R_B_link2_z + t95)*link2_S0_y - t65 + t74;
-  const T t97 = (a_R_B_link2_y + t89)*link2_mass - (alpha_R_B_link2_x + t94)*link2_S0_z + (alpha_R_B_link2_z + t95)*link2_S0_x - t66 + t75;
-  const T t98 = (a_R_B_link2_z + t90)*link2_mass + (alpha_R_B_link2_x + t94)*link2_S0_y - (alpha_R_B_link2_y + t92)*link2_S0_x - t67 + t76;
-  const T t99 = -(a_R_B_link2_y + t89)*link2_S0_z + (a_R_B_link2_z + t90)*link2_S0_y + (alpha_R_B_link2_x + t94)*link2_J0_xx + (alpha_R_B_link2_y + t92)*link2_J0_xy + (alpha_R_B_link2_z + t95)*link2_J0_xz - t68 + t80;
-  const T t100 = (a_R_B_link2_x + t88)*link2_S0_z - (a_R_B_link2_z + t90)*link2_S0_x + (alpha_R_B_link2_x + t94)*link2_J0_xy + (alpha_R_B_link2_y + t92)*link2_J0_yy + (alpha_R_B_link2_z + t95)*link2_J0_yz - t69 + t81;
-  const T t101 = -(a_R_B_link2_x + t88)*link2_S0_y + (a_R_B_link2_y + t89)*link2_S0_x + (alpha_R_B_link2_x + t94)*link2_J0_xz + (alpha_R_B_link2_y + t92)*link2_J0_yz + (alpha_R_B_link2_z + t95)*link2_J0_zz - t70 + t82;
-  const T t102 = R_PB_link2_xx*t96 + R_PB_link2_xy*t97 + R_PB_link2_xz*t98;
-  const T t103 = R_PB_link2_yx*t96 + R_PB_link2_yy*t97 + R_PB_link2_yz*t98;
-  const T t104 = R_PB_link2_zx*t96 + R_PB_link2_zy*t97 + R_PB_link2_zz*t98;
-  const T t105 = link2_p_PJ_y*t104;
-  const T t106 = -link2_p_PJ_y*t102 + t103;
-  const T t107 = R_PB_link2_xx*t99 + R_PB_link2_xy*t100 + R_PB_link2_xz*t101;
-  const T t108 = R_PB_link2_yx*t99 + R_PB_link2_yy*t100 + R_PB_link2_yz*t101;
-  const T t109 = R_PB_link2_zx*t99 + R_PB_link2_zy*t100 + R_PB_link2_zz*t101;
-  const T t110 = t105 + t107;
-  const T t111 = -t104 + t108;
-  const T t112 = t106 + t109;
-  const T t113 = t102 + t83;
-  const T t114 = t104 + t84;
-  const T t115 = t110 + t85;
-  const T t116 = t111 + t86;
-  const T t117 = t112 + t87;
-  wrenches[0] = t113;
-  wrenches[1] = t103;
-  wrenches[2] = t114;
-  wrenches[3] = t115;
-  wrenches[4] = t116;
-  wrenches[5] = t117;
-  wrenches[6] = t96;
-  wrenches[7] = t97;
-  wrenches[8] = t98;
-  wrenches[9] = t99;
-  wrenches[10] = t100;
-  wrenches[11] = t101;
+  const T t54 = link2_S0_z*t36;
+  const T t55 = link2_S0_x*w_B_link2_z - link2_S0_z*t35;
+  const T t56 = -link2_S0_x*t36;
+  const T t57 = t36*t56 - t55*w_B_link2_z;
+  const T t58 = -t35*t56 + t54*w_B_link2_z;
+  const T t59 = t35*t55 - t36*t54;
+  const T t60 = link2_J0_xx*t35 + link2_J0_xy*t36 + link2_J0_xz*w_B_link2_z;
+  const T t61 = link2_J0_xy*t35 + link2_J0_yy*t36 + link2_J0_yz*w_B_link2_z;
+  const T t62 = link2_J0_xz*t35 + link2_J0_yz*t36 + link2_J0_zz*w_B_link2_z;
+  const T t63 = t36*t62 - t61*w_B_link2_z;
+  const T t64 = -t35*t62 + t60*w_B_link2_z;
+  const T t65 = t35*t61 - t36*t60;
+  const T t66 = -link1_S0_y*udot_in[0] + t47 + t6;
+  const T t67 = link1_S0_x*udot_in[0] + t48 + t7;
+  const T t68 = link1_J0_xz*udot_in[0] - link1_S0_z*t7 + t52;
+  const T t69 = link1_J0_yz*udot_in[0] + link1_S0_z*t6 + t53;
+  const T t70 = link1_J0_zz*udot_in[0] + link1_S0_x*t7 - link1_S0_y*t6;
+  const T t71 = link2_R_PJ_zy*udot_in[0];
+  const T t72 = link2_R_PJ_zz*udot_in[0];
+  const T t73 = -link2_p_J_y*t72 + link2_p_J_z*t71;
+  const T t74 = link2_p_J_x*t72;
+  const T t75 = -link2_p_J_x*t71;
+  const T t76 = t73*t8 + t74*t9;
+  const T t77 = -t73*t9 + t74*t8;
+  const T t78 = t71*t9;
+  const T t79 = t71*t8;
+  const T t80 = t72 + udot_in[1];
+  const T t81 = (t41 + t79)*link2_S0_z + (t43 + t76)*link2_mass + t57;
+  const T t82 = -(t40 + t78)*link2_S0_z + (t44 + t77)*link2_mass + link2_S0_x*t80 + t58;
+  const T t83 = (t34 + t75)*link2_mass - (t41 + t79)*link2_S0_x + t59;
+  const T t84 = (t40 + t78)*link2_J0_xx + (t41 + t79)*link2_J0_xy - (t44 + t77)*link2_S0_z + link2_J0_xz*t80 + t63;
+  const T t85 = -(t34 + t75)*link2_S0_x + (t40 + t78)*link2_J0_xy + (t41 + t79)*link2_J0_yy + (t43 + t76)*link2_S0_z + link2_J0_yz*t80 + t64;
+  const T t86 = (t40 + t78)*link2_J0_xz + (t41 + t79)*link2_J0_yz + (t44 + t77)*link2_S0_x + link2_J0_zz*t80 + t65;
+  const T t87 = t8*t81 - t82*t9;
+  const T t88 = t8*t82 + t81*t9;
+  const T t89 = link2_p_J_y*t83 - link2_p_J_z*t88;
+  const T t90 = -link2_p_J_x*t83 + link2_p_J_z*t87;
+  const T t91 = link2_p_J_x*t88 - link2_p_J_y*t87;
+  const T t92 = t8*t84 - t85*t9;
+  const T t93 = t8*t85 + t84*t9;
+  const T t94 = t89 + t92;
+  const T t95 = t90 + t93;
+  const T t96 = t86 + t91;
+  const T t97 = link2_R_PJ_yy*t88 + link2_R_PJ_yz*t83;
+  const T t98 = link2_R_PJ_zy*t88 + link2_R_PJ_zz*t83;
+  const T t99 = link2_R_PJ_yy*t95 + link2_R_PJ_yz*t96;
+  const T t100 = link2_R_PJ_zy*t95 + link2_R_PJ_zz*t96;
+  const T t101 = t66 + t87;
+  const T t102 = t67 + t97;
+  const T t103 = t68 + t94;
+  const T t104 = t69 + t99;
+  const T t105 = t100 + t70;
+  const T t106 = link1_R_BBp_xx*t101 + link1_R_BBp_xy*t102;
+  const T t107 = link1_R_BBp_zx*t101 + link1_R_BBp_zy*t102;
+  const T t108 = link1_R_BBp_xx*t103 + link1_R_BBp_xy*t104;
+  const T t109 = link1_R_BBp_zx*t103 + link1_R_BBp_zy*t104;
+  const T t110 = link2_R_BBp_xx*t81 + link2_R_BBp_xy*t82 + link2_R_BBp_xz*t83;
+  const T t111 = link2_R_BBp_yx*t81 + link2_R_BBp_yy*t82;
+  const T t112 = link2_R_BBp_zx*t81 + link2_R_BBp_zy*t82 + link2_R_BBp_zz*t83;
+  const T t113 = link2_R_BBp_xx*t84 + link2_R_BBp_xy*t85 + link2_R_BBp_xz*t86;
+  const T t114 = link2_R_BBp_yx*t84 + link2_R_BBp_yy*t85;
+  const T t115 = link2_R_BBp_zx*t84 + link2_R_BBp_zy*t85 + link2_R_BBp_zz*t86;
+  wrenches[0] = t106;
+  wrenches[1] = t98;
+  wrenches[2] = t107;
+  wrenches[3] = t108;
+  wrenches[4] = t105;
+  wrenches[5] = t109;
+  wrenches[6] = t110;
+  wrenches[7] = t111;
+  wrenches[8] = t112;
+  wrenches[9] = t113;
+  wrenches[10] = t114;
+  wrenches[11] = t115;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

@@ -15,11 +15,11 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
-//   mass_matrix       86 (33 add, 51 mul, 0 div, 2 func)
-//   forcing          340 (133 add, 203 mul, 1 div, 3 func)
-//   udot             574 (226 add, 331 mul, 14 div, 3 func) -- composite form; composite 574, articulated 943
-//   energy           240 (88 add, 145 mul, 4 div, 3 func)
-//   momentum         353 (140 add, 209 mul, 1 div, 3 func)
+//   mass_matrix       35 (16 add, 17 mul, 0 div, 2 func)
+//   forcing          199 (82 add, 115 mul, 0 div, 2 func)
+//   udot             380 (158 add, 209 mul, 11 div, 2 func) -- composite form; composite 380, articulated 720
+//   energy           119 (46 add, 68 mul, 3 div, 2 func)
+//   momentum         288 (113 add, 171 mul, 1 div, 3 func)
 
 #pragma once
 
@@ -35,17 +35,19 @@ inline constexpr char model_hash[] = "7dec74aced06e7dc";
 
 // ---- model constants (SI units) ---------------------------------------------
 // body probe: revolute joint to bus, mass 0.001 kg
-inline constexpr double probe_R_PJ_xx = 0.955336489125606;  // joint frame orientation in the parent
-inline constexpr double probe_R_PJ_xy = -0.29552020666133955;  // joint frame orientation in the parent
-inline constexpr double probe_R_PJ_yx = 0.29552020666133955;  // joint frame orientation in the parent
-inline constexpr double probe_R_PJ_yy = 0.955336489125606;  // joint frame orientation in the parent
+inline constexpr double probe_R_PJ_xy = 0.29552020666133955;  // joint frame orientation in the parent
+inline constexpr double probe_R_PJ_xz = 0.955336489125606;  // joint frame orientation in the parent
+inline constexpr double probe_R_PJ_yy = -0.955336489125606;  // joint frame orientation in the parent
+inline constexpr double probe_R_PJ_yz = 0.29552020666133955;  // joint frame orientation in the parent
 inline constexpr double probe_p_PJ_x = 0.3;  // joint frame origin in the parent x [m]
 inline constexpr double probe_p_PJ_y = 0.1;  // joint frame origin in the parent y [m]
+inline constexpr double probe_p_J_y = -0.006877586914158754;  // joint origin from the parent's origin, joint axes y [m]
+inline constexpr double probe_p_J_z = 0.3161529674038157;  // joint origin from the parent's origin, joint axes z [m]
 inline constexpr double probe_mass = 0.001;  // mass (rigid part and plain nodes) [kg]
-inline constexpr double probe_S0_x = 5e-05;  // first mass moment about O (undeformed) x [kg m]
-inline constexpr double probe_J0_xx = 1e-09;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double probe_S0_z = 5e-05;  // first mass moment about O (undeformed) z [kg m]
+inline constexpr double probe_J0_xx = 3.3300000000000007e-06;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double probe_J0_yy = 3.3300000000000007e-06;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double probe_J0_zz = 3.3300000000000007e-06;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double probe_J0_zz = 1e-09;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double probe_k = 1e-06;  // joint spring stiffness [N m/rad or N/m]
 
 // body bus: free joint to ground, mass 20 kg
@@ -59,6 +61,48 @@ inline constexpr double bus_J0_xz = -0.008;  // inertia about O (undeformed) [kg
 inline constexpr double bus_J0_yy = 1.204;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double bus_J0_yz = 0.014;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double bus_J0_zz = 0.81;  // inertia about O (undeformed) [kg m^2]
+
+// derived: constant subexpressions, evaluated here exactly
+inline constexpr double k05f44240 = 9.12667807454839e-10;  // = k4ab06a8f*k80dbd051
+inline constexpr double k0adc6025 = 4.730120176180773e-08;  // = k539cd6f4*probe_p_J_y
+inline constexpr double k0e90f1e0 = 0.00011477601033306699;  // = k14056fb0*probe_R_PJ_yz + k539cd6f4*probe_R_PJ_yy
+inline constexpr double k10555159 = 1.5807648370190785e-05;  // = probe_S0_z*probe_p_J_z
+inline constexpr double k12a41664 = 9.995269879823815e-05;  // = probe_mass*probe_p_J_z*probe_p_J_z
+inline constexpr double k14056fb0 = 0.00036615296740381576;  // = k539cd341 + probe_S0_z
+inline constexpr double k15d08898 = 4.730120176180773e-08;  // = probe_mass*probe_p_J_y*probe_p_J_y
+inline constexpr double k213c322b = 6.661000000000001e-06;  // = probe_J0_xx + probe_J0_yy + probe_J0_zz
+inline constexpr double k25819bb6 = 0.000955336489125606;  // = probe_R_PJ_xz*probe_mass
+inline constexpr double k39abfd5e = 2.5182488571968797e-06;  // = -probe_S0_z*probe_p_J_y - probe_mass*probe_p_J_y*probe_p_J_z
+inline constexpr double k4ab06a8f = 0.9553364891256059;  // = k70ce114d*k80dbd051
+inline constexpr double k539cd341 = 0.00031615296740381574;  // = probe_mass*probe_p_J_z
+inline constexpr double k539cd6f4 = -6.877586914158754e-06;  // = probe_mass*probe_p_J_y
+inline constexpr double k6f6401e7 = 7.067368818235087e-07;  // = k79d8f120*probe_R_PJ_yz
+inline constexpr double k70ce114d = 999999999.9999999;  // = 1.0/probe_J0_zz
+inline constexpr double k79d8f120 = 2.391501040852396e-06;  // = -k39abfd5e*probe_R_PJ_yy - kbcb0f926*probe_R_PJ_yz
+inline constexpr double k7edb958f = 2.4057750219790365e-06;  // = k39abfd5e*probe_R_PJ_xz
+inline constexpr double k7edee362 = 7.44193422703504e-07;  // = k39abfd5e*probe_R_PJ_yz
+inline constexpr double k80dbd051 = 9.55336489125606e-10;  // = probe_J0_zz*probe_R_PJ_xz
+inline constexpr double k80dcbd64 = 2.9552020666133954e-10;  // = probe_J0_zz*probe_R_PJ_yz
+inline constexpr double k85239292 = 0.00013156799553861972;  // = 2.0*k10555159 + k12a41664
+inline constexpr double k87659ac3 = 8.733219254516083e-05;  // = kb2a327ab*probe_R_PJ_yz
+inline constexpr double k954b958c = 0.9999999999999999;  // = k70ce114d*probe_J0_zz
+inline constexpr double ka1e1120f = 7.903373232151769e-07;  // = k39abfd5e*probe_R_PJ_xy + kbcb0f926*probe_R_PJ_xz
+inline constexpr double ka35c9b67 = 0.00013161529674038153;  // = 2.0*k10555159 + k12a41664 + k15d08898
+inline constexpr double kb2a327ab = 0.00029552020666133953;  // = probe_R_PJ_yz*probe_mass
+inline constexpr double kbcb0f926 = 4.8301201761807726e-08;  // = probe_J0_zz + probe_mass*probe_p_J_y*probe_p_J_y
+inline constexpr double kcf881ceb = 0.2955202066613395;  // = k70ce114d*k80dcbd64
+inline constexpr double kd0817db4 = 8.733219254516081e-11;  // = k80dcbd64*kcf881ceb
+inline constexpr double kd9d9df32 = 7.550380835853164e-07;  // = ka1e1120f*probe_R_PJ_xz
+inline constexpr double kd9e71277 = 2.3356064908871898e-07;  // = ka1e1120f*probe_R_PJ_yz
+inline constexpr double kda3b4caa = 0.4001147760103331;  // = bus_S0_y + k0e90f1e0
+inline constexpr double kdb08d67b = 0.00034776682445628027;  // = k14056fb0*probe_R_PJ_xz + k539cd6f4*probe_R_PJ_xy
+inline constexpr double ke2477e11 = 2.823212366975176e-10;  // = k80dbd051*kcf881ceb
+inline constexpr double ke2d2f207 = 0.0009126678074548391;  // = k25819bb6*probe_R_PJ_xz
+inline constexpr double ke2d2fbca = 0.00028232123669751763;  // = k25819bb6*probe_R_PJ_yz
+inline constexpr double kfc617620 = -6.570409736228635e-06;  // = k539cd6f4*probe_R_PJ_xz
+inline constexpr double kfd32cd94 = 20.001;  // = bus_mass + probe_mass
+inline constexpr double kfe1ec95e = 0.2003477668244563;  // = bus_S0_x + kdb08d67b
+inline constexpr double kffa187dd = -2.0324659062035194e-06;  // = k539cd6f4*probe_R_PJ_yz
 
 
 // ---- dual numbers for jacobian() ---------------------------------------------
@@ -83,6 +127,7 @@ template <int W> inline Dual<W> operator*(double a, const Dual<W>& b) { return b
 template <int W> inline Dual<W> operator/(const Dual<W>& a, double b) { return a * (1.0 / b); }
 template <int W> inline Dual<W> operator/(double a, const Dual<W>& b) { Dual<W> r; r.v = a / b.v; const double f = -r.v / b.v; for (int i = 0; i < W; ++i) r.d[i] = f * b.d[i]; return r; }
 template <int W> inline bool operator>(const Dual<W>& a, double b) { return a.v > b; }
+template <int W> inline bool operator>(const Dual<W>& a, const Dual<W>& b) { return a.v > b.v; }
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }
@@ -127,91 +172,78 @@ void mass_matrix(const T* q, T* M) {
   // ---- body probe: outward pass (positions)
   const T t23 = cos(q[7]);
   const T t24 = sin(q[7]);
-  const T R_PB_probe_xy = probe_R_PJ_xy*t23;
-  const T R_PB_probe_xz = -probe_R_PJ_xy*t24;
-  const T R_PB_probe_yy = probe_R_PJ_yy*t23;
-  const T R_PB_probe_yz = -probe_R_PJ_yy*t24;
-  // ---- body probe: mass and velocity terms
-  const T t44 = probe_R_PJ_xx*probe_S0_x;
-  const T t45 = probe_R_PJ_yx*probe_S0_x;
-  const T t46 = probe_mass*probe_p_PJ_x;
-  const T t47 = probe_mass*probe_p_PJ_y;
-  const T t48 = t44 + t46;
-  const T t49 = t45 + t47;
-  const T t50 = probe_J0_xx*probe_R_PJ_xx;
-  const T t51 = R_PB_probe_xy*probe_J0_yy;
-  const T t52 = R_PB_probe_xz*probe_J0_zz;
-  const T t53 = probe_J0_xx*probe_R_PJ_yx;
-  const T t54 = R_PB_probe_yy*probe_J0_yy;
-  const T t55 = R_PB_probe_yz*probe_J0_zz;
-  const T t56 = probe_J0_yy*t24;
-  const T t57 = probe_J0_zz*t23;
-  const T t58 = R_PB_probe_xy*t51 + R_PB_probe_xz*t52 + probe_R_PJ_xx*t50;
-  const T t59 = R_PB_probe_yy*t51 + R_PB_probe_yz*t52 + probe_R_PJ_yx*t50;
-  const T t60 = t23*t52 + t24*t51;
-  const T t61 = R_PB_probe_yy*t54 + R_PB_probe_yz*t55 + probe_R_PJ_yx*t53;
-  const T t62 = t23*t55 + t24*t54;
-  const T t63 = t23*t57 + t24*t56;
-  const T t64 = 2.0*probe_p_PJ_y*t45 + bus_J0_xx + probe_mass*probe_p_PJ_y*probe_p_PJ_y + t58;
-  const T t65 = bus_J0_xy - probe_mass*probe_p_PJ_x*probe_p_PJ_y - probe_p_PJ_x*t45 - probe_p_PJ_y*t44 + t59;
-  const T t66 = bus_J0_xz + t60;
-  const T t67 = 2.0*probe_p_PJ_x*t44 + bus_J0_yy + probe_mass*probe_p_PJ_x*probe_p_PJ_x + t61;
-  const T t68 = bus_J0_yz + t62;
-  const T t69 = 2.0*probe_p_PJ_x*t44 + 2.0*probe_p_PJ_y*t45 + bus_J0_zz + probe_mass*probe_p_PJ_x*probe_p_PJ_x + probe_mass*probe_p_PJ_y*probe_p_PJ_y + t63;
-  const T t70 = bus_mass + probe_mass;
-  const T t71 = bus_S0_y + t49;
-  const T t72 = -bus_S0_x - t48;
-  const T t73 = -bus_S0_y - t49;
-  const T t74 = bus_S0_x + t48;
-  M[0] = t70;
+  // ---- body probe: composite inertia (inward)
+  const T t44 = probe_J0_xx*t23;
+  const T t45 = -probe_J0_yy*t24;
+  const T t46 = probe_J0_xx*t24;
+  const T t47 = probe_J0_yy*t23;
+  const T t48 = t23*t44 - t24*t45;
+  const T t49 = t23*t45 + t24*t44;
+  const T t50 = t23*t47 + t24*t46;
+  const T t51 = ka35c9b67 + t48;
+  const T t52 = k85239292 + t50;
+  const T t53 = probe_R_PJ_xy*t49;
+  const T t54 = k7edb958f + probe_R_PJ_xy*t52;
+  const T t55 = probe_R_PJ_yy*t49;
+  const T t56 = k7edee362 + probe_R_PJ_yy*t52;
+  const T t57 = kd9d9df32 + probe_R_PJ_xy*t54;
+  const T t58 = kd9e71277 + probe_R_PJ_yy*t54;
+  const T t59 = -k6f6401e7 + probe_R_PJ_yy*t56;
+  const T t60 = bus_J0_xx + t57;
+  const T t61 = bus_J0_xy + t58;
+  const T t62 = bus_J0_xz + t53;
+  const T t63 = bus_J0_yy + t59;
+  const T t64 = bus_J0_yz + t55;
+  const T t65 = bus_J0_zz + t51;
+  M[0] = kfd32cd94;
   M[1] = 0.0;
   M[2] = 0.0;
   M[3] = 0.0;
   M[4] = bus_S0_z;
-  M[5] = t73;
+  M[5] = -kda3b4caa;
   M[6] = 0.0;
   M[7] = 0.0;
-  M[8] = t70;
+  M[8] = kfd32cd94;
   M[9] = 0.0;
   M[10] = -bus_S0_z;
   M[11] = 0.0;
-  M[12] = t74;
+  M[12] = kfe1ec95e;
   M[13] = 0.0;
   M[14] = 0.0;
   M[15] = 0.0;
-  M[16] = t70;
-  M[17] = t71;
-  M[18] = t72;
+  M[16] = kfd32cd94;
+  M[17] = kda3b4caa;
+  M[18] = -kfe1ec95e;
   M[19] = 0.0;
   M[20] = 0.0;
   M[21] = 0.0;
   M[22] = -bus_S0_z;
-  M[23] = t71;
-  M[24] = t64;
-  M[25] = t65;
-  M[26] = t66;
-  M[27] = t50;
+  M[23] = kda3b4caa;
+  M[24] = t60;
+  M[25] = t61;
+  M[26] = t62;
+  M[27] = k80dbd051;
   M[28] = bus_S0_z;
   M[29] = 0.0;
-  M[30] = t72;
-  M[31] = t65;
-  M[32] = t67;
-  M[33] = t68;
-  M[34] = t53;
-  M[35] = t73;
-  M[36] = t74;
+  M[30] = -kfe1ec95e;
+  M[31] = t61;
+  M[32] = t63;
+  M[33] = t64;
+  M[34] = k80dcbd64;
+  M[35] = -kda3b4caa;
+  M[36] = kfe1ec95e;
   M[37] = 0.0;
-  M[38] = t66;
-  M[39] = t68;
-  M[40] = t69;
+  M[38] = t62;
+  M[39] = t64;
+  M[40] = t65;
   M[41] = 0.0;
   M[42] = 0.0;
   M[43] = 0.0;
   M[44] = 0.0;
-  M[45] = t50;
-  M[46] = t53;
+  M[45] = k80dbd051;
+  M[46] = k80dcbd64;
   M[47] = 0.0;
-  M[48] = probe_J0_xx;
+  M[48] = probe_J0_zz;
 }
 
 // ---- F(q, u, tau) --------------------------------------------------------------
@@ -220,146 +252,107 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
   // ---- body bus: outward pass (velocities)
-  const T t0 = (1.0/sqrt(q[3]*q[3] + q[4]*q[4] + q[5]*q[5] + q[6]*q[6]));
-  const T t1 = q[3]*t0;
-  const T t2 = q[4]*t0;
-  const T t3 = q[5]*t0;
-  const T t4 = q[6]*t0;
-  const T t5 = t2*t2;
-  const T t6 = t3*t3;
-  const T t7 = t4*t4;
-  const T t8 = t2*t3;
-  const T t9 = t2*t4;
-  const T t10 = t3*t4;
-  const T t11 = t1*t2;
-  const T t12 = t1*t3;
-  const T t13 = t1*t4;
-  const T t14 = 1.0 - 2.0*t6 - 2.0*t7;
-  const T t15 = -2.0*t13 + 2.0*t8;
-  const T t16 = 2.0*t12 + 2.0*t9;
-  const T t17 = 2.0*t13 + 2.0*t8;
-  const T t18 = 1.0 - 2.0*t5 - 2.0*t7;
-  const T t19 = 2.0*t10 - 2.0*t11;
-  const T t20 = -2.0*t12 + 2.0*t9;
-  const T t21 = 2.0*t10 + 2.0*t11;
-  const T t22 = 1.0 - 2.0*t5 - 2.0*t6;
-  const T t23 = t14*u[0] + t15*u[1] + t16*u[2];
-  const T t24 = t17*u[0] + t18*u[1] + t19*u[2];
-  const T t25 = t20*u[0] + t21*u[1] + t22*u[2];
-  const T t26 = t14*u[3] + t15*u[4] + t16*u[5];
-  const T t27 = t17*u[3] + t18*u[4] + t19*u[5];
-  const T t28 = t20*u[3] + t21*u[4] + t22*u[5];
-  const T w_B_bus_x = t14*t26 + t17*t27 + t20*t28;
-  const T w_B_bus_y = t15*t26 + t18*t27 + t21*t28;
-  const T w_B_bus_z = t16*t26 + t19*t27 + t22*t28;
-  const T t35 = -t24*t28 + t25*t27;
-  const T t36 = t23*t28 - t25*t26;
-  const T t37 = -t23*t27 + t24*t26;
-  const T a_R_B_bus_x = t14*t35 + t17*t36 + t20*t37;
-  const T a_R_B_bus_y = t15*t35 + t18*t36 + t21*t37;
-  const T a_R_B_bus_z = t16*t35 + t19*t36 + t22*t37;
+  const T t23 = -u[1]*u[5] + u[2]*u[4];
+  const T t24 = u[0]*u[5] - u[2]*u[3];
+  const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body probe: outward pass (velocities)
-  const T t41 = cos(q[7]);
-  const T t42 = sin(q[7]);
-  const T t43 = probe_R_PJ_xx*u[6];
-  const T t44 = probe_R_PJ_yx*u[6];
-  const T R_PB_probe_xy = probe_R_PJ_xy*t41;
-  const T R_PB_probe_xz = -probe_R_PJ_xy*t42;
-  const T R_PB_probe_yy = probe_R_PJ_yy*t41;
-  const T R_PB_probe_yz = -probe_R_PJ_yy*t42;
-  const T t64 = t43 + w_B_bus_x;
-  const T t65 = t44 + w_B_bus_y;
-  const T w_B_probe_x = probe_R_PJ_xx*t64 + probe_R_PJ_yx*t65;
-  const T w_B_probe_y = R_PB_probe_xy*t64 + R_PB_probe_yy*t65 + t42*w_B_bus_z;
-  const T w_B_probe_z = R_PB_probe_xz*t64 + R_PB_probe_yz*t65 + t41*w_B_bus_z;
-  const T t69 = -probe_p_PJ_y*w_B_bus_z;
-  const T t70 = probe_p_PJ_x*w_B_bus_z;
-  const T t71 = -probe_p_PJ_x*w_B_bus_y + probe_p_PJ_y*w_B_bus_x;
-  const T t78 = -t44*w_B_bus_z;
-  const T t79 = t43*w_B_bus_z;
-  const T t80 = -t43*w_B_bus_y + t44*w_B_bus_x;
-  const T alpha_R_B_probe_x = probe_R_PJ_xx*t78 + probe_R_PJ_yx*t79;
-  const T alpha_R_B_probe_y = R_PB_probe_xy*t78 + R_PB_probe_yy*t79 + t42*t80;
-  const T alpha_R_B_probe_z = R_PB_probe_xz*t78 + R_PB_probe_yz*t79 + t41*t80;
-  const T t84 = -t70*w_B_bus_z + t71*w_B_bus_y;
-  const T t85 = t69*w_B_bus_z - t71*w_B_bus_x;
-  const T t86 = -t69*w_B_bus_y + t70*w_B_bus_x;
-  const T t87 = a_R_B_bus_x + t84;
-  const T t88 = a_R_B_bus_y + t85;
-  const T t89 = a_R_B_bus_z + t86;
-  const T a_R_B_probe_x = probe_R_PJ_xx*t87 + probe_R_PJ_yx*t88;
-  const T a_R_B_probe_y = R_PB_probe_xy*t87 + R_PB_probe_yy*t88 + t42*t89;
-  const T a_R_B_probe_z = R_PB_probe_xz*t87 + R_PB_probe_yz*t88 + t41*t89;
+  const T t26 = cos(q[7]);
+  const T t27 = sin(q[7]);
+  const T t47 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
+  const T t48 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
+  const T t49 = -probe_p_J_y*t48 + probe_p_J_z*t47;
+  const T t50 = -probe_p_J_z*u[5];
+  const T t51 = probe_p_J_y*u[5];
+  const T t57 = t47*t51 - t48*t50;
+  const T t58 = t48*t49 - t51*u[5];
+  const T t59 = -t47*t49 + t50*u[5];
+  const T t60 = probe_R_PJ_xy*t23 + probe_R_PJ_yy*t24;
+  const T t61 = probe_R_PJ_xz*t23 + probe_R_PJ_yz*t24;
+  const T t62 = t25 + t57;
+  const T t63 = t58 + t60;
+  const T t64 = t59 + t61;
+  const T t65 = t26*u[5] + t27*t47;
+  const T t66 = t26*t47 - t27*u[5];
+  const T w_B_probe_z = t48 + u[6];
+  const T t70 = t66*u[6];
+  const T t71 = -t65*u[6];
+  const T t73 = t26*t62 + t27*t63;
+  const T t74 = t26*t63 - t27*t62;
   // ---- body bus: mass and velocity terms
-  const T t93 = -bus_S0_y*w_B_bus_z + bus_S0_z*w_B_bus_y;
-  const T t94 = bus_S0_x*w_B_bus_z - bus_S0_z*w_B_bus_x;
-  const T t95 = -bus_S0_x*w_B_bus_y + bus_S0_y*w_B_bus_x;
-  const T t96 = -t94*w_B_bus_z + t95*w_B_bus_y;
-  const T t97 = t93*w_B_bus_z - t95*w_B_bus_x;
-  const T t98 = -t93*w_B_bus_y + t94*w_B_bus_x;
-  const T t99 = bus_J0_xx*w_B_bus_x + bus_J0_xy*w_B_bus_y + bus_J0_xz*w_B_bus_z;
-  const T t100 = bus_J0_xy*w_B_bus_x + bus_J0_yy*w_B_bus_y + bus_J0_yz*w_B_bus_z;
-  const T t101 = bus_J0_xz*w_B_bus_x + bus_J0_yz*w_B_bus_y + bus_J0_zz*w_B_bus_z;
-  const T t102 = -t100*w_B_bus_z + t101*w_B_bus_y;
-  const T t103 = -t101*w_B_bus_x + t99*w_B_bus_z;
-  const T t104 = t100*w_B_bus_x - t99*w_B_bus_y;
+  const T t75 = -bus_S0_y*u[5] + bus_S0_z*u[4];
+  const T t76 = bus_S0_x*u[5] - bus_S0_z*u[3];
+  const T t77 = -bus_S0_x*u[4] + bus_S0_y*u[3];
+  const T t78 = -t76*u[5] + t77*u[4];
+  const T t79 = t75*u[5] - t77*u[3];
+  const T t80 = -t75*u[4] + t76*u[3];
+  const T t81 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5];
+  const T t82 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
+  const T t83 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5];
+  const T t84 = -t82*u[5] + t83*u[4];
+  const T t85 = t81*u[5] - t83*u[3];
+  const T t86 = -t81*u[4] + t82*u[3];
   // ---- body probe: mass and velocity terms
-  const T t105 = probe_S0_x*w_B_probe_z;
-  const T t106 = -probe_S0_x*w_B_probe_y;
-  const T t107 = -t105*w_B_probe_z + t106*w_B_probe_y;
-  const T t108 = -t106*w_B_probe_x;
-  const T t109 = t105*w_B_probe_x;
-  const T t110 = probe_J0_xx*w_B_probe_x;
-  const T t111 = probe_J0_yy*w_B_probe_y;
-  const T t112 = probe_J0_zz*w_B_probe_z;
-  const T t113 = -t111*w_B_probe_z + t112*w_B_probe_y;
-  const T t114 = t110*w_B_probe_z - t112*w_B_probe_x;
-  const T t115 = -t110*w_B_probe_y + t111*w_B_probe_x;
-  const T t116 = -a_R_B_bus_x*bus_mass - t96;
-  const T t117 = -a_R_B_bus_y*bus_mass - t97;
-  const T t118 = -a_R_B_bus_z*bus_mass - t98;
-  const T t119 = a_R_B_bus_y*bus_S0_z - a_R_B_bus_z*bus_S0_y - t102;
-  const T t120 = -a_R_B_bus_x*bus_S0_z + a_R_B_bus_z*bus_S0_x - t103;
-  const T t121 = a_R_B_bus_x*bus_S0_y - a_R_B_bus_y*bus_S0_x - t104;
-  const T t122 = -a_R_B_probe_x*probe_mass - t107;
-  const T t123 = -a_R_B_probe_y*probe_mass - alpha_R_B_probe_z*probe_S0_x - t108;
-  const T t124 = -a_R_B_probe_z*probe_mass + alpha_R_B_probe_y*probe_S0_x - t109;
-  const T t125 = -alpha_R_B_probe_x*probe_J0_xx - t113;
-  const T t126 = a_R_B_probe_z*probe_S0_x - alpha_R_B_probe_y*probe_J0_yy - t114;
-  const T t127 = -a_R_B_probe_y*probe_S0_x - alpha_R_B_probe_z*probe_J0_zz - t115;
-  const T t128 = -probe_k*q[7] + tau[6];
-  const T t129 = t125 + t128;
-  const T t130 = R_PB_probe_xy*t123 + R_PB_probe_xz*t124 + probe_R_PJ_xx*t122;
-  const T t131 = R_PB_probe_yy*t123 + R_PB_probe_yz*t124 + probe_R_PJ_yx*t122;
-  const T t132 = t123*t42 + t124*t41;
-  const T t133 = probe_p_PJ_y*t132;
-  const T t134 = -probe_p_PJ_x*t132;
-  const T t135 = probe_p_PJ_x*t131 - probe_p_PJ_y*t130;
-  const T t136 = R_PB_probe_xy*t126 + R_PB_probe_xz*t127 + probe_R_PJ_xx*t125;
-  const T t137 = R_PB_probe_yy*t126 + R_PB_probe_yz*t127 + probe_R_PJ_yx*t125;
-  const T t138 = t126*t42 + t127*t41;
-  const T t139 = t133 + t136;
-  const T t140 = t134 + t137;
-  const T t141 = t135 + t138;
-  const T t142 = t116 + t130;
-  const T t143 = t117 + t131;
-  const T t144 = t118 + t132;
-  const T t145 = t119 + t139;
-  const T t146 = t120 + t140;
-  const T t147 = t121 + t141;
-  const T t148 = t142 + tau[0];
-  const T t149 = t143 + tau[1];
-  const T t150 = t144 + tau[2];
-  const T t151 = t145 + tau[3];
-  const T t152 = t146 + tau[4];
-  const T t153 = t147 + tau[5];
-  F[0] = t148;
-  F[1] = t149;
-  F[2] = t150;
-  F[3] = t151;
-  F[4] = t152;
-  F[5] = t153;
-  F[6] = t129;
+  const T t87 = probe_S0_z*t66;
+  const T t88 = -probe_S0_z*t65;
+  const T t89 = -t88*w_B_probe_z;
+  const T t90 = t87*w_B_probe_z;
+  const T t91 = t65*t88 - t66*t87;
+  const T t92 = probe_J0_xx*t65;
+  const T t93 = probe_J0_yy*t66;
+  const T t94 = probe_J0_zz*w_B_probe_z;
+  const T t95 = t66*t94 - t93*w_B_probe_z;
+  const T t96 = -t65*t94 + t92*w_B_probe_z;
+  const T t97 = t65*t93 - t66*t92;
+  // ---- body bus: bias force
+  const T t98 = -bus_mass*t23 - t78;
+  const T t99 = -bus_mass*t24 - t79;
+  const T t100 = -bus_mass*t25 - t80;
+  const T t101 = -bus_S0_y*t25 + bus_S0_z*t24 - t84;
+  const T t102 = bus_S0_x*t25 - bus_S0_z*t23 - t85;
+  const T t103 = -bus_S0_x*t24 + bus_S0_y*t23 - t86;
+  // ---- body probe: bias force
+  const T t104 = -probe_S0_z*t71 - probe_mass*t73 - t89;
+  const T t105 = probe_S0_z*t70 - probe_mass*t74 - t90;
+  const T t106 = -probe_mass*t64 - t91;
+  const T t107 = -probe_J0_xx*t70 + probe_S0_z*t74 - t95;
+  const T t108 = -probe_J0_yy*t71 - probe_S0_z*t73 - t96;
+  // ---- body probe: generalized forces (inward)
+  const T t109 = -probe_k*q[7] + tau[6];
+  const T t110 = t109 - t97;
+  const T t111 = t104*t26 - t105*t27;
+  const T t112 = t104*t27 + t105*t26;
+  const T t113 = probe_p_J_y*t106 - probe_p_J_z*t112;
+  const T t114 = probe_p_J_z*t111;
+  const T t115 = -probe_p_J_y*t111;
+  const T t116 = t107*t26 - t108*t27;
+  const T t117 = t107*t27 + t108*t26;
+  const T t118 = t113 + t116;
+  const T t119 = t114 + t117;
+  const T t120 = t115 - t97;
+  const T t121 = probe_R_PJ_xy*t112 + probe_R_PJ_xz*t106;
+  const T t122 = probe_R_PJ_yy*t112 + probe_R_PJ_yz*t106;
+  const T t123 = probe_R_PJ_xy*t119 + probe_R_PJ_xz*t120;
+  const T t124 = probe_R_PJ_yy*t119 + probe_R_PJ_yz*t120;
+  const T t125 = t121 + t98;
+  const T t126 = t122 + t99;
+  const T t127 = t100 + t111;
+  const T t128 = t101 + t123;
+  const T t129 = t102 + t124;
+  const T t130 = t103 + t118;
+  // ---- body bus: generalized forces (inward)
+  const T t131 = t125 + tau[0];
+  const T t132 = t126 + tau[1];
+  const T t133 = t127 + tau[2];
+  const T t134 = t128 + tau[3];
+  const T t135 = t129 + tau[4];
+  const T t136 = t130 + tau[5];
+  F[0] = t131;
+  F[1] = t132;
+  F[2] = t133;
+  F[3] = t134;
+  F[4] = t135;
+  F[5] = t136;
+  F[6] = t110;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
@@ -369,278 +362,229 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
   // ---- body bus: outward pass (velocities)
-  const T t0 = (1.0/sqrt(q[3]*q[3] + q[4]*q[4] + q[5]*q[5] + q[6]*q[6]));
-  const T t1 = q[3]*t0;
-  const T t2 = q[4]*t0;
-  const T t3 = q[5]*t0;
-  const T t4 = q[6]*t0;
-  const T t5 = t2*t2;
-  const T t6 = t3*t3;
-  const T t7 = t4*t4;
-  const T t8 = t2*t3;
-  const T t9 = t2*t4;
-  const T t10 = t3*t4;
-  const T t11 = t1*t2;
-  const T t12 = t1*t3;
-  const T t13 = t1*t4;
-  const T t14 = 1.0 - 2.0*t6 - 2.0*t7;
-  const T t15 = -2.0*t13 + 2.0*t8;
-  const T t16 = 2.0*t12 + 2.0*t9;
-  const T t17 = 2.0*t13 + 2.0*t8;
-  const T t18 = 1.0 - 2.0*t5 - 2.0*t7;
-  const T t19 = 2.0*t10 - 2.0*t11;
-  const T t20 = -2.0*t12 + 2.0*t9;
-  const T t21 = 2.0*t10 + 2.0*t11;
-  const T t22 = 1.0 - 2.0*t5 - 2.0*t6;
-  const T t23 = t14*u[0] + t15*u[1] + t16*u[2];
-  const T t24 = t17*u[0] + t18*u[1] + t19*u[2];
-  const T t25 = t20*u[0] + t21*u[1] + t22*u[2];
-  const T t26 = t14*u[3] + t15*u[4] + t16*u[5];
-  const T t27 = t17*u[3] + t18*u[4] + t19*u[5];
-  const T t28 = t20*u[3] + t21*u[4] + t22*u[5];
-  const T w_B_bus_x = t14*t26 + t17*t27 + t20*t28;
-  const T w_B_bus_y = t15*t26 + t18*t27 + t21*t28;
-  const T w_B_bus_z = t16*t26 + t19*t27 + t22*t28;
-  const T t35 = -t24*t28 + t25*t27;
-  const T t36 = t23*t28 - t25*t26;
-  const T t37 = -t23*t27 + t24*t26;
-  const T a_R_B_bus_x = t14*t35 + t17*t36 + t20*t37;
-  const T a_R_B_bus_y = t15*t35 + t18*t36 + t21*t37;
-  const T a_R_B_bus_z = t16*t35 + t19*t36 + t22*t37;
+  const T t23 = -u[1]*u[5] + u[2]*u[4];
+  const T t24 = u[0]*u[5] - u[2]*u[3];
+  const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body probe: outward pass (velocities)
-  const T t41 = cos(q[7]);
-  const T t42 = sin(q[7]);
-  const T t43 = probe_R_PJ_xx*u[6];
-  const T t44 = probe_R_PJ_yx*u[6];
-  const T R_PB_probe_xy = probe_R_PJ_xy*t41;
-  const T R_PB_probe_xz = -probe_R_PJ_xy*t42;
-  const T R_PB_probe_yy = probe_R_PJ_yy*t41;
-  const T R_PB_probe_yz = -probe_R_PJ_yy*t42;
-  const T t64 = t43 + w_B_bus_x;
-  const T t65 = t44 + w_B_bus_y;
-  const T w_B_probe_x = probe_R_PJ_xx*t64 + probe_R_PJ_yx*t65;
-  const T w_B_probe_y = R_PB_probe_xy*t64 + R_PB_probe_yy*t65 + t42*w_B_bus_z;
-  const T w_B_probe_z = R_PB_probe_xz*t64 + R_PB_probe_yz*t65 + t41*w_B_bus_z;
-  const T t69 = -probe_p_PJ_y*w_B_bus_z;
-  const T t70 = probe_p_PJ_x*w_B_bus_z;
-  const T t71 = -probe_p_PJ_x*w_B_bus_y + probe_p_PJ_y*w_B_bus_x;
-  const T t78 = -t44*w_B_bus_z;
-  const T t79 = t43*w_B_bus_z;
-  const T t80 = -t43*w_B_bus_y + t44*w_B_bus_x;
-  const T alpha_R_B_probe_x = probe_R_PJ_xx*t78 + probe_R_PJ_yx*t79;
-  const T alpha_R_B_probe_y = R_PB_probe_xy*t78 + R_PB_probe_yy*t79 + t42*t80;
-  const T alpha_R_B_probe_z = R_PB_probe_xz*t78 + R_PB_probe_yz*t79 + t41*t80;
-  const T t84 = -t70*w_B_bus_z + t71*w_B_bus_y;
-  const T t85 = t69*w_B_bus_z - t71*w_B_bus_x;
-  const T t86 = -t69*w_B_bus_y + t70*w_B_bus_x;
-  const T t87 = a_R_B_bus_x + t84;
-  const T t88 = a_R_B_bus_y + t85;
-  const T t89 = a_R_B_bus_z + t86;
-  const T a_R_B_probe_x = probe_R_PJ_xx*t87 + probe_R_PJ_yx*t88;
-  const T a_R_B_probe_y = R_PB_probe_xy*t87 + R_PB_probe_yy*t88 + t42*t89;
-  const T a_R_B_probe_z = R_PB_probe_xz*t87 + R_PB_probe_yz*t88 + t41*t89;
+  const T t26 = cos(q[7]);
+  const T t27 = sin(q[7]);
+  const T t47 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
+  const T t48 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
+  const T t49 = -probe_p_J_y*t48 + probe_p_J_z*t47;
+  const T t50 = -probe_p_J_z*u[5];
+  const T t51 = probe_p_J_y*u[5];
+  const T t57 = t47*t51 - t48*t50;
+  const T t58 = t48*t49 - t51*u[5];
+  const T t59 = -t47*t49 + t50*u[5];
+  const T t60 = probe_R_PJ_xy*t23 + probe_R_PJ_yy*t24;
+  const T t61 = probe_R_PJ_xz*t23 + probe_R_PJ_yz*t24;
+  const T t62 = t25 + t57;
+  const T t63 = t58 + t60;
+  const T t64 = t59 + t61;
+  const T t65 = t26*u[5] + t27*t47;
+  const T t66 = t26*t47 - t27*u[5];
+  const T w_B_probe_z = t48 + u[6];
+  const T t70 = t66*u[6];
+  const T t71 = -t65*u[6];
+  const T t73 = t26*t62 + t27*t63;
+  const T t74 = t26*t63 - t27*t62;
   // ---- body bus: mass and velocity terms
-  const T t93 = -bus_S0_y*w_B_bus_z + bus_S0_z*w_B_bus_y;
-  const T t94 = bus_S0_x*w_B_bus_z - bus_S0_z*w_B_bus_x;
-  const T t95 = -bus_S0_x*w_B_bus_y + bus_S0_y*w_B_bus_x;
-  const T t96 = -t94*w_B_bus_z + t95*w_B_bus_y;
-  const T t97 = t93*w_B_bus_z - t95*w_B_bus_x;
-  const T t98 = -t93*w_B_bus_y + t94*w_B_bus_x;
-  const T t99 = bus_J0_xx*w_B_bus_x + bus_J0_xy*w_B_bus_y + bus_J0_xz*w_B_bus_z;
-  const T t100 = bus_J0_xy*w_B_bus_x + bus_J0_yy*w_B_bus_y + bus_J0_yz*w_B_bus_z;
-  const T t101 = bus_J0_xz*w_B_bus_x + bus_J0_yz*w_B_bus_y + bus_J0_zz*w_B_bus_z;
-  const T t102 = -t100*w_B_bus_z + t101*w_B_bus_y;
-  const T t103 = -t101*w_B_bus_x + t99*w_B_bus_z;
-  const T t104 = t100*w_B_bus_x - t99*w_B_bus_y;
+  const T t75 = -bus_S0_y*u[5] + bus_S0_z*u[4];
+  const T t76 = bus_S0_x*u[5] - bus_S0_z*u[3];
+  const T t77 = -bus_S0_x*u[4] + bus_S0_y*u[3];
+  const T t78 = -t76*u[5] + t77*u[4];
+  const T t79 = t75*u[5] - t77*u[3];
+  const T t80 = -t75*u[4] + t76*u[3];
+  const T t81 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5];
+  const T t82 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
+  const T t83 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5];
+  const T t84 = -t82*u[5] + t83*u[4];
+  const T t85 = t81*u[5] - t83*u[3];
+  const T t86 = -t81*u[4] + t82*u[3];
   // ---- body probe: mass and velocity terms
-  const T t105 = probe_S0_x*w_B_probe_z;
-  const T t106 = -probe_S0_x*w_B_probe_y;
-  const T t107 = -t105*w_B_probe_z + t106*w_B_probe_y;
-  const T t108 = -t106*w_B_probe_x;
-  const T t109 = t105*w_B_probe_x;
-  const T t110 = probe_J0_xx*w_B_probe_x;
-  const T t111 = probe_J0_yy*w_B_probe_y;
-  const T t112 = probe_J0_zz*w_B_probe_z;
-  const T t113 = -t111*w_B_probe_z + t112*w_B_probe_y;
-  const T t114 = t110*w_B_probe_z - t112*w_B_probe_x;
-  const T t115 = -t110*w_B_probe_y + t111*w_B_probe_x;
-  const T t116 = probe_R_PJ_xx*probe_S0_x;
-  const T t117 = probe_R_PJ_yx*probe_S0_x;
-  const T t118 = probe_mass*probe_p_PJ_x;
-  const T t119 = probe_mass*probe_p_PJ_y;
-  const T t120 = t116 + t118;
-  const T t121 = t117 + t119;
-  const T t122 = probe_J0_xx*probe_R_PJ_xx;
-  const T t123 = R_PB_probe_xy*probe_J0_yy;
-  const T t124 = R_PB_probe_xz*probe_J0_zz;
-  const T t125 = probe_J0_xx*probe_R_PJ_yx;
-  const T t126 = R_PB_probe_yy*probe_J0_yy;
-  const T t127 = R_PB_probe_yz*probe_J0_zz;
-  const T t128 = probe_J0_yy*t42;
-  const T t129 = probe_J0_zz*t41;
-  const T t130 = R_PB_probe_xy*t123 + R_PB_probe_xz*t124 + probe_R_PJ_xx*t122;
-  const T t131 = R_PB_probe_yy*t123 + R_PB_probe_yz*t124 + probe_R_PJ_yx*t122;
-  const T t132 = t123*t42 + t124*t41;
-  const T t133 = R_PB_probe_yy*t126 + R_PB_probe_yz*t127 + probe_R_PJ_yx*t125;
-  const T t134 = t126*t42 + t127*t41;
-  const T t135 = t128*t42 + t129*t41;
-  const T t136 = 2.0*probe_p_PJ_y*t117 + bus_J0_xx + probe_mass*probe_p_PJ_y*probe_p_PJ_y + t130;
-  const T t137 = bus_J0_xy - probe_mass*probe_p_PJ_x*probe_p_PJ_y - probe_p_PJ_x*t117 - probe_p_PJ_y*t116 + t131;
-  const T t138 = bus_J0_xz + t132;
-  const T t139 = 2.0*probe_p_PJ_x*t116 + bus_J0_yy + probe_mass*probe_p_PJ_x*probe_p_PJ_x + t133;
-  const T t140 = bus_J0_yz + t134;
-  const T t141 = 2.0*probe_p_PJ_x*t116 + 2.0*probe_p_PJ_y*t117 + bus_J0_zz + probe_mass*probe_p_PJ_x*probe_p_PJ_x + probe_mass*probe_p_PJ_y*probe_p_PJ_y + t135;
-  const T t142 = bus_mass + probe_mass;
-  const T t143 = bus_S0_y + t121;
-  const T t144 = -bus_S0_x - t120;
-  const T t145 = -bus_S0_y - t121;
-  const T t146 = bus_S0_x + t120;
-  const T t147 = -a_R_B_bus_x*bus_mass - t96;
-  const T t148 = -a_R_B_bus_y*bus_mass - t97;
-  const T t149 = -a_R_B_bus_z*bus_mass - t98;
-  const T t150 = a_R_B_bus_y*bus_S0_z - a_R_B_bus_z*bus_S0_y - t102;
-  const T t151 = -a_R_B_bus_x*bus_S0_z + a_R_B_bus_z*bus_S0_x - t103;
-  const T t152 = a_R_B_bus_x*bus_S0_y - a_R_B_bus_y*bus_S0_x - t104;
-  const T t153 = -a_R_B_probe_x*probe_mass - t107;
-  const T t154 = -a_R_B_probe_y*probe_mass - alpha_R_B_probe_z*probe_S0_x - t108;
-  const T t155 = -a_R_B_probe_z*probe_mass + alpha_R_B_probe_y*probe_S0_x - t109;
-  const T t156 = -alpha_R_B_probe_x*probe_J0_xx - t113;
-  const T t157 = a_R_B_probe_z*probe_S0_x - alpha_R_B_probe_y*probe_J0_yy - t114;
-  const T t158 = -a_R_B_probe_y*probe_S0_x - alpha_R_B_probe_z*probe_J0_zz - t115;
-  const T t159 = -probe_k*q[7] + tau[6];
-  const T t160 = t156 + t159;
-  const T t161 = R_PB_probe_xy*t154 + R_PB_probe_xz*t155 + probe_R_PJ_xx*t153;
-  const T t162 = R_PB_probe_yy*t154 + R_PB_probe_yz*t155 + probe_R_PJ_yx*t153;
-  const T t163 = t154*t42 + t155*t41;
-  const T t164 = probe_p_PJ_y*t163;
-  const T t165 = -probe_p_PJ_x*t163;
-  const T t166 = probe_p_PJ_x*t162 - probe_p_PJ_y*t161;
-  const T t167 = R_PB_probe_xy*t157 + R_PB_probe_xz*t158 + probe_R_PJ_xx*t156;
-  const T t168 = R_PB_probe_yy*t157 + R_PB_probe_yz*t158 + probe_R_PJ_yx*t156;
-  const T t169 = t157*t42 + t158*t41;
-  const T t170 = t164 + t167;
-  const T t171 = t165 + t168;
-  const T t172 = t166 + t169;
-  const T t173 = t147 + t161;
-  const T t174 = t148 + t162;
-  const T t175 = t149 + t163;
-  const T t176 = t150 + t170;
-  const T t177 = t151 + t171;
-  const T t178 = t152 + t172;
-  const T t179 = t173 + tau[0];
-  const T t180 = t174 + tau[1];
-  const T t181 = t175 + tau[2];
-  const T t182 = t176 + tau[3];
-  const T t183 = t177 + tau[4];
-  const T t184 = t178 + tau[5];
-  const T t185 = 1.0/probe_J0_xx;
-  const T t186 = t125*t185;
-  const T t187 = -t125*t186 + t139;
-  const T t188 = -t122*t186 + t137;
-  const T t189 = t122*t185;
-  const T t190 = -t122*t189 + t136;
-  const T t191 = 1.0/t141;
-  const T t192 = t140*t191;
-  const T t193 = -t140*t192 + t187;
-  const T t194 = -t138*t192 + t188;
-  const T t195 = -t146*t192;
-  const T t196 = bus_S0_z - t145*t192;
-  const T t197 = t138*t191;
-  const T t198 = -t138*t197 + t190;
-  const T t199 = -bus_S0_z - t146*t197;
-  const T t200 = -t145*t197;
-  const T t201 = t146*t191;
-  const T t202 = t142 - t146*t201;
-  const T t203 = -t145*t201;
-  const T t204 = t145*t191;
-  const T t205 = t142 - t145*t204;
-  const T t206 = 1.0/t193;
-  const T t207 = t194*t206;
-  const T t208 = -t194*t207 + t198;
-  const T t209 = t143 - t144*t207;
-  const T t210 = -t195*t207 + t199;
-  const T t211 = -t196*t207 + t200;
-  const T t212 = t144*t206;
-  const T t213 = t142 - t144*t212;
-  const T t214 = -t195*t212;
-  const T t215 = -t196*t212;
-  const T t216 = t195*t206;
-  const T t217 = -t195*t216 + t202;
-  const T t218 = -t196*t216 + t203;
-  const T t219 = t196*t206;
-  const T t220 = -t196*t219 + t205;
-  const T t221 = 1.0/t208;
-  const T t222 = t209*t221;
-  const T t223 = -t209*t222 + t213;
-  const T t224 = -t210*t222 + t214;
-  const T t225 = -t211*t222 + t215;
-  const T t226 = t210*t221;
-  const T t227 = -t210*t226 + t217;
-  const T t228 = -t211*t226 + t218;
-  const T t229 = t211*t221;
-  const T t230 = -t211*t229 + t220;
-  const T t231 = 1.0/t223;
-  const T t232 = t224*t231;
-  const T t233 = -t224*t232 + t227;
-  const T t234 = -t225*t232 + t228;
-  const T t235 = t225*t231;
-  const T t236 = -t225*t235 + t230;
-  const T t237 = 1.0/t233;
-  const T t238 = t234*t237;
-  const T t239 = -t234*t238 + t236;
-  const T t241 = -t160*t186 + t183;
-  const T t242 = -t160*t189 + t182;
-  const T t243 = -t184*t192 + t241;
-  const T t244 = -t184*t197 + t242;
-  const T t245 = t180 - t184*t201;
-  const T t246 = t179 - t184*t204;
-  const T t247 = -t207*t243 + t244;
-  const T t248 = t181 - t212*t243;
-  const T t249 = -t216*t243 + t245;
-  const T t250 = -t219*t243 + t246;
-  const T t251 = -t222*t247 + t248;
-  const T t252 = -t226*t247 + t249;
-  const T t253 = -t229*t247 + t250;
-  const T t254 = -t232*t251 + t252;
-  const T t255 = -t235*t251 + t253;
-  const T t256 = -t238*t254 + t255;
-  const T t257 = t256/t239;
-  const T t258 = t254/t233;
-  const T t259 = t251/t223;
-  const T t260 = t247/t208;
-  const T t261 = t243/t193;
-  const T t262 = t184/t141;
-  const T t263 = t160/probe_J0_xx;
-  const T t264 = -t238*t257 + t258;
-  const T t265 = -t232*t264 + t259;
-  const T t266 = -t235*t257 + t265;
-  const T t267 = -t222*t266 + t260;
-  const T t268 = -t226*t264 + t267;
-  const T t269 = -t229*t257 + t268;
-  const T t270 = -t207*t269 + t261;
-  const T t271 = -t212*t266 + t270;
-  const T t272 = -t216*t264 + t271;
-  const T t273 = -t219*t257 + t272;
-  const T t274 = -t192*t273 + t262;
-  const T t275 = -t197*t269 + t274;
-  const T t276 = -t201*t264 + t275;
-  const T t277 = -t204*t257 + t276;
-  const T t278 = -t186*t273 + t263;
-  const T t279 = -t189*t269 + t278;
-  if (!(t239 > 0.0)) return 1;
-  if (!(t233 > 0.0)) return 2;
-  if (!(t223 > 0.0)) return 3;
-  if (!(t208 > 0.0)) return 4;
-  if (!(t193 > 0.0)) return 5;
-  if (!(t141 > 0.0)) return 6;
-  if (!(probe_J0_xx > 0.0)) return 7;
-  udot[0] = t257;
-  udot[1] = t264;
-  udot[2] = t266;
-  udot[3] = t269;
-  udot[4] = t273;
-  udot[5] = t277;
-  udot[6] = t279;
+  const T t87 = probe_S0_z*t66;
+  const T t88 = -probe_S0_z*t65;
+  const T t89 = -t88*w_B_probe_z;
+  const T t90 = t87*w_B_probe_z;
+  const T t91 = t65*t88 - t66*t87;
+  const T t92 = probe_J0_xx*t65;
+  const T t93 = probe_J0_yy*t66;
+  const T t94 = probe_J0_zz*w_B_probe_z;
+  const T t95 = t66*t94 - t93*w_B_probe_z;
+  const T t96 = -t65*t94 + t92*w_B_probe_z;
+  const T t97 = t65*t93 - t66*t92;
+  // ---- body probe: composite inertia (inward)
+  const T t98 = probe_J0_xx*t26;
+  const T t99 = -probe_J0_yy*t27;
+  const T t100 = probe_J0_xx*t27;
+  const T t101 = probe_J0_yy*t26;
+  const T t102 = t26*t98 - t27*t99;
+  const T t103 = t26*t99 + t27*t98;
+  const T t104 = t100*t27 + t101*t26;
+  const T t105 = ka35c9b67 + t102;
+  const T t106 = k85239292 + t104;
+  const T t107 = probe_R_PJ_xy*t103;
+  const T t108 = k7edb958f + probe_R_PJ_xy*t106;
+  const T t109 = probe_R_PJ_yy*t103;
+  const T t110 = k7edee362 + probe_R_PJ_yy*t106;
+  const T t111 = kd9d9df32 + probe_R_PJ_xy*t108;
+  const T t112 = kd9e71277 + probe_R_PJ_yy*t108;
+  const T t113 = -k6f6401e7 + probe_R_PJ_yy*t110;
+  const T t114 = bus_J0_xx + t111;
+  const T t115 = bus_J0_xy + t112;
+  const T t116 = bus_J0_xz + t107;
+  const T t117 = bus_J0_yy + t113;
+  const T t118 = bus_J0_yz + t109;
+  const T t119 = bus_J0_zz + t105;
+  // ---- body bus: bias force
+  const T t120 = -bus_mass*t23 - t78;
+  const T t121 = -bus_mass*t24 - t79;
+  const T t122 = -bus_mass*t25 - t80;
+  const T t123 = -bus_S0_y*t25 + bus_S0_z*t24 - t84;
+  const T t124 = bus_S0_x*t25 - bus_S0_z*t23 - t85;
+  const T t125 = -bus_S0_x*t24 + bus_S0_y*t23 - t86;
+  // ---- body probe: bias force
+  const T t126 = -probe_S0_z*t71 - probe_mass*t73 - t89;
+  const T t127 = probe_S0_z*t70 - probe_mass*t74 - t90;
+  const T t128 = -probe_mass*t64 - t91;
+  const T t129 = -probe_J0_xx*t70 + probe_S0_z*t74 - t95;
+  const T t130 = -probe_J0_yy*t71 - probe_S0_z*t73 - t96;
+  // ---- body probe: generalized forces (inward)
+  const T t131 = -probe_k*q[7] + tau[6];
+  const T t132 = t131 - t97;
+  const T t133 = t126*t26 - t127*t27;
+  const T t134 = t126*t27 + t127*t26;
+  const T t135 = probe_p_J_y*t128 - probe_p_J_z*t134;
+  const T t136 = probe_p_J_z*t133;
+  const T t137 = -probe_p_J_y*t133;
+  const T t138 = t129*t26 - t130*t27;
+  const T t139 = t129*t27 + t130*t26;
+  const T t140 = t135 + t138;
+  const T t141 = t136 + t139;
+  const T t142 = t137 - t97;
+  const T t143 = probe_R_PJ_xy*t134 + probe_R_PJ_xz*t128;
+  const T t144 = probe_R_PJ_yy*t134 + probe_R_PJ_yz*t128;
+  const T t145 = probe_R_PJ_xy*t141 + probe_R_PJ_xz*t142;
+  const T t146 = probe_R_PJ_yy*t141 + probe_R_PJ_yz*t142;
+  const T t147 = t120 + t143;
+  const T t148 = t121 + t144;
+  const T t149 = t122 + t133;
+  const T t150 = t123 + t145;
+  const T t151 = t124 + t146;
+  const T t152 = t125 + t140;
+  // ---- body bus: generalized forces (inward)
+  const T t153 = t147 + tau[0];
+  const T t154 = t148 + tau[1];
+  const T t155 = t149 + tau[2];
+  const T t156 = t150 + tau[3];
+  const T t157 = t151 + tau[4];
+  const T t158 = t152 + tau[5];
+  // ---- M u_dot = F: L^T D L along the dof tree
+  const T t159 = -kd0817db4 + t117;
+  const T t160 = -ke2477e11 + t115;
+  const T t161 = -k05f44240 + t114;
+  const T t162 = 1.0/t119;
+  const T t163 = t118*t162;
+  const T t164 = -t118*t163 + t159;
+  const T t165 = -t116*t163 + t160;
+  const T t166 = -kfe1ec95e*t163;
+  const T t167 = bus_S0_z + kda3b4caa*t163;
+  const T t168 = t116*t162;
+  const T t169 = -t116*t168 + t161;
+  const T t170 = -bus_S0_z - kfe1ec95e*t168;
+  const T t171 = kda3b4caa*t168;
+  const T t172 = kfe1ec95e*t162;
+  const T t173 = kfd32cd94 - kfe1ec95e*t172;
+  const T t174 = kda3b4caa*t172;
+  const T t175 = -kda3b4caa*t162;
+  const T t176 = kda3b4caa*t175 + kfd32cd94;
+  const T t177 = 1.0/t164;
+  const T t178 = t165*t177;
+  const T t179 = -t165*t178 + t169;
+  const T t180 = kda3b4caa + kfe1ec95e*t178;
+  const T t181 = -t166*t178 + t170;
+  const T t182 = -t167*t178 + t171;
+  const T t183 = -kfe1ec95e*t177;
+  const T t184 = kfd32cd94 + kfe1ec95e*t183;
+  const T t185 = -t166*t183;
+  const T t186 = -t167*t183;
+  const T t187 = t166*t177;
+  const T t188 = -t166*t187 + t173;
+  const T t189 = -t167*t187 + t174;
+  const T t190 = t167*t177;
+  const T t191 = -t167*t190 + t176;
+  const T t192 = 1.0/t179;
+  const T t193 = t180*t192;
+  const T t194 = -t180*t193 + t184;
+  const T t195 = -t181*t193 + t185;
+  const T t196 = -t182*t193 + t186;
+  const T t197 = t181*t192;
+  const T t198 = -t181*t197 + t188;
+  const T t199 = -t182*t197 + t189;
+  const T t200 = t182*t192;
+  const T t201 = -t182*t200 + t191;
+  const T t202 = 1.0/t194;
+  const T t203 = t195*t202;
+  const T t204 = -t195*t203 + t198;
+  const T t205 = -t196*t203 + t199;
+  const T t206 = t196*t202;
+  const T t207 = -t196*t206 + t201;
+  const T t208 = 1.0/t204;
+  const T t209 = t205*t208;
+  const T t210 = -t205*t209 + t207;
+  const T t212 = -kcf881ceb*t132 + t157;
+  const T t213 = -k4ab06a8f*t132 + t156;
+  const T t214 = -t158*t163 + t212;
+  const T t215 = -t158*t168 + t213;
+  const T t216 = t154 - t158*t172;
+  const T t217 = t153 - t158*t175;
+  const T t218 = -t178*t214 + t215;
+  const T t219 = t155 - t183*t214;
+  const T t220 = -t187*t214 + t216;
+  const T t221 = -t190*t214 + t217;
+  const T t222 = -t193*t218 + t219;
+  const T t223 = -t197*t218 + t220;
+  const T t224 = -t200*t218 + t221;
+  const T t225 = -t203*t222 + t223;
+  const T t226 = -t206*t222 + t224;
+  const T t227 = -t209*t225 + t226;
+  const T t228 = t227/t210;
+  const T t229 = t225/t204;
+  const T t230 = t222/t194;
+  const T t231 = t218/t179;
+  const T t232 = t214/t164;
+  const T t233 = t158/t119;
+  const T t234 = k70ce114d*t132;
+  const T t235 = -t209*t228 + t229;
+  const T t236 = -t203*t235 + t230;
+  const T t237 = -t206*t228 + t236;
+  const T t238 = -t193*t237 + t231;
+  const T t239 = -t197*t235 + t238;
+  const T t240 = -t200*t228 + t239;
+  const T t241 = -t178*t240 + t232;
+  const T t242 = -t183*t237 + t241;
+  const T t243 = -t187*t235 + t242;
+  const T t244 = -t190*t228 + t243;
+  const T t245 = -t163*t244 + t233;
+  const T t246 = -t168*t240 + t245;
+  const T t247 = -t172*t235 + t246;
+  const T t248 = -t175*t228 + t247;
+  const T t249 = -kcf881ceb*t244 + t234;
+  const T t250 = -k4ab06a8f*t240 + t249;
+  if (!(t210 > 1e-14*kfd32cd94)) return 1;
+  if (!(t204 > 1e-14*kfd32cd94)) return 2;
+  if (!(t194 > 1e-14*kfd32cd94)) return 3;
+  if (!(t179 > 1e-14*t114)) return 4;
+  if (!(t164 > 1e-14*t117)) return 5;
+  if (!(t119 > 0.0)) return 6;
+  if (!(probe_J0_zz > 0.0)) return 7;
+  udot[0] = t228;
+  udot[1] = t235;
+  udot[2] = t237;
+  udot[3] = t240;
+  udot[4] = t244;
+  udot[5] = t248;
+  udot[6] = t250;
   return 0;
 }
 
@@ -649,84 +593,43 @@ template <class T>
 void energy(const T* q, const T* u, T* TV) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
-  // ---- body bus: outward pass (velocities)
-  const T t0 = (1.0/sqrt(q[3]*q[3] + q[4]*q[4] + q[5]*q[5] + q[6]*q[6]));
-  const T t1 = q[3]*t0;
-  const T t2 = q[4]*t0;
-  const T t3 = q[5]*t0;
-  const T t4 = q[6]*t0;
-  const T t5 = t2*t2;
-  const T t6 = t3*t3;
-  const T t7 = t4*t4;
-  const T t8 = t2*t3;
-  const T t9 = t2*t4;
-  const T t10 = t3*t4;
-  const T t11 = t1*t2;
-  const T t12 = t1*t3;
-  const T t13 = t1*t4;
-  const T t14 = 1.0 - 2.0*t6 - 2.0*t7;
-  const T t15 = -2.0*t13 + 2.0*t8;
-  const T t16 = 2.0*t12 + 2.0*t9;
-  const T t17 = 2.0*t13 + 2.0*t8;
-  const T t18 = 1.0 - 2.0*t5 - 2.0*t7;
-  const T t19 = 2.0*t10 - 2.0*t11;
-  const T t20 = -2.0*t12 + 2.0*t9;
-  const T t21 = 2.0*t10 + 2.0*t11;
-  const T t22 = 1.0 - 2.0*t5 - 2.0*t6;
-  const T t23 = t14*u[0] + t15*u[1] + t16*u[2];
-  const T t24 = t17*u[0] + t18*u[1] + t19*u[2];
-  const T t25 = t20*u[0] + t21*u[1] + t22*u[2];
-  const T t26 = t14*u[3] + t15*u[4] + t16*u[5];
-  const T t27 = t17*u[3] + t18*u[4] + t19*u[5];
-  const T t28 = t20*u[3] + t21*u[4] + t22*u[5];
-  const T w_B_bus_x = t14*t26 + t17*t27 + t20*t28;
-  const T w_B_bus_y = t15*t26 + t18*t27 + t21*t28;
-  const T w_B_bus_z = t16*t26 + t19*t27 + t22*t28;
-  const T v_O_B_bus_x = t14*t23 + t17*t24 + t20*t25;
-  const T v_O_B_bus_y = t15*t23 + t18*t24 + t21*t25;
-  const T v_O_B_bus_z = t16*t23 + t19*t24 + t22*t25;
   // ---- body probe: outward pass (velocities)
-  const T t41 = cos(q[7]);
-  const T t42 = sin(q[7]);
-  const T t43 = probe_R_PJ_xx*u[6];
-  const T t44 = probe_R_PJ_yx*u[6];
-  const T R_PB_probe_xy = probe_R_PJ_xy*t41;
-  const T R_PB_probe_xz = -probe_R_PJ_xy*t42;
-  const T R_PB_probe_yy = probe_R_PJ_yy*t41;
-  const T R_PB_probe_yz = -probe_R_PJ_yy*t42;
-  const T t64 = t43 + w_B_bus_x;
-  const T t65 = t44 + w_B_bus_y;
-  const T w_B_probe_x = probe_R_PJ_xx*t64 + probe_R_PJ_yx*t65;
-  const T w_B_probe_y = R_PB_probe_xy*t64 + R_PB_probe_yy*t65 + t42*w_B_bus_z;
-  const T w_B_probe_z = R_PB_probe_xz*t64 + R_PB_probe_yz*t65 + t41*w_B_bus_z;
-  const T t69 = -probe_p_PJ_y*w_B_bus_z;
-  const T t70 = probe_p_PJ_x*w_B_bus_z;
-  const T t71 = -probe_p_PJ_x*w_B_bus_y + probe_p_PJ_y*w_B_bus_x;
-  const T t72 = t69 + v_O_B_bus_x;
-  const T t73 = t70 + v_O_B_bus_y;
-  const T t74 = t71 + v_O_B_bus_z;
-  const T v_O_B_probe_x = probe_R_PJ_xx*t72 + probe_R_PJ_yx*t73;
-  const T v_O_B_probe_y = R_PB_probe_xy*t72 + R_PB_probe_yy*t73 + t42*t74;
-  const T v_O_B_probe_z = R_PB_probe_xz*t72 + R_PB_probe_yz*t73 + t41*t74;
+  const T t26 = cos(q[7]);
+  const T t27 = sin(q[7]);
+  const T t47 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
+  const T t48 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
+  const T t49 = -probe_p_J_y*t48 + probe_p_J_z*t47;
+  const T t50 = -probe_p_J_z*u[5];
+  const T t51 = probe_p_J_y*u[5];
+  const T t52 = probe_R_PJ_xy*u[0] + probe_R_PJ_yy*u[1];
+  const T t53 = probe_R_PJ_xz*u[0] + probe_R_PJ_yz*u[1];
+  const T t54 = t49 + u[2];
+  const T t55 = t50 + t52;
+  const T t56 = t51 + t53;
+  const T t65 = t26*u[5] + t27*t47;
+  const T t66 = t26*t47 - t27*u[5];
+  const T w_B_probe_z = t48 + u[6];
+  const T t68 = t26*t54 + t27*t55;
+  const T t69 = t26*t55 - t27*t54;
   // ---- body probe: mass and velocity terms
-  const T t110 = probe_J0_xx*w_B_probe_x;
-  const T t116 = -bus_S0_y*w_B_bus_z + bus_S0_z*w_B_bus_y + bus_mass*v_O_B_bus_x;
-  const T t117 = bus_S0_x*w_B_bus_z - bus_S0_z*w_B_bus_x + bus_mass*v_O_B_bus_y;
-  const T t118 = -bus_S0_x*w_B_bus_y + bus_S0_y*w_B_bus_x + bus_mass*v_O_B_bus_z;
-  const T t119 = bus_J0_xx*w_B_bus_x + bus_J0_xy*w_B_bus_y + bus_J0_xz*w_B_bus_z + bus_S0_y*v_O_B_bus_z - bus_S0_z*v_O_B_bus_y;
-  const T t120 = bus_J0_xy*w_B_bus_x + bus_J0_yy*w_B_bus_y + bus_J0_yz*w_B_bus_z - bus_S0_x*v_O_B_bus_z + bus_S0_z*v_O_B_bus_x;
-  const T t121 = bus_J0_xz*w_B_bus_x + bus_J0_yz*w_B_bus_y + bus_J0_zz*w_B_bus_z + bus_S0_x*v_O_B_bus_y - bus_S0_y*v_O_B_bus_x;
-  const T t122 = t116*v_O_B_bus_x + t117*v_O_B_bus_y + t118*v_O_B_bus_z + t119*w_B_bus_x + t120*w_B_bus_y + t121*w_B_bus_z;
-  const T t123 = probe_mass*v_O_B_probe_x;
-  const T t124 = probe_S0_x*w_B_probe_z + probe_mass*v_O_B_probe_y;
-  const T t125 = -probe_S0_x*w_B_probe_y + probe_mass*v_O_B_probe_z;
-  const T t126 = probe_J0_yy*w_B_probe_y - probe_S0_x*v_O_B_probe_z;
-  const T t127 = probe_J0_zz*w_B_probe_z + probe_S0_x*v_O_B_probe_y;
-  const T t128 = t110*w_B_probe_x + t123*v_O_B_probe_x + t124*v_O_B_probe_y + t125*v_O_B_probe_z + t126*w_B_probe_y + t127*w_B_probe_z;
-  const T t129 = t122/2.0 + t128/2.0;
-  const T t130 = probe_k*q[7]*q[7]/2.0;
-  TV[0] = t129;
-  TV[1] = t130;
+  const T t94 = probe_J0_zz*w_B_probe_z;
+  const T t98 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
+  const T t99 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
+  const T t100 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
+  const T t101 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5] + bus_S0_y*u[2] - bus_S0_z*u[1];
+  const T t102 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5] - bus_S0_x*u[2] + bus_S0_z*u[0];
+  const T t103 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5] + bus_S0_x*u[1] - bus_S0_y*u[0];
+  const T t104 = t100*u[2] + t101*u[3] + t102*u[4] + t103*u[5] + t98*u[0] + t99*u[1];
+  const T t105 = probe_S0_z*t66 + probe_mass*t68;
+  const T t106 = -probe_S0_z*t65 + probe_mass*t69;
+  const T t107 = probe_mass*t56;
+  const T t108 = probe_J0_xx*t65 - probe_S0_z*t69;
+  const T t109 = probe_J0_yy*t66 + probe_S0_z*t68;
+  const T t110 = t105*t68 + t106*t69 + t107*t56 + t108*t65 + t109*t66 + t94*w_B_probe_z;
+  const T t111 = t104/2.0 + t110/2.0;
+  const T t112 = probe_k*q[7]*q[7]/2.0;
+  TV[0] = t111;
+  TV[1] = t112;
 }
 
 // ---- momentum: p_N[3], H_N[3] about N's origin ---------------------------------
@@ -758,105 +661,92 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t20 = -2.0*t12 + 2.0*t9;
   const T t21 = 2.0*t10 + 2.0*t11;
   const T t22 = 1.0 - 2.0*t5 - 2.0*t6;
-  const T t23 = t14*u[0] + t15*u[1] + t16*u[2];
-  const T t24 = t17*u[0] + t18*u[1] + t19*u[2];
-  const T t25 = t20*u[0] + t21*u[1] + t22*u[2];
-  const T t26 = t14*u[3] + t15*u[4] + t16*u[5];
-  const T t27 = t17*u[3] + t18*u[4] + t19*u[5];
-  const T t28 = t20*u[3] + t21*u[4] + t22*u[5];
-  const T w_B_bus_x = t14*t26 + t17*t27 + t20*t28;
-  const T w_B_bus_y = t15*t26 + t18*t27 + t21*t28;
-  const T w_B_bus_z = t16*t26 + t19*t27 + t22*t28;
-  const T v_O_B_bus_x = t14*t23 + t17*t24 + t20*t25;
-  const T v_O_B_bus_y = t15*t23 + t18*t24 + t21*t25;
-  const T v_O_B_bus_z = t16*t23 + t19*t24 + t22*t25;
   // ---- body probe: outward pass (velocities)
-  const T t41 = cos(q[7]);
-  const T t42 = sin(q[7]);
-  const T t43 = probe_R_PJ_xx*u[6];
-  const T t44 = probe_R_PJ_yx*u[6];
-  const T R_PB_probe_xy = probe_R_PJ_xy*t41;
-  const T R_PB_probe_xz = -probe_R_PJ_xy*t42;
-  const T R_PB_probe_yy = probe_R_PJ_yy*t41;
-  const T R_PB_probe_yz = -probe_R_PJ_yy*t42;
-  const T R_NB_probe_xx = probe_R_PJ_xx*t14 + probe_R_PJ_yx*t15;
-  const T R_NB_probe_xy = R_PB_probe_xy*t14 + R_PB_probe_yy*t15 + t16*t42;
-  const T R_NB_probe_xz = R_PB_probe_xz*t14 + R_PB_probe_yz*t15 + t16*t41;
-  const T R_NB_probe_yx = probe_R_PJ_xx*t17 + probe_R_PJ_yx*t18;
-  const T R_NB_probe_yy = R_PB_probe_xy*t17 + R_PB_probe_yy*t18 + t19*t42;
-  const T R_NB_probe_yz = R_PB_probe_xz*t17 + R_PB_probe_yz*t18 + t19*t41;
-  const T R_NB_probe_zx = probe_R_PJ_xx*t20 + probe_R_PJ_yx*t21;
-  const T R_NB_probe_zy = R_PB_probe_xy*t20 + R_PB_probe_yy*t21 + t22*t42;
-  const T R_NB_probe_zz = R_PB_probe_xz*t20 + R_PB_probe_yz*t21 + t22*t41;
-  const T t58 = probe_p_PJ_x*t14 + probe_p_PJ_y*t15;
-  const T t59 = probe_p_PJ_x*t17 + probe_p_PJ_y*t18;
-  const T t60 = probe_p_PJ_x*t20 + probe_p_PJ_y*t21;
-  const T r_NO_N_probe_x = q[0] + t58;
-  const T r_NO_N_probe_y = q[1] + t59;
-  const T r_NO_N_probe_z = q[2] + t60;
-  const T t64 = t43 + w_B_bus_x;
-  const T t65 = t44 + w_B_bus_y;
-  const T w_B_probe_x = probe_R_PJ_xx*t64 + probe_R_PJ_yx*t65;
-  const T w_B_probe_y = R_PB_probe_xy*t64 + R_PB_probe_yy*t65 + t42*w_B_bus_z;
-  const T w_B_probe_z = R_PB_probe_xz*t64 + R_PB_probe_yz*t65 + t41*w_B_bus_z;
-  const T t69 = -probe_p_PJ_y*w_B_bus_z;
-  const T t70 = probe_p_PJ_x*w_B_bus_z;
-  const T t71 = -probe_p_PJ_x*w_B_bus_y + probe_p_PJ_y*w_B_bus_x;
-  const T t72 = t69 + v_O_B_bus_x;
-  const T t73 = t70 + v_O_B_bus_y;
-  const T t74 = t71 + v_O_B_bus_z;
-  const T v_O_B_probe_x = probe_R_PJ_xx*t72 + probe_R_PJ_yx*t73;
-  const T v_O_B_probe_y = R_PB_probe_xy*t72 + R_PB_probe_yy*t73 + t42*t74;
-  const T v_O_B_probe_z = R_PB_probe_xz*t72 + R_PB_probe_yz*t73 + t41*t74;
+  const T t26 = cos(q[7]);
+  const T t27 = sin(q[7]);
+  const T R_PB_probe_xx = probe_R_PJ_xy*t27;
+  const T R_PB_probe_xy = probe_R_PJ_xy*t26;
+  const T R_PB_probe_yx = probe_R_PJ_yy*t27;
+  const T R_PB_probe_yy = probe_R_PJ_yy*t26;
+  const T R_NB_probe_xx = R_PB_probe_xx*t14 + R_PB_probe_yx*t15 + t16*t26;
+  const T R_NB_probe_xy = R_PB_probe_xy*t14 + R_PB_probe_yy*t15 - t16*t27;
+  const T R_NB_probe_xz = probe_R_PJ_xz*t14 + probe_R_PJ_yz*t15;
+  const T R_NB_probe_yx = R_PB_probe_xx*t17 + R_PB_probe_yx*t18 + t19*t26;
+  const T R_NB_probe_yy = R_PB_probe_xy*t17 + R_PB_probe_yy*t18 - t19*t27;
+  const T R_NB_probe_yz = probe_R_PJ_xz*t17 + probe_R_PJ_yz*t18;
+  const T R_NB_probe_zx = R_PB_probe_xx*t20 + R_PB_probe_yx*t21 + t22*t26;
+  const T R_NB_probe_zy = R_PB_probe_xy*t20 + R_PB_probe_yy*t21 - t22*t27;
+  const T R_NB_probe_zz = probe_R_PJ_xz*t20 + probe_R_PJ_yz*t21;
+  const T t41 = probe_p_PJ_x*t14 + probe_p_PJ_y*t15;
+  const T t42 = probe_p_PJ_x*t17 + probe_p_PJ_y*t18;
+  const T t43 = probe_p_PJ_x*t20 + probe_p_PJ_y*t21;
+  const T r_NO_N_probe_x = q[0] + t41;
+  const T r_NO_N_probe_y = q[1] + t42;
+  const T r_NO_N_probe_z = q[2] + t43;
+  const T t47 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
+  const T t48 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
+  const T t49 = -probe_p_J_y*t48 + probe_p_J_z*t47;
+  const T t50 = -probe_p_J_z*u[5];
+  const T t51 = probe_p_J_y*u[5];
+  const T t52 = probe_R_PJ_xy*u[0] + probe_R_PJ_yy*u[1];
+  const T t53 = probe_R_PJ_xz*u[0] + probe_R_PJ_yz*u[1];
+  const T t54 = t49 + u[2];
+  const T t55 = t50 + t52;
+  const T t56 = t51 + t53;
+  const T t65 = t26*u[5] + t27*t47;
+  const T t66 = t26*t47 - t27*u[5];
+  const T w_B_probe_z = t48 + u[6];
+  const T t68 = t26*t54 + t27*t55;
+  const T t69 = t26*t55 - t27*t54;
   // ---- body probe: mass and velocity terms
-  const T t110 = probe_J0_xx*w_B_probe_x;
-  const T t116 = -bus_S0_y*w_B_bus_z + bus_S0_z*w_B_bus_y + bus_mass*v_O_B_bus_x;
-  const T t117 = bus_S0_x*w_B_bus_z - bus_S0_z*w_B_bus_x + bus_mass*v_O_B_bus_y;
-  const T t118 = -bus_S0_x*w_B_bus_y + bus_S0_y*w_B_bus_x + bus_mass*v_O_B_bus_z;
-  const T t119 = bus_J0_xx*w_B_bus_x + bus_J0_xy*w_B_bus_y + bus_J0_xz*w_B_bus_z + bus_S0_y*v_O_B_bus_z - bus_S0_z*v_O_B_bus_y;
-  const T t120 = bus_J0_xy*w_B_bus_x + bus_J0_yy*w_B_bus_y + bus_J0_yz*w_B_bus_z - bus_S0_x*v_O_B_bus_z + bus_S0_z*v_O_B_bus_x;
-  const T t121 = bus_J0_xz*w_B_bus_x + bus_J0_yz*w_B_bus_y + bus_J0_zz*w_B_bus_z + bus_S0_x*v_O_B_bus_y - bus_S0_y*v_O_B_bus_x;
-  const T t122 = t116*t14 + t117*t15 + t118*t16;
-  const T t123 = t116*t17 + t117*t18 + t118*t19;
-  const T t124 = t116*t20 + t117*t21 + t118*t22;
-  const T t125 = t119*t14 + t120*t15 + t121*t16;
-  const T t126 = t119*t17 + t120*t18 + t121*t19;
-  const T t127 = t119*t20 + t120*t21 + t121*t22;
-  const T t128 = q[1]*t124 - q[2]*t123;
-  const T t129 = -q[0]*t124 + q[2]*t122;
-  const T t130 = q[0]*t123 - q[1]*t122;
+  const T t94 = probe_J0_zz*w_B_probe_z;
+  const T t98 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
+  const T t99 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
+  const T t100 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
+  const T t101 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5] + bus_S0_y*u[2] - bus_S0_z*u[1];
+  const T t102 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5] - bus_S0_x*u[2] + bus_S0_z*u[0];
+  const T t103 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5] + bus_S0_x*u[1] - bus_S0_y*u[0];
+  const T t104 = t100*t16 + t14*t98 + t15*t99;
+  const T t105 = t100*t19 + t17*t98 + t18*t99;
+  const T t106 = t100*t22 + t20*t98 + t21*t99;
+  const T t107 = t101*t14 + t102*t15 + t103*t16;
+  const T t108 = t101*t17 + t102*t18 + t103*t19;
+  const T t109 = t101*t20 + t102*t21 + t103*t22;
+  const T t110 = q[1]*t106 - q[2]*t105;
+  const T t111 = -q[0]*t106 + q[2]*t104;
+  const T t112 = q[0]*t105 - q[1]*t104;
+  const T t113 = t107 + t110;
+  const T t114 = t108 + t111;
+  const T t115 = t109 + t112;
+  const T t116 = probe_S0_z*t66 + probe_mass*t68;
+  const T t117 = -probe_S0_z*t65 + probe_mass*t69;
+  const T t118 = probe_mass*t56;
+  const T t119 = probe_J0_xx*t65 - probe_S0_z*t69;
+  const T t120 = probe_J0_yy*t66 + probe_S0_z*t68;
+  const T t121 = R_NB_probe_xx*t116 + R_NB_probe_xy*t117 + R_NB_probe_xz*t118;
+  const T t122 = R_NB_probe_yx*t116 + R_NB_probe_yy*t117 + R_NB_probe_yz*t118;
+  const T t123 = R_NB_probe_zx*t116 + R_NB_probe_zy*t117 + R_NB_probe_zz*t118;
+  const T t124 = R_NB_probe_xx*t119 + R_NB_probe_xy*t120 + R_NB_probe_xz*t94;
+  const T t125 = R_NB_probe_yx*t119 + R_NB_probe_yy*t120 + R_NB_probe_yz*t94;
+  const T t126 = R_NB_probe_zx*t119 + R_NB_probe_zy*t120 + R_NB_probe_zz*t94;
+  const T t127 = r_NO_N_probe_y*t123 - r_NO_N_probe_z*t122;
+  const T t128 = -r_NO_N_probe_x*t123 + r_NO_N_probe_z*t121;
+  const T t129 = r_NO_N_probe_x*t122 - r_NO_N_probe_y*t121;
+  const T t130 = t124 + t127;
   const T t131 = t125 + t128;
   const T t132 = t126 + t129;
-  const T t133 = t127 + t130;
-  const T t134 = probe_mass*v_O_B_probe_x;
-  const T t135 = probe_S0_x*w_B_probe_z + probe_mass*v_O_B_probe_y;
-  const T t136 = -probe_S0_x*w_B_probe_y + probe_mass*v_O_B_probe_z;
-  const T t137 = probe_J0_yy*w_B_probe_y - probe_S0_x*v_O_B_probe_z;
-  const T t138 = probe_J0_zz*w_B_probe_z + probe_S0_x*v_O_B_probe_y;
-  const T t139 = R_NB_probe_xx*t134 + R_NB_probe_xy*t135 + R_NB_probe_xz*t136;
-  const T t140 = R_NB_probe_yx*t134 + R_NB_probe_yy*t135 + R_NB_probe_yz*t136;
-  const T t141 = R_NB_probe_zx*t134 + R_NB_probe_zy*t135 + R_NB_probe_zz*t136;
-  const T t142 = R_NB_probe_xx*t110 + R_NB_probe_xy*t137 + R_NB_probe_xz*t138;
-  const T t143 = R_NB_probe_yx*t110 + R_NB_probe_yy*t137 + R_NB_probe_yz*t138;
-  const T t144 = R_NB_probe_zx*t110 + R_NB_probe_zy*t137 + R_NB_probe_zz*t138;
-  const T t145 = r_NO_N_probe_y*t141 - r_NO_N_probe_z*t140;
-  const T t146 = -r_NO_N_probe_x*t141 + r_NO_N_probe_z*t139;
-  const T t147 = r_NO_N_probe_x*t140 - r_NO_N_probe_y*t139;
-  const T t148 = t142 + t145;
-  const T t149 = t143 + t146;
-  const T t150 = t144 + t147;
-  const T t151 = t122 + t139;
-  const T t152 = t123 + t140;
-  const T t153 = t124 + t141;
-  const T t154 = t131 + t148;
-  const T t155 = t132 + t149;
-  const T t156 = t133 + t150;
-  pH[0] = t151;
-  pH[1] = t152;
-  pH[2] = t153;
-  pH[3] = t154;
-  pH[4] = t155;
-  pH[5] = t156;
+  const T t133 = t104 + t121;
+  const T t134 = t105 + t122;
+  const T t135 = t106 + t123;
+  const T t136 = t113 + t130;
+  const T t137 = t114 + t131;
+  const T t138 = t115 + t132;
+  pH[0] = t133;
+  pH[1] = t134;
+  pH[2] = t135;
+  pH[3] = t136;
+  pH[4] = t137;
+  pH[5] = t138;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

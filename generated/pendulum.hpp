@@ -20,7 +20,7 @@
 //   udot               3 (1 add, 1 mul, 0 div, 1 func) -- composite form; composite 3, articulated 3
 //   energy             4 (0 add, 2 mul, 1 div, 1 func)
 //   momentum           4 (0 add, 2 mul, 0 div, 2 func)
-//   reactions          8 (3 add, 3 mul, 0 div, 2 func)
+//   reactions          7 (2 add, 3 mul, 0 div, 2 func)
 
 #pragma once
 
@@ -37,6 +37,7 @@ inline constexpr char model_hash[] = "434c49a01ab15824";
 // ---- model constants (SI units) ---------------------------------------------
 // model
 inline constexpr double gravity_z = -9.81;  // gravity in N z [m/s^2]
+inline constexpr double minus_gravity_z = 9.81;  // -gravity in N: the ground's fictitious acceleration z [m/s^2]
 
 
 // ---- dual numbers for jacobian() ---------------------------------------------
@@ -61,6 +62,7 @@ template <int W> inline Dual<W> operator*(double a, const Dual<W>& b) { return b
 template <int W> inline Dual<W> operator/(const Dual<W>& a, double b) { return a * (1.0 / b); }
 template <int W> inline Dual<W> operator/(double a, const Dual<W>& b) { Dual<W> r; r.v = a / b.v; const double f = -r.v / b.v; for (int i = 0; i < W; ++i) r.d[i] = f * b.d[i]; return r; }
 template <int W> inline bool operator>(const Dual<W>& a, double b) { return a.v > b; }
+template <int W> inline bool operator>(const Dual<W>& a, const Dual<W>& b) { return a.v > b.v; }
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }
@@ -88,9 +90,9 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   (void)q; (void)u; (void)tau;
   // ---- body bob: outward pass (velocities)
   const T t0 = cos(q[0]);
-  // ---- body bob: mass and velocity terms
-  const T g_B_bob_z = gravity_z*t0;
-  const T t6 = -g_B_bob_z + tau[0];
+  const T t3 = -minus_gravity_z*t0;
+  // ---- body bob: generalized forces (inward)
+  const T t6 = -t3 + tau[0];
   F[0] = t6;
 }
 
@@ -102,9 +104,9 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   (void)q; (void)u; (void)tau;
   // ---- body bob: outward pass (velocities)
   const T t0 = cos(q[0]);
-  // ---- body bob: mass and velocity terms
-  const T g_B_bob_z = gravity_z*t0;
-  const T t6 = -g_B_bob_z + tau[0];
+  const T t3 = -minus_gravity_z*t0;
+  // ---- body bob: generalized forces (inward)
+  const T t6 = -t3 + tau[0];
   udot[0] = t6;
   return 0;
 }
@@ -150,18 +152,17 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   // ---- body bob: outward pass (velocities)
   const T t0 = cos(q[0]);
   const T t1 = sin(q[0]);
+  const T t2 = -minus_gravity_z*t1;
+  const T t3 = -minus_gravity_z*t0;
   // ---- body bob: mass and velocity terms
-  const T g_B_bob_x = -gravity_z*t1;
-  const T g_B_bob_z = gravity_z*t0;
   const T t4 = -u[0]*u[0];
-  const T t5 = -g_B_bob_x + t4;
-  const T t6 = -g_B_bob_z - udot_in[0];
-  const T t7 = g_B_bob_z + udot_in[0];
+  const T t5 = t2 + t4;
+  const T t6 = t3 + udot_in[0];
   wrenches[0] = t5;
   wrenches[1] = 0.0;
-  wrenches[2] = t6;
+  wrenches[2] = -t6;
   wrenches[3] = 0.0;
-  wrenches[4] = t7;
+  wrenches[4] = t6;
   wrenches[5] = 0.0;
 }
 

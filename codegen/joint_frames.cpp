@@ -1,0 +1,107 @@
+#include "codegen/joint_frames.hpp"
+
+#include <cmath>
+
+namespace kanegen::codegen {
+
+namespace {
+
+/// A body whose frame the generator may re-choose: rigid (a flexible body's
+/// modal data are given in its frame) on a revolute or prismatic joint.
+bool reframable(const Body& b) {
+  return !b.flex && (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic);
+}
+
+/// A unit vector perpendicular to unit z: `hint`'s component across z when it
+/// has one, else the model axis least aligned with z crossed with z.
+Vec3 perpendicular(const Vec3& z, const Vec3& hint) {
+  const Vec3 h = hint - z * z.dot(hint);
+  if (h.norm() > 1e-9 * std::max(1.0, hint.norm())) return h.normalized();
+  Eigen::Index k = 0;
+  z.cwiseAbs().minCoeff(&k);
+  return z.cross(Vec3::Unit(k)).normalized();
+}
+
+Mat3 rot_x(double a) {
+  Mat3 R = Mat3::Identity();
+  const double c = std::cos(a), s = std::sin(a);
+  R(1, 1) = c, R(1, 2) = -s, R(2, 1) = s, R(2, 2) = c;
+  return R;
+}
+
+}  // namespace
+
+FramedModel keep_joint_frames(const Model& model) {
+  FramedModel f{model, std::vector<Mat3>(model.bodies.size(), Mat3::Identity()),
+                std::vector<double>(model.bodies.size(), 0.0)};
+  return f;
+}
+
+FramedModel choose_joint_frames(const Model& in) {
+  const int nb = static_cast<int>(in.bodies.size());
+  FramedModel out = keep_joint_frames(in);
+  // subtree sizes, to pick each body's main child (the one with most descendants)
+  std::vector<int> size(nb, 1);
+  for (int j = nb - 1; j >= 0; --j)
+    if (in.bodies[j].parent >= 0) size[in.bodies[j].parent] += size[j];
+  std::vector<int> main_child(nb, -1);
+  for (int j = 0; j < nb; ++j) {
+    const int p = in.bodies[j].parent;
+    if (p < 0 || !reframable(in.bodies[j])) continue;
+    if (main_child[p] < 0 || size[j] > size[main_child[p]]) main_child[p] = j;
+  }
+
+  // 1. The new frames: z along the joint axis, x along the common normal to
+  //    the main child's axis (or across the centre of mass when there is none).
+  for (int j = 0; j < nb; ++j) {
+    const Body& b = in.bodies[j];
+    if (!reframable(b)) continue;
+    const Vec3 z = b.joint.axis_J.normalized();  // in B (= J at q = 0)
+    Vec3 x;
+    if (const int c = main_child[j]; c >= 0) {
+      const Body& cb = in.bodies[c];
+      const Vec3 a_c = cb.joint.R_PJ * cb.joint.axis_J;  // the child's axis in B
+      const Vec3 n = z.cross(a_c);
+      x = n.norm() > 1e-9 ? Vec3(n.normalized()) : perpendicular(z, cb.joint.p_PJ);
+    } else {
+      x = perpendicular(z, b.rigid.com_B);
+    }
+    Mat3 Q;
+    Q.col(0) = x;
+    Q.col(1) = z.cross(x);
+    Q.col(2) = z;
+    out.R_BBp[j] = Q;
+  }
+
+  // 2. Everything given in a body's frame, re-expressed in B'.
+  for (int j = 0; j < nb; ++j) {
+    const Body& b = in.bodies[j];
+    Body& o = out.model.bodies[j];
+    const Mat3& Q = out.R_BBp[j];
+    const Mat3 Qp = b.parent >= 0 ? out.R_BBp[b.parent] : Mat3::Identity();
+    o.joint.R_PJ = Qp.transpose() * b.joint.R_PJ * Q;
+    o.joint.p_PJ = Qp.transpose() * b.joint.p_PJ;
+    if (reframable(b)) o.joint.axis_J = Vec3::UnitZ();
+    o.rigid.com_B = Q.transpose() * b.rigid.com_B;
+    o.rigid.I_c_B = Q.transpose() * b.rigid.I_c_B * Q;
+    o.rigid.I_c_B = 0.5 * (o.rigid.I_c_B + o.rigid.I_c_B.transpose()).eval();
+    // Denavit-Hartenberg: when the parent's x axis is normal to this revolute
+    // axis, R_PJ = Rx(alpha) Rz(delta), and Rz(delta) joins the joint rotation.
+    const Mat3& C = o.joint.R_PJ;
+    if (reframable(b) && b.joint.type == JointType::revolute && b.parent >= 0 && reframable(in.bodies[b.parent]) &&
+        std::abs(C(0, 2)) < 1e-12) {
+      const double alpha = std::atan2(-C(1, 2), C(2, 2));
+      const Mat3 Rz = rot_x(alpha).transpose() * C;
+      out.angle_offset[j] = std::atan2(Rz(1, 0), Rz(0, 0));
+      o.joint.R_PJ = rot_x(alpha);
+    }
+    snap_roundoff_residues(o);
+  }
+  const VecX q0 = in.q0, u0 = in.u0;
+  finalize_model(out.model);
+  out.model.q0 = q0;
+  out.model.u0 = u0;
+  return out;
+}
+
+}  // namespace kanegen::codegen
