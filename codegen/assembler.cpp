@@ -86,8 +86,33 @@ std::string call_arguments(const EmittedFunction& f) {
   return join(as, ", ");
 }
 
+/// Argument names of f, in order (the output array's too), for the calls of its parts.
+std::string argument_names(const EmittedFunction& f) {
+  std::vector<std::string> as;
+  for (Arg a : f.args) as.push_back(a == Arg::out ? f.out_name : arg_name(a));
+  return join(as, ", ");
+}
+
+/// The helper functions of a function emitted in parts.
+std::string parts_text(const EmittedFunction& f) {
+  std::string s;
+  std::vector<std::string> unused;
+  for (Arg a : f.args)
+    if (a != Arg::out) unused.push_back(fmt::format("(void){};", arg_name(a)));
+  for (std::size_t i = 0; i < f.parts.size(); ++i) {
+    s += fmt::format("\n// {}, part {} of {}\ntemplate <class T>\nKANEGEN_NOINLINE void {}_part{}({}, T* w) {{\n",
+                     f.name, i + 1, f.parts.size() + 1, f.name, i, parameters(f));
+    s += "  using std::cos; using std::sin; using std::sqrt;\n";
+    s += "  " + join(unused, " ") + " (void)" + f.out_name + "; (void)w;\n";
+    s += f.parts[i];
+    s += "}\n";
+  }
+  return s;
+}
+
 std::string function_text(const EmittedFunction& f) {
   std::string s = fmt::format("\n// ---- {} {}\n", f.title, std::string(f.title.size() < 74 ? 74 - f.title.size() : 3, '-'));
+  if (!f.parts.empty()) s += parts_text(f) + "\n";
   s += f.note;
   if (f.templated) s += "template <class T>\n";
   s += fmt::format("{}{} {}({}) {{\n", f.templated ? "" : "inline ", f.returns_status ? "int" : "void", f.name,
@@ -97,6 +122,13 @@ std::string function_text(const EmittedFunction& f) {
   for (Arg a : f.args)
     if (a != Arg::out) unused.push_back(fmt::format("(void){};", arg_name(a)));
   if (!unused.empty() && f.templated) s += "  " + join(unused, " ") + "\n";
+  if (!f.parts.empty()) {
+    // the workspace: per thread, sized once
+    s += fmt::format("  thread_local std::vector<T> workspace;\n  workspace.resize({});\n  T* w = workspace.data();\n",
+                     std::max(1, f.workspace));
+    for (std::size_t i = 0; i < f.parts.size(); ++i)
+      s += fmt::format("  {}_part{}({}, w);\n", f.name, i, argument_names(f));
+  }
   s += f.body;
   if (f.returns_status && f.templated) s += "  return 0;\n";
   s += "}\n";

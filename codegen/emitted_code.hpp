@@ -40,6 +40,11 @@ struct EmittedFunction {
   bool returns_status = false;  ///< int: 0 or the 1-based speed of a non-positive pivot; else void
   bool templated = true;        ///< template <class T> (false: double only, e.g. jacobian)
   std::string body;             ///< C++ statements (indented)
+  /// Large functions: bodies of the helper functions NAME_part0, NAME_part1,
+  /// ... that `body` runs first (same parameters plus the workspace T* w of
+  /// `workspace` entries); empty for a function emitted in one piece.
+  std::vector<std::string> parts;
+  int workspace = 0;
   OpCount ops;
   std::string note;             ///< extra comment lines for the header section (may be empty)
 };

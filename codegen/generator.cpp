@@ -30,12 +30,19 @@ std::string body_comment(const Model& model, const Body& b) {
 }
 
 /// One function's Program, checked and printed into `f`.
-void finish(const Program& p, const Constants& C, EmittedFunction& f) {
+void finish(const Program& p, const Constants& C, EmittedFunction& f, const GeneratorOptions& options) {
   const std::set<std::string> constants = C.names();
   for (const std::string& n : p.names())
     if (constants.count(n))
       throw std::logic_error(fmt::format("generator: temporary '{}' would shadow a model constant", n));
   f.body = p.emit(kIndent, f.ops);
+  if (options.split_above > 0 && f.ops.total() > options.split_above && f.templated) {
+    OpCount ops;
+    ChunkedBody c = p.emit_chunked(kIndent, ops, options.part_ops);
+    f.body = std::move(c.main);
+    f.parts = std::move(c.parts);
+    f.workspace = c.workspace;
+  }
 }
 
 EmittedFunction function(std::string name, std::string title, std::vector<Arg> args, std::string out_name,
@@ -130,7 +137,10 @@ const char* generator_hash() { return KANEGEN_GENERATOR_HASH; }
 
 std::string generator_identity(const GeneratorOptions& options) {
   return std::string(generator_hash()) + (options.udot_form == "auto" ? "" : "-" + options.udot_form) +
-         (options.merge_fixed ? "" : "-unmerged") + (options.joint_frames ? "" : "-model-frames");
+         (options.merge_fixed ? "" : "-unmerged") + (options.joint_frames ? "" : "-model-frames") +
+         (options.split_above == GeneratorOptions{}.split_above && options.part_ops == GeneratorOptions{}.part_ops
+              ? ""
+              : fmt::format("-split{}-{}", options.split_above, options.part_ops));
 }
 
 const EmittedFunction* EmittedModel::find(const std::string& name) const {
@@ -175,7 +185,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     const auto qd = compute_qdot(ctx);
     for (int i = 0; i < dyn.nq; ++i) p.assign(fmt::format("qdot[{}]", i), qd[i]);
     EmittedFunction f = function("qdot", "q_dot = W(q) u", {Arg::q, Arg::u, Arg::out}, "qdot", dyn.nq);
-    finish(p, C, f);
+    finish(p, C, f, options);
     fns.push_back(std::move(f));
   }
   {
@@ -187,7 +197,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     for (int r = 0; r < dyn.nu; ++r)
       for (int c = 0; c < dyn.nu; ++c) p.assign(fmt::format("M[{}]", r * dyn.nu + c), M(r, c));
     EmittedFunction f = function("mass_matrix", "M(q), row-major", at_t({Arg::q, Arg::out}), "M", dyn.nu * dyn.nu);
-    finish(p, C, f);
+    finish(p, C, f, options);
     fns.push_back(std::move(f));
   }
   {
@@ -198,7 +208,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     const auto F = compute_forcing(ctx);
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("F[{}]", r), F[r]);
     EmittedFunction f = function("forcing", "F(q, u, tau)", at_t({Arg::q, Arg::u, Arg::tau, Arg::out}), "F", dyn.nu);
-    finish(p, C, f);
+    finish(p, C, f, options);
     fns.push_back(std::move(f));
   }
   // u_dot: the composite-inertia form (M by composite inertias, F by the
@@ -232,7 +242,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
                                  "u_dot: M u_dot = F (form chosen by operation count, see the counts above)",
                                  at_t({Arg::q, Arg::u, Arg::tau, Arg::out}), "udot", dyn.nu, true);
     f.note = "// Returns 0, or k if the pivot of speed k (1-based) is not positive (M singular).\n";
-    finish(p, C, f);
+    finish(p, C, f, options);
     (std::string(form) == "composite" ? out.udot_composite_ops : out.udot_articulated_ops) = f.ops;
     const bool forced = options.udot_form == form;
     const bool chosen_forced = options.udot_form != "auto" && !udot.name.empty();
@@ -253,7 +263,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     p.assign("TV[0]", compute_kinetic_energy(ctx));
     p.assign("TV[1]", compute_potential_energy(ctx));
     EmittedFunction f = function("energy", "energy: T, V", at_t({Arg::q, Arg::u, Arg::out}), "TV", 2);
-    finish(p, C, f);
+    finish(p, C, f, options);
     fns.push_back(std::move(f));
   }
   if (outs.momentum) {
@@ -265,7 +275,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     for (int i = 0; i < 6; ++i) p.assign(fmt::format("pH[{}]", i), pH[i]);
     EmittedFunction f =
         function("momentum", "momentum: p_N[3], H_N[3] about N's origin", at_t({Arg::q, Arg::u, Arg::out}), "pH", 6);
-    finish(p, C, f);
+    finish(p, C, f, options);
     fns.push_back(std::move(f));
   }
   if (outs.reactions) {  // on the unmerged tree: every body, fixed ones included
@@ -289,7 +299,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     EmittedFunction f =
         function("reactions", "reactions on each body from its parent: [force; torque about O_B], body axes",
                  at_t({Arg::q, Arg::u, Arg::udot_in, Arg::out}), "wrenches", 6 * out.nbodies);
-    finish(p, C, f);
+    finish(p, C, f, options);
     fns.push_back(std::move(f));
   }
   fns.push_back(jacobian_function(dyn.nq, dyn.nu, timed, qdot_ops, udot_ops));

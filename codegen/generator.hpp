@@ -15,6 +15,12 @@ struct GeneratorOptions {
   bool merge_fixed = true;         ///< merge rigid bodies on fixed joints into their parents
   std::string udot_form = "auto";  ///< "auto" (fewer operations), "composite" or "articulated"
   bool joint_frames = true;        ///< re-choose body frames along the joint axes (joint_frames.hpp)
+  /// A function of more operations than this is emitted as a sequence of
+  /// helper functions of about `part_ops` operations each (Program::
+  /// emit_chunked): compile time and memory then grow linearly with the
+  /// model (0: never split).
+  long split_above = 12000;
+  long part_ops = 3000;
 };
 
 EmittedModel generate(const Model& model, const GeneratorOptions& options = {});

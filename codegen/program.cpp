@@ -57,9 +57,8 @@ static void collect_symbols(const ex& e, std::set<std::string>& names) {
   for (std::size_t i = 0; i < e.nops(); ++i) collect_symbols(e.op(i), names);
 }
 
-std::string Program::emit(const std::string& indent, OpCount& ops) const {
-  // Liveness: walk temporaries backwards from the statements' needs.
-  std::set<std::string> needed;
+std::vector<bool> Program::liveness(std::set<std::string>& needed) const {
+  // walk temporaries backwards from the statements' needs
   for (const Stmt& s : stmts_) collect_symbols(s.value, needed);
   std::vector<bool> live(temps_.size(), false);
   for (std::size_t k = temps_.size(); k-- > 0;) {
@@ -68,6 +67,12 @@ std::string Program::emit(const std::string& indent, OpCount& ops) const {
       collect_symbols(temps_[k].value, needed);
     }
   }
+  return live;
+}
+
+std::string Program::emit(const std::string& indent, OpCount& ops) const {
+  std::set<std::string> needed;
+  const std::vector<bool> live = liveness(needed);
   std::string out;
   for (const Prelude& p : preludes_) {
     bool used = false;
@@ -93,6 +98,100 @@ std::string Program::emit(const std::string& indent, OpCount& ops) const {
     else
       out += fmt::format("{}{} = {};\n", indent, s.lhs, print_cpp(s.value, ops));
   }
+  return out;
+}
+
+ChunkedBody Program::emit_chunked(const std::string& indent, OpCount& ops, long max_chunk_ops) const {
+  std::set<std::string> needed;
+  const std::vector<bool> live = liveness(needed);
+  // 1. the live temporaries in order, their text, cost and chunk
+  struct Line {
+    std::size_t k;
+    std::string text;
+    int chunk;
+    const std::string* section;
+    const Stmt* output;  ///< an output assignment, or nullptr for temporary k
+  };
+  std::vector<Line> lines;
+  std::map<std::string, int> chunk_of;  // temporary -> chunk that defines it
+  int chunk = 0;
+  long in_chunk = 0;
+  const std::string* pending = nullptr;
+  for (std::size_t k = 0; k < temps_.size(); ++k) {
+    if (!temps_[k].section.empty()) {
+      pending = &temps_[k].section;
+      continue;
+    }
+    if (!live[k]) continue;
+    OpCount c;
+    std::string text = print_cpp(temps_[k].value, c);
+    ops += c;
+    if (in_chunk > 0 && in_chunk + c.total() > max_chunk_ops) ++chunk, in_chunk = 0;
+    in_chunk += c.total();
+    lines.push_back({k, std::move(text), chunk, pending, nullptr});
+    pending = nullptr;
+    chunk_of[temps_[k].sym.get_name()] = chunk;
+  }
+  // the outputs, in the same sequence of parts (the verbatim statements, which
+  // may return, stay in the function itself)
+  for (const Stmt& st : stmts_) {
+    if (st.lhs.empty()) continue;
+    OpCount c;
+    std::string text = print_cpp(st.value, c);
+    ops += c;
+    if (in_chunk > 0 && in_chunk + c.total() + 1 > max_chunk_ops) ++chunk, in_chunk = 0;
+    in_chunk += c.total() + 1;
+    lines.push_back({0, std::move(text), chunk, nullptr, &st});
+  }
+  const int last = chunk + 1;  // the verbatim statements form the last part (the function itself)
+  // 2. which temporaries cross a part boundary: they go through the workspace
+  std::map<std::string, int> slot;
+  std::vector<std::set<std::string>> loads(last + 1);  // per part: temporaries read from the workspace
+  auto uses = [&](const ex& e, int part) {
+    std::set<std::string> syms;
+    collect_symbols(e, syms);
+    for (const auto& n : syms) {
+      auto it = chunk_of.find(n);
+      if (it == chunk_of.end() || it->second == part) continue;
+      slot.emplace(n, static_cast<int>(slot.size()));
+      loads[part].insert(n);
+    }
+  };
+  for (const Line& l : lines) uses(l.output ? l.output->value : temps_[l.k].value, l.chunk);
+  for (const Stmt& s : stmts_)
+    if (s.lhs.empty()) uses(s.value, last);
+  // 3. the parts
+  std::string prelude;
+  for (const Prelude& p : preludes_) {
+    bool used = false;
+    for (const auto& d : p.defines) used = used || needed.count(d);
+    if (used) prelude += indent + p.text + "\n";
+  }
+  ChunkedBody out;
+  out.parts.assign(last, prelude);
+  std::string main = prelude;
+  auto load_text = [&](int part) {
+    std::string t;
+    for (const auto& n : loads[part]) t += fmt::format("{}const T {} = w[{}];\n", indent, n, slot.at(n));
+    return t;
+  };
+  for (int p = 0; p < last; ++p) out.parts[p] += load_text(p);
+  main += load_text(last);
+  for (const Line& l : lines) {
+    std::string& dst = out.parts[l.chunk];
+    if (l.output) {
+      dst += fmt::format("{}{} = {};\n", indent, l.output->lhs, l.text);
+      continue;
+    }
+    if (l.section) dst += fmt::format("{}// ---- {}\n", indent, *l.section);
+    const std::string& n = temps_[l.k].sym.get_name();
+    dst += fmt::format("{}const T {} = {};\n", indent, n, l.text);
+    if (auto it = slot.find(n); it != slot.end()) dst += fmt::format("{}w[{}] = {};\n", indent, it->second, n);
+  }
+  for (const Stmt& s : stmts_)
+    if (s.lhs.empty()) main += indent + s.text + "\n";
+  out.main = std::move(main);
+  out.workspace = static_cast<int>(slot.size());
   return out;
 }
 

@@ -25,6 +25,16 @@ namespace kanegen::codegen {
 
 using GiNaC::ex;
 
+/// A function body split into parts of bounded size (Program::emit_chunked):
+/// parts[i] are the bodies of helper functions called in order, which leave
+/// the temporaries later parts need in a workspace `w`; `main` reads them
+/// from there and holds the statements.
+struct ChunkedBody {
+  std::vector<std::string> parts;
+  std::string main;
+  int workspace = 0;  ///< number of workspace entries
+};
+
 class Program {
  public:
   /// Applied to every expression before it is bound or assigned (e.g. the
@@ -50,10 +60,16 @@ class Program {
   /// C++ body: temporaries that some output needs (dead ones dropped), in
   /// order, as `const T name = ...;`, then the outputs. Counts operations.
   std::string emit(const std::string& indent, OpCount& ops) const;
+  /// The same code in parts of at most about `max_chunk_ops` operations: the
+  /// compiler's time and memory on one straight-line function grow faster
+  /// than linearly with its length, on a sequence of short ones linearly.
+  ChunkedBody emit_chunked(const std::string& indent, OpCount& ops, long max_chunk_ops) const;
   /// Names of the temporaries bound so far.
   const std::set<std::string>& names() const { return names_; }
 
  private:
+  /// Which temporaries some statement needs; `needed` gets their symbols.
+  std::vector<bool> liveness(std::set<std::string>& needed) const;
   struct Temp {
     GiNaC::symbol sym;
     ex value;

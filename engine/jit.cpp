@@ -137,6 +137,9 @@ struct CompileStep {
 /// it takes minutes to compile.
 constexpr long kMaxJacobianUdotOps = 6000;
 
+/// Changes whenever plan_compile() chooses differently (part of the cache key).
+constexpr int kCompilePlanVersion = 2;
+
 /// The generated functions are compiled one per translation unit, in
 /// parallel, and linked. With the default flags each part gets an
 /// optimization level suited to its size (from the manifest's operation
@@ -150,6 +153,7 @@ std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out
   std::vector<std::string> flags;
   for (auto& f : split_words(o.flags))
     if (f != "-shared" && !(default_flags && f.rfind("-O", 0) == 0)) flags.push_back(f);
+  if (o.native) flags.push_back("-march=native");
   const std::string include = "-I" + o.include_dir;
   const ManifestFunction* udot = manifest.find("udot");
   const long udot_ops = udot ? udot->ops : 0;
@@ -184,7 +188,10 @@ std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out
       if (jacobian_left_out) continue;
       add(f.name, f.ops, udot_ops <= 1500 ? "-O2" : "-O1", {});
     } else {
-      add(f.name, f.ops, f.ops > 8000 ? "-O1" : "-O2", {});
+      // u-dot is the hot path: -O2 always (large ones come in parts of a few
+      // thousand operations, which -O2 compiles in linear time); the others
+      // at -O1 when large
+      add(f.name, f.ops, f.name == "udot" || f.ops <= 8000 ? "-O2" : "-O1", {});
     }
   }
   std::stable_sort(steps.begin(), steps.end(), [](const CompileStep& a, const CompileStep& b) { return a.cost > b.cost; });
@@ -391,8 +398,9 @@ std::string jit_cache_key(const Model& model, const std::string& generator_hash,
     std::sort(only.begin(), only.end());
     flags += "\nonly " + join_quoted(only);
   }
-  return fnv1a64_hex(fmt::format("{}\n{}\n{}\n{}\n{}", model_hash(model), KANEGEN_VERSION,
-                                 KANEGEN_GENERATED_API_VERSION, generator_hash, flags));
+  if (o.native) flags += "\nnative";
+  return fnv1a64_hex(fmt::format("{}\n{}\n{}\n{}\n{}\nplan {}", model_hash(model), KANEGEN_VERSION,
+                                 KANEGEN_GENERATED_API_VERSION, generator_hash, flags, kCompilePlanVersion));
 }
 
 std::string jit_library_path(const Model& model, const std::string& generator_hash, const JitOptions& opts) {

@@ -40,6 +40,10 @@ struct JitOptions {
   /// {"reactions"}: a build without the Jacobian and the invariants compiles faster.
   std::vector<std::string> only;
   bool only_set = false;    ///< whether `only` restricts the build (an empty list then means the four alone)
+  /// Compile for this machine's CPU (-march=native on every part): the
+  /// generated code runs 1.2-2x faster (FMA, wider registers), and only on
+  /// CPUs with the same instruction sets. Opt-in; part of the cache key.
+  bool native = false;
 };
 
 /// $KANEGEN_CACHE_DIR, else $XDG_CACHE_HOME/kanegen, else ~/.cache/kanegen.

@@ -24,6 +24,13 @@
 #pragma once
 
 #include <cmath>
+#include <vector>
+
+// Large functions are emitted in parts (helper functions of a few thousand
+// operations each): kept out of line so that the compiler sees short functions.
+#ifndef KANEGEN_NOINLINE
+#define KANEGEN_NOINLINE __attribute__((noinline))
+#endif
 
 namespace kanegen_gen::long_horizon {
 
@@ -110,6 +117,7 @@ template <int W> inline Dual<W> operator/(const Dual<W>& a, double b) { return a
 template <int W> inline Dual<W> operator/(double a, const Dual<W>& b) { Dual<W> r; r.v = a / b.v; const double f = -r.v / b.v; for (int i = 0; i < W; ++i) r.d[i] = f * b.d[i]; return r; }
 template <int W> inline bool operator>(const Dual<W>& a, double b) { return a.v > b; }
 template <int W> inline bool operator>(const Dual<W>& a, const Dual<W>& b) { return a.v > b.v; }
+template <int W> inline bool operator>(double a, const Dual<W>& b) { return a > b.v; }
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }

@@ -38,6 +38,8 @@
 // about an unrecoverable failure, and the exception is rethrown unchanged
 // once the SUNDIALS call returns.
 #include "sim/integrators.hpp"
+#include "sim/odeint_integrators.hpp"
+#include "sim/output_schedule.hpp"
 
 #include <arkode/arkode_arkstep.h>
 #include <arkode/arkode_erkstep.h>
@@ -68,6 +70,8 @@ constexpr KindName kKindNames[] = {
     {IntegratorKind::cvode_bdf, "cvode-bdf"},   {IntegratorKind::cvode_adams, "cvode-adams"},
     {IntegratorKind::arkode_erk, "arkode-erk"}, {IntegratorKind::arkode_dirk, "arkode-dirk"},
     {IntegratorKind::rk4, "rk4"},               {IntegratorKind::cvode_bdf2, "cvode-bdf2"},
+    {IntegratorKind::dopri5, "dopri5"},         {IntegratorKind::rkf78, "rkf78"},
+    {IntegratorKind::automatic, "auto"},
 };
 
 // ---- formatting helpers ----------------------------------------------------
@@ -90,33 +94,6 @@ std::string first_nonfinite(const double* v, int n) {
   }
   return {};
 }
-
-// ---- output schedule ---------------------------------------------------------
-
-/// Output times t0 < t0 + dt < ... < t_end (t_end always last, no near-duplicate).
-class OutputSchedule {
- public:
-  OutputSchedule(double t0, double t_end, double dt) : t0_(t0), t_end_(t_end), dt_(dt) {
-    tol_ = 1e-9 * dt + 16 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t0), std::abs(t_end));
-  }
-  /// Next output time after the previous one; false when t_end was returned.
-  bool next(double& t) {
-    if (done_) return false;
-    ++k_;
-    double tk = t0_ + static_cast<double>(k_) * dt_;
-    if (tk >= t_end_ - tol_) {
-      tk = t_end_;
-      done_ = true;
-    }
-    t = tk;
-    return true;
-  }
-
- private:
-  double t0_, t_end_, dt_, tol_;
-  long long k_ = 0;
-  bool done_ = false;
-};
 
 // ---- SUNDIALS RAII -------------------------------------------------------------
 
@@ -636,8 +613,12 @@ IntegratorStats integrate(const OdeProblem& problem, const IntegratorOptions& op
     Eigen::VectorXd xo = x0;
     if (problem.project) problem.project(xo.data());
     if (output) output(t0, xo);
+  } else if (options.kind == IntegratorKind::automatic) {
+    throw std::invalid_argument("integrate: 'auto' is resolved by the caller (choose_integrator, simulate.hpp)");
   } else if (options.kind == IntegratorKind::rk4) {
     stats = integrate_rk4(problem, options, t0, x0, t_end, dt_out, output, std::move(stats));
+  } else if (options.kind == IntegratorKind::dopri5 || options.kind == IntegratorKind::rkf78) {
+    stats = integrate_odeint(problem, options, t0, x0, t_end, dt_out, output, std::move(stats));
   } else {
     stats = integrate_sundials(problem, options, t0, x0, t_end, dt_out, output, std::move(stats));
   }

@@ -18,9 +18,13 @@ enum class IntegratorKind {
   arkode_dirk,  ///< ARKODE ARKStep, fully implicit adaptive DIRK (order 4), Newton + dense
   rk4,          ///< classical fixed-step Runge-Kutta 4 (step = IntegratorOptions::h)
   cvode_bdf2,   ///< cvode_bdf with the order capped at 2 (A-stable): lightly damped stiff modes
+  dopri5,       ///< Boost.Odeint Dormand-Prince 5(4) with dense output: non-stiff, low overhead per step
+  rkf78,        ///< Boost.Odeint Runge-Kutta-Fehlberg 7(8): non-stiff, tight tolerances
+  automatic,    ///< chosen from the scene by choose_integrator() (simulate.hpp)
 };
 
-/// CLI names: "cvode-bdf", "cvode-bdf2", "cvode-adams", "arkode-erk", "arkode-dirk", "rk4".
+/// CLI names: "auto", "cvode-bdf", "cvode-bdf2", "cvode-adams", "arkode-erk", "arkode-dirk", "rk4",
+/// "dopri5", "rkf78".
 std::string to_string(IntegratorKind kind);
 /// Throws std::invalid_argument listing the valid names.
 IntegratorKind integrator_from_string(const std::string& name);

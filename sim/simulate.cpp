@@ -1,6 +1,8 @@
 #include "sim/simulate.hpp"
 
 #include "model/output_file.hpp"
+#include "sim/integrator_choice.hpp"
+#include "sim/work_precision.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -174,9 +176,56 @@ std::vector<std::string> csv_columns(const Model& model) {
   return cols;
 }
 
-SimulationResult simulate(Engine& engine, const State& initial, const SimulationOptions& options, std::ostream& csv) {
+std::string RunQuality::summary() const {
+  std::vector<std::string> parts;
+  if (std::isfinite(energy_drift)) parts.push_back(fmt::format("energy drift {:.2e}", energy_drift));
+  if (std::isfinite(H_drift)) parts.push_back(fmt::format("|H| drift {:.2e}", H_drift));
+  if (std::isfinite(error_estimate))
+    parts.push_back(fmt::format("estimated error {:.2e} ({})", error_estimate, error_worst));
+  if (parts.empty()) return "no invariant holds here: --estimate-error gives an error estimate";
+  std::string out;
+  for (const auto& p : parts) out += (out.empty() ? "" : ", ") + p;
+  return out;
+}
+
+namespace {
+
+/// At most this many output states are kept for the drift and the error estimate.
+constexpr double kMaxKeptStates = 2000;
+
+/// The states at every `stride`-th output time, and the last one.
+struct SampledRun {
+  long stride = 1, k = 0;
+  bench::Trajectory traj;
+  void add(double t, const VecX& x, bool last) {
+    if (k++ % stride == 0 || last) {
+      traj.t.push_back(t);
+      traj.x.push_back(x);
+    }
+  }
+};
+
+long stride_for(const State& initial, const SimulationOptions& o) {
+  const double rows = std::floor((o.t_end - initial.t) / o.dt_out) + 2;
+  return std::max(1L, static_cast<long>(std::ceil(rows / kMaxKeptStates)));
+}
+
+}  // namespace
+
+SimulationResult simulate(Engine& engine, const State& initial, const SimulationOptions& options_in,
+                          std::ostream& csv) {
   const Model& model = engine.model();
   const int nq = model.nq, nu = model.nu;
+  SimulationOptions options = options_in;
+  RunQuality quality;
+  if (options.integrator.kind == IntegratorKind::automatic) {
+    const IntegratorChoice c =
+        choose_integrator(engine, initial, options.t_end, options.dt_out, options.integrator.rtol);
+    options.integrator.kind = c.kind;
+    quality.integrator_choice = c.reason;
+  }
+  SampledRun sampled;
+  sampled.stride = stride_for(initial, options);
   std::string failure;
   OdeProblem problem = make_ode_problem(engine, initial.tau, &failure, options.use_jacobian,
                                         options.integrator.kind != IntegratorKind::rk4);
@@ -252,6 +301,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     for (std::size_t k = 0; k < row.size(); ++k)
       if (!std::isfinite(row[k]))
         throw fail_at(t, x, fmt::format("non-finite value {} in column '{}'", row[k], column_of(k + 1)));
+    sampled.add(t, x, !(t < options.t_end));
     line = fmt::format("{:.17g}", t);
     for (double v : row) line += fmt::format(",{:.17g}", v);
     csv << line << '\n';
@@ -280,6 +330,38 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     throw IntegrationError(fmt::format("{} ({})", e.reason, failure), e.t, e.x);
   }
   bar.finish();
+
+  double total_mass = 0;
+  for (const Body& b : model.bodies) total_mass += b.total_mass;
+  const bench::Drifts d = bench::invariant_drifts(engine, bench::invariants_of(model, initial.tau), sampled.traj,
+                                                  total_mass);
+  quality.energy_drift = d.energy;
+  quality.H_drift = d.H;
+  if (options.estimate_error) {
+    // the same method at tolerances 100 times tighter, at the same output times
+    SimulationOptions tight = options;
+    tight.integrator.rtol /= 100;
+    tight.integrator.atol /= 100;
+    tight.integrator.h /= 10;  // rk4: error / 1e4
+    tight.integrator.max_steps = 0;
+    SampledRun ref;
+    ref.stride = sampled.stride;
+    std::string f2;
+    OdeProblem p2 = make_ode_problem(engine, initial.tau, &f2, options.use_jacobian,
+                                     options.integrator.kind != IntegratorKind::rk4);
+    try {
+      integrate(p2, tight.integrator, initial.t, x0, options.t_end, options.dt_out, [&](double t, const VecX& x) {
+        ref.add(t, x, !(t < options.t_end));
+        return true;
+      });
+      const bench::ErrorMeasure e = bench::trajectory_error(model, sampled.traj, ref.traj);
+      quality.error_estimate = e.error;
+      quality.error_worst = fmt::format("{} at t = {:.6g}", e.worst, e.worst_t);
+    } catch (const IntegrationError& e) {
+      quality.error_worst = fmt::format("the tighter run failed: {}", e.reason);
+    }
+  }
+  result.quality = quality;
   return result;
 }
 

@@ -184,48 +184,6 @@ RunOutput run_once(Engine& engine, const State& s0, const Config& c, double tol_
   return r;
 }
 
-struct Drifts {
-  double energy = NAN, H = NAN, p = NAN;
-};
-
-Drifts invariant_drifts(GenericEngine& g, const InvariantSet& inv, const Trajectory& tr, double total_mass) {
-  Drifts d;
-  const Model& m = g.model();
-  if (tr.x.empty()) return d;
-  VecX q, u;
-  auto split = [&](const VecX& x) {
-    q = x.head(m.nq);
-    u = x.tail(m.nu);
-  };
-  if (inv.energy) {
-    double e0 = 0, scale = 0, worst = 0;
-    for (std::size_t k = 0; k < tr.x.size(); ++k) {
-      split(tr.x[k]);
-      const EnergyValues E = g.energy(q, u);
-      if (k == 0) e0 = E.T + E.V;
-      scale = std::max(scale, E.T + std::abs(E.V));
-      worst = std::max(worst, std::abs(E.T + E.V - e0));
-    }
-    d.energy = scale > 0 ? worst / scale : worst;
-  }
-  if (inv.momentum) {
-    Vec3 H0 = Vec3::Zero(), p0 = Vec3::Zero();
-    double Tmax = 0, wH = 0, wp = 0;
-    for (std::size_t k = 0; k < tr.x.size(); ++k) {
-      split(tr.x[k]);
-      const MomentumValues M = g.momentum(q, u);
-      Tmax = std::max(Tmax, g.energy(q, u).T);
-      if (k == 0) H0 = M.H_N, p0 = M.p_N;
-      wH = std::max(wH, (M.H_N - H0).norm());
-      wp = std::max(wp, (M.p_N - p0).norm());
-    }
-    d.H = H0.norm() > 0 ? wH / H0.norm() : wH;
-    const double pscale = std::sqrt(2 * total_mass * Tmax);
-    d.p = pscale > 0 ? wp / pscale : wp;
-  }
-  return d;
-}
-
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
@@ -279,6 +237,45 @@ struct Curve {
 };
 
 }  // namespace
+
+Drifts invariant_drifts(Engine& g, const InvariantSet& inv, const Trajectory& tr, double total_mass) {
+  Drifts d;
+  const Model& m = g.model();
+  if (tr.x.empty()) return d;
+  VecX q, u;
+  auto split = [&](const VecX& x) {
+    q = x.head(m.nq);
+    u = x.tail(m.nu);
+  };
+  if (inv.energy) {
+    double e0 = 0, scale = 0, worst = 0;
+    for (std::size_t k = 0; k < tr.x.size(); ++k) {
+      split(tr.x[k]);
+      const EnergyValues E = g.energy(q, u);
+      if (k == 0) e0 = E.T + E.V;
+      scale = std::max(scale, E.T + std::abs(E.V));
+      worst = std::max(worst, std::abs(E.T + E.V - e0));
+    }
+    d.energy = scale > 0 ? worst / scale : worst;
+  }
+  if (inv.momentum) {
+    Vec3 H0 = Vec3::Zero(), p0 = Vec3::Zero();
+    double Tmax = 0, wH = 0, wp = 0;
+    for (std::size_t k = 0; k < tr.x.size(); ++k) {
+      split(tr.x[k]);
+      const MomentumValues M = g.momentum(q, u);
+      Tmax = std::max(Tmax, g.energy(q, u).T);
+      if (k == 0) H0 = M.H_N, p0 = M.p_N;
+      wH = std::max(wH, (M.H_N - H0).norm());
+      wp = std::max(wp, (M.p_N - p0).norm());
+    }
+    d.H = H0.norm() > 0 ? wH / H0.norm() : wH;
+    const double pscale = std::sqrt(2 * total_mass * Tmax);
+    d.p = pscale > 0 ? wp / pscale : wp;
+  }
+  return d;
+}
+
 
 // ---- public helpers ---------------------------------------------------------------
 

@@ -70,8 +70,8 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
     const SimulationOptions opt = cli::simulation_options(sim, state);
     try {
       const SimulationResult r = simulate_to_file(engine, state, opt, sim.output);
-      fmt::print(stderr, "{} [generated engine, compiled in], {} rows to {}, max quaternion drift {:.2e}\n",
-                 r.stats.summary(), r.rows, sim.output, r.max_quaternion_drift);
+      fmt::print(stderr, "{} [generated engine, compiled in], {} rows to {}, max quaternion drift {:.2e}\n{}",
+                 r.stats.summary(), r.rows, sim.output, r.max_quaternion_drift, cli::describe_quality(r.quality));
     } catch (const IntegrationError& e) {
       fmt::print(stderr, "{}: {}\nno output written\n", program, cli::describe_failure(model, e));
       return 1;

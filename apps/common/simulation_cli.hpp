@@ -20,10 +20,11 @@
 namespace kanegen::cli {
 
 struct SimulationCli {
-  std::string output, integrator = "cvode-bdf";
-  double t_end = 10.0, rtol = 1e-8, atol = 1e-10, dt_out = 0.01, h = 1e-3;
+  std::string output, integrator = "auto";
+  double t_end = 10.0, rtol = 1e-10, atol = 1e-12, dt_out = 0.01, h = 1e-3;
   long max_steps = 100'000'000;
   bool no_progress = false;
+  bool estimate_error = false;
 };
 
 /// Largest number of CSV rows a run may write (about 2 GB for ten columns):
@@ -40,8 +41,9 @@ inline void add_simulation_options(CLI::App* c, SimulationCli& o, bool t_end_req
   else t->capture_default_str();
   c->add_option("-o,--output", o.output, "output CSV file (interface.md)");
   c->add_option("--integrator", o.integrator,
-                "cvode-bdf | cvode-bdf2 (BDF capped at order 2, for lightly damped stiff modes) | cvode-adams | "
-                "arkode-erk | arkode-dirk | rk4")
+                "auto (picked from the Jacobian's spectrum at the start; the summary says what and why) | dopri5 | "
+                "rkf78 | cvode-bdf | cvode-bdf2 (BDF capped at order 2, for lightly damped stiff modes) | "
+                "cvode-adams | arkode-erk | arkode-dirk | rk4")
       ->capture_default_str();
   c->add_option("--rtol", o.rtol, "relative tolerance (adaptive integrators), in (0, 1)")->capture_default_str();
   c->add_option("--atol", o.atol, "absolute tolerance (adaptive integrators), > 0")->capture_default_str();
@@ -49,6 +51,8 @@ inline void add_simulation_options(CLI::App* c, SimulationCli& o, bool t_end_req
   c->add_option("--h", o.h, "fixed step of rk4 [s], > 0")->capture_default_str();
   c->add_option("--max-steps", o.max_steps, "steps allowed in all before the run fails, >= 1")->capture_default_str();
   c->add_flag("--no-progress", o.no_progress, "no progress bar on stderr");
+  c->add_flag("--estimate-error", o.estimate_error,
+              "run again at tolerances 100x tighter and report the difference as the error estimate");
 }
 
 /// The SimulationOptions of `o` for a run from `initial`; throws InputError
@@ -96,7 +100,16 @@ inline SimulationOptions simulation_options(const SimulationCli& o, const State&
   opt.integrator.h = o.h;
   opt.integrator.max_steps = o.max_steps;
   opt.progress = !o.no_progress;
+  opt.estimate_error = o.estimate_error;
   return opt;
+}
+
+/// The lines a run prints after its statistics: the method `auto` picked and
+/// why, the invariant drift and the error estimate.
+inline std::string describe_quality(const RunQuality& q) {
+  std::string s;
+  if (!q.integrator_choice.empty()) s += "integrator auto: " + q.integrator_choice + "\n";
+  return s + "accuracy: " + q.summary() + "\n";
 }
 
 /// "integration failed at t = ...: reason" and the state there, by name.

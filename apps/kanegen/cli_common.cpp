@@ -17,11 +17,13 @@ Model load_checked(const std::string& path) {
   return model;
 }
 
-std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name) {
+std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name, bool native) {
   if (name == "generic") return std::make_unique<GenericEngine>(model);
   if (name == "generated") {
     try {
-      return jit_load(model, codegen::jit_code_generator());
+      JitOptions jit;
+      jit.native = native;
+      return jit_load(model, codegen::jit_code_generator(), jit);
     } catch (const JitError& e) {  // the generated code of this model does not compile
       throw InputError(Diagnostic{model.source_path, 0, "", e.what()});
     }
@@ -38,11 +40,13 @@ void add_model_option(CLI::App* c, std::string& model) {
   c->add_option("MODEL", model, "model file (YAML, model-format.md)")->required()->check(CLI::ExistingFile);
 }
 
-void add_engine_option(CLI::App* c, std::string& engine) {
+void add_engine_option(CLI::App* c, std::string& engine, bool& native) {
   c->add_option("--engine", engine,
                 "generated: the model's generated code (JIT-compiled, cached); generic: the numeric path")
       ->check(CLI::IsMember({"generated", "generic"}))
       ->capture_default_str();
+  c->add_flag("--native", native,
+              "compile the generated code for this machine's CPU (-march=native): faster, not portable");
 }
 
 }  // namespace kanegen::cli

@@ -36,13 +36,14 @@ Subcommand add_bench(CLI::App& app);
 Model load_checked(const std::string& path);
 /// "generated" (JIT, with the generator of codegen/) or "generic"; a compile
 /// failure of the generated code is a refused input.
-std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name);
+std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name, bool native = false);
 /// The model's initial state, or STATE.json when a path is given.
 State state_for(const Model& model, const std::string& state_path);
 
 /// The MODEL positional argument.
 void add_model_option(CLI::App* c, std::string& model);
 /// --engine generated|generic.
-void add_engine_option(CLI::App* c, std::string& engine);
+/// --engine, and --native (the generated code compiled with -march=native).
+void add_engine_option(CLI::App* c, std::string& engine, bool& native);
 
 }  // namespace kanegen::cli

@@ -29,7 +29,7 @@ Subcommand add_bench(CLI::App& app) {
   c->add_flag("--quick", opt->quick, "2 tolerances, 2 rk4 steps, 1 repeat");
   c->add_flag("!--no-plot", opt->plot, "skip the PNGs");
   return {c, [opt, models, suite] {
-            opt->make_engine = make_engine;
+            opt->make_engine = [](const Model& m, const std::string& name) { return make_engine(m, name); };
             return bench::run_bench(*models, *opt, *suite);
           }};
 }

@@ -13,12 +13,13 @@ namespace {
 
 struct Options {
   std::string model, state, engine = "generated";
+  bool native = false;
 };
 
 int run(const Options& o) {
   const Model model = load_checked(o.model);
   const State state = state_for(model, o.state);
-  auto engine = make_engine(model, o.engine);
+  auto engine = make_engine(model, o.engine, o.native);
   nlohmann::ordered_json j;
   try {
     j = eval_report(*engine, state);
@@ -41,7 +42,7 @@ Subcommand add_eval(CLI::App& app) {
       app.add_subcommand("eval", "evaluate M, F, u-dot (and the requested outputs) at one state, as JSON");
   add_model_option(c, o->model);
   c->add_option("--state", o->state, "STATE.json (default: the model's initial state)")->check(CLI::ExistingFile);
-  add_engine_option(c, o->engine);
+  add_engine_option(c, o->engine, o->native);
   return {c, [o] { return run(*o); }};
 }
 

@@ -10,6 +10,7 @@ namespace {
 
 struct Options {
   std::string model, state, engine = "generated";
+  bool native = false;
   SimulationCli sim;
 };
 
@@ -17,11 +18,11 @@ int run(const Options& o) {
   const Model model = load_checked(o.model);
   const State state = state_for(model, o.state);
   const SimulationOptions opt = simulation_options(o.sim, state);
-  auto engine = make_engine(model, o.engine);
+  auto engine = make_engine(model, o.engine, o.native);
   try {
     const SimulationResult r = simulate_to_file(*engine, state, opt, o.sim.output);
-    fmt::print(stderr, "{} [{} engine], {} rows to {}, max quaternion drift {:.2e}\n", r.stats.summary(),
-               engine->name(), r.rows, o.sim.output, r.max_quaternion_drift);
+    fmt::print(stderr, "{} [{} engine], {} rows to {}, max quaternion drift {:.2e}\n{}", r.stats.summary(),
+               engine->name(), r.rows, o.sim.output, r.max_quaternion_drift, describe_quality(r.quality));
   } catch (const IntegrationError& e) {
     fmt::print(stderr, "kanegen simulate: {}\nno output written\n", describe_failure(model, e));
     return kExitFailure;
@@ -39,7 +40,7 @@ Subcommand add_simulate(CLI::App& app) {
   c->get_option("-o")->required();
   c->add_option("--state", o->state, "initial STATE.json (default: the model's initial state)")
       ->check(CLI::ExistingFile);
-  add_engine_option(c, o->engine);
+  add_engine_option(c, o->engine, o->native);
   return {c, [o] { return run(*o); }};
 }
 

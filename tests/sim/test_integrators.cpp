@@ -16,7 +16,8 @@ namespace {
 
 const std::vector<IntegratorKind> kAllKinds = {IntegratorKind::cvode_bdf, IntegratorKind::cvode_adams,
                                                IntegratorKind::arkode_erk, IntegratorKind::arkode_dirk,
-                                               IntegratorKind::rk4};
+                                               IntegratorKind::rk4,       IntegratorKind::dopri5,
+                                               IntegratorKind::rkf78};
 
 struct Recorded {
   std::vector<double> t;
@@ -103,14 +104,16 @@ IntegratorOptions opts(IntegratorKind kind, double rtol = 1e-10, double atol = 1
 
 TEST_CASE("integrator names round-trip and unknown names are rejected", "[integrators]") {
   REQUIRE(integrator_names() ==
-          std::vector<std::string>{"cvode-bdf", "cvode-adams", "arkode-erk", "arkode-dirk", "rk4", "cvode-bdf2"});
+          std::vector<std::string>{"cvode-bdf", "cvode-adams", "arkode-erk", "arkode-dirk", "rk4", "cvode-bdf2", "dopri5",
+                                   "rkf78", "auto"});
   for (auto k : kAllKinds) REQUIRE(integrator_from_string(to_string(k)) == k);
   try {
     integrator_from_string("euler");
     FAIL("expected std::invalid_argument");
   } catch (const std::invalid_argument& e) {
     REQUIRE(std::string(e.what()) ==
-            "unknown integrator 'euler'; expected one of: cvode-bdf, cvode-adams, arkode-erk, arkode-dirk, rk4, cvode-bdf2");
+            "unknown integrator 'euler'; expected one of: cvode-bdf, cvode-adams, arkode-erk, arkode-dirk, rk4, cvode-bdf2, "
+            "dopri5, rkf78, auto");
   }
 }
 
@@ -429,7 +432,8 @@ TEST_CASE("projection is applied to output states", "[integrators]") {
       for (const auto& x : raw.x) max_drift_raw = std::max(max_drift_raw, std::abs(x.norm() - 1.0));
       for (const auto& x : proj.x) max_drift_proj = std::max(max_drift_proj, std::abs(x.norm() - 1.0));
       INFO("drift without projection " << max_drift_raw << ", with " << max_drift_proj);
-      REQUIRE(max_drift_raw > 1e-6);
+      // (rkf78, 8th order with steps ending on the outputs, drifts less: 1.3e-8 here)
+      REQUIRE(max_drift_raw > (kind == IntegratorKind::rkf78 ? 1e-9 : 1e-6));
       REQUIRE(max_drift_proj < 1e-14);
       // The phase is still right (projection only removes the radial error).
       REQUIRE(std::abs(std::atan2(proj.x.back()[1], proj.x.back()[0]) - std::remainder(20.0, 2 * M_PI)) < 0.05);

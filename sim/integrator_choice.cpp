@@ -1,0 +1,111 @@
+#include "sim/integrator_choice.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <complex>
+
+#include "sim/simulate.hpp"
+
+namespace kanegen {
+
+namespace {
+
+/// Explicit Runge-Kutta methods of order 5 are stable for |h lambda| up to
+/// about 3.3 (Dormand-Prince 5(4): 3.3 on the negative real axis).
+constexpr double kExplicitStabilityRadius = 3.3;
+constexpr double kStiffSteps = 1e5;        ///< stability-limited explicit steps above which BDF pays off
+constexpr double kOscillationSteps = 1e7;  ///< ... above which even a resolved oscillation is left to BDF2
+constexpr int kMaxDenseEigen = 400;
+/// rkf78 below this rtol, dopri5 above: on explorer1_rigid over 3000 s rkf78
+/// takes the same time as dopri5 at rtol 1e-6 with a 90x smaller error, and
+/// half the time at 1e-10 with a 200x smaller error (docs/speed.md).
+constexpr double kHighOrderBelowRtol = 1e-5;        ///< larger systems: power iteration for the dominant eigenvalue
+
+/// d x_dot / d x at x0 (n x n): the problem's exact Jacobian, else central differences.
+MatX jacobian_at(const OdeProblem& p, double t0, const VecX& x0) {
+  const int n = p.n;
+  MatX J(n, n);
+  VecX f0(n);
+  if (p.rhs(t0, x0.data(), f0.data()) != 0) throw std::runtime_error("the right-hand side fails at the start");
+  if (p.jacobian && p.jacobian(t0, x0.data(), f0.data(), J.data()) == 0 && J.allFinite()) return J;
+  VecX xp = x0, fp(n), fm(n);
+  for (int k = 0; k < n; ++k) {
+    const double h = 1e-6 * std::max(1.0, std::abs(x0(k)));
+    xp(k) = x0(k) + h;
+    const int a = p.rhs(t0, xp.data(), fp.data());
+    xp(k) = x0(k) - h;
+    const int b = p.rhs(t0, xp.data(), fm.data());
+    xp(k) = x0(k);
+    if (a != 0 || b != 0) throw std::runtime_error("the right-hand side fails next to the start");
+    J.col(k) = (fp - fm) / (2 * h);
+  }
+  return J;
+}
+
+/// The eigenvalue of largest modulus.
+std::complex<double> dominant_eigenvalue(const MatX& J) {
+  if (J.rows() <= kMaxDenseEigen) {
+    const Eigen::EigenSolver<MatX> es(J, false);
+    if (es.info() == Eigen::Success) {
+      const auto& ev = es.eigenvalues();
+      Eigen::Index k = 0;
+      ev.cwiseAbs().maxCoeff(&k);
+      return ev(k);
+    }
+  }
+  // Power iteration on J^2 (a complex pair of equal modulus does not converge
+  // on J itself): gives |lambda|^2; the decay rate is then not resolved.
+  VecX v = VecX::Ones(J.rows()) / std::sqrt(static_cast<double>(J.rows()));
+  double r2 = 0;
+  for (int it = 0; it < 100; ++it) {
+    VecX w = J * (J * v);
+    r2 = w.norm();
+    if (!(r2 > 0)) break;
+    v = w / r2;
+  }
+  return {0.0, std::sqrt(r2)};
+}
+
+}  // namespace
+
+IntegratorChoice choose_integrator(Engine& engine, const State& initial, double t_end, double dt_out, double rtol) {
+  const Model& model = engine.model();
+  IntegratorChoice c;
+  std::string failure;
+  const OdeProblem p = make_ode_problem(engine, initial.tau, &failure, true, true);
+  VecX x0(model.nq + model.nu);
+  x0 << initial.q, initial.u;
+  const double horizon = t_end - initial.t;
+  const std::complex<double> lambda = dominant_eigenvalue(jacobian_at(p, initial.t, x0));
+  c.spectral_radius = std::abs(lambda);
+  c.fastest_decay = std::max(0.0, -lambda.real());
+  c.explicit_steps = c.spectral_radius * horizon / kExplicitStabilityRadius;
+  const bool decays_within_a_cycle = lambda.real() < 0 && std::abs(lambda.imag()) <= 2.0 * -lambda.real();
+  const std::string spectrum = fmt::format("dominant eigenvalue {:.3g}{:+.3g}i of the Jacobian at the start",
+                                           lambda.real(), lambda.imag());
+  if (decays_within_a_cycle && c.fastest_decay * dt_out > 100 && c.explicit_steps > kStiffSteps) {
+    c.kind = IntegratorKind::cvode_bdf;
+    c.reason = fmt::format("stiff: {} (a mode that dies out within {:.2g} s, far inside the output interval {} s) "
+                           "would hold an explicit method to {:.2g} steps over the horizon: cvode-bdf with the "
+                           "exact Jacobian",
+                           spectrum, 1.0 / c.fastest_decay, dt_out, c.explicit_steps);
+  } else if (c.explicit_steps > kOscillationSteps) {
+    c.kind = IntegratorKind::cvode_bdf2;
+    c.reason = fmt::format("{} is a fast, lightly damped oscillation that would cost an explicit method {:.2g} "
+                           "steps: cvode-bdf2 (A-stable; it damps that oscillation numerically: if it matters, "
+                           "run dopri5 and compare)",
+                           spectrum, c.explicit_steps);
+  } else {
+    c.kind = rtol < kHighOrderBelowRtol ? IntegratorKind::rkf78 : IntegratorKind::dopri5;
+    c.reason = fmt::format("non-stiff: {} bounds an explicit method's steps by {:.2g} over the horizon: {} "
+                           "(explicit, {})",
+                           spectrum, c.explicit_steps, to_string(c.kind),
+                           c.kind == IntegratorKind::rkf78 ? "order 7(8), for rtol below 1e-5"
+                                                           : "order 5(4), for loose tolerances");
+  }
+  return c;
+}
+
+}  // namespace kanegen

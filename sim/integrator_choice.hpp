@@ -1,0 +1,33 @@
+// `--integrator auto`: the method picked from the scene, and why.
+#pragma once
+
+#include <string>
+
+#include "engine/engine.hpp"
+#include "model/state_io.hpp"
+#include "sim/integrators.hpp"
+
+namespace kanegen {
+
+struct IntegratorChoice {
+  IntegratorKind kind = IntegratorKind::dopri5;
+  std::string reason;            ///< one sentence for the run's summary
+  double spectral_radius = 0;    ///< max |lambda| of d x_dot / d x at the start [1/s]
+  double fastest_decay = 0;      ///< -Re lambda of that eigenvalue [1/s] (0 if it does not decay)
+  double explicit_steps = 0;     ///< steps an explicit method needs for stability alone over the horizon
+};
+
+/// Picks the method for a run of `engine` from `initial` to t_end with output
+/// interval dt_out at tolerance rtol, from the spectrum of the Jacobian of
+/// x_dot = [q_dot; u_dot] at the initial state (the engine's exact Jacobian,
+/// else central differences):
+///  - stiff (the dominant eigenvalue decays within about a cycle, faster than
+///    100 / dt_out, and an explicit method would need more than 1e5 steps for
+///    stability alone): cvode-bdf with the exact Jacobian;
+///  - a fast, lightly damped oscillation that would cost an explicit method
+///    more than 1e7 steps: cvode-bdf2 (A-stable; it damps that oscillation
+///    numerically, which the reason says);
+///  - otherwise non-stiff: rkf78, or dopri5 at rtol 1e-5 and looser.
+IntegratorChoice choose_integrator(Engine& engine, const State& initial, double t_end, double dt_out, double rtol);
+
+}  // namespace kanegen

@@ -1,0 +1,113 @@
+// `--integrator auto` and the run's error estimate.
+#include <catch2/catch.hpp>
+
+#include <sstream>
+
+#include "engine/generic_engine.hpp"
+#include "model/model_loader.hpp"
+#include "model/state_io.hpp"
+#include "sim/integrator_choice.hpp"
+#include "sim/simulate.hpp"
+#include "sim/work_precision.hpp"
+#include "tests/support/test_support.hpp"
+
+using namespace kanegen;
+
+namespace {
+
+/// A rod on a hinge with a spring k and a damper c: lambda = (-c +- sqrt(c^2 - 4 k I)) / (2 I).
+std::string damped_hinge(double k, double c) {
+  return "name: damped_hinge\n"
+         "bodies:\n"
+         "  - name: rod\n"
+         "    parent: ground\n"
+         "    joint: {type: revolute, axis: [0, 0, 1], stiffness: " + std::to_string(k) +
+         ", damping: " + std::to_string(c) + "}\n"
+         "    mass: 1.0\n"
+         "    com: [0.5, 0, 0]\n"
+         "    inertia: [0.001, 0.001, 0.001, 0, 0, 0]\n"
+         "initial:\n"
+         "  q: {rod.angle: 0.3}\n";
+}
+
+}  // namespace
+
+TEST_CASE("auto: explicit for a non-stiff scene, BDF for a stiff one, and the reason says why", "[integrators]") {
+  {
+    const Model m = load_model(test::source_path("models/explorer1_rigid.yaml"));
+    GenericEngine e(m);
+    const IntegratorChoice c = choose_integrator(e, initial_state(m), 10.0, 0.01, 1e-8);
+    CHECK(c.kind == IntegratorKind::rkf78);
+    CHECK_THAT(c.reason, Catch::Contains("non-stiff"));
+    CHECK(choose_integrator(e, initial_state(m), 10.0, 0.01, 1e-4).kind == IntegratorKind::dopri5);
+  }
+  {
+    // I = 0.001 + 0.25 = 0.251 about the hinge; c = 1000: lambda ~ -c/I = -3984 and -k/c = -0.001.
+    const Model m = load_model(test::write_temp("stiff_hinge.yaml", damped_hinge(1.0, 1000.0)));
+    GenericEngine e(m);
+    const IntegratorChoice c = choose_integrator(e, initial_state(m), 1000.0, 1.0, 1e-8);
+    CHECK(c.kind == IntegratorKind::cvode_bdf);
+    CHECK(c.fastest_decay == Approx(1000.0 / 0.251).epsilon(1e-3));
+    CHECK(c.explicit_steps == Approx(1000.0 / 0.251 * 1000.0 / 3.3).epsilon(1e-3));
+    CHECK_THAT(c.reason, Catch::Contains("stiff") && Catch::Contains("cvode-bdf"));
+  }
+  {
+    // Undamped, k = 1e8: an oscillation at 2e4 rad/s over 1000 s -> 6e6 steps: still explicit.
+    const Model m = load_model(test::write_temp("fast_hinge.yaml", damped_hinge(1e8, 0.0)));
+    GenericEngine e(m);
+    const IntegratorChoice c = choose_integrator(e, initial_state(m), 1000.0, 1.0, 1e-8);
+    CHECK(c.spectral_radius == Approx(std::sqrt(1e8 / 0.251)).epsilon(1e-6));
+    CHECK(c.kind == IntegratorKind::rkf78);
+    // ... and over 1e5 s (6e8 steps) BDF2, whose reason warns of its numerical damping.
+    const IntegratorChoice c2 = choose_integrator(e, initial_state(m), 1e5, 1.0, 1e-8);
+    CHECK(c2.kind == IntegratorKind::cvode_bdf2);
+    CHECK_THAT(c2.reason, Catch::Contains("damps"));
+  }
+}
+
+TEST_CASE("simulate: the error estimate is within 10x of the true error, drifts reported", "[integrators]") {
+  const Model m = load_model(test::source_path("models/explorer1_rigid.yaml"));
+  GenericEngine e(m);
+  const State s0 = initial_state(m);
+  SimulationOptions o;
+  o.t_end = 10.0;
+  o.dt_out = 0.1;
+  o.integrator.kind = IntegratorKind::automatic;
+  o.integrator.rtol = 1e-6;
+  o.integrator.atol = 1e-8;
+  o.estimate_error = true;
+  std::ostringstream csv;
+  const SimulationResult r = simulate(e, s0, o, csv);
+  CHECK(r.stats.integrator == "rkf78");
+  CHECK_THAT(r.quality.integrator_choice, Catch::Contains("non-stiff"));
+  // explorer1_rigid: free, no gravity, dampers: |H| holds, energy does not
+  CHECK(std::isnan(r.quality.energy_drift));
+  REQUIRE(std::isfinite(r.quality.H_drift));
+  CHECK(r.quality.H_drift < 1e-4);
+  REQUIRE(std::isfinite(r.quality.error_estimate));
+
+  // the true error, against a run at rtol 1e-13, measured as kanegen bench does
+  auto trajectory = [&](IntegratorKind kind, double rtol) {
+    bench::Trajectory tr;
+    std::string failure;
+    IntegratorOptions io;
+    io.kind = kind;
+    io.rtol = rtol;
+    io.atol = rtol * 1e-2;
+    VecX x0(m.nq + m.nu);
+    x0 << s0.q, s0.u;
+    integrate(make_ode_problem(e, s0.tau, &failure), io, 0.0, x0, o.t_end, o.dt_out, [&](double t, const VecX& x) {
+      tr.t.push_back(t);
+      tr.x.push_back(x);
+      return true;
+    });
+    return tr;
+  };
+  const double truth = bench::trajectory_error(m, trajectory(IntegratorKind::rkf78, 1e-6),
+                                               trajectory(IntegratorKind::rkf78, 1e-13))
+                           .error;
+  INFO("estimate " << r.quality.error_estimate << ", true error " << truth);
+  CHECK(r.quality.error_estimate > truth / 10);
+  CHECK(r.quality.error_estimate < truth * 10);
+  CHECK_THAT(r.quality.summary(), Catch::Contains("|H| drift") && Catch::Contains("estimated error"));
+}
