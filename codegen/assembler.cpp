@@ -100,7 +100,7 @@ std::string parts_text(const EmittedFunction& f) {
   for (Arg a : f.args)
     if (a != Arg::out) unused.push_back(fmt::format("(void){};", arg_name(a)));
   for (std::size_t i = 0; i < f.parts.size(); ++i) {
-    s += fmt::format("\n// {}, part {} of {}\ntemplate <class T>\nKANEGEN_NOINLINE void {}_part{}({}, T* w) {{\n",
+    s += fmt::format("\n// {}, part {} of {}\ntemplate <class T>\nKANEGEN_NOINLINE KANEGEN_DISPATCH void {}_part{}({}, T* w) {{\n",
                      f.name, i + 1, f.parts.size() + 1, f.name, i, parameters(f));
     s += "  using std::cos; using std::sin; using std::sqrt;\n";
     s += "  " + join(unused, " ") + " (void)" + f.out_name + "; (void)w;\n";
@@ -185,10 +185,14 @@ AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, 
     declarations += fmt::format("int {}(const KanegenArgs* a, double* out);\n", cname);
     const std::string call = fmt::format("ns::{}{}({})", f.name, f.templated ? "<double>" : "", call_arguments(f));
     wrappers += fmt::format("#if defined(KANEGEN_WHOLE) || defined(KANEGEN_PART_{})\n", f.name);
+    // the templated functions are inlined into their wrapper, which is
+    // compiled once per instruction set (KANEGEN_DISPATCH, model.hpp.in)
+    const std::string attrs = f.templated ? "KANEGEN_DISPATCH __attribute__((flatten)) " : "";
     if (f.returns_status)
-      wrappers += fmt::format("int {}(const KanegenArgs* a, double* out) {{ return {}; }}\n", cname, call);
+      wrappers += fmt::format("{}int {}(const KanegenArgs* a, double* out) {{ return {}; }}\n", attrs, cname, call);
     else
-      wrappers += fmt::format("int {}(const KanegenArgs* a, double* out) {{\n  {};\n  return 0;\n}}\n", cname, call);
+      wrappers += fmt::format("{}int {}(const KanegenArgs* a, double* out) {{\n  {};\n  return 0;\n}}\n", attrs,
+                              cname, call);
     wrappers += "#endif\n";
     table += fmt::format("#ifndef KANEGEN_OMIT_{}\n    {{\"{}\", &{}, {}}},\n#endif\n", f.name, f.name, cname,
                          f.out_size);

@@ -27,6 +27,17 @@ static std::string paren(const std::string& s, bool p) { return p ? "(" + s + ")
 static std::string print_atom(const ex& e, OpCount& ops);
 static std::string print_term(const ex& t, bool& neg, OpCount& ops);
 
+/// Sums and products of at least this many operands are printed as balanced trees.
+constexpr std::size_t kBalancedFrom = 4;
+
+/// items[lo, hi) joined by `op` as a balanced binary tree, e.g. (a + b) + (c + d).
+static std::string balanced(const std::vector<std::string>& items, std::size_t lo, std::size_t hi,
+                            const char* op) {
+  if (hi - lo == 1) return items[lo];
+  const std::size_t mid = lo + (hi - lo + 1) / 2;
+  return paren(balanced(items, lo, mid, op), mid - lo > 1) + op + paren(balanced(items, mid, hi, op), hi - mid > 1);
+}
+
 /// A sum, terms sorted by text; with `normalize`, negated if needed so that
 /// its first term is positive (`flipped` tells the caller).
 static std::string print_sum(const ex& e, bool normalize, bool& flipped, OpCount& ops) {
@@ -38,6 +49,18 @@ static std::string print_sum(const ex& e, bool normalize, bool& flipped, OpCount
   }
   std::sort(terms.begin(), terms.end());
   flipped = normalize && terms.front().second;
+  if (terms.size() >= kBalancedFrom) {
+    // (sum of the positive terms) - (sum of the negative ones), each summed as
+    // a balanced tree: the same number of additions, a dependency chain of
+    // log2(n) instead of n - 1 (C++ may not reassociate them itself)
+    std::vector<std::string> pos, neg;
+    for (const auto& [text, n] : terms) (n != flipped ? neg : pos).push_back(text);
+    ops.add += static_cast<long>(terms.size()) - 1;
+    if (pos.empty()) return "-(" + balanced(neg, 0, neg.size(), " + ") + ")";
+    const std::string p = balanced(pos, 0, pos.size(), " + ");
+    if (neg.empty()) return p;
+    return paren(p, pos.size() > 1) + " - " + paren(balanced(neg, 0, neg.size(), " + "), neg.size() > 1);
+  }
   std::string s;
   for (std::size_t i = 0; i < terms.size(); ++i) {
     const bool neg = terms[i].second != flipped;
@@ -127,12 +150,17 @@ static std::string print_term(const ex& t, bool& neg, OpCount& ops) {
       num.insert(num.begin(), print_number(coeff));
   }
   std::string s;
-  for (std::size_t i = 0; i < num.size(); ++i) {
-    if (i) {
-      s += "*";
-      ops.mul += 1;
+  if (num.size() >= kBalancedFrom) {
+    s = balanced(num, 0, num.size(), "*");
+    ops.mul += static_cast<long>(num.size()) - 1;
+  } else {
+    for (std::size_t i = 0; i < num.size(); ++i) {
+      if (i) {
+        s += "*";
+        ops.mul += 1;
+      }
+      s += num[i];
     }
-    s += num[i];
   }
   if (!den.empty()) {
     std::string d;

@@ -31,6 +31,17 @@ class GeneratedEngine final : public Engine {
   const std::string& library_path() const { return library_path_; }
   void set_library_path(std::string path) { library_path_ = std::move(path); }
 
+  /// x_dot = [q_dot; u_dot] straight from x = [q; u] (nq + nu doubles, tau nu
+  /// doubles): no copies, no size checks, for an integrator's right-hand
+  /// side. Returns 0, or the 1-based speed of a non-positive pivot (udot()
+  /// then throws the SingularMassMatrix that names it).
+  int state_derivative(double t, const double* x, const double* tau, double* xdot) const {
+    const int nq = model().nq;
+    const KanegenArgs a{t, x, x + nq, tau, nullptr};
+    qdot_(&a, xdot);
+    return udot_(&a, xdot + nq);
+  }
+
  protected:
   void do_qdot(const VecX& q, const VecX& u, VecX& qdot) override;
   void do_mass_matrix(double t, const VecX& q, MatX& M) override;

@@ -33,6 +33,20 @@
 #define KANEGEN_NOINLINE __attribute__((noinline))
 #endif
 
+// Function multiversioning (GCC on x86-64): the functions the runtime calls
+// (and the parts of large ones) are compiled twice, for x86-64-v3 (AVX2, FMA:
+// about twice as fast on this code) and for the x86-64 baseline, and the
+// loader picks the one this CPU runs, so the code stays portable. Off with
+// -DKANEGEN_NO_DISPATCH, or when compiling for AVX2 anyway (-march=native).
+#ifndef KANEGEN_DISPATCH
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(__AVX2__) && \
+    !defined(KANEGEN_NO_DISPATCH)
+#define KANEGEN_DISPATCH __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define KANEGEN_DISPATCH
+#endif
+#endif
+
 namespace kanegen_gen::branched_tree {
 
 inline constexpr int nq = 13;
@@ -221,18 +235,18 @@ template <class T>
 void qdot(const T* q, const T* u, T* qdot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
-  const T t0 = 1.0/((q[3]*q[3] + q[4]*q[4] + q[5]*q[5] + q[6]*q[6]));
-  const T t1 = q[3]*q[3] + q[4]*q[4] - q[5]*q[5] - q[6]*q[6];
+  const T t0 = 1.0/(((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
+  const T t1 = (q[3]*q[3] + q[4]*q[4]) - (q[5]*q[5] + q[6]*q[6]);
   const T t2 = -2.0*q[3]*q[6] + 2.0*q[4]*q[5];
   const T t3 = 2.0*q[3]*q[5] + 2.0*q[4]*q[6];
   const T t4 = (t1*u[0] + t2*u[1] + t3*u[2])*t0;
   const T t5 = 2.0*q[3]*q[6] + 2.0*q[4]*q[5];
-  const T t6 = q[3]*q[3] - q[4]*q[4] + q[5]*q[5] - q[6]*q[6];
+  const T t6 = (q[3]*q[3] + q[5]*q[5]) - (q[4]*q[4] + q[6]*q[6]);
   const T t7 = -2.0*q[3]*q[4] + 2.0*q[5]*q[6];
   const T t8 = (t5*u[0] + t6*u[1] + t7*u[2])*t0;
   const T t9 = -2.0*q[3]*q[5] + 2.0*q[4]*q[6];
   const T t10 = 2.0*q[3]*q[4] + 2.0*q[5]*q[6];
-  const T t11 = q[3]*q[3] - q[4]*q[4] - q[5]*q[5] + q[6]*q[6];
+  const T t11 = (q[3]*q[3] + q[6]*q[6]) - (q[4]*q[4] + q[5]*q[5]);
   const T t12 = (t10*u[1] + t11*u[2] + t9*u[0])*t0;
   const T t13 = -q[4]*u[3]/2.0 - q[5]*u[4]/2.0 - q[6]*u[5]/2.0;
   const T t14 = q[3]*u[3]/2.0 + q[5]*u[5]/2.0 - q[6]*u[4]/2.0;
@@ -302,8 +316,8 @@ void mass_matrix(const T* q, T* M) {
   const T t122 = t117*t80 + t118*t79;
   const T t123 = 2.0*gimbal_p_J_z*t102 + k9136c873 + t120;
   const T t124 = -gimbal_p_J_x*t113 + t121;
-  const T t125 = -gimbal_p_J_x*t102 - gimbal_p_J_z*t112 - k57f719a1 + t116;
-  const T t126 = 2.0*gimbal_p_J_x*t112 + 2.0*gimbal_p_J_z*t102 + k7a4a712d + t122;
+  const T t125 = t116 - ((gimbal_p_J_x*t102 + gimbal_p_J_z*t112) + k57f719a1);
+  const T t126 = (2.0*gimbal_p_J_x*t112 + 2.0*gimbal_p_J_z*t102) + (k7a4a712d + t122);
   const T t127 = -gimbal_p_J_z*t113 + t119;
   const T t128 = 2.0*gimbal_p_J_x*t112 + k57f71b07 + t111;
   const T t129 = k051c014d + t112;
@@ -826,18 +840,18 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t323 = t132*yoke_b_S0_y - t276;
   // ---- body panel_b: bias force
   const T t324 = -alpha_R_B_panel_b_y*panel_b_S0_z - panel_b_mass*t172 - t280;
-  const T t325 = alpha_R_B_panel_b_x*panel_b_S0_z + panel_b_S0_x*t130 - panel_b_mass*t173 - t281;
+  const T t325 = (alpha_R_B_panel_b_x*panel_b_S0_z + panel_b_S0_x*t130) - (panel_b_mass*t173 + t281);
   const T t326 = alpha_R_B_panel_b_y*panel_b_S0_x - panel_b_mass*t159 - t282;
-  const T t327 = -alpha_R_B_panel_b_x*panel_b_J0_xx + panel_b_J0_xz*t130 + panel_b_S0_z*t173 - t286;
-  const T t328 = -alpha_R_B_panel_b_y*panel_b_J0_yy + panel_b_S0_x*t159 - panel_b_S0_z*t172 - t287;
-  const T t329 = -alpha_R_B_panel_b_x*panel_b_J0_xz + panel_b_J0_zz*t130 - panel_b_S0_x*t173 - t288;
+  const T t327 = (panel_b_J0_xz*t130 + panel_b_S0_z*t173) - (alpha_R_B_panel_b_x*panel_b_J0_xx + t286);
+  const T t328 = panel_b_S0_x*t159 - ((alpha_R_B_panel_b_y*panel_b_J0_yy + panel_b_S0_z*t172) + t287);
+  const T t329 = panel_b_J0_zz*t130 - ((alpha_R_B_panel_b_x*panel_b_J0_xz + panel_b_S0_x*t173) + t288);
   // ---- body dish: bias force
   const T t330 = -dish_mass*t230 - t291;
   const T t331 = dish_S0_x*t206 - dish_mass*t231 - t292;
   const T t332 = alpha_R_B_dish_y*dish_S0_x + dish_mass*t209 - t293;
-  const T t333 = -alpha_R_B_dish_x*dish_J0_xx - alpha_R_B_dish_y*dish_J0_xy + dish_J0_xz*t206 - t297;
-  const T t334 = -alpha_R_B_dish_x*dish_J0_xy - alpha_R_B_dish_y*dish_J0_yy + dish_J0_yz*t206 - dish_S0_x*t209 - t298;
-  const T t335 = -alpha_R_B_dish_x*dish_J0_xz - alpha_R_B_dish_y*dish_J0_yz + dish_J0_zz*t206 - dish_S0_x*t231 - t299;
+  const T t333 = dish_J0_xz*t206 - ((alpha_R_B_dish_x*dish_J0_xx + alpha_R_B_dish_y*dish_J0_xy) + t297);
+  const T t334 = dish_J0_yz*t206 - ((alpha_R_B_dish_x*dish_J0_xy + alpha_R_B_dish_y*dish_J0_yy) + (dish_S0_x*t209 + t298));
+  const T t335 = dish_J0_zz*t206 - ((alpha_R_B_dish_x*dish_J0_xz + alpha_R_B_dish_y*dish_J0_yz) + (dish_S0_x*t231 + t299));
   // ---- body dish: generalized forces (inward)
   const T t336 = t335 + tau[11];
   const T t337 = t210*t330 - t211*t331;
@@ -1178,8 +1192,8 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t321 = t174*t317 + t175*t316;
   const T t322 = 2.0*gimbal_p_J_z*t301 + k9136c873 + t319;
   const T t323 = -gimbal_p_J_x*t312 + t320;
-  const T t324 = -gimbal_p_J_x*t301 - gimbal_p_J_z*t311 - k57f719a1 + t315;
-  const T t325 = 2.0*gimbal_p_J_x*t311 + 2.0*gimbal_p_J_z*t301 + k7a4a712d + t321;
+  const T t324 = t315 - ((gimbal_p_J_x*t301 + gimbal_p_J_z*t311) + k57f719a1);
+  const T t325 = (2.0*gimbal_p_J_x*t311 + 2.0*gimbal_p_J_z*t301) + (k7a4a712d + t321);
   const T t326 = -gimbal_p_J_z*t312 + t318;
   const T t327 = 2.0*gimbal_p_J_x*t311 + k57f71b07 + t310;
   const T t328 = k051c014d + t311;
@@ -1356,18 +1370,18 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t485 = t132*yoke_b_S0_y - t276;
   // ---- body panel_b: bias force
   const T t486 = -alpha_R_B_panel_b_y*panel_b_S0_z - panel_b_mass*t172 - t280;
-  const T t487 = alpha_R_B_panel_b_x*panel_b_S0_z + panel_b_S0_x*t130 - panel_b_mass*t173 - t281;
+  const T t487 = (alpha_R_B_panel_b_x*panel_b_S0_z + panel_b_S0_x*t130) - (panel_b_mass*t173 + t281);
   const T t488 = alpha_R_B_panel_b_y*panel_b_S0_x - panel_b_mass*t159 - t282;
-  const T t489 = -alpha_R_B_panel_b_x*panel_b_J0_xx + panel_b_J0_xz*t130 + panel_b_S0_z*t173 - t286;
-  const T t490 = -alpha_R_B_panel_b_y*panel_b_J0_yy + panel_b_S0_x*t159 - panel_b_S0_z*t172 - t287;
-  const T t491 = -alpha_R_B_panel_b_x*panel_b_J0_xz + panel_b_J0_zz*t130 - panel_b_S0_x*t173 - t288;
+  const T t489 = (panel_b_J0_xz*t130 + panel_b_S0_z*t173) - (alpha_R_B_panel_b_x*panel_b_J0_xx + t286);
+  const T t490 = panel_b_S0_x*t159 - ((alpha_R_B_panel_b_y*panel_b_J0_yy + panel_b_S0_z*t172) + t287);
+  const T t491 = panel_b_J0_zz*t130 - ((alpha_R_B_panel_b_x*panel_b_J0_xz + panel_b_S0_x*t173) + t288);
   // ---- body dish: bias force
   const T t492 = -dish_mass*t230 - t291;
   const T t493 = dish_S0_x*t206 - dish_mass*t231 - t292;
   const T t494 = alpha_R_B_dish_y*dish_S0_x + dish_mass*t209 - t293;
-  const T t495 = -alpha_R_B_dish_x*dish_J0_xx - alpha_R_B_dish_y*dish_J0_xy + dish_J0_xz*t206 - t297;
-  const T t496 = -alpha_R_B_dish_x*dish_J0_xy - alpha_R_B_dish_y*dish_J0_yy + dish_J0_yz*t206 - dish_S0_x*t209 - t298;
-  const T t497 = -alpha_R_B_dish_x*dish_J0_xz - alpha_R_B_dish_y*dish_J0_yz + dish_J0_zz*t206 - dish_S0_x*t231 - t299;
+  const T t495 = dish_J0_xz*t206 - ((alpha_R_B_dish_x*dish_J0_xx + alpha_R_B_dish_y*dish_J0_xy) + t297);
+  const T t496 = dish_J0_yz*t206 - ((alpha_R_B_dish_x*dish_J0_xy + alpha_R_B_dish_y*dish_J0_yy) + (dish_S0_x*t209 + t298));
+  const T t497 = dish_J0_zz*t206 - ((alpha_R_B_dish_x*dish_J0_xz + alpha_R_B_dish_y*dish_J0_yz) + (dish_S0_x*t231 + t299));
   // ---- body dish: generalized forces (inward)
   const T t498 = t497 + tau[11];
   const T t499 = t210*t492 - t211*t493;
@@ -1896,40 +1910,40 @@ void energy(const T* q, const T* u, T* TV) {
   const T t300 = -hub_S0_y*u[5] + hub_S0_z*u[4] + hub_mass*u[0];
   const T t301 = hub_S0_x*u[5] - hub_S0_z*u[3] + hub_mass*u[1];
   const T t302 = -hub_S0_x*u[4] + hub_S0_y*u[3] + hub_mass*u[2];
-  const T t303 = hub_J0_xx*u[3] + hub_J0_xy*u[4] + hub_J0_xz*u[5] + hub_S0_y*u[2] - hub_S0_z*u[1];
-  const T t304 = hub_J0_xy*u[3] + hub_J0_yy*u[4] + hub_J0_yz*u[5] - hub_S0_x*u[2] + hub_S0_z*u[0];
-  const T t305 = hub_J0_xz*u[3] + hub_J0_yz*u[4] + hub_J0_zz*u[5] + hub_S0_x*u[1] - hub_S0_y*u[0];
-  const T t306 = t300*u[0] + t301*u[1] + t302*u[2] + t303*u[3] + t304*u[4] + t305*u[5];
+  const T t303 = ((hub_J0_xx*u[3] + hub_J0_xy*u[4]) + (hub_J0_xz*u[5] + hub_S0_y*u[2])) - hub_S0_z*u[1];
+  const T t304 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + (hub_J0_yz*u[5] + hub_S0_z*u[0])) - hub_S0_x*u[2];
+  const T t305 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + (hub_J0_zz*u[5] + hub_S0_x*u[1])) - hub_S0_y*u[0];
+  const T t306 = ((t300*u[0] + t301*u[1]) + t302*u[2]) + ((t303*u[3] + t304*u[4]) + t305*u[5]);
   const T t307 = t53 - w_B_yoke_a_z*yoke_a_S0_y;
   const T t308 = t43 + t50*yoke_a_S0_y;
   const T t309 = t43*yoke_a_S0_y + t50*yoke_a_J0_xx;
   const T t310 = -t53*yoke_a_S0_y + w_B_yoke_a_z*yoke_a_J0_zz;
-  const T t311 = t250*t51 + t307*t53 + t308*t43 + t309*t50 + t310*w_B_yoke_a_z + t54*t54;
+  const T t311 = ((t250*t51 + t307*t53) + t308*t43) + ((t309*t50 + t310*w_B_yoke_a_z) + t54*t54);
   const T t312 = panel_a_S0_z*t87 + panel_a_mass*t89;
   const T t313 = -panel_a_S0_z*t86 + panel_a_mass*t90;
   const T t314 = -panel_a_mass*t54;
   const T t315 = panel_a_J0_xx*t86 - panel_a_S0_z*t90;
   const T t316 = panel_a_J0_yy*t87 + panel_a_S0_z*t89;
-  const T t317 = t262*w_B_panel_a_z + t312*t89 + t313*t90 - t314*t54 + t315*t86 + t316*t87;
+  const T t317 = (((t262*w_B_panel_a_z + t312*t89) + t313*t90) + (t315*t86 + t316*t87)) - t314*t54;
   const T t318 = t127 - w_B_yoke_b_z*yoke_b_S0_y;
   const T t319 = t117 + t124*yoke_b_S0_y;
   const T t320 = t117*yoke_b_S0_y + t124*yoke_b_J0_xx;
   const T t321 = -t127*yoke_b_S0_y + w_B_yoke_b_z*yoke_b_J0_zz;
-  const T t322 = t117*t319 + t124*t320 + t125*t272 + t127*t318 + t128*t128 + t321*w_B_yoke_b_z;
+  const T t322 = ((t117*t319 + t124*t320) + t125*t272) + ((t127*t318 + t128*t128) + t321*w_B_yoke_b_z);
   const T t323 = panel_b_S0_z*t161 + panel_b_mass*t163;
   const T t324 = panel_b_S0_x*w_B_panel_b_z - panel_b_S0_z*t160 + panel_b_mass*t164;
   const T t325 = -panel_b_S0_x*t161 - panel_b_mass*t128;
   const T t326 = panel_b_J0_xx*t160 + panel_b_J0_xz*w_B_panel_b_z - panel_b_S0_z*t164;
   const T t327 = panel_b_J0_yy*t161 + panel_b_S0_x*t128 + panel_b_S0_z*t163;
   const T t328 = panel_b_J0_xz*t160 + panel_b_J0_zz*w_B_panel_b_z + panel_b_S0_x*t164;
-  const T t329 = -t128*t325 + t160*t326 + t161*t327 + t163*t323 + t164*t324 + t328*w_B_panel_b_z;
+  const T t329 = (((t160*t326 + t161*t327) + t163*t323) + (t164*t324 + t328*w_B_panel_b_z)) - t128*t325;
   const T t330 = dish_mass*t221;
   const T t331 = dish_S0_x*w_B_dish_z + dish_mass*t222;
   const T t332 = -dish_S0_x*t219 - dish_mass*t204;
-  const T t333 = dish_J0_xy*t218 + dish_J0_yy*t219 + dish_J0_yz*w_B_dish_z + dish_S0_x*t204;
-  const T t334 = dish_J0_xz*t218 + dish_J0_yz*t219 + dish_J0_zz*w_B_dish_z + dish_S0_x*t222;
-  const T t335 = -t204*t332 + t218*t294 + t219*t333 + t221*t330 + t222*t331 + t334*w_B_dish_z;
-  const T t336 = t306/2.0 + t311/2.0 + t317/2.0 + t322/2.0 + t329/2.0 + t335/2.0;
+  const T t333 = (dish_J0_xy*t218 + dish_J0_yy*t219) + (dish_J0_yz*w_B_dish_z + dish_S0_x*t204);
+  const T t334 = (dish_J0_xz*t218 + dish_J0_yz*t219) + (dish_J0_zz*w_B_dish_z + dish_S0_x*t222);
+  const T t335 = (((t218*t294 + t219*t333) + t221*t330) + (t222*t331 + t334*w_B_dish_z)) - t204*t332;
+  const T t336 = ((t306/2.0 + t311/2.0) + t317/2.0) + ((t322/2.0 + t329/2.0) + t335/2.0);
   const T t337 = q[7]*q[7]*yoke_a_k/2.0;
   const T t338 = panel_a_k*q[8]*q[8]/2.0 + t337;
   const T t339 = q[9]*q[9]*yoke_b_k/2.0 + t338;
@@ -1944,7 +1958,7 @@ void momentum(const T* q, const T* u, T* pH) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
   // ---- body hub: outward pass (velocities)
-  const T t0 = (1.0/sqrt(q[3]*q[3] + q[4]*q[4] + q[5]*q[5] + q[6]*q[6]));
+  const T t0 = (1.0/sqrt((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
   const T t1 = q[3]*t0;
   const T t2 = q[4]*t0;
   const T t3 = q[5]*t0;
@@ -2114,9 +2128,9 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t300 = -hub_S0_y*u[5] + hub_S0_z*u[4] + hub_mass*u[0];
   const T t301 = hub_S0_x*u[5] - hub_S0_z*u[3] + hub_mass*u[1];
   const T t302 = -hub_S0_x*u[4] + hub_S0_y*u[3] + hub_mass*u[2];
-  const T t303 = hub_J0_xx*u[3] + hub_J0_xy*u[4] + hub_J0_xz*u[5] + hub_S0_y*u[2] - hub_S0_z*u[1];
-  const T t304 = hub_J0_xy*u[3] + hub_J0_yy*u[4] + hub_J0_yz*u[5] - hub_S0_x*u[2] + hub_S0_z*u[0];
-  const T t305 = hub_J0_xz*u[3] + hub_J0_yz*u[4] + hub_J0_zz*u[5] + hub_S0_x*u[1] - hub_S0_y*u[0];
+  const T t303 = ((hub_J0_xx*u[3] + hub_J0_xy*u[4]) + (hub_J0_xz*u[5] + hub_S0_y*u[2])) - hub_S0_z*u[1];
+  const T t304 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + (hub_J0_yz*u[5] + hub_S0_z*u[0])) - hub_S0_x*u[2];
+  const T t305 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + (hub_J0_zz*u[5] + hub_S0_x*u[1])) - hub_S0_y*u[0];
   const T t306 = t14*t300 + t15*t301 + t16*t302;
   const T t307 = t17*t300 + t18*t301 + t19*t302;
   const T t308 = t20*t300 + t21*t301 + t22*t302;
@@ -2223,8 +2237,8 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t409 = dish_mass*t221;
   const T t410 = dish_S0_x*w_B_dish_z + dish_mass*t222;
   const T t411 = -dish_S0_x*t219 - dish_mass*t204;
-  const T t412 = dish_J0_xy*t218 + dish_J0_yy*t219 + dish_J0_yz*w_B_dish_z + dish_S0_x*t204;
-  const T t413 = dish_J0_xz*t218 + dish_J0_yz*t219 + dish_J0_zz*w_B_dish_z + dish_S0_x*t222;
+  const T t412 = (dish_J0_xy*t218 + dish_J0_yy*t219) + (dish_J0_yz*w_B_dish_z + dish_S0_x*t204);
+  const T t413 = (dish_J0_xz*t218 + dish_J0_yz*t219) + (dish_J0_zz*w_B_dish_z + dish_S0_x*t222);
   const T t414 = R_NB_dish_xx*t409 + R_NB_dish_xy*t410 - R_NB_gimbal_xy*t411;
   const T t415 = R_NB_dish_yx*t409 + R_NB_dish_yy*t410 - R_NB_gimbal_yy*t411;
   const T t416 = R_NB_dish_zx*t409 + R_NB_dish_zy*t410 - R_NB_gimbal_zy*t411;
@@ -2472,12 +2486,12 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t324 = t235*t323 - t322*w_B_dish_z;
   const T t325 = -t234*t323 + t321*w_B_dish_z;
   const T t326 = t234*t322 - t235*t321;
-  const T t327 = (t23 + udot_in[0])*hub_mass_2 + hub_S0_z_2*udot_in[4] + t251 + udot_in[5];
-  const T t328 = (t24 + udot_in[1])*hub_mass_2 + hub_S0_x_2*udot_in[5] - hub_S0_z_2*udot_in[3] + t252;
-  const T t329 = (t25 + udot_in[2])*hub_mass_2 - hub_S0_x_2*udot_in[4] + t253 - udot_in[3];
-  const T t330 = -(t24 + udot_in[1])*hub_S0_z_2 + hub_J0_xx_2*udot_in[3] + hub_J0_xy*udot_in[4] + hub_J0_xz*udot_in[5] - t25 + t257 - udot_in[2];
-  const T t331 = (t23 + udot_in[0])*hub_S0_z_2 - (t25 + udot_in[2])*hub_S0_x_2 + hub_J0_xy*udot_in[3] + hub_J0_yy_2*udot_in[4] + hub_J0_yz_2*udot_in[5] + t258;
-  const T t332 = (t24 + udot_in[1])*hub_S0_x_2 + hub_J0_xz*udot_in[3] + hub_J0_yz_2*udot_in[4] + hub_J0_zz_2*udot_in[5] + t23 + t259 + udot_in[0];
+  const T t327 = ((t23 + udot_in[0])*hub_mass_2 + hub_S0_z_2*udot_in[4]) + (t251 + udot_in[5]);
+  const T t328 = (((t24 + udot_in[1])*hub_mass_2 + hub_S0_x_2*udot_in[5]) + t252) - hub_S0_z_2*udot_in[3];
+  const T t329 = ((t25 + udot_in[2])*hub_mass_2 + t253) - (hub_S0_x_2*udot_in[4] + udot_in[3]);
+  const T t330 = ((hub_J0_xx_2*udot_in[3] + hub_J0_xy*udot_in[4]) + (hub_J0_xz*udot_in[5] + t257)) - (((t24 + udot_in[1])*hub_S0_z_2 + t25) + udot_in[2]);
+  const T t331 = ((((t23 + udot_in[0])*hub_S0_z_2 + hub_J0_xy*udot_in[3]) + hub_J0_yy_2*udot_in[4]) + (hub_J0_yz_2*udot_in[5] + t258)) - (t25 + udot_in[2])*hub_S0_x_2;
+  const T t332 = (((t24 + udot_in[1])*hub_S0_x_2 + hub_J0_xz*udot_in[3]) + (hub_J0_yz_2*udot_in[4] + hub_J0_zz_2*udot_in[5])) + ((t23 + t259) + udot_in[0]);
   const T t333 = -udot_in[4]*yoke_a_p_J_y;
   const T t334 = -udot_in[5]*yoke_a_p_J_y;
   const T t335 = t333 - udot_in[2];
@@ -2487,9 +2501,9 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t339 = -t26*udot_in[5] - t27*udot_in[3];
   const T t340 = -t26*udot_in[3] + t27*udot_in[5];
   const T t341 = udot_in[4] + udot_in[6];
-  const T t342 = t262 + t337 - t341*yoke_a_S0_y + t58;
+  const T t342 = ((t262 + t337) + t58) - t341*yoke_a_S0_y;
   const T t343 = t263 + t338 + t59;
-  const T t344 = (t339 + t55)*yoke_a_S0_y + t264 + t336 + t49;
+  const T t344 = ((t339 + t55)*yoke_a_S0_y + t264) + (t336 + t49);
   const T t345 = (t336 + t49)*yoke_a_S0_y + (t339 + t55)*yoke_a_J0_xx + t268;
   const T t346 = (t340 + t56)*yoke_a_J0_yy + t269;
   const T t347 = -(t337 + t58)*yoke_a_S0_y + t270 + t341*yoke_a_J0_zz;
@@ -2517,9 +2531,9 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t369 = -t100*udot_in[5] + t101*udot_in[3];
   const T t370 = t100*udot_in[3] + t101*udot_in[5];
   const T t371 = -udot_in[4] + udot_in[8];
-  const T t372 = t132 + t284 + t367 - t371*yoke_b_S0_y;
+  const T t372 = ((t132 + t284) + t367) - t371*yoke_b_S0_y;
   const T t373 = t133 + t285 + t368;
-  const T t374 = (t129 + t369)*yoke_b_S0_y + t123 + t286 + t366;
+  const T t374 = ((t129 + t369)*yoke_b_S0_y + t123) + (t286 + t366);
   const T t375 = (t123 + t366)*yoke_b_S0_y + (t129 + t369)*yoke_b_J0_xx + t290;
   const T t376 = (t130 + t370)*yoke_b_J0_yy + t291;
   const T t377 = -(t132 + t367)*yoke_b_S0_y + t292 + t371*yoke_b_J0_zz;
@@ -2533,11 +2547,11 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t385 = t134*t371 - t135*t369;
   const T t386 = -t370 + udot_in[9];
   const T t387 = (alpha_R_B_panel_b_y + t385)*panel_b_S0_z + (t172 + t382)*panel_b_mass + t296;
-  const T t388 = -(alpha_R_B_panel_b_x + t384)*panel_b_S0_z - (t130 - t386)*panel_b_S0_x + (t173 + t383)*panel_b_mass + t297;
+  const T t388 = ((t173 + t383)*panel_b_mass + t297) - ((alpha_R_B_panel_b_x + t384)*panel_b_S0_z + (t130 - t386)*panel_b_S0_x);
   const T t389 = -(alpha_R_B_panel_b_y + t385)*panel_b_S0_x + (t159 - t368)*panel_b_mass + t298;
-  const T t390 = (alpha_R_B_panel_b_x + t384)*panel_b_J0_xx - (t130 - t386)*panel_b_J0_xz - (t173 + t383)*panel_b_S0_z + t302;
-  const T t391 = (alpha_R_B_panel_b_y + t385)*panel_b_J0_yy - (t159 - t368)*panel_b_S0_x + (t172 + t382)*panel_b_S0_z + t303;
-  const T t392 = (alpha_R_B_panel_b_x + t384)*panel_b_J0_xz - (t130 - t386)*panel_b_J0_zz + (t173 + t383)*panel_b_S0_x + t304;
+  const T t390 = ((alpha_R_B_panel_b_x + t384)*panel_b_J0_xx + t302) - ((t130 - t386)*panel_b_J0_xz + (t173 + t383)*panel_b_S0_z);
+  const T t391 = (((alpha_R_B_panel_b_y + t385)*panel_b_J0_yy + (t172 + t382)*panel_b_S0_z) + t303) - (t159 - t368)*panel_b_S0_x;
+  const T t392 = (((alpha_R_B_panel_b_x + t384)*panel_b_J0_xz + (t173 + t383)*panel_b_S0_x) + t304) - (t130 - t386)*panel_b_J0_zz;
   const T t393 = -mast_p_J_z*udot_in[3];
   const T t394 = mast_p_J_x*udot_in[5] - mast_p_J_z*udot_in[4];
   const T t395 = mast_p_J_x*udot_in[3];
@@ -2567,9 +2581,9 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t419 = (t246 + t414)*dish_mass + t318;
   const T t420 = -(t222 - t418)*dish_S0_x + (t247 + t415)*dish_mass + t319;
   const T t421 = -(alpha_R_B_dish_y + t417)*dish_S0_x - (t225 + t410)*dish_mass + t320;
-  const T t422 = (alpha_R_B_dish_x + t416)*dish_J0_xx + (alpha_R_B_dish_y + t417)*dish_J0_xy - (t222 - t418)*dish_J0_xz + t324;
-  const T t423 = (alpha_R_B_dish_x + t416)*dish_J0_xy + (alpha_R_B_dish_y + t417)*dish_J0_yy - (t222 - t418)*dish_J0_yz + (t225 + t410)*dish_S0_x + t325;
-  const T t424 = (alpha_R_B_dish_x + t416)*dish_J0_xz + (alpha_R_B_dish_y + t417)*dish_J0_yz - (t222 - t418)*dish_J0_zz + (t247 + t415)*dish_S0_x + t326;
+  const T t422 = (((alpha_R_B_dish_x + t416)*dish_J0_xx + (alpha_R_B_dish_y + t417)*dish_J0_xy) + t324) - (t222 - t418)*dish_J0_xz;
+  const T t423 = (((alpha_R_B_dish_x + t416)*dish_J0_xy + (alpha_R_B_dish_y + t417)*dish_J0_yy) + ((t225 + t410)*dish_S0_x + t325)) - (t222 - t418)*dish_J0_yz;
+  const T t424 = (((alpha_R_B_dish_x + t416)*dish_J0_xz + (alpha_R_B_dish_y + t417)*dish_J0_yz) + ((t247 + t415)*dish_S0_x + t326)) - (t222 - t418)*dish_J0_zz;
   const T t425 = t226*t419 - t227*t420;
   const T t426 = t226*t420 + t227*t419;
   const T t427 = t226*t422 - t227*t423;

@@ -32,6 +32,20 @@
 #define KANEGEN_NOINLINE __attribute__((noinline))
 #endif
 
+// Function multiversioning (GCC on x86-64): the functions the runtime calls
+// (and the parts of large ones) are compiled twice, for x86-64-v3 (AVX2, FMA:
+// about twice as fast on this code) and for the x86-64 baseline, and the
+// loader picks the one this CPU runs, so the code stays portable. Off with
+// -DKANEGEN_NO_DISPATCH, or when compiling for AVX2 anyway (-march=native).
+#ifndef KANEGEN_DISPATCH
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(__AVX2__) && \
+    !defined(KANEGEN_NO_DISPATCH)
+#define KANEGEN_DISPATCH __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define KANEGEN_DISPATCH
+#endif
+#endif
+
 namespace kanegen_gen::chain5_prismatic {
 
 inline constexpr int nq = 5;
@@ -269,12 +283,12 @@ void mass_matrix(const T* q, T* M) {
   const T t145 = t139*t23 - t140*t24;
   const T t146 = t139*t24 + t140*t23;
   const T t147 = t142*t24 + t143*t23;
-  const T t148 = 2.0*l4_p_J_y*t138 + 2.0*l4_p_J_z*t135 + k3fe5f27d + t145;
-  const T t149 = -k21d7fc0e - l4_p_J_x*t138 - l4_p_J_y*t137 + t146;
-  const T t150 = -k21d7fdc3 - l4_p_J_x*t135 - l4_p_J_z*t137 + t141;
-  const T t151 = 2.0*l4_p_J_x*t137 + 2.0*l4_p_J_z*t135 + k20a04250 + t147;
-  const T t152 = -k021f5b82 - l4_p_J_y*t135 - l4_p_J_z*t138 + t144;
-  const T t153 = 2.0*l4_p_J_x*t137 + 2.0*l4_p_J_y*t138 + k151f037b + t132;
+  const T t148 = (2.0*l4_p_J_y*t138 + 2.0*l4_p_J_z*t135) + (k3fe5f27d + t145);
+  const T t149 = t146 - ((k21d7fc0e + l4_p_J_x*t138) + l4_p_J_y*t137);
+  const T t150 = t141 - ((k21d7fdc3 + l4_p_J_x*t135) + l4_p_J_z*t137);
+  const T t151 = (2.0*l4_p_J_x*t137 + 2.0*l4_p_J_z*t135) + (k20a04250 + t147);
+  const T t152 = t144 - ((k021f5b82 + l4_p_J_y*t135) + l4_p_J_z*t138);
+  const T t153 = (2.0*l4_p_J_x*t137 + 2.0*l4_p_J_y*t138) + (k151f037b + t132);
   const T t154 = l4_p_J_x + t137;
   const T t155 = l4_p_J_y + t138;
   const T t156 = l4_p_J_z + t135;
@@ -599,12 +613,12 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t257 = -a_R_B_l3_x*l3_S0_z - l3_J0_yy*t37 - t219;
   const T t258 = l3_J0_zz*t18 - t220;
   // ---- body l4: bias force
-  const T t259 = -alpha_R_B_l4_y*l4_S0_z + l4_S0_y*t98 - l4_mass*t133 - t224;
+  const T t259 = l4_S0_y*t98 - ((alpha_R_B_l4_y*l4_S0_z + l4_mass*t133) + t224);
   const T t260 = alpha_R_B_l4_x*l4_S0_z - l4_mass*t134 - t225;
   const T t261 = -alpha_R_B_l4_x*l4_S0_y - l4_mass*t120 - t226;
-  const T t262 = -alpha_R_B_l4_x*l4_J0_xx - alpha_R_B_l4_y*l4_J0_xy - l4_J0_xz*t98 - l4_S0_y*t120 + l4_S0_z*t134 - t230;
-  const T t263 = -alpha_R_B_l4_x*l4_J0_xy - alpha_R_B_l4_y*l4_J0_yy - l4_J0_yz*t98 - l4_S0_z*t133 - t231;
-  const T t264 = -alpha_R_B_l4_x*l4_J0_xz - alpha_R_B_l4_y*l4_J0_yz - l4_J0_zz*t98 + l4_S0_y*t133 - t232;
+  const T t262 = l4_S0_z*t134 - (((alpha_R_B_l4_x*l4_J0_xx + alpha_R_B_l4_y*l4_J0_xy) + l4_J0_xz*t98) + (l4_S0_y*t120 + t230));
+  const T t263 = -(((alpha_R_B_l4_x*l4_J0_xy + alpha_R_B_l4_y*l4_J0_yy) + l4_J0_yz*t98) + (l4_S0_z*t133 + t231));
+  const T t264 = l4_S0_y*t133 - ((alpha_R_B_l4_x*l4_J0_xz + alpha_R_B_l4_y*l4_J0_yz) + (l4_J0_zz*t98 + t232));
   // ---- body l5: bias force
   const T t265 = -l5_mass*t194 - t235;
   const T t266 = -l5_S0_x*t159 - l5_mass*t195 - t236;
@@ -912,12 +926,12 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t289 = t283*t74 - t284*t75;
   const T t290 = t283*t75 + t284*t74;
   const T t291 = t286*t75 + t287*t74;
-  const T t292 = 2.0*l4_p_J_y*t282 + 2.0*l4_p_J_z*t279 + k3fe5f27d + t289;
-  const T t293 = -k21d7fc0e - l4_p_J_x*t282 - l4_p_J_y*t281 + t290;
-  const T t294 = -k21d7fdc3 - l4_p_J_x*t279 - l4_p_J_z*t281 + t285;
-  const T t295 = 2.0*l4_p_J_x*t281 + 2.0*l4_p_J_z*t279 + k20a04250 + t291;
-  const T t296 = -k021f5b82 - l4_p_J_y*t279 - l4_p_J_z*t282 + t288;
-  const T t297 = 2.0*l4_p_J_x*t281 + 2.0*l4_p_J_y*t282 + k151f037b + t276;
+  const T t292 = (2.0*l4_p_J_y*t282 + 2.0*l4_p_J_z*t279) + (k3fe5f27d + t289);
+  const T t293 = t290 - ((k21d7fc0e + l4_p_J_x*t282) + l4_p_J_y*t281);
+  const T t294 = t285 - ((k21d7fdc3 + l4_p_J_x*t279) + l4_p_J_z*t281);
+  const T t295 = (2.0*l4_p_J_x*t281 + 2.0*l4_p_J_z*t279) + (k20a04250 + t291);
+  const T t296 = t288 - ((k021f5b82 + l4_p_J_y*t279) + l4_p_J_z*t282);
+  const T t297 = (2.0*l4_p_J_x*t281 + 2.0*l4_p_J_y*t282) + (k151f037b + t276);
   const T t298 = l4_p_J_x + t281;
   const T t299 = l4_p_J_y + t282;
   const T t300 = l4_p_J_z + t279;
@@ -1041,12 +1055,12 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t453 = -a_R_B_l3_x*l3_S0_z - l3_J0_yy*t37 - t219;
   const T t454 = l3_J0_zz*t18 - t220;
   // ---- body l4: bias force
-  const T t455 = -alpha_R_B_l4_y*l4_S0_z + l4_S0_y*t98 - l4_mass*t133 - t224;
+  const T t455 = l4_S0_y*t98 - ((alpha_R_B_l4_y*l4_S0_z + l4_mass*t133) + t224);
   const T t456 = alpha_R_B_l4_x*l4_S0_z - l4_mass*t134 - t225;
   const T t457 = -alpha_R_B_l4_x*l4_S0_y - l4_mass*t120 - t226;
-  const T t458 = -alpha_R_B_l4_x*l4_J0_xx - alpha_R_B_l4_y*l4_J0_xy - l4_J0_xz*t98 - l4_S0_y*t120 + l4_S0_z*t134 - t230;
-  const T t459 = -alpha_R_B_l4_x*l4_J0_xy - alpha_R_B_l4_y*l4_J0_yy - l4_J0_yz*t98 - l4_S0_z*t133 - t231;
-  const T t460 = -alpha_R_B_l4_x*l4_J0_xz - alpha_R_B_l4_y*l4_J0_yz - l4_J0_zz*t98 + l4_S0_y*t133 - t232;
+  const T t458 = l4_S0_z*t134 - (((alpha_R_B_l4_x*l4_J0_xx + alpha_R_B_l4_y*l4_J0_xy) + l4_J0_xz*t98) + (l4_S0_y*t120 + t230));
+  const T t459 = -(((alpha_R_B_l4_x*l4_J0_xy + alpha_R_B_l4_y*l4_J0_yy) + l4_J0_yz*t98) + (l4_S0_z*t133 + t231));
+  const T t460 = l4_S0_y*t133 - ((alpha_R_B_l4_x*l4_J0_xz + alpha_R_B_l4_y*l4_J0_yz) + (l4_J0_zz*t98 + t232));
   // ---- body l5: bias force
   const T t461 = -l5_mass*t194 - t235;
   const T t462 = -l5_S0_x*t159 - l5_mass*t195 - t236;
@@ -1292,27 +1306,27 @@ void energy(const T* q, const T* u, T* TV) {
   const T t244 = t198*u[0];
   const T t245 = l2_S0_y*t15 + t12;
   const T t246 = l2_J0_xx*t15 + l2_J0_xz*u[1] + l2_S0_y*t12;
-  const T t247 = t12*t245 + t15*t246 + t16*t205 + t206*u[1];
+  const T t247 = (t12*t245 + t15*t246) + (t16*t205 + t206*u[1]);
   const T t248 = l3_S0_z*t35 + l3_mass*t58;
   const T t249 = -l3_S0_z*t34 + l3_mass*t59;
   const T t250 = l3_mass*u[2];
   const T t251 = l3_J0_xx*t34 - l3_S0_z*t59;
   const T t252 = l3_J0_yy*t35 + l3_S0_z*t58;
-  const T t253 = -t16*t217 + t248*t58 + t249*t59 + t250*u[2] + t251*t34 + t252*t35;
+  const T t253 = (((t248*t58 + t249*t59) + t250*u[2]) + (t251*t34 + t252*t35)) - t16*t217;
   const T t254 = -l4_S0_y*w_B_l4_z + l4_S0_z*t122 + l4_mass*t124;
   const T t255 = -l4_S0_z*t121 + l4_mass*t125;
   const T t256 = l4_S0_y*t121 + l4_mass*t106;
-  const T t257 = l4_J0_xx*t121 + l4_J0_xy*t122 + l4_J0_xz*w_B_l4_z + l4_S0_y*t106 - l4_S0_z*t125;
-  const T t258 = l4_J0_xy*t121 + l4_J0_yy*t122 + l4_J0_yz*w_B_l4_z + l4_S0_z*t124;
-  const T t259 = l4_J0_xz*t121 + l4_J0_yz*t122 + l4_J0_zz*w_B_l4_z - l4_S0_y*t124;
-  const T t260 = t106*t256 + t121*t257 + t122*t258 + t124*t254 + t125*t255 + t259*w_B_l4_z;
+  const T t257 = ((l4_J0_xx*t121 + l4_J0_xy*t122) + (l4_J0_xz*w_B_l4_z + l4_S0_y*t106)) - l4_S0_z*t125;
+  const T t258 = (l4_J0_xy*t121 + l4_J0_yy*t122) + (l4_J0_yz*w_B_l4_z + l4_S0_z*t124);
+  const T t259 = ((l4_J0_xz*t121 + l4_J0_yz*t122) + l4_J0_zz*w_B_l4_z) - l4_S0_y*t124;
+  const T t260 = ((t106*t256 + t121*t257) + t122*t258) + ((t124*t254 + t125*t255) + t259*w_B_l4_z);
   const T t261 = l5_mass*t185;
   const T t262 = l5_S0_x*w_B_l5_z + l5_mass*t186;
   const T t263 = -l5_S0_x*t183 + l5_mass*t167;
   const T t264 = l5_J0_yy*t183 - l5_S0_x*t167;
   const T t265 = l5_J0_zz*w_B_l5_z + l5_S0_x*t186;
-  const T t266 = t167*t263 + t182*t238 + t183*t264 + t185*t261 + t186*t262 + t265*w_B_l5_z;
-  const T t267 = t244/2.0 + t247/2.0 + t253/2.0 + t260/2.0 + t266/2.0;
+  const T t266 = ((t167*t263 + t182*t238) + t183*t264) + ((t185*t261 + t186*t262) + t265*w_B_l5_z);
+  const T t267 = ((t244/2.0 + t247/2.0) + t253/2.0) + (t260/2.0 + t266/2.0);
   const T t269 = -l1_S0_x*t0;
   const T t270 = -gravity_z*t269 + l1_k*q[0]*q[0]/2.0;
   const T t273 = R_NB_l2_zy*l2_S0_y;
@@ -1516,10 +1530,10 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t249 = t4*udot_in[0];
   const T t250 = -l2_S0_y*udot_in[1] + t19 + t201;
   const T t251 = t20 + t202;
-  const T t252 = (t17 + t248)*l2_S0_y + t203 + t247 - t3;
-  const T t253 = (t17 + t248)*l2_J0_xx + (t247 - t3)*l2_S0_y + l2_J0_xz*udot_in[1] + t207;
+  const T t252 = (((t17 + t248)*l2_S0_y + t203) + t247) - t3;
+  const T t253 = ((t17 + t248)*l2_J0_xx + (t247 - t3)*l2_S0_y) + (l2_J0_xz*udot_in[1] + t207);
   const T t254 = (t18 + t249)*l2_J0_yy + t208;
-  const T t255 = (t17 + t248)*l2_J0_xz + l2_J0_zz*udot_in[1] - l2_S0_y*t19 + t209;
+  const T t255 = (((t17 + t248)*l2_J0_xz + l2_J0_zz*udot_in[1]) + t209) - l2_S0_y*t19;
   const T t256 = l3_R_PJ_xx*t248 + l3_R_PJ_zx*udot_in[1];
   const T t257 = l3_R_PJ_xy*t248 + l3_R_PJ_zy*udot_in[1];
   const T t258 = t21*t257;
@@ -1549,12 +1563,12 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t282 = t256*t74 + t270*t75;
   const T t283 = -t256*t75 + t270*t74;
   const T t284 = t271 + udot_in[3];
-  const T t285 = (alpha_R_B_l4_y + t283)*l4_S0_z + (t133 + t280)*l4_mass - (t284 + t98)*l4_S0_y + t224;
+  const T t285 = (((alpha_R_B_l4_y + t283)*l4_S0_z + (t133 + t280)*l4_mass) + t224) - (t284 + t98)*l4_S0_y;
   const T t286 = -(alpha_R_B_l4_x + t282)*l4_S0_z + (t134 + t281)*l4_mass + t225;
   const T t287 = (alpha_R_B_l4_x + t282)*l4_S0_y + (t120 + t279)*l4_mass + t226;
-  const T t288 = (alpha_R_B_l4_x + t282)*l4_J0_xx + (alpha_R_B_l4_y + t283)*l4_J0_xy + (t120 + t279)*l4_S0_y - (t134 + t281)*l4_S0_z + (t284 + t98)*l4_J0_xz + t230;
-  const T t289 = (alpha_R_B_l4_x + t282)*l4_J0_xy + (alpha_R_B_l4_y + t283)*l4_J0_yy + (t133 + t280)*l4_S0_z + (t284 + t98)*l4_J0_yz + t231;
-  const T t290 = (alpha_R_B_l4_x + t282)*l4_J0_xz + (alpha_R_B_l4_y + t283)*l4_J0_yz - (t133 + t280)*l4_S0_y + (t284 + t98)*l4_J0_zz + t232;
+  const T t288 = ((((alpha_R_B_l4_x + t282)*l4_J0_xx + (alpha_R_B_l4_y + t283)*l4_J0_xy) + (t120 + t279)*l4_S0_y) + ((t284 + t98)*l4_J0_xz + t230)) - (t134 + t281)*l4_S0_z;
+  const T t289 = (((alpha_R_B_l4_x + t282)*l4_J0_xy + (alpha_R_B_l4_y + t283)*l4_J0_yy) + (t133 + t280)*l4_S0_z) + ((t284 + t98)*l4_J0_yz + t231);
+  const T t290 = (((alpha_R_B_l4_x + t282)*l4_J0_xz + (alpha_R_B_l4_y + t283)*l4_J0_yz) + ((t284 + t98)*l4_J0_zz + t232)) - (t133 + t280)*l4_S0_y;
   const T t291 = l5_R_PJ_yy*t283 + l5_R_PJ_zy*t284;
   const T t292 = l5_R_PJ_yz*t283 + l5_R_PJ_zz*t284;
   const T t293 = -l5_p_J_y*t292 + l5_p_J_z*t291;

@@ -32,6 +32,20 @@
 #define KANEGEN_NOINLINE __attribute__((noinline))
 #endif
 
+// Function multiversioning (GCC on x86-64): the functions the runtime calls
+// (and the parts of large ones) are compiled twice, for x86-64-v3 (AVX2, FMA:
+// about twice as fast on this code) and for the x86-64 baseline, and the
+// loader picks the one this CPU runs, so the code stays portable. Off with
+// -DKANEGEN_NO_DISPATCH, or when compiling for AVX2 anyway (-march=native).
+#ifndef KANEGEN_DISPATCH
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(__AVX2__) && \
+    !defined(KANEGEN_NO_DISPATCH)
+#define KANEGEN_DISPATCH __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define KANEGEN_DISPATCH
+#endif
+#endif
+
 namespace kanegen_gen::deep_chain {
 
 inline constexpr int nq = 39;
@@ -574,18 +588,18 @@ template <class T>
 void qdot(const T* q, const T* u, T* qdot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
-  const T t0 = 1.0/((q[3]*q[3] + q[4]*q[4] + q[5]*q[5] + q[6]*q[6]));
-  const T t1 = q[3]*q[3] + q[4]*q[4] - q[5]*q[5] - q[6]*q[6];
+  const T t0 = 1.0/(((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
+  const T t1 = (q[3]*q[3] + q[4]*q[4]) - (q[5]*q[5] + q[6]*q[6]);
   const T t2 = -2.0*q[3]*q[6] + 2.0*q[4]*q[5];
   const T t3 = 2.0*q[3]*q[5] + 2.0*q[4]*q[6];
   const T t4 = (t1*u[0] + t2*u[1] + t3*u[2])*t0;
   const T t5 = 2.0*q[3]*q[6] + 2.0*q[4]*q[5];
-  const T t6 = q[3]*q[3] - q[4]*q[4] + q[5]*q[5] - q[6]*q[6];
+  const T t6 = (q[3]*q[3] + q[5]*q[5]) - (q[4]*q[4] + q[6]*q[6]);
   const T t7 = -2.0*q[3]*q[4] + 2.0*q[5]*q[6];
   const T t8 = (t5*u[0] + t6*u[1] + t7*u[2])*t0;
   const T t9 = -2.0*q[3]*q[5] + 2.0*q[4]*q[6];
   const T t10 = 2.0*q[3]*q[4] + 2.0*q[5]*q[6];
-  const T t11 = q[3]*q[3] - q[4]*q[4] - q[5]*q[5] + q[6]*q[6];
+  const T t11 = (q[3]*q[3] + q[6]*q[6]) - (q[4]*q[4] + q[5]*q[5]);
   const T t12 = (t10*u[1] + t11*u[2] + t9*u[0])*t0;
   const T t13 = -q[4]*u[3]/2.0 - q[5]*u[4]/2.0 - q[6]*u[5]/2.0;
   const T t14 = q[3]*u[3]/2.0 + q[5]*u[5]/2.0 - q[6]*u[4]/2.0;
@@ -14513,37 +14527,37 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5363 = -(t5288 + t5316*t5351*t5352 + t5355*t5357*t5358)*t5362;
   const T t5364 = -(t5316*t5351*t5353 - t5322 + t5355*t5357*t5359)*t5362;
   const T t5365 = (t5310 - t5316*t5351*t5354 - t5355*t5357*t5360)*t5362;
-  const T t5366 = -t5316*t5352*t5352 + t5323 - t5355*t5358*t5358 - t5361*t5363*t5363;
+  const T t5366 = t5323 - ((t5316*t5352*t5352 + t5355*t5358*t5358) + t5361*t5363*t5363);
   const T t5367 = 1.0/t5366;
-  const T t5368 = -(t5316*t5352*t5353 - t5324 + t5355*t5358*t5359 + t5361*t5363*t5364)*t5367;
-  const T t5369 = -(t5316*t5352*t5354 - t5325 + t5355*t5358*t5360 + t5361*t5363*t5365)*t5367;
-  const T t5370 = -t5316*t5353*t5353 + t5326 - t5355*t5359*t5359 - t5361*t5364*t5364 - t5366*t5368*t5368;
+  const T t5368 = -(((t5316*t5352*t5353 + t5355*t5358*t5359) + t5361*t5363*t5364) - t5324)*t5367;
+  const T t5369 = -(((t5316*t5352*t5354 + t5355*t5358*t5360) + t5361*t5363*t5365) - t5325)*t5367;
+  const T t5370 = t5326 - ((t5316*t5353*t5353 + t5355*t5359*t5359) + (t5361*t5364*t5364 + t5366*t5368*t5368));
   const T t5371 = 1.0/t5370;
-  const T t5372 = -(t5316*t5353*t5354 - t5327 + t5355*t5359*t5360 + t5361*t5364*t5365 + t5366*t5368*t5369)*t5371;
-  const T t5373 = -t5316*t5354*t5354 + t5328 - t5355*t5360*t5360 - t5361*t5365*t5365 - t5366*t5369*t5369 - t5370*t5372*t5372;
+  const T t5372 = -(((t5316*t5353*t5354 + t5355*t5359*t5360) + (t5361*t5364*t5365 + t5366*t5368*t5369)) - t5327)*t5371;
+  const T t5373 = t5328 - (((t5316*t5354*t5354 + t5355*t5360*t5360) + t5361*t5365*t5365) + (t5366*t5369*t5369 + t5370*t5372*t5372));
   const T t5374 = 1.0/t5373;
   const T t5375 = t5350*t5357 - t5351;
   const T t5376 = t5350*t5358 - t5352 - t5363*t5375;
-  const T t5377 = t5350*t5359 - t5353 - t5364*t5375 - t5368*t5376;
-  const T t5378 = t5350*t5360 - t5354 - t5365*t5375 - t5369*t5376 - t5372*t5377;
+  const T t5377 = t5350*t5359 - ((t5353 + t5364*t5375) + t5368*t5376);
+  const T t5378 = t5350*t5360 - ((t5354 + t5365*t5375) + (t5369*t5376 + t5372*t5377));
   const T t5379 = t5357*t5363 - t5358;
   const T t5380 = t5357*t5364 - t5359 - t5368*t5379;
-  const T t5381 = t5357*t5365 - t5360 - t5369*t5379 - t5372*t5380;
+  const T t5381 = t5357*t5365 - ((t5360 + t5369*t5379) + t5372*t5380);
   const T t5382 = t5363*t5368 - t5364;
   const T t5383 = t5363*t5369 - t5365 - t5372*t5382;
   const T t5384 = t5368*t5372 - t5369;
-  const T t5385 = 1.0/t5316 + t5350*t5350/t5355 + t5375*t5375/t5361 + t5376*t5376/t5366 + t5377*t5377/t5370 + t5378*t5378/t5373;
-  const T t5386 = -t5350/t5355 - t5357*t5375/t5361 + t5376*t5379/t5366 + t5377*t5380/t5370 + t5378*t5381/t5373;
-  const T t5387 = -t5363*t5376/t5366 + t5375/t5361 + t5377*t5382/t5370 + t5378*t5383/t5373;
+  const T t5385 = ((1.0/t5316 + t5350*t5350/t5355) + t5375*t5375/t5361) + ((t5376*t5376/t5366 + t5377*t5377/t5370) + t5378*t5378/t5373);
+  const T t5386 = ((t5376*t5379/t5366 + t5377*t5380/t5370) + t5378*t5381/t5373) - (t5350/t5355 + t5357*t5375/t5361);
+  const T t5387 = ((t5375/t5361 + t5377*t5382/t5370) + t5378*t5383/t5373) - t5363*t5376/t5366;
   const T t5388 = -t5368*t5377/t5370 + t5376/t5366 + t5378*t5384/t5373;
   const T t5389 = -t5372*t5378/t5373 + t5377/t5370;
   const T t5390 = t5378/t5373;
-  const T t5391 = 1.0/t5355 + t5357*t5357/t5361 + t5379*t5379/t5366 + t5380*t5380/t5370 + t5381*t5381/t5373;
-  const T t5392 = -t5357/t5361 - t5363*t5379/t5366 + t5380*t5382/t5370 + t5381*t5383/t5373;
+  const T t5391 = ((1.0/t5355 + t5357*t5357/t5361) + t5379*t5379/t5366) + (t5380*t5380/t5370 + t5381*t5381/t5373);
+  const T t5392 = (t5380*t5382/t5370 + t5381*t5383/t5373) - (t5357/t5361 + t5363*t5379/t5366);
   const T t5393 = -t5368*t5380/t5370 + t5379/t5366 + t5381*t5384/t5373;
   const T t5394 = -t5372*t5381/t5373 + t5380/t5370;
   const T t5395 = t5381/t5373;
-  const T t5396 = 1.0/t5361 + t5363*t5363/t5366 + t5382*t5382/t5370 + t5383*t5383/t5373;
+  const T t5396 = (1.0/t5361 + t5363*t5363/t5366) + (t5382*t5382/t5370 + t5383*t5383/t5373);
   const T t5397 = -t5363/t5366 - t5368*t5382/t5370 + t5383*t5384/t5373;
   const T t5398 = -t5372*t5383/t5373 + t5382/t5370;
   const T t5399 = t5383/t5373;
@@ -14555,12 +14569,12 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5405 = t5316 + t5318 + t5321;
   const T t5406 = t5323 + t5326 + t5328;
   // ---- body base: accelerations (outward)
-  const T t5407 = t5343*t5385 + t5344*t5386 + t5345*t5387 + t5346*t5388 + t5347*t5389 + t5348*t5390;
-  const T t5408 = t5343*t5386 + t5344*t5391 + t5345*t5392 + t5346*t5393 + t5347*t5394 + t5348*t5395;
-  const T t5409 = t5343*t5387 + t5344*t5392 + t5345*t5396 + t5346*t5397 + t5347*t5398 + t5348*t5399;
-  const T t5410 = t5343*t5388 + t5344*t5393 + t5345*t5397 + t5346*t5400 + t5347*t5401 + t5348*t5402;
-  const T t5411 = t5343*t5389 + t5344*t5394 + t5345*t5398 + t5346*t5401 + t5347*t5403 + t5348*t5404;
-  const T t5412 = t5343*t5390 + t5344*t5395 + t5345*t5399 + t5346*t5402 + t5347*t5404 + t5348*t5374;
+  const T t5407 = ((t5343*t5385 + t5344*t5386) + t5345*t5387) + ((t5346*t5388 + t5347*t5389) + t5348*t5390);
+  const T t5408 = ((t5343*t5386 + t5344*t5391) + t5345*t5392) + ((t5346*t5393 + t5347*t5394) + t5348*t5395);
+  const T t5409 = ((t5343*t5387 + t5344*t5392) + t5345*t5396) + ((t5346*t5397 + t5347*t5398) + t5348*t5399);
+  const T t5410 = ((t5343*t5388 + t5344*t5393) + t5345*t5397) + ((t5346*t5400 + t5347*t5401) + t5348*t5402);
+  const T t5411 = ((t5343*t5389 + t5344*t5394) + t5345*t5398) + ((t5346*t5401 + t5347*t5403) + t5348*t5404);
+  const T t5412 = ((t5343*t5390 + t5344*t5395) + t5345*t5399) + ((t5346*t5402 + t5347*t5404) + t5348*t5374);
   // ---- body link1: accelerations (outward)
   const T t5413 = link1_p_J_x*t5411;
   const T t5414 = link1_p_J_x*t5412;
@@ -14570,7 +14584,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5418 = t26*t5415 - t27*t5407;
   const T t5419 = t26*t5410 - t27*t5412;
   const T t5420 = -t26*t5412 - t27*t5410;
-  const T t5421 = -t5213*t5417 - t5214*t5416 - t5216*t5419 + t5218*t5420 - t5222*t5418 - t5227*t5411 + t5243;
+  const T t5421 = (t5218*t5420 + t5243) - (((t5213*t5417 + t5214*t5416) + t5216*t5419) + (t5222*t5418 + t5227*t5411));
   const T t5422 = t5244*t5421;
   const T t5423 = t5411 + t5422;
   // ---- body link2: accelerations (outward)
@@ -14582,7 +14596,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5429 = -t5417*t61 + t5426*t60;
   const T t5430 = t5419*t60 + t5423*t61;
   const T t5431 = -t5419*t61 + t5423*t60;
-  const T t5432 = -t5117*t5428 - t5118*t5427 - t5120*t5430 + t5122*t5431 - t5126*t5429 + t5131*t5420 + t5147;
+  const T t5432 = ((t5122*t5431 + t5131*t5420) + t5147) - ((t5117*t5428 + t5118*t5427) + (t5120*t5430 + t5126*t5429));
   const T t5433 = t5148*t5432;
   const T t5434 = -t5420 + t5433;
   // ---- body link3: accelerations (outward)
@@ -14594,7 +14608,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5440 = t100*t5437 - t101*t5428;
   const T t5441 = t100*t5430 + t101*t5434;
   const T t5442 = t100*t5434 - t101*t5430;
-  const T t5443 = -t5010*t5439 - t5014*t5438 - t5018*t5441 - t5022*t5442 - t5026*t5440 + t5031*t5431 + t5051;
+  const T t5443 = (t5031*t5431 + t5051) - (((t5010*t5439 + t5014*t5438) + t5018*t5441) + (t5022*t5442 + t5026*t5440));
   const T t5444 = t5052*t5443;
   const T t5445 = -t5431 + t5444;
   // ---- body link4: accelerations (outward)
@@ -14610,7 +14624,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5455 = t142*t5452 - t143*t5439;
   const T t5456 = t142*t5441 + t143*t5446;
   const T t5457 = t142*t5446 - t143*t5441;
-  const T t5458 = -t4891*t5454 - t4892*t5453 - t4894*t5456 + t4896*t5457 - t4900*t5455 - t4905*t5447 + t4921;
+  const T t5458 = (t4896*t5457 + t4921) - (((t4891*t5454 + t4892*t5453) + t4894*t5456) + (t4900*t5455 + t4905*t5447));
   const T t5459 = t4922*t5458;
   const T t5460 = t5447 + t5459;
   // ---- body link5: accelerations (outward)
@@ -14622,7 +14636,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5466 = t199*t5463 - t200*t5454;
   const T t5467 = t199*t5456 + t200*t5460;
   const T t5468 = t199*t5460 - t200*t5456;
-  const T t5469 = -t4795*t5465 - t4796*t5464 - t4798*t5467 + t4800*t5468 - t4804*t5466 + t4809*t5457 + t4825;
+  const T t5469 = ((t4800*t5468 + t4809*t5457) + t4825) - ((t4795*t5465 + t4796*t5464) + (t4798*t5467 + t4804*t5466));
   const T t5470 = t4826*t5469;
   const T t5471 = -t5457 + t5470;
   // ---- body link6: accelerations (outward)
@@ -14634,7 +14648,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5477 = t241*t5474 - t242*t5465;
   const T t5478 = t241*t5467 + t242*t5471;
   const T t5479 = t241*t5471 - t242*t5467;
-  const T t5480 = -t4699*t5476 - t4700*t5475 - t4702*t5478 + t4704*t5479 - t4708*t5477 + t4713*t5468 + t4729;
+  const T t5480 = ((t4704*t5479 + t4713*t5468) + t4729) - ((t4699*t5476 + t4700*t5475) + (t4702*t5478 + t4708*t5477));
   const T t5481 = t4730*t5480;
   const T t5482 = -t5468 + t5481;
   // ---- body link7: accelerations (outward)
@@ -14646,7 +14660,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5488 = t283*t5485 - t284*t5476;
   const T t5489 = t283*t5478 + t284*t5482;
   const T t5490 = t283*t5482 - t284*t5478;
-  const T t5491 = -t4592*t5487 - t4596*t5486 - t4600*t5489 - t4604*t5490 - t4608*t5488 + t4613*t5479 + t4633;
+  const T t5491 = (t4613*t5479 + t4633) - (((t4592*t5487 + t4596*t5486) + t4600*t5489) + (t4604*t5490 + t4608*t5488));
   const T t5492 = t4634*t5491;
   const T t5493 = -t5479 + t5492;
   // ---- body link8: accelerations (outward)
@@ -14662,7 +14676,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5503 = t325*t5500 - t326*t5487;
   const T t5504 = t325*t5489 + t326*t5494;
   const T t5505 = t325*t5494 - t326*t5489;
-  const T t5506 = -t4473*t5502 - t4474*t5501 - t4476*t5504 + t4478*t5505 - t4482*t5503 - t4487*t5495 + t4503;
+  const T t5506 = (t4478*t5505 + t4503) - (((t4473*t5502 + t4474*t5501) + t4476*t5504) + (t4482*t5503 + t4487*t5495));
   const T t5507 = t4504*t5506;
   const T t5508 = t5495 + t5507;
   // ---- body link9: accelerations (outward)
@@ -14674,7 +14688,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5514 = t382*t5511 - t383*t5502;
   const T t5515 = t382*t5504 + t383*t5508;
   const T t5516 = t382*t5508 - t383*t5504;
-  const T t5517 = -t4377*t5513 - t4378*t5512 - t4380*t5515 + t4382*t5516 - t4386*t5514 + t4391*t5505 + t4407;
+  const T t5517 = ((t4382*t5516 + t4391*t5505) + t4407) - ((t4377*t5513 + t4378*t5512) + (t4380*t5515 + t4386*t5514));
   const T t5518 = t4408*t5517;
   const T t5519 = -t5505 + t5518;
   // ---- body link10: accelerations (outward)
@@ -14686,7 +14700,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5525 = t424*t5522 - t425*t5513;
   const T t5526 = t424*t5515 + t425*t5519;
   const T t5527 = t424*t5519 - t425*t5515;
-  const T t5528 = -t4281*t5524 - t4282*t5523 - t4284*t5526 + t4286*t5527 - t4290*t5525 + t4295*t5516 + t4311;
+  const T t5528 = ((t4286*t5527 + t4295*t5516) + t4311) - ((t4281*t5524 + t4282*t5523) + (t4284*t5526 + t4290*t5525));
   const T t5529 = t4312*t5528;
   const T t5530 = -t5516 + t5529;
   // ---- body link11: accelerations (outward)
@@ -14698,7 +14712,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5536 = t466*t5533 - t467*t5524;
   const T t5537 = t466*t5526 + t467*t5530;
   const T t5538 = t466*t5530 - t467*t5526;
-  const T t5539 = -t4174*t5535 - t4178*t5534 - t4182*t5537 - t4186*t5538 - t4190*t5536 + t4195*t5527 + t4215;
+  const T t5539 = (t4195*t5527 + t4215) - (((t4174*t5535 + t4178*t5534) + t4182*t5537) + (t4186*t5538 + t4190*t5536));
   const T t5540 = t4216*t5539;
   const T t5541 = -t5527 + t5540;
   // ---- body link12: accelerations (outward)
@@ -14714,7 +14728,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5551 = t508*t5548 - t509*t5535;
   const T t5552 = t508*t5537 + t509*t5542;
   const T t5553 = t508*t5542 - t509*t5537;
-  const T t5554 = -t4055*t5550 - t4056*t5549 - t4058*t5552 + t4060*t5553 - t4064*t5551 - t4069*t5543 + t4085;
+  const T t5554 = (t4060*t5553 + t4085) - (((t4055*t5550 + t4056*t5549) + t4058*t5552) + (t4064*t5551 + t4069*t5543));
   const T t5555 = t4086*t5554;
   const T t5556 = t5543 + t5555;
   // ---- body link13: accelerations (outward)
@@ -14726,7 +14740,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5562 = -t5550*t566 + t5559*t565;
   const T t5563 = t5552*t565 + t5556*t566;
   const T t5564 = -t5552*t566 + t5556*t565;
-  const T t5565 = -t3959*t5561 - t3960*t5560 - t3962*t5563 + t3964*t5564 - t3968*t5562 + t3973*t5553 + t3989;
+  const T t5565 = ((t3964*t5564 + t3973*t5553) + t3989) - ((t3959*t5561 + t3960*t5560) + (t3962*t5563 + t3968*t5562));
   const T t5566 = t3990*t5565;
   const T t5567 = -t5553 + t5566;
   // ---- body link14: accelerations (outward)
@@ -14738,7 +14752,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5573 = -t5561*t608 + t5570*t607;
   const T t5574 = t5563*t607 + t5567*t608;
   const T t5575 = -t5563*t608 + t5567*t607;
-  const T t5576 = -t3863*t5572 - t3864*t5571 - t3866*t5574 + t3868*t5575 - t3872*t5573 + t3877*t5564 + t3893;
+  const T t5576 = ((t3868*t5575 + t3877*t5564) + t3893) - ((t3863*t5572 + t3864*t5571) + (t3866*t5574 + t3872*t5573));
   const T t5577 = t3894*t5576;
   const T t5578 = -t5564 + t5577;
   // ---- body link15: accelerations (outward)
@@ -14750,7 +14764,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5584 = -t5572*t650 + t5581*t649;
   const T t5585 = t5574*t649 + t5578*t650;
   const T t5586 = -t5574*t650 + t5578*t649;
-  const T t5587 = -t3756*t5583 - t3760*t5582 - t3764*t5585 - t3768*t5586 - t3772*t5584 + t3777*t5575 + t3797;
+  const T t5587 = (t3777*t5575 + t3797) - (((t3756*t5583 + t3760*t5582) + t3764*t5585) + (t3768*t5586 + t3772*t5584));
   const T t5588 = t3798*t5587;
   const T t5589 = -t5575 + t5588;
   // ---- body link16: accelerations (outward)
@@ -14766,7 +14780,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5599 = -t5583*t692 + t5596*t691;
   const T t5600 = t5585*t691 + t5590*t692;
   const T t5601 = -t5585*t692 + t5590*t691;
-  const T t5602 = -t3637*t5598 - t3638*t5597 - t3640*t5600 + t3642*t5601 - t3646*t5599 - t3651*t5591 + t3667;
+  const T t5602 = (t3642*t5601 + t3667) - (((t3637*t5598 + t3638*t5597) + t3640*t5600) + (t3646*t5599 + t3651*t5591));
   const T t5603 = t3668*t5602;
   const T t5604 = t5591 + t5603;
   // ---- body link17: accelerations (outward)
@@ -14778,7 +14792,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5610 = -t5598*t749 + t5607*t748;
   const T t5611 = t5600*t748 + t5604*t749;
   const T t5612 = -t5600*t749 + t5604*t748;
-  const T t5613 = -t3541*t5609 - t3542*t5608 - t3544*t5611 + t3546*t5612 - t3550*t5610 + t3555*t5601 + t3571;
+  const T t5613 = ((t3546*t5612 + t3555*t5601) + t3571) - ((t3541*t5609 + t3542*t5608) + (t3544*t5611 + t3550*t5610));
   const T t5614 = t3572*t5613;
   const T t5615 = -t5601 + t5614;
   // ---- body link18: accelerations (outward)
@@ -14790,7 +14804,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5621 = -t5609*t791 + t5618*t790;
   const T t5622 = t5611*t790 + t5615*t791;
   const T t5623 = -t5611*t791 + t5615*t790;
-  const T t5624 = -t3445*t5620 - t3446*t5619 - t3448*t5622 + t3450*t5623 - t3454*t5621 + t3459*t5612 + t3475;
+  const T t5624 = ((t3450*t5623 + t3459*t5612) + t3475) - ((t3445*t5620 + t3446*t5619) + (t3448*t5622 + t3454*t5621));
   const T t5625 = t3476*t5624;
   const T t5626 = -t5612 + t5625;
   // ---- body link19: accelerations (outward)
@@ -14802,7 +14816,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5632 = -t5620*t833 + t5629*t832;
   const T t5633 = t5622*t832 + t5626*t833;
   const T t5634 = -t5622*t833 + t5626*t832;
-  const T t5635 = -t3338*t5631 - t3342*t5630 - t3346*t5633 - t3350*t5634 - t3354*t5632 + t3359*t5623 + t3379;
+  const T t5635 = (t3359*t5623 + t3379) - (((t3338*t5631 + t3342*t5630) + t3346*t5633) + (t3350*t5634 + t3354*t5632));
   const T t5636 = t3380*t5635;
   const T t5637 = -t5623 + t5636;
   // ---- body link20: accelerations (outward)
@@ -14818,7 +14832,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5647 = -t5631*t875 + t5644*t874;
   const T t5648 = t5633*t874 + t5638*t875;
   const T t5649 = -t5633*t875 + t5638*t874;
-  const T t5650 = -t3219*t5646 - t3220*t5645 - t3222*t5648 + t3224*t5649 - t3228*t5647 - t3233*t5639 + t3249;
+  const T t5650 = (t3224*t5649 + t3249) - (((t3219*t5646 + t3220*t5645) + t3222*t5648) + (t3228*t5647 + t3233*t5639));
   const T t5651 = t3250*t5650;
   const T t5652 = t5639 + t5651;
   // ---- body link21: accelerations (outward)
@@ -14830,7 +14844,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5658 = -t5646*t932 + t5655*t931;
   const T t5659 = t5648*t931 + t5652*t932;
   const T t5660 = -t5648*t932 + t5652*t931;
-  const T t5661 = -t3123*t5657 - t3124*t5656 - t3126*t5659 + t3128*t5660 - t3132*t5658 + t3137*t5649 + t3153;
+  const T t5661 = ((t3128*t5660 + t3137*t5649) + t3153) - ((t3123*t5657 + t3124*t5656) + (t3126*t5659 + t3132*t5658));
   const T t5662 = t3154*t5661;
   const T t5663 = -t5649 + t5662;
   // ---- body link22: accelerations (outward)
@@ -14842,7 +14856,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5669 = -t5657*t974 + t5666*t973;
   const T t5670 = t5659*t973 + t5663*t974;
   const T t5671 = -t5659*t974 + t5663*t973;
-  const T t5672 = -t3027*t5668 - t3028*t5667 - t3030*t5670 + t3032*t5671 - t3036*t5669 + t3041*t5660 + t3057;
+  const T t5672 = ((t3032*t5671 + t3041*t5660) + t3057) - ((t3027*t5668 + t3028*t5667) + (t3030*t5670 + t3036*t5669));
   const T t5673 = t3058*t5672;
   const T t5674 = -t5660 + t5673;
   // ---- body link23: accelerations (outward)
@@ -14854,7 +14868,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5680 = t1015*t5677 - t1016*t5668;
   const T t5681 = t1015*t5670 + t1016*t5674;
   const T t5682 = t1015*t5674 - t1016*t5670;
-  const T t5683 = -t2920*t5679 - t2924*t5678 - t2928*t5681 - t2932*t5682 - t2936*t5680 + t2941*t5671 + t2961;
+  const T t5683 = (t2941*t5671 + t2961) - (((t2920*t5679 + t2924*t5678) + t2928*t5681) + (t2932*t5682 + t2936*t5680));
   const T t5684 = t2962*t5683;
   const T t5685 = -t5671 + t5684;
   // ---- body link24: accelerations (outward)
@@ -14870,7 +14884,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5695 = t1057*t5692 - t1058*t5679;
   const T t5696 = t1057*t5681 + t1058*t5686;
   const T t5697 = t1057*t5686 - t1058*t5681;
-  const T t5698 = -t2801*t5694 - t2802*t5693 - t2804*t5696 + t2806*t5697 - t2810*t5695 - t2815*t5687 + t2831;
+  const T t5698 = (t2806*t5697 + t2831) - (((t2801*t5694 + t2802*t5693) + t2804*t5696) + (t2810*t5695 + t2815*t5687));
   const T t5699 = t2832*t5698;
   const T t5700 = t5687 + t5699;
   // ---- body link25: accelerations (outward)
@@ -14882,7 +14896,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5706 = t1114*t5703 - t1115*t5694;
   const T t5707 = t1114*t5696 + t1115*t5700;
   const T t5708 = t1114*t5700 - t1115*t5696;
-  const T t5709 = -t2705*t5705 - t2706*t5704 - t2708*t5707 + t2710*t5708 - t2714*t5706 + t2719*t5697 + t2735;
+  const T t5709 = ((t2710*t5708 + t2719*t5697) + t2735) - ((t2705*t5705 + t2706*t5704) + (t2708*t5707 + t2714*t5706));
   const T t5710 = t2736*t5709;
   const T t5711 = -t5697 + t5710;
   // ---- body link26: accelerations (outward)
@@ -14894,7 +14908,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5717 = t1156*t5714 - t1157*t5705;
   const T t5718 = t1156*t5707 + t1157*t5711;
   const T t5719 = t1156*t5711 - t1157*t5707;
-  const T t5720 = -t2609*t5716 - t2610*t5715 - t2612*t5718 + t2614*t5719 - t2618*t5717 + t2623*t5708 + t2639;
+  const T t5720 = ((t2614*t5719 + t2623*t5708) + t2639) - ((t2609*t5716 + t2610*t5715) + (t2612*t5718 + t2618*t5717));
   const T t5721 = t2640*t5720;
   const T t5722 = -t5708 + t5721;
   // ---- body link27: accelerations (outward)
@@ -14906,7 +14920,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5728 = t1198*t5725 - t1199*t5716;
   const T t5729 = t1198*t5718 + t1199*t5722;
   const T t5730 = t1198*t5722 - t1199*t5718;
-  const T t5731 = -t2502*t5727 - t2506*t5726 - t2510*t5729 - t2514*t5730 - t2518*t5728 + t2523*t5719 + t2543;
+  const T t5731 = (t2523*t5719 + t2543) - (((t2502*t5727 + t2506*t5726) + t2510*t5729) + (t2514*t5730 + t2518*t5728));
   const T t5732 = t2544*t5731;
   const T t5733 = -t5719 + t5732;
   // ---- body link28: accelerations (outward)
@@ -14922,7 +14936,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5743 = t1240*t5740 - t1241*t5727;
   const T t5744 = t1240*t5729 + t1241*t5734;
   const T t5745 = t1240*t5734 - t1241*t5729;
-  const T t5746 = -t2383*t5742 - t2384*t5741 - t2386*t5744 + t2388*t5745 - t2392*t5743 - t2397*t5735 + t2413;
+  const T t5746 = (t2388*t5745 + t2413) - (((t2383*t5742 + t2384*t5741) + t2386*t5744) + (t2392*t5743 + t2397*t5735));
   const T t5747 = t2414*t5746;
   const T t5748 = t5735 + t5747;
   // ---- body link29: accelerations (outward)
@@ -14934,7 +14948,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5754 = t1297*t5751 - t1298*t5742;
   const T t5755 = t1297*t5744 + t1298*t5748;
   const T t5756 = t1297*t5748 - t1298*t5744;
-  const T t5757 = -t2287*t5753 - t2288*t5752 - t2290*t5755 + t2292*t5756 - t2296*t5754 + t2301*t5745 + t2317;
+  const T t5757 = ((t2292*t5756 + t2301*t5745) + t2317) - ((t2287*t5753 + t2288*t5752) + (t2290*t5755 + t2296*t5754));
   const T t5758 = t2318*t5757;
   const T t5759 = -t5745 + t5758;
   // ---- body link30: accelerations (outward)
@@ -14946,7 +14960,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5765 = t1339*t5762 - t1340*t5753;
   const T t5766 = t1339*t5755 + t1340*t5759;
   const T t5767 = t1339*t5759 - t1340*t5755;
-  const T t5768 = -t2191*t5764 - t2192*t5763 - t2194*t5766 + t2196*t5767 - t2200*t5765 + t2205*t5756 + t2221;
+  const T t5768 = ((t2196*t5767 + t2205*t5756) + t2221) - ((t2191*t5764 + t2192*t5763) + (t2194*t5766 + t2200*t5765));
   const T t5769 = t2222*t5768;
   const T t5770 = -t5756 + t5769;
   // ---- body link31: accelerations (outward)
@@ -14958,7 +14972,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t5776 = t1381*t5773 - t1382*t5764;
   const T t5777 = t1381*t5766 + t1382*t5770;
   const T t5778 = t1381*t5770 - t1382*t5766;
-  const T t5779 = -t2084*t5775 - t2088*t5774 - t2092*t5777 - t2096*t5778 - t2100*t5776 + t2105*t5767 + t2125;
+  const T t5779 = (t2105*t5767 + t2125) - (((t2084*t5775 + t2088*t5774) + t2092*t5777) + (t2096*t5778 + t2100*t5776));
   const T t5780 = t2126*t5779;
   const T t5781 = -t5767 + t5780;
   // ---- body link32: accelerations (outward)
@@ -15536,203 +15550,203 @@ void energy(const T* q, const T* u, T* TV) {
   const T t1844 = base_S0_z*u[4] + base_mass*u[0];
   const T t1845 = base_S0_x*u[5] - base_S0_z*u[3] + base_mass*u[1];
   const T t1846 = -base_S0_x*u[4] + base_mass*u[2];
-  const T t1847 = base_J0_xx*u[3] + base_J0_xy*u[4] + base_J0_xz*u[5] - base_S0_z*u[1];
-  const T t1848 = base_J0_xy*u[3] + base_J0_yy*u[4] + base_J0_yz*u[5] - base_S0_x*u[2] + base_S0_z*u[0];
-  const T t1849 = base_J0_xz*u[3] + base_J0_yz*u[4] + base_J0_zz*u[5] + base_S0_x*u[1];
-  const T t1850 = t1844*u[0] + t1845*u[1] + t1846*u[2] + t1847*u[3] + t1848*u[4] + t1849*u[5];
+  const T t1847 = ((base_J0_xx*u[3] + base_J0_xy*u[4]) + base_J0_xz*u[5]) - base_S0_z*u[1];
+  const T t1848 = ((base_J0_xy*u[3] + base_J0_yy*u[4]) + (base_J0_yz*u[5] + base_S0_z*u[0])) - base_S0_x*u[2];
+  const T t1849 = (base_J0_xz*u[3] + base_J0_yz*u[4]) + (base_J0_zz*u[5] + base_S0_x*u[1]);
+  const T t1850 = ((t1844*u[0] + t1845*u[1]) + t1846*u[2]) + ((t1847*u[3] + t1848*u[4]) + t1849*u[5]);
   const T t1851 = link1_mass*t53;
   const T t1852 = link1_S0_x*w_B_link1_z + link1_mass*t54;
   const T t1853 = -link1_S0_x*t51 + link1_mass*t43;
   const T t1854 = link1_J0_yy*t51 - link1_S0_x*t43;
   const T t1855 = link1_J0_zz*w_B_link1_z + link1_S0_x*t54;
-  const T t1856 = t1497*t50 + t1851*t53 + t1852*t54 + t1853*t43 + t1854*t51 + t1855*w_B_link1_z;
+  const T t1856 = ((t1497*t50 + t1851*t53) + t1852*t54) + ((t1853*t43 + t1854*t51) + t1855*w_B_link1_z);
   const T t1857 = link2_mass*t89;
   const T t1858 = link2_S0_x*w_B_link2_z + link2_mass*t90;
   const T t1859 = -link2_S0_x*t87 + link2_mass*t77;
   const T t1860 = link2_J0_yy*t87 - link2_S0_x*t77;
   const T t1861 = link2_J0_zz*w_B_link2_z + link2_S0_x*t90;
-  const T t1862 = t1508*t86 + t1857*t89 + t1858*t90 + t1859*t77 + t1860*t87 + t1861*w_B_link2_z;
+  const T t1862 = ((t1508*t86 + t1857*t89) + t1858*t90) + ((t1859*t77 + t1860*t87) + t1861*w_B_link2_z);
   const T t1863 = link3_mass*t131;
   const T t1864 = link3_S0_x*w_B_link3_z + link3_mass*t132;
   const T t1865 = -link3_S0_x*t129 + link3_mass*t117;
   const T t1866 = link3_J0_yy*t129 - link3_S0_x*t117;
   const T t1867 = link3_J0_zz*w_B_link3_z + link3_S0_x*t132;
-  const T t1868 = t117*t1865 + t128*t1519 + t129*t1866 + t131*t1863 + t132*t1864 + t1867*w_B_link3_z;
+  const T t1868 = ((t117*t1865 + t128*t1519) + t129*t1866) + ((t131*t1863 + t132*t1864) + t1867*w_B_link3_z);
   const T t1869 = link4_mass*t188;
   const T t1870 = link4_S0_x*w_B_link4_z + link4_mass*t189;
   const T t1871 = -link4_S0_x*t186 + link4_mass*t172;
   const T t1872 = link4_J0_yy*t186 - link4_S0_x*t172;
   const T t1873 = link4_J0_zz*w_B_link4_z + link4_S0_x*t189;
-  const T t1874 = t1530*t185 + t172*t1871 + t186*t1872 + t1869*t188 + t1870*t189 + t1873*w_B_link4_z;
+  const T t1874 = ((t1530*t185 + t172*t1871) + t186*t1872) + ((t1869*t188 + t1870*t189) + t1873*w_B_link4_z);
   const T t1875 = link5_mass*t230;
   const T t1876 = link5_S0_x*w_B_link5_z + link5_mass*t231;
   const T t1877 = -link5_S0_x*t228 + link5_mass*t216;
   const T t1878 = link5_J0_yy*t228 - link5_S0_x*t216;
   const T t1879 = link5_J0_zz*w_B_link5_z + link5_S0_x*t231;
-  const T t1880 = t1541*t227 + t1875*t230 + t1876*t231 + t1877*t216 + t1878*t228 + t1879*w_B_link5_z;
+  const T t1880 = ((t1541*t227 + t1875*t230) + t1876*t231) + ((t1877*t216 + t1878*t228) + t1879*w_B_link5_z);
   const T t1881 = link6_mass*t272;
   const T t1882 = link6_S0_x*w_B_link6_z + link6_mass*t273;
   const T t1883 = -link6_S0_x*t270 + link6_mass*t258;
   const T t1884 = link6_J0_yy*t270 - link6_S0_x*t258;
   const T t1885 = link6_J0_zz*w_B_link6_z + link6_S0_x*t273;
-  const T t1886 = t1552*t269 + t1881*t272 + t1882*t273 + t1883*t258 + t1884*t270 + t1885*w_B_link6_z;
+  const T t1886 = ((t1552*t269 + t1881*t272) + t1882*t273) + ((t1883*t258 + t1884*t270) + t1885*w_B_link6_z);
   const T t1887 = link7_mass*t314;
   const T t1888 = link7_S0_x*w_B_link7_z + link7_mass*t315;
   const T t1889 = -link7_S0_x*t312 + link7_mass*t300;
   const T t1890 = link7_J0_yy*t312 - link7_S0_x*t300;
   const T t1891 = link7_J0_zz*w_B_link7_z + link7_S0_x*t315;
-  const T t1892 = t1563*t311 + t1887*t314 + t1888*t315 + t1889*t300 + t1890*t312 + t1891*w_B_link7_z;
+  const T t1892 = ((t1563*t311 + t1887*t314) + t1888*t315) + ((t1889*t300 + t1890*t312) + t1891*w_B_link7_z);
   const T t1893 = link8_mass*t371;
   const T t1894 = link8_S0_x*w_B_link8_z + link8_mass*t372;
   const T t1895 = -link8_S0_x*t369 + link8_mass*t355;
   const T t1896 = link8_J0_yy*t369 - link8_S0_x*t355;
   const T t1897 = link8_J0_zz*w_B_link8_z + link8_S0_x*t372;
-  const T t1898 = t1574*t368 + t1893*t371 + t1894*t372 + t1895*t355 + t1896*t369 + t1897*w_B_link8_z;
+  const T t1898 = ((t1574*t368 + t1893*t371) + t1894*t372) + ((t1895*t355 + t1896*t369) + t1897*w_B_link8_z);
   const T t1899 = link9_mass*t413;
   const T t1900 = link9_S0_x*w_B_link9_z + link9_mass*t414;
   const T t1901 = -link9_S0_x*t411 + link9_mass*t399;
   const T t1902 = link9_J0_yy*t411 - link9_S0_x*t399;
   const T t1903 = link9_J0_zz*w_B_link9_z + link9_S0_x*t414;
-  const T t1904 = t1585*t410 + t1899*t413 + t1900*t414 + t1901*t399 + t1902*t411 + t1903*w_B_link9_z;
+  const T t1904 = ((t1585*t410 + t1899*t413) + t1900*t414) + ((t1901*t399 + t1902*t411) + t1903*w_B_link9_z);
   const T t1905 = link10_mass*t455;
   const T t1906 = link10_S0_x*w_B_link10_z + link10_mass*t456;
   const T t1907 = -link10_S0_x*t453 + link10_mass*t441;
   const T t1908 = link10_J0_yy*t453 - link10_S0_x*t441;
   const T t1909 = link10_J0_zz*w_B_link10_z + link10_S0_x*t456;
-  const T t1910 = t1596*t452 + t1905*t455 + t1906*t456 + t1907*t441 + t1908*t453 + t1909*w_B_link10_z;
+  const T t1910 = ((t1596*t452 + t1905*t455) + t1906*t456) + ((t1907*t441 + t1908*t453) + t1909*w_B_link10_z);
   const T t1911 = link11_mass*t497;
   const T t1912 = link11_S0_x*w_B_link11_z + link11_mass*t498;
   const T t1913 = -link11_S0_x*t495 + link11_mass*t483;
   const T t1914 = link11_J0_yy*t495 - link11_S0_x*t483;
   const T t1915 = link11_J0_zz*w_B_link11_z + link11_S0_x*t498;
-  const T t1916 = t1607*t494 + t1911*t497 + t1912*t498 + t1913*t483 + t1914*t495 + t1915*w_B_link11_z;
+  const T t1916 = ((t1607*t494 + t1911*t497) + t1912*t498) + ((t1913*t483 + t1914*t495) + t1915*w_B_link11_z);
   const T t1917 = link12_mass*t554;
   const T t1918 = link12_S0_x*w_B_link12_z + link12_mass*t555;
   const T t1919 = -link12_S0_x*t552 + link12_mass*t538;
   const T t1920 = link12_J0_yy*t552 - link12_S0_x*t538;
   const T t1921 = link12_J0_zz*w_B_link12_z + link12_S0_x*t555;
-  const T t1922 = t1618*t551 + t1917*t554 + t1918*t555 + t1919*t538 + t1920*t552 + t1921*w_B_link12_z;
+  const T t1922 = ((t1618*t551 + t1917*t554) + t1918*t555) + ((t1919*t538 + t1920*t552) + t1921*w_B_link12_z);
   const T t1923 = link13_mass*t596;
   const T t1924 = link13_S0_x*w_B_link13_z + link13_mass*t597;
   const T t1925 = -link13_S0_x*t594 + link13_mass*t582;
   const T t1926 = link13_J0_yy*t594 - link13_S0_x*t582;
   const T t1927 = link13_J0_zz*w_B_link13_z + link13_S0_x*t597;
-  const T t1928 = t1629*t593 + t1923*t596 + t1924*t597 + t1925*t582 + t1926*t594 + t1927*w_B_link13_z;
+  const T t1928 = ((t1629*t593 + t1923*t596) + t1924*t597) + ((t1925*t582 + t1926*t594) + t1927*w_B_link13_z);
   const T t1929 = link14_mass*t638;
   const T t1930 = link14_S0_x*w_B_link14_z + link14_mass*t639;
   const T t1931 = -link14_S0_x*t636 + link14_mass*t624;
   const T t1932 = link14_J0_yy*t636 - link14_S0_x*t624;
   const T t1933 = link14_J0_zz*w_B_link14_z + link14_S0_x*t639;
-  const T t1934 = t1640*t635 + t1929*t638 + t1930*t639 + t1931*t624 + t1932*t636 + t1933*w_B_link14_z;
+  const T t1934 = ((t1640*t635 + t1929*t638) + t1930*t639) + ((t1931*t624 + t1932*t636) + t1933*w_B_link14_z);
   const T t1935 = link15_mass*t680;
   const T t1936 = link15_S0_x*w_B_link15_z + link15_mass*t681;
   const T t1937 = -link15_S0_x*t678 + link15_mass*t666;
   const T t1938 = link15_J0_yy*t678 - link15_S0_x*t666;
   const T t1939 = link15_J0_zz*w_B_link15_z + link15_S0_x*t681;
-  const T t1940 = t1651*t677 + t1935*t680 + t1936*t681 + t1937*t666 + t1938*t678 + t1939*w_B_link15_z;
+  const T t1940 = ((t1651*t677 + t1935*t680) + t1936*t681) + ((t1937*t666 + t1938*t678) + t1939*w_B_link15_z);
   const T t1941 = link16_mass*t737;
   const T t1942 = link16_S0_x*w_B_link16_z + link16_mass*t738;
   const T t1943 = -link16_S0_x*t735 + link16_mass*t721;
   const T t1944 = link16_J0_yy*t735 - link16_S0_x*t721;
   const T t1945 = link16_J0_zz*w_B_link16_z + link16_S0_x*t738;
-  const T t1946 = t1662*t734 + t1941*t737 + t1942*t738 + t1943*t721 + t1944*t735 + t1945*w_B_link16_z;
+  const T t1946 = ((t1662*t734 + t1941*t737) + t1942*t738) + ((t1943*t721 + t1944*t735) + t1945*w_B_link16_z);
   const T t1947 = link17_mass*t779;
   const T t1948 = link17_S0_x*w_B_link17_z + link17_mass*t780;
   const T t1949 = -link17_S0_x*t777 + link17_mass*t765;
   const T t1950 = link17_J0_yy*t777 - link17_S0_x*t765;
   const T t1951 = link17_J0_zz*w_B_link17_z + link17_S0_x*t780;
-  const T t1952 = t1673*t776 + t1947*t779 + t1948*t780 + t1949*t765 + t1950*t777 + t1951*w_B_link17_z;
+  const T t1952 = ((t1673*t776 + t1947*t779) + t1948*t780) + ((t1949*t765 + t1950*t777) + t1951*w_B_link17_z);
   const T t1953 = link18_mass*t821;
   const T t1954 = link18_S0_x*w_B_link18_z + link18_mass*t822;
   const T t1955 = -link18_S0_x*t819 + link18_mass*t807;
   const T t1956 = link18_J0_yy*t819 - link18_S0_x*t807;
   const T t1957 = link18_J0_zz*w_B_link18_z + link18_S0_x*t822;
-  const T t1958 = t1684*t818 + t1953*t821 + t1954*t822 + t1955*t807 + t1956*t819 + t1957*w_B_link18_z;
+  const T t1958 = ((t1684*t818 + t1953*t821) + t1954*t822) + ((t1955*t807 + t1956*t819) + t1957*w_B_link18_z);
   const T t1959 = link19_mass*t863;
   const T t1960 = link19_S0_x*w_B_link19_z + link19_mass*t864;
   const T t1961 = -link19_S0_x*t861 + link19_mass*t849;
   const T t1962 = link19_J0_yy*t861 - link19_S0_x*t849;
   const T t1963 = link19_J0_zz*w_B_link19_z + link19_S0_x*t864;
-  const T t1964 = t1695*t860 + t1959*t863 + t1960*t864 + t1961*t849 + t1962*t861 + t1963*w_B_link19_z;
+  const T t1964 = ((t1695*t860 + t1959*t863) + t1960*t864) + ((t1961*t849 + t1962*t861) + t1963*w_B_link19_z);
   const T t1965 = link20_mass*t920;
   const T t1966 = link20_S0_x*w_B_link20_z + link20_mass*t921;
   const T t1967 = -link20_S0_x*t918 + link20_mass*t904;
   const T t1968 = link20_J0_yy*t918 - link20_S0_x*t904;
   const T t1969 = link20_J0_zz*w_B_link20_z + link20_S0_x*t921;
-  const T t1970 = t1706*t917 + t1965*t920 + t1966*t921 + t1967*t904 + t1968*t918 + t1969*w_B_link20_z;
+  const T t1970 = ((t1706*t917 + t1965*t920) + t1966*t921) + ((t1967*t904 + t1968*t918) + t1969*w_B_link20_z);
   const T t1971 = link21_mass*t962;
   const T t1972 = link21_S0_x*w_B_link21_z + link21_mass*t963;
   const T t1973 = -link21_S0_x*t960 + link21_mass*t948;
   const T t1974 = link21_J0_yy*t960 - link21_S0_x*t948;
   const T t1975 = link21_J0_zz*w_B_link21_z + link21_S0_x*t963;
-  const T t1976 = t1717*t959 + t1971*t962 + t1972*t963 + t1973*t948 + t1974*t960 + t1975*w_B_link21_z;
+  const T t1976 = ((t1717*t959 + t1971*t962) + t1972*t963) + ((t1973*t948 + t1974*t960) + t1975*w_B_link21_z);
   const T t1977 = link22_mass*t1004;
   const T t1978 = link22_S0_x*w_B_link22_z + link22_mass*t1005;
   const T t1979 = -link22_S0_x*t1002 + link22_mass*t990;
   const T t1980 = link22_J0_yy*t1002 - link22_S0_x*t990;
   const T t1981 = link22_J0_zz*w_B_link22_z + link22_S0_x*t1005;
-  const T t1982 = t1001*t1728 + t1002*t1980 + t1004*t1977 + t1005*t1978 + t1979*t990 + t1981*w_B_link22_z;
+  const T t1982 = ((t1001*t1728 + t1002*t1980) + t1004*t1977) + ((t1005*t1978 + t1979*t990) + t1981*w_B_link22_z);
   const T t1983 = link23_mass*t1046;
   const T t1984 = link23_S0_x*w_B_link23_z + link23_mass*t1047;
   const T t1985 = -link23_S0_x*t1044 + link23_mass*t1032;
   const T t1986 = link23_J0_yy*t1044 - link23_S0_x*t1032;
   const T t1987 = link23_J0_zz*w_B_link23_z + link23_S0_x*t1047;
-  const T t1988 = t1032*t1985 + t1043*t1739 + t1044*t1986 + t1046*t1983 + t1047*t1984 + t1987*w_B_link23_z;
+  const T t1988 = ((t1032*t1985 + t1043*t1739) + t1044*t1986) + ((t1046*t1983 + t1047*t1984) + t1987*w_B_link23_z);
   const T t1989 = link24_mass*t1103;
   const T t1990 = link24_S0_x*w_B_link24_z + link24_mass*t1104;
   const T t1991 = -link24_S0_x*t1101 + link24_mass*t1087;
   const T t1992 = link24_J0_yy*t1101 - link24_S0_x*t1087;
   const T t1993 = link24_J0_zz*w_B_link24_z + link24_S0_x*t1104;
-  const T t1994 = t1087*t1991 + t1100*t1750 + t1101*t1992 + t1103*t1989 + t1104*t1990 + t1993*w_B_link24_z;
+  const T t1994 = ((t1087*t1991 + t1100*t1750) + t1101*t1992) + ((t1103*t1989 + t1104*t1990) + t1993*w_B_link24_z);
   const T t1995 = link25_mass*t1145;
   const T t1996 = link25_S0_x*w_B_link25_z + link25_mass*t1146;
   const T t1997 = -link25_S0_x*t1143 + link25_mass*t1131;
   const T t1998 = link25_J0_yy*t1143 - link25_S0_x*t1131;
   const T t1999 = link25_J0_zz*w_B_link25_z + link25_S0_x*t1146;
-  const T t2000 = t1131*t1997 + t1142*t1761 + t1143*t1998 + t1145*t1995 + t1146*t1996 + t1999*w_B_link25_z;
+  const T t2000 = ((t1131*t1997 + t1142*t1761) + t1143*t1998) + ((t1145*t1995 + t1146*t1996) + t1999*w_B_link25_z);
   const T t2001 = link26_mass*t1187;
   const T t2002 = link26_S0_x*w_B_link26_z + link26_mass*t1188;
   const T t2003 = -link26_S0_x*t1185 + link26_mass*t1173;
   const T t2004 = link26_J0_yy*t1185 - link26_S0_x*t1173;
   const T t2005 = link26_J0_zz*w_B_link26_z + link26_S0_x*t1188;
-  const T t2006 = t1173*t2003 + t1184*t1772 + t1185*t2004 + t1187*t2001 + t1188*t2002 + t2005*w_B_link26_z;
+  const T t2006 = ((t1173*t2003 + t1184*t1772) + t1185*t2004) + ((t1187*t2001 + t1188*t2002) + t2005*w_B_link26_z);
   const T t2007 = link27_mass*t1229;
   const T t2008 = link27_S0_x*w_B_link27_z + link27_mass*t1230;
   const T t2009 = -link27_S0_x*t1227 + link27_mass*t1215;
   const T t2010 = link27_J0_yy*t1227 - link27_S0_x*t1215;
   const T t2011 = link27_J0_zz*w_B_link27_z + link27_S0_x*t1230;
-  const T t2012 = t1215*t2009 + t1226*t1783 + t1227*t2010 + t1229*t2007 + t1230*t2008 + t2011*w_B_link27_z;
+  const T t2012 = ((t1215*t2009 + t1226*t1783) + t1227*t2010) + ((t1229*t2007 + t1230*t2008) + t2011*w_B_link27_z);
   const T t2013 = link28_mass*t1286;
   const T t2014 = link28_S0_x*w_B_link28_z + link28_mass*t1287;
   const T t2015 = -link28_S0_x*t1284 + link28_mass*t1270;
   const T t2016 = link28_J0_yy*t1284 - link28_S0_x*t1270;
   const T t2017 = link28_J0_zz*w_B_link28_z + link28_S0_x*t1287;
-  const T t2018 = t1270*t2015 + t1283*t1794 + t1284*t2016 + t1286*t2013 + t1287*t2014 + t2017*w_B_link28_z;
+  const T t2018 = ((t1270*t2015 + t1283*t1794) + t1284*t2016) + ((t1286*t2013 + t1287*t2014) + t2017*w_B_link28_z);
   const T t2019 = link29_mass*t1328;
   const T t2020 = link29_S0_x*w_B_link29_z + link29_mass*t1329;
   const T t2021 = -link29_S0_x*t1326 + link29_mass*t1314;
   const T t2022 = link29_J0_yy*t1326 - link29_S0_x*t1314;
   const T t2023 = link29_J0_zz*w_B_link29_z + link29_S0_x*t1329;
-  const T t2024 = t1314*t2021 + t1325*t1805 + t1326*t2022 + t1328*t2019 + t1329*t2020 + t2023*w_B_link29_z;
+  const T t2024 = ((t1314*t2021 + t1325*t1805) + t1326*t2022) + ((t1328*t2019 + t1329*t2020) + t2023*w_B_link29_z);
   const T t2025 = link30_mass*t1370;
   const T t2026 = link30_S0_x*w_B_link30_z + link30_mass*t1371;
   const T t2027 = -link30_S0_x*t1368 + link30_mass*t1356;
   const T t2028 = link30_J0_yy*t1368 - link30_S0_x*t1356;
   const T t2029 = link30_J0_zz*w_B_link30_z + link30_S0_x*t1371;
-  const T t2030 = t1356*t2027 + t1367*t1816 + t1368*t2028 + t1370*t2025 + t1371*t2026 + t2029*w_B_link30_z;
+  const T t2030 = ((t1356*t2027 + t1367*t1816) + t1368*t2028) + ((t1370*t2025 + t1371*t2026) + t2029*w_B_link30_z);
   const T t2031 = link31_mass*t1412;
   const T t2032 = link31_S0_x*w_B_link31_z + link31_mass*t1413;
   const T t2033 = -link31_S0_x*t1410 + link31_mass*t1398;
   const T t2034 = link31_J0_yy*t1410 - link31_S0_x*t1398;
   const T t2035 = link31_J0_zz*w_B_link31_z + link31_S0_x*t1413;
-  const T t2036 = t1398*t2033 + t1409*t1827 + t1410*t2034 + t1412*t2031 + t1413*t2032 + t2035*w_B_link31_z;
+  const T t2036 = ((t1398*t2033 + t1409*t1827) + t1410*t2034) + ((t1412*t2031 + t1413*t2032) + t2035*w_B_link31_z);
   const T t2037 = link32_mass*t1469;
   const T t2038 = link32_S0_x*w_B_link32_z + link32_mass*t1470;
   const T t2039 = -link32_S0_x*t1467 + link32_mass*t1453;
   const T t2040 = link32_J0_yy*t1467 - link32_S0_x*t1453;
   const T t2041 = link32_J0_zz*w_B_link32_z + link32_S0_x*t1470;
-  const T t2042 = t1453*t2039 + t1466*t1838 + t1467*t2040 + t1469*t2037 + t1470*t2038 + t2041*w_B_link32_z;
-  const T t2043 = t1850/2.0 + t1856/2.0 + t1862/2.0 + t1868/2.0 + t1874/2.0 + t1880/2.0 + t1886/2.0 + t1892/2.0 + t1898/2.0 + t1904/2.0 + t1910/2.0 + t1916/2.0 + t1922/2.0 + t1928/2.0 + t1934/2.0 + t1940/2.0 + t1946/2.0 + t1952/2.0 + t1958/2.0 + t1964/2.0 + t1970/2.0 + t1976/2.0 + t1982/2.0 + t1988/2.0 + t1994/2.0 + t2000/2.0 + t2006/2.0 + t2012/2.0 + t2018/2.0 + t2024/2.0 + t2030/2.0 + t2036/2.0 + t2042/2.0;
+  const T t2042 = ((t1453*t2039 + t1466*t1838) + t1467*t2040) + ((t1469*t2037 + t1470*t2038) + t2041*w_B_link32_z);
+  const T t2043 = (((((t1850/2.0 + t1856/2.0) + t1862/2.0) + (t1868/2.0 + t1874/2.0)) + ((t1880/2.0 + t1886/2.0) + (t1892/2.0 + t1898/2.0))) + (((t1904/2.0 + t1910/2.0) + (t1916/2.0 + t1922/2.0)) + ((t1928/2.0 + t1934/2.0) + (t1940/2.0 + t1946/2.0)))) + ((((t1952/2.0 + t1958/2.0) + (t1964/2.0 + t1970/2.0)) + ((t1976/2.0 + t1982/2.0) + (t1988/2.0 + t1994/2.0))) + (((t2000/2.0 + t2006/2.0) + (t2012/2.0 + t2018/2.0)) + ((t2024/2.0 + t2030/2.0) + (t2036/2.0 + t2042/2.0))));
   const T t2044 = link1_k*q[7]*q[7]/2.0;
   const T t2045 = link2_k*q[8]*q[8]/2.0 + t2044;
   const T t2046 = link3_k*q[9]*q[9]/2.0 + t2045;
@@ -15775,7 +15789,7 @@ void momentum(const T* q, const T* u, T* pH) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
   // ---- body base: outward pass (velocities)
-  const T t0 = (1.0/sqrt(q[3]*q[3] + q[4]*q[4] + q[5]*q[5] + q[6]*q[6]));
+  const T t0 = (1.0/sqrt((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
   const T t1 = q[3]*t0;
   const T t2 = q[4]*t0;
   const T t3 = q[5]*t0;
@@ -16721,9 +16735,9 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t1844 = base_S0_z*u[4] + base_mass*u[0];
   const T t1845 = base_S0_x*u[5] - base_S0_z*u[3] + base_mass*u[1];
   const T t1846 = -base_S0_x*u[4] + base_mass*u[2];
-  const T t1847 = base_J0_xx*u[3] + base_J0_xy*u[4] + base_J0_xz*u[5] - base_S0_z*u[1];
-  const T t1848 = base_J0_xy*u[3] + base_J0_yy*u[4] + base_J0_yz*u[5] - base_S0_x*u[2] + base_S0_z*u[0];
-  const T t1849 = base_J0_xz*u[3] + base_J0_yz*u[4] + base_J0_zz*u[5] + base_S0_x*u[1];
+  const T t1847 = ((base_J0_xx*u[3] + base_J0_xy*u[4]) + base_J0_xz*u[5]) - base_S0_z*u[1];
+  const T t1848 = ((base_J0_xy*u[3] + base_J0_yy*u[4]) + (base_J0_yz*u[5] + base_S0_z*u[0])) - base_S0_x*u[2];
+  const T t1849 = (base_J0_xz*u[3] + base_J0_yz*u[4]) + (base_J0_zz*u[5] + base_S0_x*u[1]);
   const T t1850 = t14*t1844 + t15*t1845 + t16*t1846;
   const T t1851 = t17*t1844 + t18*t1845 + t1846*t19;
   const T t1852 = t1844*t20 + t1845*t21 + t1846*t22;

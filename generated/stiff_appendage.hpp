@@ -32,6 +32,20 @@
 #define KANEGEN_NOINLINE __attribute__((noinline))
 #endif
 
+// Function multiversioning (GCC on x86-64): the functions the runtime calls
+// (and the parts of large ones) are compiled twice, for x86-64-v3 (AVX2, FMA:
+// about twice as fast on this code) and for the x86-64 baseline, and the
+// loader picks the one this CPU runs, so the code stays portable. Off with
+// -DKANEGEN_NO_DISPATCH, or when compiling for AVX2 anyway (-march=native).
+#ifndef KANEGEN_DISPATCH
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(__AVX2__) && \
+    !defined(KANEGEN_NO_DISPATCH)
+#define KANEGEN_DISPATCH __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define KANEGEN_DISPATCH
+#endif
+#endif
+
 namespace kanegen_gen::stiff_appendage {
 
 inline constexpr int nq = 11;
@@ -188,32 +202,31 @@ inline constexpr double bus_J0_yz = 0.16;  // inertia about O (undeformed) [kg m
 inline constexpr double bus_J0_zz = 33.4;  // inertia about O (undeformed) [kg m^2]
 
 // derived: constant subexpressions, evaluated here exactly
-inline constexpr double k0240019f = 1.562979358576007;  // = -mast_node10_Phi1_z*mast_node10_mass - mast_node11_Phi1_z*mast_node11_mass - mast_node2_Phi1_z*ma...
+inline constexpr double k01fcb0da = 1.3599999999999999;  // = 1.0 + kec082e90
+inline constexpr double k0844733d = 0.7814896792880035;  // = k2a14daf5*mast_p_J_x
 inline constexpr double k094e5c9b = 0.24788371774037354;  // = mast_node10_Phi3_z*mast_node10_Phi3_z
 inline constexpr double k1419bca2 = 0.26725917143405903;  // = mast_node4_Phi3_z*mast_node4_Phi3_z
-inline constexpr double k154b4382 = 0.4688938075728014;  // = kabdf954e*mast_p_J_z
-inline constexpr double k154b46e4 = 0.7814896792880024;  // = kabdf954e*mast_p_J_x
 inline constexpr double k16a783d2 = 0.26725917143406;  // = mast_node4_Phi4_y*mast_node4_Phi4_y
 inline constexpr double k19e9a446 = 0.0870321195526911;  // = mast_node3_Phi3_z*mast_node3_Phi3_z
-inline constexpr double k1e157129 = 204;  // = bus_mass + k42b9c281
 inline constexpr double k200456b4 = 0.10788068165964189;  // = mast_node8_Phi4_y*mast_node8_Phi4_y
 inline constexpr double k21022677 = -0.0015095549325467995;  // = mast_node2_Phi1_z*mast_node2_Phi3_z
 inline constexpr double k21d167b3 = -0.27134872962817747;  // = mast_node7_Phi1_z*mast_node7_Phi3_z
-inline constexpr double k2a628834 = 1.2;  // = k42b9c281*mast_p_J_z
-inline constexpr double k2a62bbae = 2;  // = k42b9c281*mast_p_J_x
+inline constexpr double k22bda376 = 0.8684157910089494;  // = (((mast_node10_Phi3_z*mast_node10_mass + mast_node11_Phi3_z*mast_node11_mass) + mast_node2_Phi3_z...
+inline constexpr double k24097295 = 0.7814896792880024;  // = kee8c9a7d*mast_p_J_x
+inline constexpr double k24098ffb = 0.4688938075728014;  // = kee8c9a7d*mast_p_J_z
+inline constexpr double k2a14daf5 = 1.562979358576007;  // = -((((mast_node10_Phi1_z*mast_node10_mass + mast_node11_Phi1_z*mast_node11_mass) + mast_node2_Phi1...
 inline constexpr double k2abc0aee = -0.001509554932546789;  // = mast_node2_Phi2_y*mast_node2_Phi4_y
 inline constexpr double k2dddc8ad = 0.3456688760232597;  // = mast_node8_Phi1_z*mast_node8_Phi1_z
 inline constexpr double k2ee243d4 = 0.008208008249345223;  // = mast_node2_Phi4_y*mast_node2_Phi4_y
-inline constexpr double k355b04fe = 1.3599999999999999;  // = 1.0 + kd1a89804
+inline constexpr double k30db3e2a = 204;  // = bus_mass + k4c1b0bc9
 inline constexpr double k35a98d43 = -0.19310876203298283;  // = mast_node8_Phi1_z*mast_node8_Phi3_z
 inline constexpr double k38f226b5 = 0.210392065033996;  // = mast_node7_Phi1_z*mast_node7_Phi1_z
-inline constexpr double k3a85681b = 0.8684157910089545;  // = -mast_node10_Phi4_y*mast_node10_mass - mast_node11_Phi4_y*mast_node11_mass - mast_node2_Phi4_y*ma...
 inline constexpr double k3b15453b = 0.5214658032019842;  // = mast_node9_Phi2_y*mast_node9_Phi2_y
+inline constexpr double k3dbf0db5 = 0.8684157910089545;  // = -((((mast_node10_Phi4_y*mast_node10_mass + mast_node11_Phi4_y*mast_node11_mass) + mast_node2_Phi4...
 inline constexpr double k3e59d29b = 0.052223643759987406;  // = mast_node5_Phi2_y*mast_node5_Phi2_y
 inline constexpr double k3f963b2d = -0.01872171457214315;  // = mast_node3_Phi2_y*mast_node3_Phi4_y
-inline constexpr double k4079da1e = 0.8684157910089494;  // = mast_node10_Phi3_z*mast_node10_mass + mast_node11_Phi3_z*mast_node11_mass + mast_node2_Phi3_z*mas...
-inline constexpr double k42b9c281 = 4;  // = mast_mass + mast_node10_mass + mast_node11_mass + mast_node2_mass + mast_node3_mass + mast_node4_...
 inline constexpr double k4414aef2 = 0.42754643705316486;  // = mast_node10_Phi1_z*mast_node10_Phi3_z
+inline constexpr double k4c1b0bc9 = 4;  // = (((mast_mass + mast_node10_mass) + mast_node11_mass) + ((mast_node2_mass + mast_node3_mass) + mas...
 inline constexpr double k4ee3fd31 = 0.5017167106485358;  // = mast_node6_Phi4_y*mast_node6_Phi4_y
 inline constexpr double k4ee9e46e = -0.07012178947028751;  // = mast_node4_Phi1_z*mast_node4_Phi3_z
 inline constexpr double k51c1a3e9 = -0.15407624903602568;  // = mast_node5_Phi2_y*mast_node5_Phi4_y
@@ -226,12 +239,15 @@ inline constexpr double k6b0d1b70 = 0.018398116450527552;  // = mast_node4_Phi1_
 inline constexpr double k6d774ca5 = 0.9459736306388654;  // = mast_node11_Phi3_z*mast_node11_Phi3_z
 inline constexpr double k6d828db7 = 0.9922750684441128;  // = mast_node11_Phi2_y*mast_node11_Phi2_y
 inline constexpr double k710256ea = -0.23913821967398602;  // = mast_node6_Phi2_y*mast_node6_Phi4_y
+inline constexpr double k710d01dc = 0.2605247373026863;  // = k3dbf0db5*mast_p_J_z
+inline constexpr double k710d0662 = 0.43420789550447725;  // = k3dbf0db5*mast_p_J_x
+inline constexpr double k7372e9ce = 0.4342078955044747;  // = k22bda376*mast_p_J_x
 inline constexpr double k754ff94d = 0.9688477945934058;  // = mast_node11_Phi2_y*mast_node11_Phi4_y
 inline constexpr double k76339540 = 0.4545736147043816;  // = mast_node5_Phi4_y*mast_node5_Phi4_y
 inline constexpr double k7882a571 = 0.00027762595079728204;  // = mast_node2_Phi1_z*mast_node2_Phi1_z
 inline constexpr double k7ad1f498 = -0.19310876203298344;  // = mast_node8_Phi2_y*mast_node8_Phi4_y
+inline constexpr double k8533ce25 = 0.6;  // = k4c1b0bc9*mast_p_J_x*mast_p_J_z
 inline constexpr double k863a002d = 0.34996630247879496;  // = mast_node7_Phi3_z*mast_node7_Phi3_z
-inline constexpr double k8f75f259 = 0.7814896792880035;  // = k0240019f*mast_p_J_x
 inline constexpr double k959a002d = -0.07012178947028697;  // = mast_node4_Phi2_y*mast_node4_Phi4_y
 inline constexpr double k9c4025a8 = -0.23913821967398752;  // = mast_node6_Phi1_z*mast_node6_Phi3_z
 inline constexpr double k9d7b9219 = 0.9459736306388654;  // = mast_node11_Phi4_y*mast_node11_Phi4_y
@@ -241,25 +257,23 @@ inline constexpr double ka584852e = 0.11398282515828974;  // = mast_node6_Phi1_z
 inline constexpr double ka73aea37 = 0.5017167106485358;  // = mast_node6_Phi3_z*mast_node6_Phi3_z
 inline constexpr double ka79633a1 = -0.27134872962817674;  // = mast_node7_Phi2_y*mast_node7_Phi4_y
 inline constexpr double ka8f5f92f = -0.01872171457214321;  // = mast_node3_Phi1_z*mast_node3_Phi3_z
-inline constexpr double kabdf954e = 1.5629793585760048;  // = mast_node10_Phi2_y*mast_node10_mass + mast_node11_Phi2_y*mast_node11_mass + mast_node2_Phi2_y*mas...
-inline constexpr double kaebba745 = 0.4342078955044747;  // = k4079da1e*mast_p_J_x
-inline constexpr double kb8102252 = 0.43420789550447725;  // = k3a85681b*mast_p_J_x
-inline constexpr double kb8103fbc = 0.2605247373026863;  // = k3a85681b*mast_p_J_z
 inline constexpr double kb8ce49f5 = 0.9922750684441097;  // = mast_node11_Phi1_z*mast_node11_Phi1_z
 inline constexpr double kc05077f3 = 0.9688477945934042;  // = mast_node11_Phi1_z*mast_node11_Phi3_z
+inline constexpr double kc0599600 = 2;  // = k4c1b0bc9*mast_p_J_x
+inline constexpr double kc0599966 = 1.2;  // = k4c1b0bc9*mast_p_J_z
 inline constexpr double kc2a1e523 = 0.08703211955269193;  // = mast_node3_Phi4_y*mast_node3_Phi4_y
 inline constexpr double kc566d56a = 0.345668876023259;  // = mast_node8_Phi2_y*mast_node8_Phi2_y
 inline constexpr double kcca12401 = 0.008208008249345117;  // = mast_node2_Phi3_z*mast_node2_Phi3_z
 inline constexpr double kcd8dd844 = 0.2478837177403647;  // = mast_node10_Phi4_y*mast_node10_Phi4_y
-inline constexpr double kd1a89804 = 0.36;  // = k42b9c281*mast_p_J_z*mast_p_J_z
-inline constexpr double kd330843a = 0.6;  // = k42b9c281*mast_p_J_x*mast_p_J_z
 inline constexpr double kd4b94eec = 0.7374262315539064;  // = mast_node10_Phi1_z*mast_node10_Phi1_z
 inline constexpr double kdb2fc6e7 = 0.004027278645197099;  // = mast_node3_Phi2_y*mast_node3_Phi2_y
 inline constexpr double kdc3cf3d8 = 0.7374262315539086;  // = mast_node10_Phi2_y*mast_node10_Phi2_y
 inline constexpr double ke356577f = 0.10788068165964101;  // = mast_node8_Phi3_z*mast_node8_Phi3_z
 inline constexpr double ke45e832e = 0.052223643759988295;  // = mast_node5_Phi1_z*mast_node5_Phi1_z
 inline constexpr double ke7a1e193 = 0.45457361470437685;  // = mast_node5_Phi3_z*mast_node5_Phi3_z
+inline constexpr double kec082e90 = 0.36;  // = k4c1b0bc9*mast_p_J_z*mast_p_J_z
 inline constexpr double ked08cf24 = 0.0002776259507972745;  // = mast_node2_Phi2_y*mast_node2_Phi2_y
+inline constexpr double kee8c9a7d = 1.5629793585760048;  // = (((mast_node10_Phi2_y*mast_node10_mass + mast_node11_Phi2_y*mast_node11_mass) + mast_node2_Phi2_y...
 inline constexpr double kf4247400 = -0.15407624903602618;  // = mast_node5_Phi1_z*mast_node5_Phi3_z
 inline constexpr double kf4809fe2 = 0.4275464370531579;  // = mast_node10_Phi2_y*mast_node10_Phi4_y
 inline constexpr double kf4ccc8cc = 0.0024928582127519373;  // = mast_node9_Phi3_z*mast_node9_Phi3_z
@@ -300,18 +314,18 @@ template <class T>
 void qdot(const T* q, const T* u, T* qdot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
-  const T t0 = 1.0/((q[3]*q[3] + q[4]*q[4] + q[5]*q[5] + q[6]*q[6]));
-  const T t1 = q[3]*q[3] + q[4]*q[4] - q[5]*q[5] - q[6]*q[6];
+  const T t0 = 1.0/(((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
+  const T t1 = (q[3]*q[3] + q[4]*q[4]) - (q[5]*q[5] + q[6]*q[6]);
   const T t2 = -2.0*q[3]*q[6] + 2.0*q[4]*q[5];
   const T t3 = 2.0*q[3]*q[5] + 2.0*q[4]*q[6];
   const T t4 = (t1*u[0] + t2*u[1] + t3*u[2])*t0;
   const T t5 = 2.0*q[3]*q[6] + 2.0*q[4]*q[5];
-  const T t6 = q[3]*q[3] - q[4]*q[4] + q[5]*q[5] - q[6]*q[6];
+  const T t6 = (q[3]*q[3] + q[5]*q[5]) - (q[4]*q[4] + q[6]*q[6]);
   const T t7 = -2.0*q[3]*q[4] + 2.0*q[5]*q[6];
   const T t8 = (t5*u[0] + t6*u[1] + t7*u[2])*t0;
   const T t9 = -2.0*q[3]*q[5] + 2.0*q[4]*q[6];
   const T t10 = 2.0*q[3]*q[4] + 2.0*q[5]*q[6];
-  const T t11 = q[3]*q[3] - q[4]*q[4] - q[5]*q[5] + q[6]*q[6];
+  const T t11 = (q[3]*q[3] + q[6]*q[6]) - (q[4]*q[4] + q[5]*q[5]);
   const T t12 = (t10*u[1] + t11*u[2] + t9*u[0])*t0;
   const T t13 = -q[4]*u[3]/2.0 - q[5]*u[4]/2.0 - q[6]*u[5]/2.0;
   const T t14 = q[3]*u[3]/2.0 + q[5]*u[5]/2.0 - q[6]*u[4]/2.0;
@@ -340,7 +354,7 @@ void mass_matrix(const T* q, T* M) {
   const T t30 = mast_node2_Gammax_2_2*q[8] + mast_node2_Gammax_2_4*q[10];
   const T t31 = mast_node2_Gammax_1_3*q[7] + mast_node2_Gammax_3_3*q[9];
   const T t32 = mast_node2_Gammax_2_4*q[8] + mast_node2_Gammax_4_4*q[10];
-  const T s_B_mast_node2_x = mast_node2_rho_x + q[10]*t32/2.0 + q[7]*t29/2.0 + q[8]*t30/2.0 + q[9]*t31/2.0;
+  const T s_B_mast_node2_x = ((mast_node2_rho_x + q[10]*t32/2.0) + q[7]*t29/2.0) + (q[8]*t30/2.0 + q[9]*t31/2.0);
   const T s_B_mast_node2_y = mast_node2_Phi2_y*q[8] + mast_node2_Phi4_y*q[10];
   const T s_B_mast_node2_z = mast_node2_Phi1_z*q[7] + mast_node2_Phi3_z*q[9];
   const T t36 = s_B_mast_node2_x*s_B_mast_node2_x + s_B_mast_node2_y*s_B_mast_node2_y + s_B_mast_node2_z*s_B_mast_node2_z;
@@ -371,7 +385,7 @@ void mass_matrix(const T* q, T* M) {
   const T t60 = mast_node3_Gammax_2_2*q[8] + mast_node3_Gammax_2_4*q[10];
   const T t61 = mast_node3_Gammax_1_3*q[7] + mast_node3_Gammax_3_3*q[9];
   const T t62 = mast_node3_Gammax_2_4*q[8] + mast_node3_Gammax_4_4*q[10];
-  const T s_B_mast_node3_x = mast_node3_rho_x + q[10]*t62/2.0 + q[7]*t59/2.0 + q[8]*t60/2.0 + q[9]*t61/2.0;
+  const T s_B_mast_node3_x = ((mast_node3_rho_x + q[10]*t62/2.0) + q[7]*t59/2.0) + (q[8]*t60/2.0 + q[9]*t61/2.0);
   const T s_B_mast_node3_y = mast_node3_Phi2_y*q[8] + mast_node3_Phi4_y*q[10];
   const T s_B_mast_node3_z = mast_node3_Phi1_z*q[7] + mast_node3_Phi3_z*q[9];
   const T t66 = s_B_mast_node3_x*s_B_mast_node3_x + s_B_mast_node3_y*s_B_mast_node3_y + s_B_mast_node3_z*s_B_mast_node3_z;
@@ -402,7 +416,7 @@ void mass_matrix(const T* q, T* M) {
   const T t90 = mast_node4_Gammax_2_2*q[8] + mast_node4_Gammax_2_4*q[10];
   const T t91 = mast_node4_Gammax_1_3*q[7] + mast_node4_Gammax_3_3*q[9];
   const T t92 = mast_node4_Gammax_2_4*q[8] + mast_node4_Gammax_4_4*q[10];
-  const T s_B_mast_node4_x = mast_node4_rho_x + q[10]*t92/2.0 + q[7]*t89/2.0 + q[8]*t90/2.0 + q[9]*t91/2.0;
+  const T s_B_mast_node4_x = ((mast_node4_rho_x + q[10]*t92/2.0) + q[7]*t89/2.0) + (q[8]*t90/2.0 + q[9]*t91/2.0);
   const T s_B_mast_node4_y = mast_node4_Phi2_y*q[8] + mast_node4_Phi4_y*q[10];
   const T s_B_mast_node4_z = mast_node4_Phi1_z*q[7] + mast_node4_Phi3_z*q[9];
   const T t96 = s_B_mast_node4_x*s_B_mast_node4_x + s_B_mast_node4_y*s_B_mast_node4_y + s_B_mast_node4_z*s_B_mast_node4_z;
@@ -433,7 +447,7 @@ void mass_matrix(const T* q, T* M) {
   const T t120 = mast_node5_Gammax_2_2*q[8] + mast_node5_Gammax_2_4*q[10];
   const T t121 = mast_node5_Gammax_1_3*q[7] + mast_node5_Gammax_3_3*q[9];
   const T t122 = mast_node5_Gammax_2_4*q[8] + mast_node5_Gammax_4_4*q[10];
-  const T s_B_mast_node5_x = mast_node5_rho_x + q[10]*t122/2.0 + q[7]*t119/2.0 + q[8]*t120/2.0 + q[9]*t121/2.0;
+  const T s_B_mast_node5_x = ((mast_node5_rho_x + q[10]*t122/2.0) + q[7]*t119/2.0) + (q[8]*t120/2.0 + q[9]*t121/2.0);
   const T s_B_mast_node5_y = mast_node5_Phi2_y*q[8] + mast_node5_Phi4_y*q[10];
   const T s_B_mast_node5_z = mast_node5_Phi1_z*q[7] + mast_node5_Phi3_z*q[9];
   const T t126 = s_B_mast_node5_x*s_B_mast_node5_x + s_B_mast_node5_y*s_B_mast_node5_y + s_B_mast_node5_z*s_B_mast_node5_z;
@@ -464,7 +478,7 @@ void mass_matrix(const T* q, T* M) {
   const T t150 = mast_node6_Gammax_2_2*q[8] + mast_node6_Gammax_2_4*q[10];
   const T t151 = mast_node6_Gammax_1_3*q[7] + mast_node6_Gammax_3_3*q[9];
   const T t152 = mast_node6_Gammax_2_4*q[8] + mast_node6_Gammax_4_4*q[10];
-  const T s_B_mast_node6_x = mast_node6_rho_x + q[10]*t152/2.0 + q[7]*t149/2.0 + q[8]*t150/2.0 + q[9]*t151/2.0;
+  const T s_B_mast_node6_x = ((mast_node6_rho_x + q[10]*t152/2.0) + q[7]*t149/2.0) + (q[8]*t150/2.0 + q[9]*t151/2.0);
   const T s_B_mast_node6_y = mast_node6_Phi2_y*q[8] + mast_node6_Phi4_y*q[10];
   const T s_B_mast_node6_z = mast_node6_Phi1_z*q[7] + mast_node6_Phi3_z*q[9];
   const T t156 = s_B_mast_node6_x*s_B_mast_node6_x + s_B_mast_node6_y*s_B_mast_node6_y + s_B_mast_node6_z*s_B_mast_node6_z;
@@ -495,7 +509,7 @@ void mass_matrix(const T* q, T* M) {
   const T t180 = mast_node7_Gammax_2_2*q[8] + mast_node7_Gammax_2_4*q[10];
   const T t181 = mast_node7_Gammax_1_3*q[7] + mast_node7_Gammax_3_3*q[9];
   const T t182 = mast_node7_Gammax_2_4*q[8] + mast_node7_Gammax_4_4*q[10];
-  const T s_B_mast_node7_x = mast_node7_rho_x + q[10]*t182/2.0 + q[7]*t179/2.0 + q[8]*t180/2.0 + q[9]*t181/2.0;
+  const T s_B_mast_node7_x = ((mast_node7_rho_x + q[10]*t182/2.0) + q[7]*t179/2.0) + (q[8]*t180/2.0 + q[9]*t181/2.0);
   const T s_B_mast_node7_y = mast_node7_Phi2_y*q[8] + mast_node7_Phi4_y*q[10];
   const T s_B_mast_node7_z = mast_node7_Phi1_z*q[7] + mast_node7_Phi3_z*q[9];
   const T t186 = s_B_mast_node7_x*s_B_mast_node7_x + s_B_mast_node7_y*s_B_mast_node7_y + s_B_mast_node7_z*s_B_mast_node7_z;
@@ -526,7 +540,7 @@ void mass_matrix(const T* q, T* M) {
   const T t210 = mast_node8_Gammax_2_2*q[8] + mast_node8_Gammax_2_4*q[10];
   const T t211 = mast_node8_Gammax_1_3*q[7] + mast_node8_Gammax_3_3*q[9];
   const T t212 = mast_node8_Gammax_2_4*q[8] + mast_node8_Gammax_4_4*q[10];
-  const T s_B_mast_node8_x = mast_node8_rho_x + q[10]*t212/2.0 + q[7]*t209/2.0 + q[8]*t210/2.0 + q[9]*t211/2.0;
+  const T s_B_mast_node8_x = ((mast_node8_rho_x + q[10]*t212/2.0) + q[7]*t209/2.0) + (q[8]*t210/2.0 + q[9]*t211/2.0);
   const T s_B_mast_node8_y = mast_node8_Phi2_y*q[8] + mast_node8_Phi4_y*q[10];
   const T s_B_mast_node8_z = mast_node8_Phi1_z*q[7] + mast_node8_Phi3_z*q[9];
   const T t216 = s_B_mast_node8_x*s_B_mast_node8_x + s_B_mast_node8_y*s_B_mast_node8_y + s_B_mast_node8_z*s_B_mast_node8_z;
@@ -557,7 +571,7 @@ void mass_matrix(const T* q, T* M) {
   const T t240 = mast_node9_Gammax_2_2*q[8] + mast_node9_Gammax_2_4*q[10];
   const T t241 = mast_node9_Gammax_1_3*q[7] + mast_node9_Gammax_3_3*q[9];
   const T t242 = mast_node9_Gammax_2_4*q[8] + mast_node9_Gammax_4_4*q[10];
-  const T s_B_mast_node9_x = mast_node9_rho_x + q[10]*t242/2.0 + q[7]*t239/2.0 + q[8]*t240/2.0 + q[9]*t241/2.0;
+  const T s_B_mast_node9_x = ((mast_node9_rho_x + q[10]*t242/2.0) + q[7]*t239/2.0) + (q[8]*t240/2.0 + q[9]*t241/2.0);
   const T s_B_mast_node9_y = mast_node9_Phi2_y*q[8] + mast_node9_Phi4_y*q[10];
   const T s_B_mast_node9_z = mast_node9_Phi1_z*q[7] + mast_node9_Phi3_z*q[9];
   const T t246 = s_B_mast_node9_x*s_B_mast_node9_x + s_B_mast_node9_y*s_B_mast_node9_y + s_B_mast_node9_z*s_B_mast_node9_z;
@@ -588,7 +602,7 @@ void mass_matrix(const T* q, T* M) {
   const T t270 = mast_node10_Gammax_2_2*q[8] + mast_node10_Gammax_2_4*q[10];
   const T t271 = mast_node10_Gammax_1_3*q[7] + mast_node10_Gammax_3_3*q[9];
   const T t272 = mast_node10_Gammax_2_4*q[8] + mast_node10_Gammax_4_4*q[10];
-  const T s_B_mast_node10_x = mast_node10_rho_x + q[10]*t272/2.0 + q[7]*t269/2.0 + q[8]*t270/2.0 + q[9]*t271/2.0;
+  const T s_B_mast_node10_x = ((mast_node10_rho_x + q[10]*t272/2.0) + q[7]*t269/2.0) + (q[8]*t270/2.0 + q[9]*t271/2.0);
   const T s_B_mast_node10_y = mast_node10_Phi2_y*q[8] + mast_node10_Phi4_y*q[10];
   const T s_B_mast_node10_z = mast_node10_Phi1_z*q[7] + mast_node10_Phi3_z*q[9];
   const T t276 = s_B_mast_node10_x*s_B_mast_node10_x + s_B_mast_node10_y*s_B_mast_node10_y + s_B_mast_node10_z*s_B_mast_node10_z;
@@ -619,7 +633,7 @@ void mass_matrix(const T* q, T* M) {
   const T t300 = mast_node11_Gammax_2_2*q[8] + mast_node11_Gammax_2_4*q[10];
   const T t301 = mast_node11_Gammax_1_3*q[7] + mast_node11_Gammax_3_3*q[9];
   const T t302 = mast_node11_Gammax_2_4*q[8] + mast_node11_Gammax_4_4*q[10];
-  const T s_B_mast_node11_x = 1.0 + q[10]*t302/2.0 + q[7]*t299/2.0 + q[8]*t300/2.0 + q[9]*t301/2.0;
+  const T s_B_mast_node11_x = ((1.0 + q[10]*t302/2.0) + q[7]*t299/2.0) + (q[8]*t300/2.0 + q[9]*t301/2.0);
   const T s_B_mast_node11_y = mast_node11_Phi2_y*q[8] + mast_node11_Phi4_y*q[10];
   const T s_B_mast_node11_z = mast_node11_Phi1_z*q[7] + mast_node11_Phi3_z*q[9];
   const T t306 = s_B_mast_node11_x*s_B_mast_node11_x + s_B_mast_node11_y*s_B_mast_node11_y + s_B_mast_node11_z*s_B_mast_node11_z;
@@ -646,49 +660,49 @@ void mass_matrix(const T* q, T* M) {
   const T t327 = mast_node11_Phi4_y*s_B_mast_node11_x - s_B_mast_node11_y*t302;
   const T t328 = k9d7b9219 + t302*t302;
   // ---- body mast: composite inertia (inward)
-  const T t329 = mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z;
-  const T t331 = mast_node10_mass*t269 + mast_node11_mass*t299 + mast_node2_mass*t29 + mast_node3_mass*t59 + mast_node4_mass*t89 + mast_node5_mass*t119 + mast_node6_mass*t149 + mast_node7_mass*t179 + mast_node8_mass*t209 + mast_node9_mass*t239;
-  const T t332 = mast_node10_mass*t270 + mast_node11_mass*t300 + mast_node2_mass*t30 + mast_node3_mass*t60 + mast_node4_mass*t90 + mast_node5_mass*t120 + mast_node6_mass*t150 + mast_node7_mass*t180 + mast_node8_mass*t210 + mast_node9_mass*t240;
-  const T t333 = mast_node10_mass*t271 + mast_node11_mass*t301 + mast_node2_mass*t31 + mast_node3_mass*t61 + mast_node4_mass*t91 + mast_node5_mass*t121 + mast_node6_mass*t151 + mast_node7_mass*t181 + mast_node8_mass*t211 + mast_node9_mass*t241;
-  const T t334 = mast_node10_mass*t272 + mast_node11_mass*t302 + mast_node2_mass*t32 + mast_node3_mass*t62 + mast_node4_mass*t92 + mast_node5_mass*t122 + mast_node6_mass*t152 + mast_node7_mass*t182 + mast_node8_mass*t212 + mast_node9_mass*t242;
-  const T t336 = mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x;
-  const T t337 = mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y;
-  const T t339 = -(s_B_mast_node10_x*s_B_mast_node10_x - t276)*mast_node10_mass - (s_B_mast_node11_x*s_B_mast_node11_x - t306)*mast_node11_mass - (s_B_mast_node2_x*s_B_mast_node2_x - t36)*mast_node2_mass - (s_B_mast_node3_x*s_B_mast_node3_x - t66)*mast_node3_mass - (s_B_mast_node4_x*s_B_mast_node4_x - t96)*mast_node4_mass - (s_B_mast_node5_x*s_B_mast_node5_x - t126)*mast_node5_mass - (s_B_mast_node6_x*s_B_mast_node6_x - t156)*mast_node6_mass - (s_B_mast_node7_x*s_B_mast_node7_x - t186)*mast_node7_mass - (s_B_mast_node8_x*s_B_mast_node8_x - t216)*mast_node8_mass - (s_B_mast_node9_x*s_B_mast_node9_x - t246)*mast_node9_mass;
-  const T t340 = -mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y - mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y - mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y - mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y - mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y - mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y - mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y - mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y - mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y - mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y;
-  const T t341 = -mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z - mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z - mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z - mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z - mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z - mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z - mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z - mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z - mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z - mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z;
-  const T t342 = mast_node10_mass*t277 + mast_node11_mass*t307 + mast_node2_mass*t37 + mast_node3_mass*t67 + mast_node4_mass*t97 + mast_node5_mass*t127 + mast_node6_mass*t157 + mast_node7_mass*t187 + mast_node8_mass*t217 + mast_node9_mass*t247;
-  const T t343 = mast_node10_mass*t284 + mast_node11_mass*t314 + mast_node2_mass*t44 + mast_node3_mass*t74 + mast_node4_mass*t104 + mast_node5_mass*t134 + mast_node6_mass*t164 + mast_node7_mass*t194 + mast_node8_mass*t224 + mast_node9_mass*t254;
-  const T t344 = mast_node10_mass*t290 + mast_node11_mass*t320 + mast_node2_mass*t50 + mast_node3_mass*t80 + mast_node4_mass*t110 + mast_node5_mass*t140 + mast_node6_mass*t170 + mast_node7_mass*t200 + mast_node8_mass*t230 + mast_node9_mass*t260;
-  const T t345 = mast_node10_mass*t295 + mast_node11_mass*t325 + mast_node2_mass*t55 + mast_node3_mass*t85 + mast_node4_mass*t115 + mast_node5_mass*t145 + mast_node6_mass*t175 + mast_node7_mass*t205 + mast_node8_mass*t235 + mast_node9_mass*t265;
-  const T t346 = -(s_B_mast_node10_y*s_B_mast_node10_y - t276)*mast_node10_mass - (s_B_mast_node11_y*s_B_mast_node11_y - t306)*mast_node11_mass - (s_B_mast_node2_y*s_B_mast_node2_y - t36)*mast_node2_mass - (s_B_mast_node3_y*s_B_mast_node3_y - t66)*mast_node3_mass - (s_B_mast_node4_y*s_B_mast_node4_y - t96)*mast_node4_mass - (s_B_mast_node5_y*s_B_mast_node5_y - t126)*mast_node5_mass - (s_B_mast_node6_y*s_B_mast_node6_y - t156)*mast_node6_mass - (s_B_mast_node7_y*s_B_mast_node7_y - t186)*mast_node7_mass - (s_B_mast_node8_y*s_B_mast_node8_y - t216)*mast_node8_mass - (s_B_mast_node9_y*s_B_mast_node9_y - t246)*mast_node9_mass;
-  const T t347 = -mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z - mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z - mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z - mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z - mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z - mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z - mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z - mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z - mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z - mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z;
-  const T t348 = mast_node10_mass*t278 + mast_node11_mass*t308 + mast_node2_mass*t38 + mast_node3_mass*t68 + mast_node4_mass*t98 + mast_node5_mass*t128 + mast_node6_mass*t158 + mast_node7_mass*t188 + mast_node8_mass*t218 + mast_node9_mass*t248;
-  const T t349 = mast_node10_mass*t285 + mast_node11_mass*t315 + mast_node2_mass*t45 + mast_node3_mass*t75 + mast_node4_mass*t105 + mast_node5_mass*t135 + mast_node6_mass*t165 + mast_node7_mass*t195 + mast_node8_mass*t225 + mast_node9_mass*t255;
-  const T t350 = mast_node10_mass*t291 + mast_node11_mass*t321 + mast_node2_mass*t51 + mast_node3_mass*t81 + mast_node4_mass*t111 + mast_node5_mass*t141 + mast_node6_mass*t171 + mast_node7_mass*t201 + mast_node8_mass*t231 + mast_node9_mass*t261;
-  const T t351 = mast_node10_mass*t296 + mast_node11_mass*t326 + mast_node2_mass*t56 + mast_node3_mass*t86 + mast_node4_mass*t116 + mast_node5_mass*t146 + mast_node6_mass*t176 + mast_node7_mass*t206 + mast_node8_mass*t236 + mast_node9_mass*t266;
-  const T t352 = -(s_B_mast_node10_z*s_B_mast_node10_z - t276)*mast_node10_mass - (s_B_mast_node11_z*s_B_mast_node11_z - t306)*mast_node11_mass - (s_B_mast_node2_z*s_B_mast_node2_z - t36)*mast_node2_mass - (s_B_mast_node3_z*s_B_mast_node3_z - t66)*mast_node3_mass - (s_B_mast_node4_z*s_B_mast_node4_z - t96)*mast_node4_mass - (s_B_mast_node5_z*s_B_mast_node5_z - t126)*mast_node5_mass - (s_B_mast_node6_z*s_B_mast_node6_z - t156)*mast_node6_mass - (s_B_mast_node7_z*s_B_mast_node7_z - t186)*mast_node7_mass - (s_B_mast_node8_z*s_B_mast_node8_z - t216)*mast_node8_mass - (s_B_mast_node9_z*s_B_mast_node9_z - t246)*mast_node9_mass;
-  const T t353 = mast_node10_mass*t279 + mast_node11_mass*t309 + mast_node2_mass*t39 + mast_node3_mass*t69 + mast_node4_mass*t99 + mast_node5_mass*t129 + mast_node6_mass*t159 + mast_node7_mass*t189 + mast_node8_mass*t219 + mast_node9_mass*t249;
-  const T t354 = mast_node10_mass*t286 + mast_node11_mass*t316 + mast_node2_mass*t46 + mast_node3_mass*t76 + mast_node4_mass*t106 + mast_node5_mass*t136 + mast_node6_mass*t166 + mast_node7_mass*t196 + mast_node8_mass*t226 + mast_node9_mass*t256;
-  const T t355 = mast_node10_mass*t292 + mast_node11_mass*t322 + mast_node2_mass*t52 + mast_node3_mass*t82 + mast_node4_mass*t112 + mast_node5_mass*t142 + mast_node6_mass*t172 + mast_node7_mass*t202 + mast_node8_mass*t232 + mast_node9_mass*t262;
-  const T t356 = mast_node10_mass*t297 + mast_node11_mass*t327 + mast_node2_mass*t57 + mast_node3_mass*t87 + mast_node4_mass*t117 + mast_node5_mass*t147 + mast_node6_mass*t177 + mast_node7_mass*t207 + mast_node8_mass*t237 + mast_node9_mass*t267;
-  const T t357 = mast_node10_mass*t280 + mast_node11_mass*t310 + mast_node2_mass*t40 + mast_node3_mass*t70 + mast_node4_mass*t100 + mast_node5_mass*t130 + mast_node6_mass*t160 + mast_node7_mass*t190 + mast_node8_mass*t220 + mast_node9_mass*t250;
-  const T t358 = mast_node10_mass*t281 + mast_node11_mass*t311 + mast_node2_mass*t41 + mast_node3_mass*t71 + mast_node4_mass*t101 + mast_node5_mass*t131 + mast_node6_mass*t161 + mast_node7_mass*t191 + mast_node8_mass*t221 + mast_node9_mass*t251;
-  const T t359 = mast_node10_mass*t282 + mast_node11_mass*t312 + mast_node2_mass*t42 + mast_node3_mass*t72 + mast_node4_mass*t102 + mast_node5_mass*t132 + mast_node6_mass*t162 + mast_node7_mass*t192 + mast_node8_mass*t222 + mast_node9_mass*t252;
-  const T t360 = mast_node10_mass*t283 + mast_node11_mass*t313 + mast_node2_mass*t43 + mast_node3_mass*t73 + mast_node4_mass*t103 + mast_node5_mass*t133 + mast_node6_mass*t163 + mast_node7_mass*t193 + mast_node8_mass*t223 + mast_node9_mass*t253;
-  const T t361 = mast_node10_mass*t287 + mast_node11_mass*t317 + mast_node2_mass*t47 + mast_node3_mass*t77 + mast_node4_mass*t107 + mast_node5_mass*t137 + mast_node6_mass*t167 + mast_node7_mass*t197 + mast_node8_mass*t227 + mast_node9_mass*t257;
-  const T t362 = mast_node10_mass*t288 + mast_node11_mass*t318 + mast_node2_mass*t48 + mast_node3_mass*t78 + mast_node4_mass*t108 + mast_node5_mass*t138 + mast_node6_mass*t168 + mast_node7_mass*t198 + mast_node8_mass*t228 + mast_node9_mass*t258;
-  const T t363 = mast_node10_mass*t289 + mast_node11_mass*t319 + mast_node2_mass*t49 + mast_node3_mass*t79 + mast_node4_mass*t109 + mast_node5_mass*t139 + mast_node6_mass*t169 + mast_node7_mass*t199 + mast_node8_mass*t229 + mast_node9_mass*t259;
-  const T t364 = mast_node10_mass*t293 + mast_node11_mass*t323 + mast_node2_mass*t53 + mast_node3_mass*t83 + mast_node4_mass*t113 + mast_node5_mass*t143 + mast_node6_mass*t173 + mast_node7_mass*t203 + mast_node8_mass*t233 + mast_node9_mass*t263;
-  const T t365 = mast_node10_mass*t294 + mast_node11_mass*t324 + mast_node2_mass*t54 + mast_node3_mass*t84 + mast_node4_mass*t114 + mast_node5_mass*t144 + mast_node6_mass*t174 + mast_node7_mass*t204 + mast_node8_mass*t234 + mast_node9_mass*t264;
-  const T t366 = mast_node10_mass*t298 + mast_node11_mass*t328 + mast_node2_mass*t58 + mast_node3_mass*t88 + mast_node4_mass*t118 + mast_node5_mass*t148 + mast_node6_mass*t178 + mast_node7_mass*t208 + mast_node8_mass*t238 + mast_node9_mass*t268;
-  const T t367 = 2.0*mast_p_J_z*t329 + kd1a89804 + t339;
+  const T t329 = (((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z));
+  const T t331 = (((mast_node10_mass*t269 + mast_node11_mass*t299) + mast_node2_mass*t29) + (mast_node3_mass*t59 + mast_node4_mass*t89)) + (((mast_node5_mass*t119 + mast_node6_mass*t149) + mast_node7_mass*t179) + (mast_node8_mass*t209 + mast_node9_mass*t239));
+  const T t332 = (((mast_node10_mass*t270 + mast_node11_mass*t300) + mast_node2_mass*t30) + (mast_node3_mass*t60 + mast_node4_mass*t90)) + (((mast_node5_mass*t120 + mast_node6_mass*t150) + mast_node7_mass*t180) + (mast_node8_mass*t210 + mast_node9_mass*t240));
+  const T t333 = (((mast_node10_mass*t271 + mast_node11_mass*t301) + mast_node2_mass*t31) + (mast_node3_mass*t61 + mast_node4_mass*t91)) + (((mast_node5_mass*t121 + mast_node6_mass*t151) + mast_node7_mass*t181) + (mast_node8_mass*t211 + mast_node9_mass*t241));
+  const T t334 = (((mast_node10_mass*t272 + mast_node11_mass*t302) + mast_node2_mass*t32) + (mast_node3_mass*t62 + mast_node4_mass*t92)) + (((mast_node5_mass*t122 + mast_node6_mass*t152) + mast_node7_mass*t182) + (mast_node8_mass*t212 + mast_node9_mass*t242));
+  const T t336 = (((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x));
+  const T t337 = (((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y));
+  const T t339 = -(((((s_B_mast_node10_x*s_B_mast_node10_x - t276)*mast_node10_mass + (s_B_mast_node11_x*s_B_mast_node11_x - t306)*mast_node11_mass) + (s_B_mast_node2_x*s_B_mast_node2_x - t36)*mast_node2_mass) + ((s_B_mast_node3_x*s_B_mast_node3_x - t66)*mast_node3_mass + (s_B_mast_node4_x*s_B_mast_node4_x - t96)*mast_node4_mass)) + ((((s_B_mast_node5_x*s_B_mast_node5_x - t126)*mast_node5_mass + (s_B_mast_node6_x*s_B_mast_node6_x - t156)*mast_node6_mass) + (s_B_mast_node7_x*s_B_mast_node7_x - t186)*mast_node7_mass) + ((s_B_mast_node8_x*s_B_mast_node8_x - t216)*mast_node8_mass + (s_B_mast_node9_x*s_B_mast_node9_x - t246)*mast_node9_mass)));
+  const T t340 = -((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y)));
+  const T t341 = -((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z)));
+  const T t342 = (((mast_node10_mass*t277 + mast_node11_mass*t307) + mast_node2_mass*t37) + (mast_node3_mass*t67 + mast_node4_mass*t97)) + (((mast_node5_mass*t127 + mast_node6_mass*t157) + mast_node7_mass*t187) + (mast_node8_mass*t217 + mast_node9_mass*t247));
+  const T t343 = (((mast_node10_mass*t284 + mast_node11_mass*t314) + mast_node2_mass*t44) + (mast_node3_mass*t74 + mast_node4_mass*t104)) + (((mast_node5_mass*t134 + mast_node6_mass*t164) + mast_node7_mass*t194) + (mast_node8_mass*t224 + mast_node9_mass*t254));
+  const T t344 = (((mast_node10_mass*t290 + mast_node11_mass*t320) + mast_node2_mass*t50) + (mast_node3_mass*t80 + mast_node4_mass*t110)) + (((mast_node5_mass*t140 + mast_node6_mass*t170) + mast_node7_mass*t200) + (mast_node8_mass*t230 + mast_node9_mass*t260));
+  const T t345 = (((mast_node10_mass*t295 + mast_node11_mass*t325) + mast_node2_mass*t55) + (mast_node3_mass*t85 + mast_node4_mass*t115)) + (((mast_node5_mass*t145 + mast_node6_mass*t175) + mast_node7_mass*t205) + (mast_node8_mass*t235 + mast_node9_mass*t265));
+  const T t346 = -(((((s_B_mast_node10_y*s_B_mast_node10_y - t276)*mast_node10_mass + (s_B_mast_node11_y*s_B_mast_node11_y - t306)*mast_node11_mass) + (s_B_mast_node2_y*s_B_mast_node2_y - t36)*mast_node2_mass) + ((s_B_mast_node3_y*s_B_mast_node3_y - t66)*mast_node3_mass + (s_B_mast_node4_y*s_B_mast_node4_y - t96)*mast_node4_mass)) + ((((s_B_mast_node5_y*s_B_mast_node5_y - t126)*mast_node5_mass + (s_B_mast_node6_y*s_B_mast_node6_y - t156)*mast_node6_mass) + (s_B_mast_node7_y*s_B_mast_node7_y - t186)*mast_node7_mass) + ((s_B_mast_node8_y*s_B_mast_node8_y - t216)*mast_node8_mass + (s_B_mast_node9_y*s_B_mast_node9_y - t246)*mast_node9_mass)));
+  const T t347 = -((((mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z)));
+  const T t348 = (((mast_node10_mass*t278 + mast_node11_mass*t308) + mast_node2_mass*t38) + (mast_node3_mass*t68 + mast_node4_mass*t98)) + (((mast_node5_mass*t128 + mast_node6_mass*t158) + mast_node7_mass*t188) + (mast_node8_mass*t218 + mast_node9_mass*t248));
+  const T t349 = (((mast_node10_mass*t285 + mast_node11_mass*t315) + mast_node2_mass*t45) + (mast_node3_mass*t75 + mast_node4_mass*t105)) + (((mast_node5_mass*t135 + mast_node6_mass*t165) + mast_node7_mass*t195) + (mast_node8_mass*t225 + mast_node9_mass*t255));
+  const T t350 = (((mast_node10_mass*t291 + mast_node11_mass*t321) + mast_node2_mass*t51) + (mast_node3_mass*t81 + mast_node4_mass*t111)) + (((mast_node5_mass*t141 + mast_node6_mass*t171) + mast_node7_mass*t201) + (mast_node8_mass*t231 + mast_node9_mass*t261));
+  const T t351 = (((mast_node10_mass*t296 + mast_node11_mass*t326) + mast_node2_mass*t56) + (mast_node3_mass*t86 + mast_node4_mass*t116)) + (((mast_node5_mass*t146 + mast_node6_mass*t176) + mast_node7_mass*t206) + (mast_node8_mass*t236 + mast_node9_mass*t266));
+  const T t352 = -(((((s_B_mast_node10_z*s_B_mast_node10_z - t276)*mast_node10_mass + (s_B_mast_node11_z*s_B_mast_node11_z - t306)*mast_node11_mass) + (s_B_mast_node2_z*s_B_mast_node2_z - t36)*mast_node2_mass) + ((s_B_mast_node3_z*s_B_mast_node3_z - t66)*mast_node3_mass + (s_B_mast_node4_z*s_B_mast_node4_z - t96)*mast_node4_mass)) + ((((s_B_mast_node5_z*s_B_mast_node5_z - t126)*mast_node5_mass + (s_B_mast_node6_z*s_B_mast_node6_z - t156)*mast_node6_mass) + (s_B_mast_node7_z*s_B_mast_node7_z - t186)*mast_node7_mass) + ((s_B_mast_node8_z*s_B_mast_node8_z - t216)*mast_node8_mass + (s_B_mast_node9_z*s_B_mast_node9_z - t246)*mast_node9_mass)));
+  const T t353 = (((mast_node10_mass*t279 + mast_node11_mass*t309) + mast_node2_mass*t39) + (mast_node3_mass*t69 + mast_node4_mass*t99)) + (((mast_node5_mass*t129 + mast_node6_mass*t159) + mast_node7_mass*t189) + (mast_node8_mass*t219 + mast_node9_mass*t249));
+  const T t354 = (((mast_node10_mass*t286 + mast_node11_mass*t316) + mast_node2_mass*t46) + (mast_node3_mass*t76 + mast_node4_mass*t106)) + (((mast_node5_mass*t136 + mast_node6_mass*t166) + mast_node7_mass*t196) + (mast_node8_mass*t226 + mast_node9_mass*t256));
+  const T t355 = (((mast_node10_mass*t292 + mast_node11_mass*t322) + mast_node2_mass*t52) + (mast_node3_mass*t82 + mast_node4_mass*t112)) + (((mast_node5_mass*t142 + mast_node6_mass*t172) + mast_node7_mass*t202) + (mast_node8_mass*t232 + mast_node9_mass*t262));
+  const T t356 = (((mast_node10_mass*t297 + mast_node11_mass*t327) + mast_node2_mass*t57) + (mast_node3_mass*t87 + mast_node4_mass*t117)) + (((mast_node5_mass*t147 + mast_node6_mass*t177) + mast_node7_mass*t207) + (mast_node8_mass*t237 + mast_node9_mass*t267));
+  const T t357 = (((mast_node10_mass*t280 + mast_node11_mass*t310) + mast_node2_mass*t40) + (mast_node3_mass*t70 + mast_node4_mass*t100)) + (((mast_node5_mass*t130 + mast_node6_mass*t160) + mast_node7_mass*t190) + (mast_node8_mass*t220 + mast_node9_mass*t250));
+  const T t358 = (((mast_node10_mass*t281 + mast_node11_mass*t311) + mast_node2_mass*t41) + (mast_node3_mass*t71 + mast_node4_mass*t101)) + (((mast_node5_mass*t131 + mast_node6_mass*t161) + mast_node7_mass*t191) + (mast_node8_mass*t221 + mast_node9_mass*t251));
+  const T t359 = (((mast_node10_mass*t282 + mast_node11_mass*t312) + mast_node2_mass*t42) + (mast_node3_mass*t72 + mast_node4_mass*t102)) + (((mast_node5_mass*t132 + mast_node6_mass*t162) + mast_node7_mass*t192) + (mast_node8_mass*t222 + mast_node9_mass*t252));
+  const T t360 = (((mast_node10_mass*t283 + mast_node11_mass*t313) + mast_node2_mass*t43) + (mast_node3_mass*t73 + mast_node4_mass*t103)) + (((mast_node5_mass*t133 + mast_node6_mass*t163) + mast_node7_mass*t193) + (mast_node8_mass*t223 + mast_node9_mass*t253));
+  const T t361 = (((mast_node10_mass*t287 + mast_node11_mass*t317) + mast_node2_mass*t47) + (mast_node3_mass*t77 + mast_node4_mass*t107)) + (((mast_node5_mass*t137 + mast_node6_mass*t167) + mast_node7_mass*t197) + (mast_node8_mass*t227 + mast_node9_mass*t257));
+  const T t362 = (((mast_node10_mass*t288 + mast_node11_mass*t318) + mast_node2_mass*t48) + (mast_node3_mass*t78 + mast_node4_mass*t108)) + (((mast_node5_mass*t138 + mast_node6_mass*t168) + mast_node7_mass*t198) + (mast_node8_mass*t228 + mast_node9_mass*t258));
+  const T t363 = (((mast_node10_mass*t289 + mast_node11_mass*t319) + mast_node2_mass*t49) + (mast_node3_mass*t79 + mast_node4_mass*t109)) + (((mast_node5_mass*t139 + mast_node6_mass*t169) + mast_node7_mass*t199) + (mast_node8_mass*t229 + mast_node9_mass*t259));
+  const T t364 = (((mast_node10_mass*t293 + mast_node11_mass*t323) + mast_node2_mass*t53) + (mast_node3_mass*t83 + mast_node4_mass*t113)) + (((mast_node5_mass*t143 + mast_node6_mass*t173) + mast_node7_mass*t203) + (mast_node8_mass*t233 + mast_node9_mass*t263));
+  const T t365 = (((mast_node10_mass*t294 + mast_node11_mass*t324) + mast_node2_mass*t54) + (mast_node3_mass*t84 + mast_node4_mass*t114)) + (((mast_node5_mass*t144 + mast_node6_mass*t174) + mast_node7_mass*t204) + (mast_node8_mass*t234 + mast_node9_mass*t264));
+  const T t366 = (((mast_node10_mass*t298 + mast_node11_mass*t328) + mast_node2_mass*t58) + (mast_node3_mass*t88 + mast_node4_mass*t118)) + (((mast_node5_mass*t148 + mast_node6_mass*t178) + mast_node7_mass*t208) + (mast_node8_mass*t238 + mast_node9_mass*t268));
+  const T t367 = 2.0*mast_p_J_z*t329 + kec082e90 + t339;
   const T t368 = -mast_p_J_x*t337 + t340;
-  const T t369 = -kd330843a - mast_p_J_x*t329 - mast_p_J_z*t336 + t341;
-  const T t370 = 2.0*mast_p_J_x*t336 + 2.0*mast_p_J_z*t329 + k355b04fe + t346;
+  const T t369 = t341 - ((k8533ce25 + mast_p_J_x*t329) + mast_p_J_z*t336);
+  const T t370 = (2.0*mast_p_J_x*t336 + 2.0*mast_p_J_z*t329) + (k01fcb0da + t346);
   const T t371 = -mast_p_J_z*t337 + t347;
   const T t372 = 1.0 + 2.0*mast_p_J_x*t336 + t352;
-  const T t373 = k2a62bbae + t336;
-  const T t374 = k2a628834 + t329;
+  const T t373 = kc0599600 + t336;
+  const T t374 = kc0599966 + t329;
   const T t375 = bus_J0_xx + t367;
   const T t376 = bus_J0_xy + t368;
   const T t377 = bus_J0_xz + t369;
@@ -702,19 +716,19 @@ void mass_matrix(const T* q, T* M) {
   const T t385 = -bus_S0_y - t337;
   const T t386 = bus_S0_x + t373;
   // ---- body mast: its columns of M (walked to the root)
-  const T t387 = k8f75f259 + mast_p_J_z*t331;
+  const T t387 = k0844733d + mast_p_J_z*t331;
   const T t388 = t348 + t387;
   const T t389 = mast_p_J_z*t332;
-  const T t390 = -k154b4382 + t343;
+  const T t390 = -k24098ffb + t343;
   const T t391 = t349 + t389;
-  const T t392 = k154b46e4 + t354;
-  const T t393 = -kaebba745 + mast_p_J_z*t333;
+  const T t392 = k24097295 + t354;
+  const T t393 = -k7372e9ce + mast_p_J_z*t333;
   const T t394 = t350 + t393;
   const T t395 = mast_p_J_z*t334;
-  const T t396 = kb8103fbc + t345;
+  const T t396 = k710d01dc + t345;
   const T t397 = t351 + t395;
-  const T t398 = -kb8102252 + t356;
-  M[0] = k1e157129;
+  const T t398 = -k710d0662 + t356;
+  M[0] = k30db3e2a;
   M[1] = 0.0;
   M[2] = 0.0;
   M[3] = 0.0;
@@ -725,24 +739,24 @@ void mass_matrix(const T* q, T* M) {
   M[8] = t333;
   M[9] = t334;
   M[10] = 0.0;
-  M[11] = k1e157129;
+  M[11] = k30db3e2a;
   M[12] = 0.0;
   M[13] = t381;
   M[14] = 0.0;
   M[15] = t386;
   M[16] = 0.0;
-  M[17] = kabdf954e;
+  M[17] = kee8c9a7d;
   M[18] = 0.0;
-  M[19] = -k3a85681b;
+  M[19] = -k3dbf0db5;
   M[20] = 0.0;
   M[21] = 0.0;
-  M[22] = k1e157129;
+  M[22] = k30db3e2a;
   M[23] = t382;
   M[24] = t384;
   M[25] = 0.0;
-  M[26] = -k0240019f;
+  M[26] = -k2a14daf5;
   M[27] = 0.0;
-  M[28] = k4079da1e;
+  M[28] = k22bda376;
   M[29] = 0.0;
   M[30] = 0.0;
   M[31] = t381;
@@ -776,7 +790,7 @@ void mass_matrix(const T* q, T* M) {
   M[59] = t398;
   M[60] = t331;
   M[61] = 0.0;
-  M[62] = -k0240019f;
+  M[62] = -k2a14daf5;
   M[63] = t342;
   M[64] = t388;
   M[65] = t353;
@@ -785,7 +799,7 @@ void mass_matrix(const T* q, T* M) {
   M[68] = t359;
   M[69] = t360;
   M[70] = t332;
-  M[71] = kabdf954e;
+  M[71] = kee8c9a7d;
   M[72] = 0.0;
   M[73] = t390;
   M[74] = t391;
@@ -796,7 +810,7 @@ void mass_matrix(const T* q, T* M) {
   M[79] = t363;
   M[80] = t333;
   M[81] = 0.0;
-  M[82] = k4079da1e;
+  M[82] = k22bda376;
   M[83] = t344;
   M[84] = t394;
   M[85] = t355;
@@ -805,7 +819,7 @@ void mass_matrix(const T* q, T* M) {
   M[88] = t364;
   M[89] = t365;
   M[90] = t334;
-  M[91] = -k3a85681b;
+  M[91] = -k3dbf0db5;
   M[92] = 0.0;
   M[93] = t396;
   M[94] = t397;
@@ -857,11 +871,11 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t62 = mast_node2_Gammax_1_3*u[6] + mast_node2_Gammax_3_3*u[8];
   const T t63 = mast_node2_Gammax_2_4*q[8] + mast_node2_Gammax_4_4*q[10];
   const T t64 = mast_node2_Gammax_2_4*u[7] + mast_node2_Gammax_4_4*u[9];
-  const T t65 = t58*u[6] + t60*u[7] + t62*u[8] + t64*u[9];
-  const T s_B_mast_node2_x = mast_node2_rho_x + q[10]*t63/2.0 + q[7]*t57/2.0 + q[8]*t59/2.0 + q[9]*t61/2.0;
+  const T t65 = (t58*u[6] + t60*u[7]) + (t62*u[8] + t64*u[9]);
+  const T s_B_mast_node2_x = ((mast_node2_rho_x + q[10]*t63/2.0) + q[7]*t57/2.0) + (q[8]*t59/2.0 + q[9]*t61/2.0);
   const T s_B_mast_node2_y = mast_node2_Phi2_y*q[8] + mast_node2_Phi4_y*q[10];
   const T s_B_mast_node2_z = mast_node2_Phi1_z*q[7] + mast_node2_Phi3_z*q[9];
-  const T t92 = t57*u[6] + t59*u[7] + t61*u[8] + t63*u[9];
+  const T t92 = (t57*u[6] + t59*u[7]) + (t61*u[8] + t63*u[9]);
   const T t93 = mast_node2_Phi2_y*u[7] + mast_node2_Phi4_y*u[9];
   const T t94 = mast_node2_Phi1_z*u[6] + mast_node2_Phi3_z*u[8];
   const T t95 = -t93*u[5] + t94*u[4];
@@ -893,11 +907,11 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t120 = mast_node3_Gammax_1_3*u[6] + mast_node3_Gammax_3_3*u[8];
   const T t121 = mast_node3_Gammax_2_4*q[8] + mast_node3_Gammax_4_4*q[10];
   const T t122 = mast_node3_Gammax_2_4*u[7] + mast_node3_Gammax_4_4*u[9];
-  const T t123 = t116*u[6] + t118*u[7] + t120*u[8] + t122*u[9];
-  const T s_B_mast_node3_x = mast_node3_rho_x + q[10]*t121/2.0 + q[7]*t115/2.0 + q[8]*t117/2.0 + q[9]*t119/2.0;
+  const T t123 = (t116*u[6] + t118*u[7]) + (t120*u[8] + t122*u[9]);
+  const T s_B_mast_node3_x = ((mast_node3_rho_x + q[10]*t121/2.0) + q[7]*t115/2.0) + (q[8]*t117/2.0 + q[9]*t119/2.0);
   const T s_B_mast_node3_y = mast_node3_Phi2_y*q[8] + mast_node3_Phi4_y*q[10];
   const T s_B_mast_node3_z = mast_node3_Phi1_z*q[7] + mast_node3_Phi3_z*q[9];
-  const T t150 = t115*u[6] + t117*u[7] + t119*u[8] + t121*u[9];
+  const T t150 = (t115*u[6] + t117*u[7]) + (t119*u[8] + t121*u[9]);
   const T t151 = mast_node3_Phi2_y*u[7] + mast_node3_Phi4_y*u[9];
   const T t152 = mast_node3_Phi1_z*u[6] + mast_node3_Phi3_z*u[8];
   const T t153 = -t151*u[5] + t152*u[4];
@@ -929,11 +943,11 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t178 = mast_node4_Gammax_1_3*u[6] + mast_node4_Gammax_3_3*u[8];
   const T t179 = mast_node4_Gammax_2_4*q[8] + mast_node4_Gammax_4_4*q[10];
   const T t180 = mast_node4_Gammax_2_4*u[7] + mast_node4_Gammax_4_4*u[9];
-  const T t181 = t174*u[6] + t176*u[7] + t178*u[8] + t180*u[9];
-  const T s_B_mast_node4_x = mast_node4_rho_x + q[10]*t179/2.0 + q[7]*t173/2.0 + q[8]*t175/2.0 + q[9]*t177/2.0;
+  const T t181 = (t174*u[6] + t176*u[7]) + (t178*u[8] + t180*u[9]);
+  const T s_B_mast_node4_x = ((mast_node4_rho_x + q[10]*t179/2.0) + q[7]*t173/2.0) + (q[8]*t175/2.0 + q[9]*t177/2.0);
   const T s_B_mast_node4_y = mast_node4_Phi2_y*q[8] + mast_node4_Phi4_y*q[10];
   const T s_B_mast_node4_z = mast_node4_Phi1_z*q[7] + mast_node4_Phi3_z*q[9];
-  const T t208 = t173*u[6] + t175*u[7] + t177*u[8] + t179*u[9];
+  const T t208 = (t173*u[6] + t175*u[7]) + (t177*u[8] + t179*u[9]);
   const T t209 = mast_node4_Phi2_y*u[7] + mast_node4_Phi4_y*u[9];
   const T t210 = mast_node4_Phi1_z*u[6] + mast_node4_Phi3_z*u[8];
   const T t211 = -t209*u[5] + t210*u[4];
@@ -965,11 +979,11 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t236 = mast_node5_Gammax_1_3*u[6] + mast_node5_Gammax_3_3*u[8];
   const T t237 = mast_node5_Gammax_2_4*q[8] + mast_node5_Gammax_4_4*q[10];
   const T t238 = mast_node5_Gammax_2_4*u[7] + mast_node5_Gammax_4_4*u[9];
-  const T t239 = t232*u[6] + t234*u[7] + t236*u[8] + t238*u[9];
-  const T s_B_mast_node5_x = mast_node5_rho_x + q[10]*t237/2.0 + q[7]*t231/2.0 + q[8]*t233/2.0 + q[9]*t235/2.0;
+  const T t239 = (t232*u[6] + t234*u[7]) + (t236*u[8] + t238*u[9]);
+  const T s_B_mast_node5_x = ((mast_node5_rho_x + q[10]*t237/2.0) + q[7]*t231/2.0) + (q[8]*t233/2.0 + q[9]*t235/2.0);
   const T s_B_mast_node5_y = mast_node5_Phi2_y*q[8] + mast_node5_Phi4_y*q[10];
   const T s_B_mast_node5_z = mast_node5_Phi1_z*q[7] + mast_node5_Phi3_z*q[9];
-  const T t266 = t231*u[6] + t233*u[7] + t235*u[8] + t237*u[9];
+  const T t266 = (t231*u[6] + t233*u[7]) + (t235*u[8] + t237*u[9]);
   const T t267 = mast_node5_Phi2_y*u[7] + mast_node5_Phi4_y*u[9];
   const T t268 = mast_node5_Phi1_z*u[6] + mast_node5_Phi3_z*u[8];
   const T t269 = -t267*u[5] + t268*u[4];
@@ -1001,11 +1015,11 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t294 = mast_node6_Gammax_1_3*u[6] + mast_node6_Gammax_3_3*u[8];
   const T t295 = mast_node6_Gammax_2_4*q[8] + mast_node6_Gammax_4_4*q[10];
   const T t296 = mast_node6_Gammax_2_4*u[7] + mast_node6_Gammax_4_4*u[9];
-  const T t297 = t290*u[6] + t292*u[7] + t294*u[8] + t296*u[9];
-  const T s_B_mast_node6_x = mast_node6_rho_x + q[10]*t295/2.0 + q[7]*t289/2.0 + q[8]*t291/2.0 + q[9]*t293/2.0;
+  const T t297 = (t290*u[6] + t292*u[7]) + (t294*u[8] + t296*u[9]);
+  const T s_B_mast_node6_x = ((mast_node6_rho_x + q[10]*t295/2.0) + q[7]*t289/2.0) + (q[8]*t291/2.0 + q[9]*t293/2.0);
   const T s_B_mast_node6_y = mast_node6_Phi2_y*q[8] + mast_node6_Phi4_y*q[10];
   const T s_B_mast_node6_z = mast_node6_Phi1_z*q[7] + mast_node6_Phi3_z*q[9];
-  const T t324 = t289*u[6] + t291*u[7] + t293*u[8] + t295*u[9];
+  const T t324 = (t289*u[6] + t291*u[7]) + (t293*u[8] + t295*u[9]);
   const T t325 = mast_node6_Phi2_y*u[7] + mast_node6_Phi4_y*u[9];
   const T t326 = mast_node6_Phi1_z*u[6] + mast_node6_Phi3_z*u[8];
   const T t327 = -t325*u[5] + t326*u[4];
@@ -1037,11 +1051,11 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t352 = mast_node7_Gammax_1_3*u[6] + mast_node7_Gammax_3_3*u[8];
   const T t353 = mast_node7_Gammax_2_4*q[8] + mast_node7_Gammax_4_4*q[10];
   const T t354 = mast_node7_Gammax_2_4*u[7] + mast_node7_Gammax_4_4*u[9];
-  const T t355 = t348*u[6] + t350*u[7] + t352*u[8] + t354*u[9];
-  const T s_B_mast_node7_x = mast_node7_rho_x + q[10]*t353/2.0 + q[7]*t347/2.0 + q[8]*t349/2.0 + q[9]*t351/2.0;
+  const T t355 = (t348*u[6] + t350*u[7]) + (t352*u[8] + t354*u[9]);
+  const T s_B_mast_node7_x = ((mast_node7_rho_x + q[10]*t353/2.0) + q[7]*t347/2.0) + (q[8]*t349/2.0 + q[9]*t351/2.0);
   const T s_B_mast_node7_y = mast_node7_Phi2_y*q[8] + mast_node7_Phi4_y*q[10];
   const T s_B_mast_node7_z = mast_node7_Phi1_z*q[7] + mast_node7_Phi3_z*q[9];
-  const T t382 = t347*u[6] + t349*u[7] + t351*u[8] + t353*u[9];
+  const T t382 = (t347*u[6] + t349*u[7]) + (t351*u[8] + t353*u[9]);
   const T t383 = mast_node7_Phi2_y*u[7] + mast_node7_Phi4_y*u[9];
   const T t384 = mast_node7_Phi1_z*u[6] + mast_node7_Phi3_z*u[8];
   const T t385 = -t383*u[5] + t384*u[4];
@@ -1073,11 +1087,11 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t410 = mast_node8_Gammax_1_3*u[6] + mast_node8_Gammax_3_3*u[8];
   const T t411 = mast_node8_Gammax_2_4*q[8] + mast_node8_Gammax_4_4*q[10];
   const T t412 = mast_node8_Gammax_2_4*u[7] + mast_node8_Gammax_4_4*u[9];
-  const T t413 = t406*u[6] + t408*u[7] + t410*u[8] + t412*u[9];
-  const T s_B_mast_node8_x = mast_node8_rho_x + q[10]*t411/2.0 + q[7]*t405/2.0 + q[8]*t407/2.0 + q[9]*t409/2.0;
+  const T t413 = (t406*u[6] + t408*u[7]) + (t410*u[8] + t412*u[9]);
+  const T s_B_mast_node8_x = ((mast_node8_rho_x + q[10]*t411/2.0) + q[7]*t405/2.0) + (q[8]*t407/2.0 + q[9]*t409/2.0);
   const T s_B_mast_node8_y = mast_node8_Phi2_y*q[8] + mast_node8_Phi4_y*q[10];
   const T s_B_mast_node8_z = mast_node8_Phi1_z*q[7] + mast_node8_Phi3_z*q[9];
-  const T t440 = t405*u[6] + t407*u[7] + t409*u[8] + t411*u[9];
+  const T t440 = (t405*u[6] + t407*u[7]) + (t409*u[8] + t411*u[9]);
   const T t441 = mast_node8_Phi2_y*u[7] + mast_node8_Phi4_y*u[9];
   const T t442 = mast_node8_Phi1_z*u[6] + mast_node8_Phi3_z*u[8];
   const T t443 = -t441*u[5] + t442*u[4];
@@ -1109,11 +1123,11 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t468 = mast_node9_Gammax_1_3*u[6] + mast_node9_Gammax_3_3*u[8];
   const T t469 = mast_node9_Gammax_2_4*q[8] + mast_node9_Gammax_4_4*q[10];
   const T t470 = mast_node9_Gammax_2_4*u[7] + mast_node9_Gammax_4_4*u[9];
-  const T t471 = t464*u[6] + t466*u[7] + t468*u[8] + t470*u[9];
-  const T s_B_mast_node9_x = mast_node9_rho_x + q[10]*t469/2.0 + q[7]*t463/2.0 + q[8]*t465/2.0 + q[9]*t467/2.0;
+  const T t471 = (t464*u[6] + t466*u[7]) + (t468*u[8] + t470*u[9]);
+  const T s_B_mast_node9_x = ((mast_node9_rho_x + q[10]*t469/2.0) + q[7]*t463/2.0) + (q[8]*t465/2.0 + q[9]*t467/2.0);
   const T s_B_mast_node9_y = mast_node9_Phi2_y*q[8] + mast_node9_Phi4_y*q[10];
   const T s_B_mast_node9_z = mast_node9_Phi1_z*q[7] + mast_node9_Phi3_z*q[9];
-  const T t498 = t463*u[6] + t465*u[7] + t467*u[8] + t469*u[9];
+  const T t498 = (t463*u[6] + t465*u[7]) + (t467*u[8] + t469*u[9]);
   const T t499 = mast_node9_Phi2_y*u[7] + mast_node9_Phi4_y*u[9];
   const T t500 = mast_node9_Phi1_z*u[6] + mast_node9_Phi3_z*u[8];
   const T t501 = -t499*u[5] + t500*u[4];
@@ -1145,11 +1159,11 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t526 = mast_node10_Gammax_1_3*u[6] + mast_node10_Gammax_3_3*u[8];
   const T t527 = mast_node10_Gammax_2_4*q[8] + mast_node10_Gammax_4_4*q[10];
   const T t528 = mast_node10_Gammax_2_4*u[7] + mast_node10_Gammax_4_4*u[9];
-  const T t529 = t522*u[6] + t524*u[7] + t526*u[8] + t528*u[9];
-  const T s_B_mast_node10_x = mast_node10_rho_x + q[10]*t527/2.0 + q[7]*t521/2.0 + q[8]*t523/2.0 + q[9]*t525/2.0;
+  const T t529 = (t522*u[6] + t524*u[7]) + (t526*u[8] + t528*u[9]);
+  const T s_B_mast_node10_x = ((mast_node10_rho_x + q[10]*t527/2.0) + q[7]*t521/2.0) + (q[8]*t523/2.0 + q[9]*t525/2.0);
   const T s_B_mast_node10_y = mast_node10_Phi2_y*q[8] + mast_node10_Phi4_y*q[10];
   const T s_B_mast_node10_z = mast_node10_Phi1_z*q[7] + mast_node10_Phi3_z*q[9];
-  const T t556 = t521*u[6] + t523*u[7] + t525*u[8] + t527*u[9];
+  const T t556 = (t521*u[6] + t523*u[7]) + (t525*u[8] + t527*u[9]);
   const T t557 = mast_node10_Phi2_y*u[7] + mast_node10_Phi4_y*u[9];
   const T t558 = mast_node10_Phi1_z*u[6] + mast_node10_Phi3_z*u[8];
   const T t559 = -t557*u[5] + t558*u[4];
@@ -1181,11 +1195,11 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t584 = mast_node11_Gammax_1_3*u[6] + mast_node11_Gammax_3_3*u[8];
   const T t585 = mast_node11_Gammax_2_4*q[8] + mast_node11_Gammax_4_4*q[10];
   const T t586 = mast_node11_Gammax_2_4*u[7] + mast_node11_Gammax_4_4*u[9];
-  const T t587 = t580*u[6] + t582*u[7] + t584*u[8] + t586*u[9];
-  const T s_B_mast_node11_x = 1.0 + q[10]*t585/2.0 + q[7]*t579/2.0 + q[8]*t581/2.0 + q[9]*t583/2.0;
+  const T t587 = (t580*u[6] + t582*u[7]) + (t584*u[8] + t586*u[9]);
+  const T s_B_mast_node11_x = ((1.0 + q[10]*t585/2.0) + q[7]*t579/2.0) + (q[8]*t581/2.0 + q[9]*t583/2.0);
   const T s_B_mast_node11_y = mast_node11_Phi2_y*q[8] + mast_node11_Phi4_y*q[10];
   const T s_B_mast_node11_z = mast_node11_Phi1_z*q[7] + mast_node11_Phi3_z*q[9];
-  const T t614 = t579*u[6] + t581*u[7] + t583*u[8] + t585*u[9];
+  const T t614 = (t579*u[6] + t581*u[7]) + (t583*u[8] + t585*u[9]);
   const T t615 = mast_node11_Phi2_y*u[7] + mast_node11_Phi4_y*u[9];
   const T t616 = mast_node11_Phi1_z*u[6] + mast_node11_Phi3_z*u[8];
   const T t617 = -t615*u[5] + t616*u[4];
@@ -1216,16 +1230,16 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t641 = bus_S0_x*t25 - bus_S0_z*t23 - t54;
   const T t642 = -bus_S0_x*t24 + bus_S0_y*t23 - t55;
   // ---- body mast: bias force
-  const T t643 = -k42b9c281*t41 - mast_node10_mass*t571 - mast_node11_mass*t629 - mast_node2_mass*t107 - mast_node3_mass*t165 - mast_node4_mass*t223 - mast_node5_mass*t281 - mast_node6_mass*t339 - mast_node7_mass*t397 - mast_node8_mass*t455 - mast_node9_mass*t513;
-  const T t644 = -k42b9c281*t42 - mast_node10_mass*t569 - mast_node11_mass*t627 - mast_node2_mass*t105 - mast_node3_mass*t163 - mast_node4_mass*t221 - mast_node5_mass*t279 - mast_node6_mass*t337 - mast_node7_mass*t395 - mast_node8_mass*t453 - mast_node9_mass*t511;
-  const T t645 = -k42b9c281*t43 - mast_node10_mass*t570 - mast_node11_mass*t628 - mast_node2_mass*t106 - mast_node3_mass*t164 - mast_node4_mass*t222 - mast_node5_mass*t280 - mast_node6_mass*t338 - mast_node7_mass*t396 - mast_node8_mass*t454 - mast_node9_mass*t512;
-  const T t646 = -(mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*t43 + (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*t42 - mast_node10_mass*t572 - mast_node11_mass*t630 - mast_node2_mass*t108 - mast_node3_mass*t166 - mast_node4_mass*t224 - mast_node5_mass*t282 - mast_node6_mass*t340 - mast_node7_mass*t398 - mast_node8_mass*t456 - mast_node9_mass*t514;
-  const T t647 = (mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*t43 - (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*t41 - mast_node10_mass*t573 - mast_node11_mass*t631 - mast_node2_mass*t109 - mast_node3_mass*t167 - mast_node4_mass*t225 - mast_node5_mass*t283 - mast_node6_mass*t341 - mast_node7_mass*t399 - mast_node8_mass*t457 - mast_node9_mass*t515;
-  const T t648 = -(mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*t42 + (mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*t41 - mast_node10_mass*t574 - mast_node11_mass*t632 - mast_node2_mass*t110 - mast_node3_mass*t168 - mast_node4_mass*t226 - mast_node5_mass*t284 - mast_node6_mass*t342 - mast_node7_mass*t400 - mast_node8_mass*t458 - mast_node9_mass*t516;
-  const T t649 = -(mast_node10_mass*t521 + mast_node11_mass*t579 + mast_node2_mass*t57 + mast_node3_mass*t115 + mast_node4_mass*t173 + mast_node5_mass*t231 + mast_node6_mass*t289 + mast_node7_mass*t347 + mast_node8_mass*t405 + mast_node9_mass*t463)*t41 + k0240019f*t43 - mast_node10_mass*t575 - mast_node11_mass*t633 - mast_node2_mass*t111 - mast_node3_mass*t169 - mast_node4_mass*t227 - mast_node5_mass*t285 - mast_node6_mass*t343 - mast_node7_mass*t401 - mast_node8_mass*t459 - mast_node9_mass*t517;
-  const T t650 = -(mast_node10_mass*t523 + mast_node11_mass*t581 + mast_node2_mass*t59 + mast_node3_mass*t117 + mast_node4_mass*t175 + mast_node5_mass*t233 + mast_node6_mass*t291 + mast_node7_mass*t349 + mast_node8_mass*t407 + mast_node9_mass*t465)*t41 - kabdf954e*t42 - mast_node10_mass*t576 - mast_node11_mass*t634 - mast_node2_mass*t112 - mast_node3_mass*t170 - mast_node4_mass*t228 - mast_node5_mass*t286 - mast_node6_mass*t344 - mast_node7_mass*t402 - mast_node8_mass*t460 - mast_node9_mass*t518;
-  const T t651 = -(mast_node10_mass*t525 + mast_node11_mass*t583 + mast_node2_mass*t61 + mast_node3_mass*t119 + mast_node4_mass*t177 + mast_node5_mass*t235 + mast_node6_mass*t293 + mast_node7_mass*t351 + mast_node8_mass*t409 + mast_node9_mass*t467)*t41 - k4079da1e*t43 - mast_node10_mass*t577 - mast_node11_mass*t635 - mast_node2_mass*t113 - mast_node3_mass*t171 - mast_node4_mass*t229 - mast_node5_mass*t287 - mast_node6_mass*t345 - mast_node7_mass*t403 - mast_node8_mass*t461 - mast_node9_mass*t519;
-  const T t652 = -(mast_node10_mass*t527 + mast_node11_mass*t585 + mast_node2_mass*t63 + mast_node3_mass*t121 + mast_node4_mass*t179 + mast_node5_mass*t237 + mast_node6_mass*t295 + mast_node7_mass*t353 + mast_node8_mass*t411 + mast_node9_mass*t469)*t41 + k3a85681b*t42 - mast_node10_mass*t578 - mast_node11_mass*t636 - mast_node2_mass*t114 - mast_node3_mass*t172 - mast_node4_mass*t230 - mast_node5_mass*t288 - mast_node6_mass*t346 - mast_node7_mass*t404 - mast_node8_mass*t462 - mast_node9_mass*t520;
+  const T t643 = -((((k4c1b0bc9*t41 + mast_node10_mass*t571) + mast_node11_mass*t629) + ((mast_node2_mass*t107 + mast_node3_mass*t165) + mast_node4_mass*t223)) + (((mast_node5_mass*t281 + mast_node6_mass*t339) + mast_node7_mass*t397) + (mast_node8_mass*t455 + mast_node9_mass*t513)));
+  const T t644 = -((((k4c1b0bc9*t42 + mast_node10_mass*t569) + mast_node11_mass*t627) + ((mast_node2_mass*t105 + mast_node3_mass*t163) + mast_node4_mass*t221)) + (((mast_node5_mass*t279 + mast_node6_mass*t337) + mast_node7_mass*t395) + (mast_node8_mass*t453 + mast_node9_mass*t511)));
+  const T t645 = -((((k4c1b0bc9*t43 + mast_node10_mass*t570) + mast_node11_mass*t628) + ((mast_node2_mass*t106 + mast_node3_mass*t164) + mast_node4_mass*t222)) + (((mast_node5_mass*t280 + mast_node6_mass*t338) + mast_node7_mass*t396) + (mast_node8_mass*t454 + mast_node9_mass*t512)));
+  const T t646 = ((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*t42 - ((((((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*t43 + mast_node10_mass*t572) + mast_node11_mass*t630) + ((mast_node2_mass*t108 + mast_node3_mass*t166) + mast_node4_mass*t224)) + (((mast_node5_mass*t282 + mast_node6_mass*t340) + mast_node7_mass*t398) + (mast_node8_mass*t456 + mast_node9_mass*t514)));
+  const T t647 = ((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*t43 - ((((((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*t41 + mast_node10_mass*t573) + mast_node11_mass*t631) + ((mast_node2_mass*t109 + mast_node3_mass*t167) + mast_node4_mass*t225)) + (((mast_node5_mass*t283 + mast_node6_mass*t341) + mast_node7_mass*t399) + (mast_node8_mass*t457 + mast_node9_mass*t515)));
+  const T t648 = ((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*t41 - ((((((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*t42 + mast_node10_mass*t574) + mast_node11_mass*t632) + ((mast_node2_mass*t110 + mast_node3_mass*t168) + mast_node4_mass*t226)) + (((mast_node5_mass*t284 + mast_node6_mass*t342) + mast_node7_mass*t400) + (mast_node8_mass*t458 + mast_node9_mass*t516)));
+  const T t649 = k2a14daf5*t43 - ((((((((mast_node10_mass*t521 + mast_node11_mass*t579) + mast_node2_mass*t57) + (mast_node3_mass*t115 + mast_node4_mass*t173)) + (((mast_node5_mass*t231 + mast_node6_mass*t289) + mast_node7_mass*t347) + (mast_node8_mass*t405 + mast_node9_mass*t463)))*t41 + mast_node10_mass*t575) + mast_node11_mass*t633) + ((mast_node2_mass*t111 + mast_node3_mass*t169) + mast_node4_mass*t227)) + (((mast_node5_mass*t285 + mast_node6_mass*t343) + mast_node7_mass*t401) + (mast_node8_mass*t459 + mast_node9_mass*t517)));
+  const T t650 = -((((((((mast_node10_mass*t523 + mast_node11_mass*t581) + mast_node2_mass*t59) + (mast_node3_mass*t117 + mast_node4_mass*t175)) + (((mast_node5_mass*t233 + mast_node6_mass*t291) + mast_node7_mass*t349) + (mast_node8_mass*t407 + mast_node9_mass*t465)))*t41 + kee8c9a7d*t42) + mast_node10_mass*t576) + ((mast_node11_mass*t634 + mast_node2_mass*t112) + mast_node3_mass*t170)) + (((mast_node4_mass*t228 + mast_node5_mass*t286) + mast_node6_mass*t344) + ((mast_node7_mass*t402 + mast_node8_mass*t460) + mast_node9_mass*t518)));
+  const T t651 = -((((((((mast_node10_mass*t525 + mast_node11_mass*t583) + mast_node2_mass*t61) + (mast_node3_mass*t119 + mast_node4_mass*t177)) + (((mast_node5_mass*t235 + mast_node6_mass*t293) + mast_node7_mass*t351) + (mast_node8_mass*t409 + mast_node9_mass*t467)))*t41 + k22bda376*t43) + mast_node10_mass*t577) + ((mast_node11_mass*t635 + mast_node2_mass*t113) + mast_node3_mass*t171)) + (((mast_node4_mass*t229 + mast_node5_mass*t287) + mast_node6_mass*t345) + ((mast_node7_mass*t403 + mast_node8_mass*t461) + mast_node9_mass*t519)));
+  const T t652 = k3dbf0db5*t42 - ((((((((mast_node10_mass*t527 + mast_node11_mass*t585) + mast_node2_mass*t63) + (mast_node3_mass*t121 + mast_node4_mass*t179)) + (((mast_node5_mass*t237 + mast_node6_mass*t295) + mast_node7_mass*t353) + (mast_node8_mass*t411 + mast_node9_mass*t469)))*t41 + mast_node10_mass*t578) + mast_node11_mass*t636) + ((mast_node2_mass*t114 + mast_node3_mass*t172) + mast_node4_mass*t230)) + (((mast_node5_mass*t288 + mast_node6_mass*t346) + mast_node7_mass*t404) + (mast_node8_mass*t462 + mast_node9_mass*t520)));
   // ---- body mast: generalized forces (inward)
   const T t653 = -mast_D1*u[6] - mast_K1*q[7] + tau[6];
   const T t654 = t649 + t653;
@@ -1308,8 +1322,8 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t62 = mast_node2_Gammax_1_3*u[6] + mast_node2_Gammax_3_3*u[8];
   const T t63 = mast_node2_Gammax_2_4*q[8] + mast_node2_Gammax_4_4*q[10];
   const T t64 = mast_node2_Gammax_2_4*u[7] + mast_node2_Gammax_4_4*u[9];
-  const T t65 = t58*u[6] + t60*u[7] + t62*u[8] + t64*u[9];
-  const T s_B_mast_node2_x = mast_node2_rho_x + q[10]*t63/2.0 + q[7]*t57/2.0 + q[8]*t59/2.0 + q[9]*t61/2.0;
+  const T t65 = (t58*u[6] + t60*u[7]) + (t62*u[8] + t64*u[9]);
+  const T s_B_mast_node2_x = ((mast_node2_rho_x + q[10]*t63/2.0) + q[7]*t57/2.0) + (q[8]*t59/2.0 + q[9]*t61/2.0);
   const T s_B_mast_node2_y = mast_node2_Phi2_y*q[8] + mast_node2_Phi4_y*q[10];
   const T s_B_mast_node2_z = mast_node2_Phi1_z*q[7] + mast_node2_Phi3_z*q[9];
   const T t69 = s_B_mast_node2_x*s_B_mast_node2_x + s_B_mast_node2_y*s_B_mast_node2_y + s_B_mast_node2_z*s_B_mast_node2_z;
@@ -1335,7 +1349,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t89 = s_B_mast_node2_z*t63;
   const T t90 = mast_node2_Phi4_y*s_B_mast_node2_x - s_B_mast_node2_y*t63;
   const T t91 = k2ee243d4 + t63*t63;
-  const T t92 = t57*u[6] + t59*u[7] + t61*u[8] + t63*u[9];
+  const T t92 = (t57*u[6] + t59*u[7]) + (t61*u[8] + t63*u[9]);
   const T t93 = mast_node2_Phi2_y*u[7] + mast_node2_Phi4_y*u[9];
   const T t94 = mast_node2_Phi1_z*u[6] + mast_node2_Phi3_z*u[8];
   const T t95 = -t93*u[5] + t94*u[4];
@@ -1367,8 +1381,8 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t120 = mast_node3_Gammax_1_3*u[6] + mast_node3_Gammax_3_3*u[8];
   const T t121 = mast_node3_Gammax_2_4*q[8] + mast_node3_Gammax_4_4*q[10];
   const T t122 = mast_node3_Gammax_2_4*u[7] + mast_node3_Gammax_4_4*u[9];
-  const T t123 = t116*u[6] + t118*u[7] + t120*u[8] + t122*u[9];
-  const T s_B_mast_node3_x = mast_node3_rho_x + q[10]*t121/2.0 + q[7]*t115/2.0 + q[8]*t117/2.0 + q[9]*t119/2.0;
+  const T t123 = (t116*u[6] + t118*u[7]) + (t120*u[8] + t122*u[9]);
+  const T s_B_mast_node3_x = ((mast_node3_rho_x + q[10]*t121/2.0) + q[7]*t115/2.0) + (q[8]*t117/2.0 + q[9]*t119/2.0);
   const T s_B_mast_node3_y = mast_node3_Phi2_y*q[8] + mast_node3_Phi4_y*q[10];
   const T s_B_mast_node3_z = mast_node3_Phi1_z*q[7] + mast_node3_Phi3_z*q[9];
   const T t127 = s_B_mast_node3_x*s_B_mast_node3_x + s_B_mast_node3_y*s_B_mast_node3_y + s_B_mast_node3_z*s_B_mast_node3_z;
@@ -1394,7 +1408,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t147 = s_B_mast_node3_z*t121;
   const T t148 = mast_node3_Phi4_y*s_B_mast_node3_x - s_B_mast_node3_y*t121;
   const T t149 = kc2a1e523 + t121*t121;
-  const T t150 = t115*u[6] + t117*u[7] + t119*u[8] + t121*u[9];
+  const T t150 = (t115*u[6] + t117*u[7]) + (t119*u[8] + t121*u[9]);
   const T t151 = mast_node3_Phi2_y*u[7] + mast_node3_Phi4_y*u[9];
   const T t152 = mast_node3_Phi1_z*u[6] + mast_node3_Phi3_z*u[8];
   const T t153 = -t151*u[5] + t152*u[4];
@@ -1426,8 +1440,8 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t178 = mast_node4_Gammax_1_3*u[6] + mast_node4_Gammax_3_3*u[8];
   const T t179 = mast_node4_Gammax_2_4*q[8] + mast_node4_Gammax_4_4*q[10];
   const T t180 = mast_node4_Gammax_2_4*u[7] + mast_node4_Gammax_4_4*u[9];
-  const T t181 = t174*u[6] + t176*u[7] + t178*u[8] + t180*u[9];
-  const T s_B_mast_node4_x = mast_node4_rho_x + q[10]*t179/2.0 + q[7]*t173/2.0 + q[8]*t175/2.0 + q[9]*t177/2.0;
+  const T t181 = (t174*u[6] + t176*u[7]) + (t178*u[8] + t180*u[9]);
+  const T s_B_mast_node4_x = ((mast_node4_rho_x + q[10]*t179/2.0) + q[7]*t173/2.0) + (q[8]*t175/2.0 + q[9]*t177/2.0);
   const T s_B_mast_node4_y = mast_node4_Phi2_y*q[8] + mast_node4_Phi4_y*q[10];
   const T s_B_mast_node4_z = mast_node4_Phi1_z*q[7] + mast_node4_Phi3_z*q[9];
   const T t185 = s_B_mast_node4_x*s_B_mast_node4_x + s_B_mast_node4_y*s_B_mast_node4_y + s_B_mast_node4_z*s_B_mast_node4_z;
@@ -1453,7 +1467,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t205 = s_B_mast_node4_z*t179;
   const T t206 = mast_node4_Phi4_y*s_B_mast_node4_x - s_B_mast_node4_y*t179;
   const T t207 = k16a783d2 + t179*t179;
-  const T t208 = t173*u[6] + t175*u[7] + t177*u[8] + t179*u[9];
+  const T t208 = (t173*u[6] + t175*u[7]) + (t177*u[8] + t179*u[9]);
   const T t209 = mast_node4_Phi2_y*u[7] + mast_node4_Phi4_y*u[9];
   const T t210 = mast_node4_Phi1_z*u[6] + mast_node4_Phi3_z*u[8];
   const T t211 = -t209*u[5] + t210*u[4];
@@ -1485,8 +1499,8 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t236 = mast_node5_Gammax_1_3*u[6] + mast_node5_Gammax_3_3*u[8];
   const T t237 = mast_node5_Gammax_2_4*q[8] + mast_node5_Gammax_4_4*q[10];
   const T t238 = mast_node5_Gammax_2_4*u[7] + mast_node5_Gammax_4_4*u[9];
-  const T t239 = t232*u[6] + t234*u[7] + t236*u[8] + t238*u[9];
-  const T s_B_mast_node5_x = mast_node5_rho_x + q[10]*t237/2.0 + q[7]*t231/2.0 + q[8]*t233/2.0 + q[9]*t235/2.0;
+  const T t239 = (t232*u[6] + t234*u[7]) + (t236*u[8] + t238*u[9]);
+  const T s_B_mast_node5_x = ((mast_node5_rho_x + q[10]*t237/2.0) + q[7]*t231/2.0) + (q[8]*t233/2.0 + q[9]*t235/2.0);
   const T s_B_mast_node5_y = mast_node5_Phi2_y*q[8] + mast_node5_Phi4_y*q[10];
   const T s_B_mast_node5_z = mast_node5_Phi1_z*q[7] + mast_node5_Phi3_z*q[9];
   const T t243 = s_B_mast_node5_x*s_B_mast_node5_x + s_B_mast_node5_y*s_B_mast_node5_y + s_B_mast_node5_z*s_B_mast_node5_z;
@@ -1512,7 +1526,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t263 = s_B_mast_node5_z*t237;
   const T t264 = mast_node5_Phi4_y*s_B_mast_node5_x - s_B_mast_node5_y*t237;
   const T t265 = k76339540 + t237*t237;
-  const T t266 = t231*u[6] + t233*u[7] + t235*u[8] + t237*u[9];
+  const T t266 = (t231*u[6] + t233*u[7]) + (t235*u[8] + t237*u[9]);
   const T t267 = mast_node5_Phi2_y*u[7] + mast_node5_Phi4_y*u[9];
   const T t268 = mast_node5_Phi1_z*u[6] + mast_node5_Phi3_z*u[8];
   const T t269 = -t267*u[5] + t268*u[4];
@@ -1544,8 +1558,8 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t294 = mast_node6_Gammax_1_3*u[6] + mast_node6_Gammax_3_3*u[8];
   const T t295 = mast_node6_Gammax_2_4*q[8] + mast_node6_Gammax_4_4*q[10];
   const T t296 = mast_node6_Gammax_2_4*u[7] + mast_node6_Gammax_4_4*u[9];
-  const T t297 = t290*u[6] + t292*u[7] + t294*u[8] + t296*u[9];
-  const T s_B_mast_node6_x = mast_node6_rho_x + q[10]*t295/2.0 + q[7]*t289/2.0 + q[8]*t291/2.0 + q[9]*t293/2.0;
+  const T t297 = (t290*u[6] + t292*u[7]) + (t294*u[8] + t296*u[9]);
+  const T s_B_mast_node6_x = ((mast_node6_rho_x + q[10]*t295/2.0) + q[7]*t289/2.0) + (q[8]*t291/2.0 + q[9]*t293/2.0);
   const T s_B_mast_node6_y = mast_node6_Phi2_y*q[8] + mast_node6_Phi4_y*q[10];
   const T s_B_mast_node6_z = mast_node6_Phi1_z*q[7] + mast_node6_Phi3_z*q[9];
   const T t301 = s_B_mast_node6_x*s_B_mast_node6_x + s_B_mast_node6_y*s_B_mast_node6_y + s_B_mast_node6_z*s_B_mast_node6_z;
@@ -1571,7 +1585,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t321 = s_B_mast_node6_z*t295;
   const T t322 = mast_node6_Phi4_y*s_B_mast_node6_x - s_B_mast_node6_y*t295;
   const T t323 = k4ee3fd31 + t295*t295;
-  const T t324 = t289*u[6] + t291*u[7] + t293*u[8] + t295*u[9];
+  const T t324 = (t289*u[6] + t291*u[7]) + (t293*u[8] + t295*u[9]);
   const T t325 = mast_node6_Phi2_y*u[7] + mast_node6_Phi4_y*u[9];
   const T t326 = mast_node6_Phi1_z*u[6] + mast_node6_Phi3_z*u[8];
   const T t327 = -t325*u[5] + t326*u[4];
@@ -1603,8 +1617,8 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t352 = mast_node7_Gammax_1_3*u[6] + mast_node7_Gammax_3_3*u[8];
   const T t353 = mast_node7_Gammax_2_4*q[8] + mast_node7_Gammax_4_4*q[10];
   const T t354 = mast_node7_Gammax_2_4*u[7] + mast_node7_Gammax_4_4*u[9];
-  const T t355 = t348*u[6] + t350*u[7] + t352*u[8] + t354*u[9];
-  const T s_B_mast_node7_x = mast_node7_rho_x + q[10]*t353/2.0 + q[7]*t347/2.0 + q[8]*t349/2.0 + q[9]*t351/2.0;
+  const T t355 = (t348*u[6] + t350*u[7]) + (t352*u[8] + t354*u[9]);
+  const T s_B_mast_node7_x = ((mast_node7_rho_x + q[10]*t353/2.0) + q[7]*t347/2.0) + (q[8]*t349/2.0 + q[9]*t351/2.0);
   const T s_B_mast_node7_y = mast_node7_Phi2_y*q[8] + mast_node7_Phi4_y*q[10];
   const T s_B_mast_node7_z = mast_node7_Phi1_z*q[7] + mast_node7_Phi3_z*q[9];
   const T t359 = s_B_mast_node7_x*s_B_mast_node7_x + s_B_mast_node7_y*s_B_mast_node7_y + s_B_mast_node7_z*s_B_mast_node7_z;
@@ -1630,7 +1644,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t379 = s_B_mast_node7_z*t353;
   const T t380 = mast_node7_Phi4_y*s_B_mast_node7_x - s_B_mast_node7_y*t353;
   const T t381 = kf5604f27 + t353*t353;
-  const T t382 = t347*u[6] + t349*u[7] + t351*u[8] + t353*u[9];
+  const T t382 = (t347*u[6] + t349*u[7]) + (t351*u[8] + t353*u[9]);
   const T t383 = mast_node7_Phi2_y*u[7] + mast_node7_Phi4_y*u[9];
   const T t384 = mast_node7_Phi1_z*u[6] + mast_node7_Phi3_z*u[8];
   const T t385 = -t383*u[5] + t384*u[4];
@@ -1662,8 +1676,8 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t410 = mast_node8_Gammax_1_3*u[6] + mast_node8_Gammax_3_3*u[8];
   const T t411 = mast_node8_Gammax_2_4*q[8] + mast_node8_Gammax_4_4*q[10];
   const T t412 = mast_node8_Gammax_2_4*u[7] + mast_node8_Gammax_4_4*u[9];
-  const T t413 = t406*u[6] + t408*u[7] + t410*u[8] + t412*u[9];
-  const T s_B_mast_node8_x = mast_node8_rho_x + q[10]*t411/2.0 + q[7]*t405/2.0 + q[8]*t407/2.0 + q[9]*t409/2.0;
+  const T t413 = (t406*u[6] + t408*u[7]) + (t410*u[8] + t412*u[9]);
+  const T s_B_mast_node8_x = ((mast_node8_rho_x + q[10]*t411/2.0) + q[7]*t405/2.0) + (q[8]*t407/2.0 + q[9]*t409/2.0);
   const T s_B_mast_node8_y = mast_node8_Phi2_y*q[8] + mast_node8_Phi4_y*q[10];
   const T s_B_mast_node8_z = mast_node8_Phi1_z*q[7] + mast_node8_Phi3_z*q[9];
   const T t417 = s_B_mast_node8_x*s_B_mast_node8_x + s_B_mast_node8_y*s_B_mast_node8_y + s_B_mast_node8_z*s_B_mast_node8_z;
@@ -1689,7 +1703,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t437 = s_B_mast_node8_z*t411;
   const T t438 = mast_node8_Phi4_y*s_B_mast_node8_x - s_B_mast_node8_y*t411;
   const T t439 = k200456b4 + t411*t411;
-  const T t440 = t405*u[6] + t407*u[7] + t409*u[8] + t411*u[9];
+  const T t440 = (t405*u[6] + t407*u[7]) + (t409*u[8] + t411*u[9]);
   const T t441 = mast_node8_Phi2_y*u[7] + mast_node8_Phi4_y*u[9];
   const T t442 = mast_node8_Phi1_z*u[6] + mast_node8_Phi3_z*u[8];
   const T t443 = -t441*u[5] + t442*u[4];
@@ -1721,8 +1735,8 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t468 = mast_node9_Gammax_1_3*u[6] + mast_node9_Gammax_3_3*u[8];
   const T t469 = mast_node9_Gammax_2_4*q[8] + mast_node9_Gammax_4_4*q[10];
   const T t470 = mast_node9_Gammax_2_4*u[7] + mast_node9_Gammax_4_4*u[9];
-  const T t471 = t464*u[6] + t466*u[7] + t468*u[8] + t470*u[9];
-  const T s_B_mast_node9_x = mast_node9_rho_x + q[10]*t469/2.0 + q[7]*t463/2.0 + q[8]*t465/2.0 + q[9]*t467/2.0;
+  const T t471 = (t464*u[6] + t466*u[7]) + (t468*u[8] + t470*u[9]);
+  const T s_B_mast_node9_x = ((mast_node9_rho_x + q[10]*t469/2.0) + q[7]*t463/2.0) + (q[8]*t465/2.0 + q[9]*t467/2.0);
   const T s_B_mast_node9_y = mast_node9_Phi2_y*q[8] + mast_node9_Phi4_y*q[10];
   const T s_B_mast_node9_z = mast_node9_Phi1_z*q[7] + mast_node9_Phi3_z*q[9];
   const T t475 = s_B_mast_node9_x*s_B_mast_node9_x + s_B_mast_node9_y*s_B_mast_node9_y + s_B_mast_node9_z*s_B_mast_node9_z;
@@ -1748,7 +1762,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t495 = s_B_mast_node9_z*t469;
   const T t496 = mast_node9_Phi4_y*s_B_mast_node9_x - s_B_mast_node9_y*t469;
   const T t497 = kf88e0228 + t469*t469;
-  const T t498 = t463*u[6] + t465*u[7] + t467*u[8] + t469*u[9];
+  const T t498 = (t463*u[6] + t465*u[7]) + (t467*u[8] + t469*u[9]);
   const T t499 = mast_node9_Phi2_y*u[7] + mast_node9_Phi4_y*u[9];
   const T t500 = mast_node9_Phi1_z*u[6] + mast_node9_Phi3_z*u[8];
   const T t501 = -t499*u[5] + t500*u[4];
@@ -1780,8 +1794,8 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t526 = mast_node10_Gammax_1_3*u[6] + mast_node10_Gammax_3_3*u[8];
   const T t527 = mast_node10_Gammax_2_4*q[8] + mast_node10_Gammax_4_4*q[10];
   const T t528 = mast_node10_Gammax_2_4*u[7] + mast_node10_Gammax_4_4*u[9];
-  const T t529 = t522*u[6] + t524*u[7] + t526*u[8] + t528*u[9];
-  const T s_B_mast_node10_x = mast_node10_rho_x + q[10]*t527/2.0 + q[7]*t521/2.0 + q[8]*t523/2.0 + q[9]*t525/2.0;
+  const T t529 = (t522*u[6] + t524*u[7]) + (t526*u[8] + t528*u[9]);
+  const T s_B_mast_node10_x = ((mast_node10_rho_x + q[10]*t527/2.0) + q[7]*t521/2.0) + (q[8]*t523/2.0 + q[9]*t525/2.0);
   const T s_B_mast_node10_y = mast_node10_Phi2_y*q[8] + mast_node10_Phi4_y*q[10];
   const T s_B_mast_node10_z = mast_node10_Phi1_z*q[7] + mast_node10_Phi3_z*q[9];
   const T t533 = s_B_mast_node10_x*s_B_mast_node10_x + s_B_mast_node10_y*s_B_mast_node10_y + s_B_mast_node10_z*s_B_mast_node10_z;
@@ -1807,7 +1821,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t553 = s_B_mast_node10_z*t527;
   const T t554 = mast_node10_Phi4_y*s_B_mast_node10_x - s_B_mast_node10_y*t527;
   const T t555 = kcd8dd844 + t527*t527;
-  const T t556 = t521*u[6] + t523*u[7] + t525*u[8] + t527*u[9];
+  const T t556 = (t521*u[6] + t523*u[7]) + (t525*u[8] + t527*u[9]);
   const T t557 = mast_node10_Phi2_y*u[7] + mast_node10_Phi4_y*u[9];
   const T t558 = mast_node10_Phi1_z*u[6] + mast_node10_Phi3_z*u[8];
   const T t559 = -t557*u[5] + t558*u[4];
@@ -1839,8 +1853,8 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t584 = mast_node11_Gammax_1_3*u[6] + mast_node11_Gammax_3_3*u[8];
   const T t585 = mast_node11_Gammax_2_4*q[8] + mast_node11_Gammax_4_4*q[10];
   const T t586 = mast_node11_Gammax_2_4*u[7] + mast_node11_Gammax_4_4*u[9];
-  const T t587 = t580*u[6] + t582*u[7] + t584*u[8] + t586*u[9];
-  const T s_B_mast_node11_x = 1.0 + q[10]*t585/2.0 + q[7]*t579/2.0 + q[8]*t581/2.0 + q[9]*t583/2.0;
+  const T t587 = (t580*u[6] + t582*u[7]) + (t584*u[8] + t586*u[9]);
+  const T s_B_mast_node11_x = ((1.0 + q[10]*t585/2.0) + q[7]*t579/2.0) + (q[8]*t581/2.0 + q[9]*t583/2.0);
   const T s_B_mast_node11_y = mast_node11_Phi2_y*q[8] + mast_node11_Phi4_y*q[10];
   const T s_B_mast_node11_z = mast_node11_Phi1_z*q[7] + mast_node11_Phi3_z*q[9];
   const T t591 = s_B_mast_node11_x*s_B_mast_node11_x + s_B_mast_node11_y*s_B_mast_node11_y + s_B_mast_node11_z*s_B_mast_node11_z;
@@ -1866,7 +1880,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t611 = s_B_mast_node11_z*t585;
   const T t612 = mast_node11_Phi4_y*s_B_mast_node11_x - s_B_mast_node11_y*t585;
   const T t613 = k9d7b9219 + t585*t585;
-  const T t614 = t579*u[6] + t581*u[7] + t583*u[8] + t585*u[9];
+  const T t614 = (t579*u[6] + t581*u[7]) + (t583*u[8] + t585*u[9]);
   const T t615 = mast_node11_Phi2_y*u[7] + mast_node11_Phi4_y*u[9];
   const T t616 = mast_node11_Phi1_z*u[6] + mast_node11_Phi3_z*u[8];
   const T t617 = -t615*u[5] + t616*u[4];
@@ -1890,49 +1904,49 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t635 = mast_node11_Phi3_z*t628 + t583*t629;
   const T t636 = mast_node11_Phi4_y*t627 + t585*t629;
   // ---- body mast: composite inertia (inward)
-  const T t637 = mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z;
-  const T t639 = mast_node10_mass*t521 + mast_node11_mass*t579 + mast_node2_mass*t57 + mast_node3_mass*t115 + mast_node4_mass*t173 + mast_node5_mass*t231 + mast_node6_mass*t289 + mast_node7_mass*t347 + mast_node8_mass*t405 + mast_node9_mass*t463;
-  const T t640 = mast_node10_mass*t523 + mast_node11_mass*t581 + mast_node2_mass*t59 + mast_node3_mass*t117 + mast_node4_mass*t175 + mast_node5_mass*t233 + mast_node6_mass*t291 + mast_node7_mass*t349 + mast_node8_mass*t407 + mast_node9_mass*t465;
-  const T t641 = mast_node10_mass*t525 + mast_node11_mass*t583 + mast_node2_mass*t61 + mast_node3_mass*t119 + mast_node4_mass*t177 + mast_node5_mass*t235 + mast_node6_mass*t293 + mast_node7_mass*t351 + mast_node8_mass*t409 + mast_node9_mass*t467;
-  const T t642 = mast_node10_mass*t527 + mast_node11_mass*t585 + mast_node2_mass*t63 + mast_node3_mass*t121 + mast_node4_mass*t179 + mast_node5_mass*t237 + mast_node6_mass*t295 + mast_node7_mass*t353 + mast_node8_mass*t411 + mast_node9_mass*t469;
-  const T t644 = mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x;
-  const T t645 = mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y;
-  const T t647 = -(s_B_mast_node10_x*s_B_mast_node10_x - t533)*mast_node10_mass - (s_B_mast_node11_x*s_B_mast_node11_x - t591)*mast_node11_mass - (s_B_mast_node2_x*s_B_mast_node2_x - t69)*mast_node2_mass - (s_B_mast_node3_x*s_B_mast_node3_x - t127)*mast_node3_mass - (s_B_mast_node4_x*s_B_mast_node4_x - t185)*mast_node4_mass - (s_B_mast_node5_x*s_B_mast_node5_x - t243)*mast_node5_mass - (s_B_mast_node6_x*s_B_mast_node6_x - t301)*mast_node6_mass - (s_B_mast_node7_x*s_B_mast_node7_x - t359)*mast_node7_mass - (s_B_mast_node8_x*s_B_mast_node8_x - t417)*mast_node8_mass - (s_B_mast_node9_x*s_B_mast_node9_x - t475)*mast_node9_mass;
-  const T t648 = -mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y - mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y - mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y - mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y - mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y - mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y - mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y - mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y - mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y - mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y;
-  const T t649 = -mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z - mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z - mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z - mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z - mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z - mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z - mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z - mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z - mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z - mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z;
-  const T t650 = mast_node10_mass*t534 + mast_node11_mass*t592 + mast_node2_mass*t70 + mast_node3_mass*t128 + mast_node4_mass*t186 + mast_node5_mass*t244 + mast_node6_mass*t302 + mast_node7_mass*t360 + mast_node8_mass*t418 + mast_node9_mass*t476;
-  const T t651 = mast_node10_mass*t541 + mast_node11_mass*t599 + mast_node2_mass*t77 + mast_node3_mass*t135 + mast_node4_mass*t193 + mast_node5_mass*t251 + mast_node6_mass*t309 + mast_node7_mass*t367 + mast_node8_mass*t425 + mast_node9_mass*t483;
-  const T t652 = mast_node10_mass*t547 + mast_node11_mass*t605 + mast_node2_mass*t83 + mast_node3_mass*t141 + mast_node4_mass*t199 + mast_node5_mass*t257 + mast_node6_mass*t315 + mast_node7_mass*t373 + mast_node8_mass*t431 + mast_node9_mass*t489;
-  const T t653 = mast_node10_mass*t552 + mast_node11_mass*t610 + mast_node2_mass*t88 + mast_node3_mass*t146 + mast_node4_mass*t204 + mast_node5_mass*t262 + mast_node6_mass*t320 + mast_node7_mass*t378 + mast_node8_mass*t436 + mast_node9_mass*t494;
-  const T t654 = -(s_B_mast_node10_y*s_B_mast_node10_y - t533)*mast_node10_mass - (s_B_mast_node11_y*s_B_mast_node11_y - t591)*mast_node11_mass - (s_B_mast_node2_y*s_B_mast_node2_y - t69)*mast_node2_mass - (s_B_mast_node3_y*s_B_mast_node3_y - t127)*mast_node3_mass - (s_B_mast_node4_y*s_B_mast_node4_y - t185)*mast_node4_mass - (s_B_mast_node5_y*s_B_mast_node5_y - t243)*mast_node5_mass - (s_B_mast_node6_y*s_B_mast_node6_y - t301)*mast_node6_mass - (s_B_mast_node7_y*s_B_mast_node7_y - t359)*mast_node7_mass - (s_B_mast_node8_y*s_B_mast_node8_y - t417)*mast_node8_mass - (s_B_mast_node9_y*s_B_mast_node9_y - t475)*mast_node9_mass;
-  const T t655 = -mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z - mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z - mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z - mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z - mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z - mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z - mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z - mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z - mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z - mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z;
-  const T t656 = mast_node10_mass*t535 + mast_node11_mass*t593 + mast_node2_mass*t71 + mast_node3_mass*t129 + mast_node4_mass*t187 + mast_node5_mass*t245 + mast_node6_mass*t303 + mast_node7_mass*t361 + mast_node8_mass*t419 + mast_node9_mass*t477;
-  const T t657 = mast_node10_mass*t542 + mast_node11_mass*t600 + mast_node2_mass*t78 + mast_node3_mass*t136 + mast_node4_mass*t194 + mast_node5_mass*t252 + mast_node6_mass*t310 + mast_node7_mass*t368 + mast_node8_mass*t426 + mast_node9_mass*t484;
-  const T t658 = mast_node10_mass*t548 + mast_node11_mass*t606 + mast_node2_mass*t84 + mast_node3_mass*t142 + mast_node4_mass*t200 + mast_node5_mass*t258 + mast_node6_mass*t316 + mast_node7_mass*t374 + mast_node8_mass*t432 + mast_node9_mass*t490;
-  const T t659 = mast_node10_mass*t553 + mast_node11_mass*t611 + mast_node2_mass*t89 + mast_node3_mass*t147 + mast_node4_mass*t205 + mast_node5_mass*t263 + mast_node6_mass*t321 + mast_node7_mass*t379 + mast_node8_mass*t437 + mast_node9_mass*t495;
-  const T t660 = -(s_B_mast_node10_z*s_B_mast_node10_z - t533)*mast_node10_mass - (s_B_mast_node11_z*s_B_mast_node11_z - t591)*mast_node11_mass - (s_B_mast_node2_z*s_B_mast_node2_z - t69)*mast_node2_mass - (s_B_mast_node3_z*s_B_mast_node3_z - t127)*mast_node3_mass - (s_B_mast_node4_z*s_B_mast_node4_z - t185)*mast_node4_mass - (s_B_mast_node5_z*s_B_mast_node5_z - t243)*mast_node5_mass - (s_B_mast_node6_z*s_B_mast_node6_z - t301)*mast_node6_mass - (s_B_mast_node7_z*s_B_mast_node7_z - t359)*mast_node7_mass - (s_B_mast_node8_z*s_B_mast_node8_z - t417)*mast_node8_mass - (s_B_mast_node9_z*s_B_mast_node9_z - t475)*mast_node9_mass;
-  const T t661 = mast_node10_mass*t536 + mast_node11_mass*t594 + mast_node2_mass*t72 + mast_node3_mass*t130 + mast_node4_mass*t188 + mast_node5_mass*t246 + mast_node6_mass*t304 + mast_node7_mass*t362 + mast_node8_mass*t420 + mast_node9_mass*t478;
-  const T t662 = mast_node10_mass*t543 + mast_node11_mass*t601 + mast_node2_mass*t79 + mast_node3_mass*t137 + mast_node4_mass*t195 + mast_node5_mass*t253 + mast_node6_mass*t311 + mast_node7_mass*t369 + mast_node8_mass*t427 + mast_node9_mass*t485;
-  const T t663 = mast_node10_mass*t549 + mast_node11_mass*t607 + mast_node2_mass*t85 + mast_node3_mass*t143 + mast_node4_mass*t201 + mast_node5_mass*t259 + mast_node6_mass*t317 + mast_node7_mass*t375 + mast_node8_mass*t433 + mast_node9_mass*t491;
-  const T t664 = mast_node10_mass*t554 + mast_node11_mass*t612 + mast_node2_mass*t90 + mast_node3_mass*t148 + mast_node4_mass*t206 + mast_node5_mass*t264 + mast_node6_mass*t322 + mast_node7_mass*t380 + mast_node8_mass*t438 + mast_node9_mass*t496;
-  const T t665 = mast_node10_mass*t537 + mast_node11_mass*t595 + mast_node2_mass*t73 + mast_node3_mass*t131 + mast_node4_mass*t189 + mast_node5_mass*t247 + mast_node6_mass*t305 + mast_node7_mass*t363 + mast_node8_mass*t421 + mast_node9_mass*t479;
-  const T t666 = mast_node10_mass*t538 + mast_node11_mass*t596 + mast_node2_mass*t74 + mast_node3_mass*t132 + mast_node4_mass*t190 + mast_node5_mass*t248 + mast_node6_mass*t306 + mast_node7_mass*t364 + mast_node8_mass*t422 + mast_node9_mass*t480;
-  const T t667 = mast_node10_mass*t539 + mast_node11_mass*t597 + mast_node2_mass*t75 + mast_node3_mass*t133 + mast_node4_mass*t191 + mast_node5_mass*t249 + mast_node6_mass*t307 + mast_node7_mass*t365 + mast_node8_mass*t423 + mast_node9_mass*t481;
-  const T t668 = mast_node10_mass*t540 + mast_node11_mass*t598 + mast_node2_mass*t76 + mast_node3_mass*t134 + mast_node4_mass*t192 + mast_node5_mass*t250 + mast_node6_mass*t308 + mast_node7_mass*t366 + mast_node8_mass*t424 + mast_node9_mass*t482;
-  const T t669 = mast_node10_mass*t544 + mast_node11_mass*t602 + mast_node2_mass*t80 + mast_node3_mass*t138 + mast_node4_mass*t196 + mast_node5_mass*t254 + mast_node6_mass*t312 + mast_node7_mass*t370 + mast_node8_mass*t428 + mast_node9_mass*t486;
-  const T t670 = mast_node10_mass*t545 + mast_node11_mass*t603 + mast_node2_mass*t81 + mast_node3_mass*t139 + mast_node4_mass*t197 + mast_node5_mass*t255 + mast_node6_mass*t313 + mast_node7_mass*t371 + mast_node8_mass*t429 + mast_node9_mass*t487;
-  const T t671 = mast_node10_mass*t546 + mast_node11_mass*t604 + mast_node2_mass*t82 + mast_node3_mass*t140 + mast_node4_mass*t198 + mast_node5_mass*t256 + mast_node6_mass*t314 + mast_node7_mass*t372 + mast_node8_mass*t430 + mast_node9_mass*t488;
-  const T t672 = mast_node10_mass*t550 + mast_node11_mass*t608 + mast_node2_mass*t86 + mast_node3_mass*t144 + mast_node4_mass*t202 + mast_node5_mass*t260 + mast_node6_mass*t318 + mast_node7_mass*t376 + mast_node8_mass*t434 + mast_node9_mass*t492;
-  const T t673 = mast_node10_mass*t551 + mast_node11_mass*t609 + mast_node2_mass*t87 + mast_node3_mass*t145 + mast_node4_mass*t203 + mast_node5_mass*t261 + mast_node6_mass*t319 + mast_node7_mass*t377 + mast_node8_mass*t435 + mast_node9_mass*t493;
-  const T t674 = mast_node10_mass*t555 + mast_node11_mass*t613 + mast_node2_mass*t91 + mast_node3_mass*t149 + mast_node4_mass*t207 + mast_node5_mass*t265 + mast_node6_mass*t323 + mast_node7_mass*t381 + mast_node8_mass*t439 + mast_node9_mass*t497;
-  const T t675 = 2.0*mast_p_J_z*t637 + kd1a89804 + t647;
+  const T t637 = (((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z));
+  const T t639 = (((mast_node10_mass*t521 + mast_node11_mass*t579) + mast_node2_mass*t57) + (mast_node3_mass*t115 + mast_node4_mass*t173)) + (((mast_node5_mass*t231 + mast_node6_mass*t289) + mast_node7_mass*t347) + (mast_node8_mass*t405 + mast_node9_mass*t463));
+  const T t640 = (((mast_node10_mass*t523 + mast_node11_mass*t581) + mast_node2_mass*t59) + (mast_node3_mass*t117 + mast_node4_mass*t175)) + (((mast_node5_mass*t233 + mast_node6_mass*t291) + mast_node7_mass*t349) + (mast_node8_mass*t407 + mast_node9_mass*t465));
+  const T t641 = (((mast_node10_mass*t525 + mast_node11_mass*t583) + mast_node2_mass*t61) + (mast_node3_mass*t119 + mast_node4_mass*t177)) + (((mast_node5_mass*t235 + mast_node6_mass*t293) + mast_node7_mass*t351) + (mast_node8_mass*t409 + mast_node9_mass*t467));
+  const T t642 = (((mast_node10_mass*t527 + mast_node11_mass*t585) + mast_node2_mass*t63) + (mast_node3_mass*t121 + mast_node4_mass*t179)) + (((mast_node5_mass*t237 + mast_node6_mass*t295) + mast_node7_mass*t353) + (mast_node8_mass*t411 + mast_node9_mass*t469));
+  const T t644 = (((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x));
+  const T t645 = (((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y));
+  const T t647 = -(((((s_B_mast_node10_x*s_B_mast_node10_x - t533)*mast_node10_mass + (s_B_mast_node11_x*s_B_mast_node11_x - t591)*mast_node11_mass) + (s_B_mast_node2_x*s_B_mast_node2_x - t69)*mast_node2_mass) + ((s_B_mast_node3_x*s_B_mast_node3_x - t127)*mast_node3_mass + (s_B_mast_node4_x*s_B_mast_node4_x - t185)*mast_node4_mass)) + ((((s_B_mast_node5_x*s_B_mast_node5_x - t243)*mast_node5_mass + (s_B_mast_node6_x*s_B_mast_node6_x - t301)*mast_node6_mass) + (s_B_mast_node7_x*s_B_mast_node7_x - t359)*mast_node7_mass) + ((s_B_mast_node8_x*s_B_mast_node8_x - t417)*mast_node8_mass + (s_B_mast_node9_x*s_B_mast_node9_x - t475)*mast_node9_mass)));
+  const T t648 = -((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y)));
+  const T t649 = -((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z)));
+  const T t650 = (((mast_node10_mass*t534 + mast_node11_mass*t592) + mast_node2_mass*t70) + (mast_node3_mass*t128 + mast_node4_mass*t186)) + (((mast_node5_mass*t244 + mast_node6_mass*t302) + mast_node7_mass*t360) + (mast_node8_mass*t418 + mast_node9_mass*t476));
+  const T t651 = (((mast_node10_mass*t541 + mast_node11_mass*t599) + mast_node2_mass*t77) + (mast_node3_mass*t135 + mast_node4_mass*t193)) + (((mast_node5_mass*t251 + mast_node6_mass*t309) + mast_node7_mass*t367) + (mast_node8_mass*t425 + mast_node9_mass*t483));
+  const T t652 = (((mast_node10_mass*t547 + mast_node11_mass*t605) + mast_node2_mass*t83) + (mast_node3_mass*t141 + mast_node4_mass*t199)) + (((mast_node5_mass*t257 + mast_node6_mass*t315) + mast_node7_mass*t373) + (mast_node8_mass*t431 + mast_node9_mass*t489));
+  const T t653 = (((mast_node10_mass*t552 + mast_node11_mass*t610) + mast_node2_mass*t88) + (mast_node3_mass*t146 + mast_node4_mass*t204)) + (((mast_node5_mass*t262 + mast_node6_mass*t320) + mast_node7_mass*t378) + (mast_node8_mass*t436 + mast_node9_mass*t494));
+  const T t654 = -(((((s_B_mast_node10_y*s_B_mast_node10_y - t533)*mast_node10_mass + (s_B_mast_node11_y*s_B_mast_node11_y - t591)*mast_node11_mass) + (s_B_mast_node2_y*s_B_mast_node2_y - t69)*mast_node2_mass) + ((s_B_mast_node3_y*s_B_mast_node3_y - t127)*mast_node3_mass + (s_B_mast_node4_y*s_B_mast_node4_y - t185)*mast_node4_mass)) + ((((s_B_mast_node5_y*s_B_mast_node5_y - t243)*mast_node5_mass + (s_B_mast_node6_y*s_B_mast_node6_y - t301)*mast_node6_mass) + (s_B_mast_node7_y*s_B_mast_node7_y - t359)*mast_node7_mass) + ((s_B_mast_node8_y*s_B_mast_node8_y - t417)*mast_node8_mass + (s_B_mast_node9_y*s_B_mast_node9_y - t475)*mast_node9_mass)));
+  const T t655 = -((((mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z)));
+  const T t656 = (((mast_node10_mass*t535 + mast_node11_mass*t593) + mast_node2_mass*t71) + (mast_node3_mass*t129 + mast_node4_mass*t187)) + (((mast_node5_mass*t245 + mast_node6_mass*t303) + mast_node7_mass*t361) + (mast_node8_mass*t419 + mast_node9_mass*t477));
+  const T t657 = (((mast_node10_mass*t542 + mast_node11_mass*t600) + mast_node2_mass*t78) + (mast_node3_mass*t136 + mast_node4_mass*t194)) + (((mast_node5_mass*t252 + mast_node6_mass*t310) + mast_node7_mass*t368) + (mast_node8_mass*t426 + mast_node9_mass*t484));
+  const T t658 = (((mast_node10_mass*t548 + mast_node11_mass*t606) + mast_node2_mass*t84) + (mast_node3_mass*t142 + mast_node4_mass*t200)) + (((mast_node5_mass*t258 + mast_node6_mass*t316) + mast_node7_mass*t374) + (mast_node8_mass*t432 + mast_node9_mass*t490));
+  const T t659 = (((mast_node10_mass*t553 + mast_node11_mass*t611) + mast_node2_mass*t89) + (mast_node3_mass*t147 + mast_node4_mass*t205)) + (((mast_node5_mass*t263 + mast_node6_mass*t321) + mast_node7_mass*t379) + (mast_node8_mass*t437 + mast_node9_mass*t495));
+  const T t660 = -(((((s_B_mast_node10_z*s_B_mast_node10_z - t533)*mast_node10_mass + (s_B_mast_node11_z*s_B_mast_node11_z - t591)*mast_node11_mass) + (s_B_mast_node2_z*s_B_mast_node2_z - t69)*mast_node2_mass) + ((s_B_mast_node3_z*s_B_mast_node3_z - t127)*mast_node3_mass + (s_B_mast_node4_z*s_B_mast_node4_z - t185)*mast_node4_mass)) + ((((s_B_mast_node5_z*s_B_mast_node5_z - t243)*mast_node5_mass + (s_B_mast_node6_z*s_B_mast_node6_z - t301)*mast_node6_mass) + (s_B_mast_node7_z*s_B_mast_node7_z - t359)*mast_node7_mass) + ((s_B_mast_node8_z*s_B_mast_node8_z - t417)*mast_node8_mass + (s_B_mast_node9_z*s_B_mast_node9_z - t475)*mast_node9_mass)));
+  const T t661 = (((mast_node10_mass*t536 + mast_node11_mass*t594) + mast_node2_mass*t72) + (mast_node3_mass*t130 + mast_node4_mass*t188)) + (((mast_node5_mass*t246 + mast_node6_mass*t304) + mast_node7_mass*t362) + (mast_node8_mass*t420 + mast_node9_mass*t478));
+  const T t662 = (((mast_node10_mass*t543 + mast_node11_mass*t601) + mast_node2_mass*t79) + (mast_node3_mass*t137 + mast_node4_mass*t195)) + (((mast_node5_mass*t253 + mast_node6_mass*t311) + mast_node7_mass*t369) + (mast_node8_mass*t427 + mast_node9_mass*t485));
+  const T t663 = (((mast_node10_mass*t549 + mast_node11_mass*t607) + mast_node2_mass*t85) + (mast_node3_mass*t143 + mast_node4_mass*t201)) + (((mast_node5_mass*t259 + mast_node6_mass*t317) + mast_node7_mass*t375) + (mast_node8_mass*t433 + mast_node9_mass*t491));
+  const T t664 = (((mast_node10_mass*t554 + mast_node11_mass*t612) + mast_node2_mass*t90) + (mast_node3_mass*t148 + mast_node4_mass*t206)) + (((mast_node5_mass*t264 + mast_node6_mass*t322) + mast_node7_mass*t380) + (mast_node8_mass*t438 + mast_node9_mass*t496));
+  const T t665 = (((mast_node10_mass*t537 + mast_node11_mass*t595) + mast_node2_mass*t73) + (mast_node3_mass*t131 + mast_node4_mass*t189)) + (((mast_node5_mass*t247 + mast_node6_mass*t305) + mast_node7_mass*t363) + (mast_node8_mass*t421 + mast_node9_mass*t479));
+  const T t666 = (((mast_node10_mass*t538 + mast_node11_mass*t596) + mast_node2_mass*t74) + (mast_node3_mass*t132 + mast_node4_mass*t190)) + (((mast_node5_mass*t248 + mast_node6_mass*t306) + mast_node7_mass*t364) + (mast_node8_mass*t422 + mast_node9_mass*t480));
+  const T t667 = (((mast_node10_mass*t539 + mast_node11_mass*t597) + mast_node2_mass*t75) + (mast_node3_mass*t133 + mast_node4_mass*t191)) + (((mast_node5_mass*t249 + mast_node6_mass*t307) + mast_node7_mass*t365) + (mast_node8_mass*t423 + mast_node9_mass*t481));
+  const T t668 = (((mast_node10_mass*t540 + mast_node11_mass*t598) + mast_node2_mass*t76) + (mast_node3_mass*t134 + mast_node4_mass*t192)) + (((mast_node5_mass*t250 + mast_node6_mass*t308) + mast_node7_mass*t366) + (mast_node8_mass*t424 + mast_node9_mass*t482));
+  const T t669 = (((mast_node10_mass*t544 + mast_node11_mass*t602) + mast_node2_mass*t80) + (mast_node3_mass*t138 + mast_node4_mass*t196)) + (((mast_node5_mass*t254 + mast_node6_mass*t312) + mast_node7_mass*t370) + (mast_node8_mass*t428 + mast_node9_mass*t486));
+  const T t670 = (((mast_node10_mass*t545 + mast_node11_mass*t603) + mast_node2_mass*t81) + (mast_node3_mass*t139 + mast_node4_mass*t197)) + (((mast_node5_mass*t255 + mast_node6_mass*t313) + mast_node7_mass*t371) + (mast_node8_mass*t429 + mast_node9_mass*t487));
+  const T t671 = (((mast_node10_mass*t546 + mast_node11_mass*t604) + mast_node2_mass*t82) + (mast_node3_mass*t140 + mast_node4_mass*t198)) + (((mast_node5_mass*t256 + mast_node6_mass*t314) + mast_node7_mass*t372) + (mast_node8_mass*t430 + mast_node9_mass*t488));
+  const T t672 = (((mast_node10_mass*t550 + mast_node11_mass*t608) + mast_node2_mass*t86) + (mast_node3_mass*t144 + mast_node4_mass*t202)) + (((mast_node5_mass*t260 + mast_node6_mass*t318) + mast_node7_mass*t376) + (mast_node8_mass*t434 + mast_node9_mass*t492));
+  const T t673 = (((mast_node10_mass*t551 + mast_node11_mass*t609) + mast_node2_mass*t87) + (mast_node3_mass*t145 + mast_node4_mass*t203)) + (((mast_node5_mass*t261 + mast_node6_mass*t319) + mast_node7_mass*t377) + (mast_node8_mass*t435 + mast_node9_mass*t493));
+  const T t674 = (((mast_node10_mass*t555 + mast_node11_mass*t613) + mast_node2_mass*t91) + (mast_node3_mass*t149 + mast_node4_mass*t207)) + (((mast_node5_mass*t265 + mast_node6_mass*t323) + mast_node7_mass*t381) + (mast_node8_mass*t439 + mast_node9_mass*t497));
+  const T t675 = 2.0*mast_p_J_z*t637 + kec082e90 + t647;
   const T t676 = -mast_p_J_x*t645 + t648;
-  const T t677 = -kd330843a - mast_p_J_x*t637 - mast_p_J_z*t644 + t649;
-  const T t678 = 2.0*mast_p_J_x*t644 + 2.0*mast_p_J_z*t637 + k355b04fe + t654;
+  const T t677 = t649 - ((k8533ce25 + mast_p_J_x*t637) + mast_p_J_z*t644);
+  const T t678 = (2.0*mast_p_J_x*t644 + 2.0*mast_p_J_z*t637) + (k01fcb0da + t654);
   const T t679 = -mast_p_J_z*t645 + t655;
   const T t680 = 1.0 + 2.0*mast_p_J_x*t644 + t660;
-  const T t681 = k2a62bbae + t644;
-  const T t682 = k2a628834 + t637;
+  const T t681 = kc0599600 + t644;
+  const T t682 = kc0599966 + t637;
   const T t683 = bus_J0_xx + t675;
   const T t684 = bus_J0_xy + t676;
   const T t685 = bus_J0_xz + t677;
@@ -1946,18 +1960,18 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t693 = -bus_S0_y - t645;
   const T t694 = bus_S0_x + t681;
   // ---- body mast: its columns of M (walked to the root)
-  const T t695 = k8f75f259 + mast_p_J_z*t639;
+  const T t695 = k0844733d + mast_p_J_z*t639;
   const T t696 = t656 + t695;
   const T t697 = mast_p_J_z*t640;
-  const T t698 = -k154b4382 + t651;
+  const T t698 = -k24098ffb + t651;
   const T t699 = t657 + t697;
-  const T t700 = k154b46e4 + t662;
-  const T t701 = -kaebba745 + mast_p_J_z*t641;
+  const T t700 = k24097295 + t662;
+  const T t701 = -k7372e9ce + mast_p_J_z*t641;
   const T t702 = t658 + t701;
   const T t703 = mast_p_J_z*t642;
-  const T t704 = kb8103fbc + t653;
+  const T t704 = k710d01dc + t653;
   const T t705 = t659 + t703;
-  const T t706 = -kb8102252 + t664;
+  const T t706 = -k710d0662 + t664;
   // ---- body bus: bias force
   const T t707 = -bus_mass*t23 - t47;
   const T t708 = -bus_mass*t24 - t48;
@@ -1966,16 +1980,16 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t711 = bus_S0_x*t25 - bus_S0_z*t23 - t54;
   const T t712 = -bus_S0_x*t24 + bus_S0_y*t23 - t55;
   // ---- body mast: bias force
-  const T t713 = -k42b9c281*t41 - mast_node10_mass*t571 - mast_node11_mass*t629 - mast_node2_mass*t107 - mast_node3_mass*t165 - mast_node4_mass*t223 - mast_node5_mass*t281 - mast_node6_mass*t339 - mast_node7_mass*t397 - mast_node8_mass*t455 - mast_node9_mass*t513;
-  const T t714 = -k42b9c281*t42 - mast_node10_mass*t569 - mast_node11_mass*t627 - mast_node2_mass*t105 - mast_node3_mass*t163 - mast_node4_mass*t221 - mast_node5_mass*t279 - mast_node6_mass*t337 - mast_node7_mass*t395 - mast_node8_mass*t453 - mast_node9_mass*t511;
-  const T t715 = -k42b9c281*t43 - mast_node10_mass*t570 - mast_node11_mass*t628 - mast_node2_mass*t106 - mast_node3_mass*t164 - mast_node4_mass*t222 - mast_node5_mass*t280 - mast_node6_mass*t338 - mast_node7_mass*t396 - mast_node8_mass*t454 - mast_node9_mass*t512;
-  const T t716 = -(mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*t43 + (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*t42 - mast_node10_mass*t572 - mast_node11_mass*t630 - mast_node2_mass*t108 - mast_node3_mass*t166 - mast_node4_mass*t224 - mast_node5_mass*t282 - mast_node6_mass*t340 - mast_node7_mass*t398 - mast_node8_mass*t456 - mast_node9_mass*t514;
-  const T t717 = (mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*t43 - (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*t41 - mast_node10_mass*t573 - mast_node11_mass*t631 - mast_node2_mass*t109 - mast_node3_mass*t167 - mast_node4_mass*t225 - mast_node5_mass*t283 - mast_node6_mass*t341 - mast_node7_mass*t399 - mast_node8_mass*t457 - mast_node9_mass*t515;
-  const T t718 = -(mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*t42 + (mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*t41 - mast_node10_mass*t574 - mast_node11_mass*t632 - mast_node2_mass*t110 - mast_node3_mass*t168 - mast_node4_mass*t226 - mast_node5_mass*t284 - mast_node6_mass*t342 - mast_node7_mass*t400 - mast_node8_mass*t458 - mast_node9_mass*t516;
-  const T t719 = -(mast_node10_mass*t521 + mast_node11_mass*t579 + mast_node2_mass*t57 + mast_node3_mass*t115 + mast_node4_mass*t173 + mast_node5_mass*t231 + mast_node6_mass*t289 + mast_node7_mass*t347 + mast_node8_mass*t405 + mast_node9_mass*t463)*t41 + k0240019f*t43 - mast_node10_mass*t575 - mast_node11_mass*t633 - mast_node2_mass*t111 - mast_node3_mass*t169 - mast_node4_mass*t227 - mast_node5_mass*t285 - mast_node6_mass*t343 - mast_node7_mass*t401 - mast_node8_mass*t459 - mast_node9_mass*t517;
-  const T t720 = -(mast_node10_mass*t523 + mast_node11_mass*t581 + mast_node2_mass*t59 + mast_node3_mass*t117 + mast_node4_mass*t175 + mast_node5_mass*t233 + mast_node6_mass*t291 + mast_node7_mass*t349 + mast_node8_mass*t407 + mast_node9_mass*t465)*t41 - kabdf954e*t42 - mast_node10_mass*t576 - mast_node11_mass*t634 - mast_node2_mass*t112 - mast_node3_mass*t170 - mast_node4_mass*t228 - mast_node5_mass*t286 - mast_node6_mass*t344 - mast_node7_mass*t402 - mast_node8_mass*t460 - mast_node9_mass*t518;
-  const T t721 = -(mast_node10_mass*t525 + mast_node11_mass*t583 + mast_node2_mass*t61 + mast_node3_mass*t119 + mast_node4_mass*t177 + mast_node5_mass*t235 + mast_node6_mass*t293 + mast_node7_mass*t351 + mast_node8_mass*t409 + mast_node9_mass*t467)*t41 - k4079da1e*t43 - mast_node10_mass*t577 - mast_node11_mass*t635 - mast_node2_mass*t113 - mast_node3_mass*t171 - mast_node4_mass*t229 - mast_node5_mass*t287 - mast_node6_mass*t345 - mast_node7_mass*t403 - mast_node8_mass*t461 - mast_node9_mass*t519;
-  const T t722 = -(mast_node10_mass*t527 + mast_node11_mass*t585 + mast_node2_mass*t63 + mast_node3_mass*t121 + mast_node4_mass*t179 + mast_node5_mass*t237 + mast_node6_mass*t295 + mast_node7_mass*t353 + mast_node8_mass*t411 + mast_node9_mass*t469)*t41 + k3a85681b*t42 - mast_node10_mass*t578 - mast_node11_mass*t636 - mast_node2_mass*t114 - mast_node3_mass*t172 - mast_node4_mass*t230 - mast_node5_mass*t288 - mast_node6_mass*t346 - mast_node7_mass*t404 - mast_node8_mass*t462 - mast_node9_mass*t520;
+  const T t713 = -((((k4c1b0bc9*t41 + mast_node10_mass*t571) + mast_node11_mass*t629) + ((mast_node2_mass*t107 + mast_node3_mass*t165) + mast_node4_mass*t223)) + (((mast_node5_mass*t281 + mast_node6_mass*t339) + mast_node7_mass*t397) + (mast_node8_mass*t455 + mast_node9_mass*t513)));
+  const T t714 = -((((k4c1b0bc9*t42 + mast_node10_mass*t569) + mast_node11_mass*t627) + ((mast_node2_mass*t105 + mast_node3_mass*t163) + mast_node4_mass*t221)) + (((mast_node5_mass*t279 + mast_node6_mass*t337) + mast_node7_mass*t395) + (mast_node8_mass*t453 + mast_node9_mass*t511)));
+  const T t715 = -((((k4c1b0bc9*t43 + mast_node10_mass*t570) + mast_node11_mass*t628) + ((mast_node2_mass*t106 + mast_node3_mass*t164) + mast_node4_mass*t222)) + (((mast_node5_mass*t280 + mast_node6_mass*t338) + mast_node7_mass*t396) + (mast_node8_mass*t454 + mast_node9_mass*t512)));
+  const T t716 = ((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*t42 - ((((((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*t43 + mast_node10_mass*t572) + mast_node11_mass*t630) + ((mast_node2_mass*t108 + mast_node3_mass*t166) + mast_node4_mass*t224)) + (((mast_node5_mass*t282 + mast_node6_mass*t340) + mast_node7_mass*t398) + (mast_node8_mass*t456 + mast_node9_mass*t514)));
+  const T t717 = ((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*t43 - ((((((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*t41 + mast_node10_mass*t573) + mast_node11_mass*t631) + ((mast_node2_mass*t109 + mast_node3_mass*t167) + mast_node4_mass*t225)) + (((mast_node5_mass*t283 + mast_node6_mass*t341) + mast_node7_mass*t399) + (mast_node8_mass*t457 + mast_node9_mass*t515)));
+  const T t718 = ((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*t41 - ((((((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*t42 + mast_node10_mass*t574) + mast_node11_mass*t632) + ((mast_node2_mass*t110 + mast_node3_mass*t168) + mast_node4_mass*t226)) + (((mast_node5_mass*t284 + mast_node6_mass*t342) + mast_node7_mass*t400) + (mast_node8_mass*t458 + mast_node9_mass*t516)));
+  const T t719 = k2a14daf5*t43 - ((((((((mast_node10_mass*t521 + mast_node11_mass*t579) + mast_node2_mass*t57) + (mast_node3_mass*t115 + mast_node4_mass*t173)) + (((mast_node5_mass*t231 + mast_node6_mass*t289) + mast_node7_mass*t347) + (mast_node8_mass*t405 + mast_node9_mass*t463)))*t41 + mast_node10_mass*t575) + mast_node11_mass*t633) + ((mast_node2_mass*t111 + mast_node3_mass*t169) + mast_node4_mass*t227)) + (((mast_node5_mass*t285 + mast_node6_mass*t343) + mast_node7_mass*t401) + (mast_node8_mass*t459 + mast_node9_mass*t517)));
+  const T t720 = -((((((((mast_node10_mass*t523 + mast_node11_mass*t581) + mast_node2_mass*t59) + (mast_node3_mass*t117 + mast_node4_mass*t175)) + (((mast_node5_mass*t233 + mast_node6_mass*t291) + mast_node7_mass*t349) + (mast_node8_mass*t407 + mast_node9_mass*t465)))*t41 + kee8c9a7d*t42) + mast_node10_mass*t576) + ((mast_node11_mass*t634 + mast_node2_mass*t112) + mast_node3_mass*t170)) + (((mast_node4_mass*t228 + mast_node5_mass*t286) + mast_node6_mass*t344) + ((mast_node7_mass*t402 + mast_node8_mass*t460) + mast_node9_mass*t518)));
+  const T t721 = -((((((((mast_node10_mass*t525 + mast_node11_mass*t583) + mast_node2_mass*t61) + (mast_node3_mass*t119 + mast_node4_mass*t177)) + (((mast_node5_mass*t235 + mast_node6_mass*t293) + mast_node7_mass*t351) + (mast_node8_mass*t409 + mast_node9_mass*t467)))*t41 + k22bda376*t43) + mast_node10_mass*t577) + ((mast_node11_mass*t635 + mast_node2_mass*t113) + mast_node3_mass*t171)) + (((mast_node4_mass*t229 + mast_node5_mass*t287) + mast_node6_mass*t345) + ((mast_node7_mass*t403 + mast_node8_mass*t461) + mast_node9_mass*t519)));
+  const T t722 = k3dbf0db5*t42 - ((((((((mast_node10_mass*t527 + mast_node11_mass*t585) + mast_node2_mass*t63) + (mast_node3_mass*t121 + mast_node4_mass*t179)) + (((mast_node5_mass*t237 + mast_node6_mass*t295) + mast_node7_mass*t353) + (mast_node8_mass*t411 + mast_node9_mass*t469)))*t41 + mast_node10_mass*t578) + mast_node11_mass*t636) + ((mast_node2_mass*t114 + mast_node3_mass*t172) + mast_node4_mass*t230)) + (((mast_node5_mass*t288 + mast_node6_mass*t346) + mast_node7_mass*t404) + (mast_node8_mass*t462 + mast_node9_mass*t520)));
   // ---- body mast: generalized forces (inward)
   const T t723 = -mast_D1*u[6] - mast_K1*q[7] + tau[6];
   const T t724 = t719 + t723;
@@ -2013,7 +2027,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t754 = t663 - t706*t750;
   const T t755 = t702 - t705*t750;
   const T t756 = t652 - t704*t750;
-  const T t757 = k3a85681b*t750;
+  const T t757 = k3dbf0db5*t750;
   const T t758 = t641 - t642*t750;
   const T t759 = t671*t749;
   const T t760 = t669 - t671*t759;
@@ -2021,35 +2035,35 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t762 = t700 - t706*t759;
   const T t763 = t699 - t705*t759;
   const T t764 = t698 - t704*t759;
-  const T t765 = k3a85681b*t759 + kabdf954e;
+  const T t765 = k3dbf0db5*t759 + kee8c9a7d;
   const T t766 = t640 - t642*t759;
   const T t767 = t668*t749;
   const T t768 = t665 - t668*t767;
   const T t769 = t661 - t706*t767;
   const T t770 = t696 - t705*t767;
   const T t771 = t650 - t704*t767;
-  const T t772 = k3a85681b*t767;
+  const T t772 = k3dbf0db5*t767;
   const T t773 = t639 - t642*t767;
   const T t774 = t706*t749;
   const T t775 = t688 - t706*t774;
   const T t776 = t687 - t705*t774;
   const T t777 = t685 - t704*t774;
-  const T t778 = k3a85681b*t774 + t694;
+  const T t778 = k3dbf0db5*t774 + t694;
   const T t779 = -t642*t774 + t693;
   const T t780 = t705*t749;
   const T t781 = t686 - t705*t780;
   const T t782 = t684 - t704*t780;
-  const T t783 = k3a85681b*t780;
+  const T t783 = k3dbf0db5*t780;
   const T t784 = -t642*t780 + t691;
   const T t785 = t704*t749;
   const T t786 = t683 - t704*t785;
-  const T t787 = k3a85681b*t785 + t689;
+  const T t787 = k3dbf0db5*t785 + t689;
   const T t788 = -t642*t785;
-  const T t789 = -k3a85681b*t749;
-  const T t790 = k1e157129 + k3a85681b*t789;
+  const T t789 = -k3dbf0db5*t749;
+  const T t790 = k30db3e2a + k3dbf0db5*t789;
   const T t791 = -t642*t789;
   const T t792 = t642*t749;
-  const T t793 = k1e157129 - t642*t792;
+  const T t793 = k30db3e2a - t642*t792;
   const T t794 = 1.0/t751;
   const T t795 = t752*t794;
   const T t796 = -t752*t795 + t760;
@@ -2057,7 +2071,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t798 = -t754*t795 + t762;
   const T t799 = -t755*t795 + t763;
   const T t800 = -t756*t795 + t764;
-  const T t801 = -k4079da1e*t795;
+  const T t801 = -k22bda376*t795;
   const T t802 = -t757*t795 + t765;
   const T t803 = -t758*t795 + t766;
   const T t804 = t753*t794;
@@ -2065,29 +2079,29 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t806 = -t754*t804 + t769;
   const T t807 = -t755*t804 + t770;
   const T t808 = -t756*t804 + t771;
-  const T t809 = -k0240019f - k4079da1e*t804;
+  const T t809 = -k22bda376*t804 - k2a14daf5;
   const T t810 = -t757*t804 + t772;
   const T t811 = -t758*t804 + t773;
   const T t812 = t754*t794;
   const T t813 = -t754*t812 + t775;
   const T t814 = -t755*t812 + t776;
   const T t815 = -t756*t812 + t777;
-  const T t816 = -k4079da1e*t812;
+  const T t816 = -k22bda376*t812;
   const T t817 = -t757*t812 + t778;
   const T t818 = -t758*t812 + t779;
   const T t819 = t755*t794;
   const T t820 = -t755*t819 + t781;
   const T t821 = -t756*t819 + t782;
-  const T t822 = -k4079da1e*t819 + t692;
+  const T t822 = -k22bda376*t819 + t692;
   const T t823 = -t757*t819 + t783;
   const T t824 = -t758*t819 + t784;
   const T t825 = t756*t794;
   const T t826 = -t756*t825 + t786;
-  const T t827 = -k4079da1e*t825 + t690;
+  const T t827 = -k22bda376*t825 + t690;
   const T t828 = -t757*t825 + t787;
   const T t829 = -t758*t825 + t788;
-  const T t830 = k4079da1e*t794;
-  const T t831 = k1e157129 - k4079da1e*t830;
+  const T t830 = k22bda376*t794;
+  const T t831 = -k22bda376*t830 + k30db3e2a;
   const T t832 = -t757*t830;
   const T t833 = -t758*t830;
   const T t834 = t757*t794;
@@ -2312,9 +2326,9 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1054 = -t1018*t785 + t1053;
   const T t1055 = -t1013*t789 + t1054;
   const T t1056 = -t1003*t792 + t1055;
-  if (!(t957 > 1e-14*k1e157129)) return 1;
-  if (!(t951 > 1e-14*k1e157129)) return 2;
-  if (!(t941 > 1e-14*k1e157129)) return 3;
+  if (!(t957 > 1e-14*k30db3e2a)) return 1;
+  if (!(t951 > 1e-14*k30db3e2a)) return 2;
+  if (!(t941 > 1e-14*k30db3e2a)) return 3;
   if (!(t926 > 1e-14*t683)) return 4;
   if (!(t905 > 1e-14*t686)) return 5;
   if (!(t877 > 1e-14*t688)) return 6;
@@ -2352,7 +2366,7 @@ void energy(const T* q, const T* u, T* TV) {
   const T t59 = mast_node2_Gammax_2_2*q[8] + mast_node2_Gammax_2_4*q[10];
   const T t61 = mast_node2_Gammax_1_3*q[7] + mast_node2_Gammax_3_3*q[9];
   const T t63 = mast_node2_Gammax_2_4*q[8] + mast_node2_Gammax_4_4*q[10];
-  const T s_B_mast_node2_x = mast_node2_rho_x + q[10]*t63/2.0 + q[7]*t57/2.0 + q[8]*t59/2.0 + q[9]*t61/2.0;
+  const T s_B_mast_node2_x = ((mast_node2_rho_x + q[10]*t63/2.0) + q[7]*t57/2.0) + (q[8]*t59/2.0 + q[9]*t61/2.0);
   const T s_B_mast_node2_y = mast_node2_Phi2_y*q[8] + mast_node2_Phi4_y*q[10];
   const T s_B_mast_node2_z = mast_node2_Phi1_z*q[7] + mast_node2_Phi3_z*q[9];
   const T t69 = s_B_mast_node2_x*s_B_mast_node2_x + s_B_mast_node2_y*s_B_mast_node2_y + s_B_mast_node2_z*s_B_mast_node2_z;
@@ -2383,7 +2397,7 @@ void energy(const T* q, const T* u, T* TV) {
   const T t117 = mast_node3_Gammax_2_2*q[8] + mast_node3_Gammax_2_4*q[10];
   const T t119 = mast_node3_Gammax_1_3*q[7] + mast_node3_Gammax_3_3*q[9];
   const T t121 = mast_node3_Gammax_2_4*q[8] + mast_node3_Gammax_4_4*q[10];
-  const T s_B_mast_node3_x = mast_node3_rho_x + q[10]*t121/2.0 + q[7]*t115/2.0 + q[8]*t117/2.0 + q[9]*t119/2.0;
+  const T s_B_mast_node3_x = ((mast_node3_rho_x + q[10]*t121/2.0) + q[7]*t115/2.0) + (q[8]*t117/2.0 + q[9]*t119/2.0);
   const T s_B_mast_node3_y = mast_node3_Phi2_y*q[8] + mast_node3_Phi4_y*q[10];
   const T s_B_mast_node3_z = mast_node3_Phi1_z*q[7] + mast_node3_Phi3_z*q[9];
   const T t127 = s_B_mast_node3_x*s_B_mast_node3_x + s_B_mast_node3_y*s_B_mast_node3_y + s_B_mast_node3_z*s_B_mast_node3_z;
@@ -2414,7 +2428,7 @@ void energy(const T* q, const T* u, T* TV) {
   const T t175 = mast_node4_Gammax_2_2*q[8] + mast_node4_Gammax_2_4*q[10];
   const T t177 = mast_node4_Gammax_1_3*q[7] + mast_node4_Gammax_3_3*q[9];
   const T t179 = mast_node4_Gammax_2_4*q[8] + mast_node4_Gammax_4_4*q[10];
-  const T s_B_mast_node4_x = mast_node4_rho_x + q[10]*t179/2.0 + q[7]*t173/2.0 + q[8]*t175/2.0 + q[9]*t177/2.0;
+  const T s_B_mast_node4_x = ((mast_node4_rho_x + q[10]*t179/2.0) + q[7]*t173/2.0) + (q[8]*t175/2.0 + q[9]*t177/2.0);
   const T s_B_mast_node4_y = mast_node4_Phi2_y*q[8] + mast_node4_Phi4_y*q[10];
   const T s_B_mast_node4_z = mast_node4_Phi1_z*q[7] + mast_node4_Phi3_z*q[9];
   const T t185 = s_B_mast_node4_x*s_B_mast_node4_x + s_B_mast_node4_y*s_B_mast_node4_y + s_B_mast_node4_z*s_B_mast_node4_z;
@@ -2445,7 +2459,7 @@ void energy(const T* q, const T* u, T* TV) {
   const T t233 = mast_node5_Gammax_2_2*q[8] + mast_node5_Gammax_2_4*q[10];
   const T t235 = mast_node5_Gammax_1_3*q[7] + mast_node5_Gammax_3_3*q[9];
   const T t237 = mast_node5_Gammax_2_4*q[8] + mast_node5_Gammax_4_4*q[10];
-  const T s_B_mast_node5_x = mast_node5_rho_x + q[10]*t237/2.0 + q[7]*t231/2.0 + q[8]*t233/2.0 + q[9]*t235/2.0;
+  const T s_B_mast_node5_x = ((mast_node5_rho_x + q[10]*t237/2.0) + q[7]*t231/2.0) + (q[8]*t233/2.0 + q[9]*t235/2.0);
   const T s_B_mast_node5_y = mast_node5_Phi2_y*q[8] + mast_node5_Phi4_y*q[10];
   const T s_B_mast_node5_z = mast_node5_Phi1_z*q[7] + mast_node5_Phi3_z*q[9];
   const T t243 = s_B_mast_node5_x*s_B_mast_node5_x + s_B_mast_node5_y*s_B_mast_node5_y + s_B_mast_node5_z*s_B_mast_node5_z;
@@ -2476,7 +2490,7 @@ void energy(const T* q, const T* u, T* TV) {
   const T t291 = mast_node6_Gammax_2_2*q[8] + mast_node6_Gammax_2_4*q[10];
   const T t293 = mast_node6_Gammax_1_3*q[7] + mast_node6_Gammax_3_3*q[9];
   const T t295 = mast_node6_Gammax_2_4*q[8] + mast_node6_Gammax_4_4*q[10];
-  const T s_B_mast_node6_x = mast_node6_rho_x + q[10]*t295/2.0 + q[7]*t289/2.0 + q[8]*t291/2.0 + q[9]*t293/2.0;
+  const T s_B_mast_node6_x = ((mast_node6_rho_x + q[10]*t295/2.0) + q[7]*t289/2.0) + (q[8]*t291/2.0 + q[9]*t293/2.0);
   const T s_B_mast_node6_y = mast_node6_Phi2_y*q[8] + mast_node6_Phi4_y*q[10];
   const T s_B_mast_node6_z = mast_node6_Phi1_z*q[7] + mast_node6_Phi3_z*q[9];
   const T t301 = s_B_mast_node6_x*s_B_mast_node6_x + s_B_mast_node6_y*s_B_mast_node6_y + s_B_mast_node6_z*s_B_mast_node6_z;
@@ -2507,7 +2521,7 @@ void energy(const T* q, const T* u, T* TV) {
   const T t349 = mast_node7_Gammax_2_2*q[8] + mast_node7_Gammax_2_4*q[10];
   const T t351 = mast_node7_Gammax_1_3*q[7] + mast_node7_Gammax_3_3*q[9];
   const T t353 = mast_node7_Gammax_2_4*q[8] + mast_node7_Gammax_4_4*q[10];
-  const T s_B_mast_node7_x = mast_node7_rho_x + q[10]*t353/2.0 + q[7]*t347/2.0 + q[8]*t349/2.0 + q[9]*t351/2.0;
+  const T s_B_mast_node7_x = ((mast_node7_rho_x + q[10]*t353/2.0) + q[7]*t347/2.0) + (q[8]*t349/2.0 + q[9]*t351/2.0);
   const T s_B_mast_node7_y = mast_node7_Phi2_y*q[8] + mast_node7_Phi4_y*q[10];
   const T s_B_mast_node7_z = mast_node7_Phi1_z*q[7] + mast_node7_Phi3_z*q[9];
   const T t359 = s_B_mast_node7_x*s_B_mast_node7_x + s_B_mast_node7_y*s_B_mast_node7_y + s_B_mast_node7_z*s_B_mast_node7_z;
@@ -2538,7 +2552,7 @@ void energy(const T* q, const T* u, T* TV) {
   const T t407 = mast_node8_Gammax_2_2*q[8] + mast_node8_Gammax_2_4*q[10];
   const T t409 = mast_node8_Gammax_1_3*q[7] + mast_node8_Gammax_3_3*q[9];
   const T t411 = mast_node8_Gammax_2_4*q[8] + mast_node8_Gammax_4_4*q[10];
-  const T s_B_mast_node8_x = mast_node8_rho_x + q[10]*t411/2.0 + q[7]*t405/2.0 + q[8]*t407/2.0 + q[9]*t409/2.0;
+  const T s_B_mast_node8_x = ((mast_node8_rho_x + q[10]*t411/2.0) + q[7]*t405/2.0) + (q[8]*t407/2.0 + q[9]*t409/2.0);
   const T s_B_mast_node8_y = mast_node8_Phi2_y*q[8] + mast_node8_Phi4_y*q[10];
   const T s_B_mast_node8_z = mast_node8_Phi1_z*q[7] + mast_node8_Phi3_z*q[9];
   const T t417 = s_B_mast_node8_x*s_B_mast_node8_x + s_B_mast_node8_y*s_B_mast_node8_y + s_B_mast_node8_z*s_B_mast_node8_z;
@@ -2569,7 +2583,7 @@ void energy(const T* q, const T* u, T* TV) {
   const T t465 = mast_node9_Gammax_2_2*q[8] + mast_node9_Gammax_2_4*q[10];
   const T t467 = mast_node9_Gammax_1_3*q[7] + mast_node9_Gammax_3_3*q[9];
   const T t469 = mast_node9_Gammax_2_4*q[8] + mast_node9_Gammax_4_4*q[10];
-  const T s_B_mast_node9_x = mast_node9_rho_x + q[10]*t469/2.0 + q[7]*t463/2.0 + q[8]*t465/2.0 + q[9]*t467/2.0;
+  const T s_B_mast_node9_x = ((mast_node9_rho_x + q[10]*t469/2.0) + q[7]*t463/2.0) + (q[8]*t465/2.0 + q[9]*t467/2.0);
   const T s_B_mast_node9_y = mast_node9_Phi2_y*q[8] + mast_node9_Phi4_y*q[10];
   const T s_B_mast_node9_z = mast_node9_Phi1_z*q[7] + mast_node9_Phi3_z*q[9];
   const T t475 = s_B_mast_node9_x*s_B_mast_node9_x + s_B_mast_node9_y*s_B_mast_node9_y + s_B_mast_node9_z*s_B_mast_node9_z;
@@ -2600,7 +2614,7 @@ void energy(const T* q, const T* u, T* TV) {
   const T t523 = mast_node10_Gammax_2_2*q[8] + mast_node10_Gammax_2_4*q[10];
   const T t525 = mast_node10_Gammax_1_3*q[7] + mast_node10_Gammax_3_3*q[9];
   const T t527 = mast_node10_Gammax_2_4*q[8] + mast_node10_Gammax_4_4*q[10];
-  const T s_B_mast_node10_x = mast_node10_rho_x + q[10]*t527/2.0 + q[7]*t521/2.0 + q[8]*t523/2.0 + q[9]*t525/2.0;
+  const T s_B_mast_node10_x = ((mast_node10_rho_x + q[10]*t527/2.0) + q[7]*t521/2.0) + (q[8]*t523/2.0 + q[9]*t525/2.0);
   const T s_B_mast_node10_y = mast_node10_Phi2_y*q[8] + mast_node10_Phi4_y*q[10];
   const T s_B_mast_node10_z = mast_node10_Phi1_z*q[7] + mast_node10_Phi3_z*q[9];
   const T t533 = s_B_mast_node10_x*s_B_mast_node10_x + s_B_mast_node10_y*s_B_mast_node10_y + s_B_mast_node10_z*s_B_mast_node10_z;
@@ -2631,7 +2645,7 @@ void energy(const T* q, const T* u, T* TV) {
   const T t581 = mast_node11_Gammax_2_2*q[8] + mast_node11_Gammax_2_4*q[10];
   const T t583 = mast_node11_Gammax_1_3*q[7] + mast_node11_Gammax_3_3*q[9];
   const T t585 = mast_node11_Gammax_2_4*q[8] + mast_node11_Gammax_4_4*q[10];
-  const T s_B_mast_node11_x = 1.0 + q[10]*t585/2.0 + q[7]*t579/2.0 + q[8]*t581/2.0 + q[9]*t583/2.0;
+  const T s_B_mast_node11_x = ((1.0 + q[10]*t585/2.0) + q[7]*t579/2.0) + (q[8]*t581/2.0 + q[9]*t583/2.0);
   const T s_B_mast_node11_y = mast_node11_Phi2_y*q[8] + mast_node11_Phi4_y*q[10];
   const T s_B_mast_node11_z = mast_node11_Phi1_z*q[7] + mast_node11_Phi3_z*q[9];
   const T t591 = s_B_mast_node11_x*s_B_mast_node11_x + s_B_mast_node11_y*s_B_mast_node11_y + s_B_mast_node11_z*s_B_mast_node11_z;
@@ -2660,23 +2674,23 @@ void energy(const T* q, const T* u, T* TV) {
   const T t637 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
   const T t638 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
   const T t639 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
-  const T t640 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5] + bus_S0_y*u[2] - bus_S0_z*u[1];
-  const T t641 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5] - bus_S0_x*u[2] + bus_S0_z*u[0];
-  const T t642 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5] + bus_S0_x*u[1] - bus_S0_y*u[0];
-  const T t643 = t637*u[0] + t638*u[1] + t639*u[2] + t640*u[3] + t641*u[4] + t642*u[5];
-  const T t644 = -(mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*u[5] + (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*u[4] + (mast_node10_mass*t521 + mast_node11_mass*t579 + mast_node2_mass*t57 + mast_node3_mass*t115 + mast_node4_mass*t173 + mast_node5_mass*t231 + mast_node6_mass*t289 + mast_node7_mass*t347 + mast_node8_mass*t405 + mast_node9_mass*t463)*u[6] + (mast_node10_mass*t523 + mast_node11_mass*t581 + mast_node2_mass*t59 + mast_node3_mass*t117 + mast_node4_mass*t175 + mast_node5_mass*t233 + mast_node6_mass*t291 + mast_node7_mass*t349 + mast_node8_mass*t407 + mast_node9_mass*t465)*u[7] + (mast_node10_mass*t525 + mast_node11_mass*t583 + mast_node2_mass*t61 + mast_node3_mass*t119 + mast_node4_mass*t177 + mast_node5_mass*t235 + mast_node6_mass*t293 + mast_node7_mass*t351 + mast_node8_mass*t409 + mast_node9_mass*t467)*u[8] + (mast_node10_mass*t527 + mast_node11_mass*t585 + mast_node2_mass*t63 + mast_node3_mass*t121 + mast_node4_mass*t179 + mast_node5_mass*t237 + mast_node6_mass*t295 + mast_node7_mass*t353 + mast_node8_mass*t411 + mast_node9_mass*t469)*u[9] + k42b9c281*t35;
-  const T t645 = (mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*u[5] - (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*u[3] - k3a85681b*u[9] + k42b9c281*t36 + kabdf954e*u[7];
-  const T t646 = -(mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*u[4] + (mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*u[3] - k0240019f*u[6] + k4079da1e*u[8] + k42b9c281*t37;
-  const T t647 = -((s_B_mast_node10_x*s_B_mast_node10_x - t533)*mast_node10_mass + (s_B_mast_node11_x*s_B_mast_node11_x - t591)*mast_node11_mass + (s_B_mast_node2_x*s_B_mast_node2_x - t69)*mast_node2_mass + (s_B_mast_node3_x*s_B_mast_node3_x - t127)*mast_node3_mass + (s_B_mast_node4_x*s_B_mast_node4_x - t185)*mast_node4_mass + (s_B_mast_node5_x*s_B_mast_node5_x - t243)*mast_node5_mass + (s_B_mast_node6_x*s_B_mast_node6_x - t301)*mast_node6_mass + (s_B_mast_node7_x*s_B_mast_node7_x - t359)*mast_node7_mass + (s_B_mast_node8_x*s_B_mast_node8_x - t417)*mast_node8_mass + (s_B_mast_node9_x*s_B_mast_node9_x - t475)*mast_node9_mass)*u[3] - (mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y)*u[4] - (mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z)*u[5] + (mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*t37 - (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*t36 + (mast_node10_mass*t534 + mast_node11_mass*t592 + mast_node2_mass*t70 + mast_node3_mass*t128 + mast_node4_mass*t186 + mast_node5_mass*t244 + mast_node6_mass*t302 + mast_node7_mass*t360 + mast_node8_mass*t418 + mast_node9_mass*t476)*u[6] + (mast_node10_mass*t541 + mast_node11_mass*t599 + mast_node2_mass*t77 + mast_node3_mass*t135 + mast_node4_mass*t193 + mast_node5_mass*t251 + mast_node6_mass*t309 + mast_node7_mass*t367 + mast_node8_mass*t425 + mast_node9_mass*t483)*u[7] + (mast_node10_mass*t547 + mast_node11_mass*t605 + mast_node2_mass*t83 + mast_node3_mass*t141 + mast_node4_mass*t199 + mast_node5_mass*t257 + mast_node6_mass*t315 + mast_node7_mass*t373 + mast_node8_mass*t431 + mast_node9_mass*t489)*u[8] + (mast_node10_mass*t552 + mast_node11_mass*t610 + mast_node2_mass*t88 + mast_node3_mass*t146 + mast_node4_mass*t204 + mast_node5_mass*t262 + mast_node6_mass*t320 + mast_node7_mass*t378 + mast_node8_mass*t436 + mast_node9_mass*t494)*u[9];
-  const T t648 = -((s_B_mast_node10_y*s_B_mast_node10_y - t533)*mast_node10_mass + (s_B_mast_node11_y*s_B_mast_node11_y - t591)*mast_node11_mass + (s_B_mast_node2_y*s_B_mast_node2_y - t69)*mast_node2_mass + (s_B_mast_node3_y*s_B_mast_node3_y - t127)*mast_node3_mass + (s_B_mast_node4_y*s_B_mast_node4_y - t185)*mast_node4_mass + (s_B_mast_node5_y*s_B_mast_node5_y - t243)*mast_node5_mass + (s_B_mast_node6_y*s_B_mast_node6_y - t301)*mast_node6_mass + (s_B_mast_node7_y*s_B_mast_node7_y - t359)*mast_node7_mass + (s_B_mast_node8_y*s_B_mast_node8_y - t417)*mast_node8_mass + (s_B_mast_node9_y*s_B_mast_node9_y - t475)*mast_node9_mass)*u[4] - (mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*t37 - (mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y)*u[3] - (mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z)*u[5] + (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*t35 + (mast_node10_mass*t535 + mast_node11_mass*t593 + mast_node2_mass*t71 + mast_node3_mass*t129 + mast_node4_mass*t187 + mast_node5_mass*t245 + mast_node6_mass*t303 + mast_node7_mass*t361 + mast_node8_mass*t419 + mast_node9_mass*t477)*u[6] + (mast_node10_mass*t542 + mast_node11_mass*t600 + mast_node2_mass*t78 + mast_node3_mass*t136 + mast_node4_mass*t194 + mast_node5_mass*t252 + mast_node6_mass*t310 + mast_node7_mass*t368 + mast_node8_mass*t426 + mast_node9_mass*t484)*u[7] + (mast_node10_mass*t548 + mast_node11_mass*t606 + mast_node2_mass*t84 + mast_node3_mass*t142 + mast_node4_mass*t200 + mast_node5_mass*t258 + mast_node6_mass*t316 + mast_node7_mass*t374 + mast_node8_mass*t432 + mast_node9_mass*t490)*u[8] + (mast_node10_mass*t553 + mast_node11_mass*t611 + mast_node2_mass*t89 + mast_node3_mass*t147 + mast_node4_mass*t205 + mast_node5_mass*t263 + mast_node6_mass*t321 + mast_node7_mass*t379 + mast_node8_mass*t437 + mast_node9_mass*t495)*u[9];
-  const T t649 = -((s_B_mast_node10_z*s_B_mast_node10_z - t533)*mast_node10_mass + (s_B_mast_node11_z*s_B_mast_node11_z - t591)*mast_node11_mass + (s_B_mast_node2_z*s_B_mast_node2_z - t69)*mast_node2_mass + (s_B_mast_node3_z*s_B_mast_node3_z - t127)*mast_node3_mass + (s_B_mast_node4_z*s_B_mast_node4_z - t185)*mast_node4_mass + (s_B_mast_node5_z*s_B_mast_node5_z - t243)*mast_node5_mass + (s_B_mast_node6_z*s_B_mast_node6_z - t301)*mast_node6_mass + (s_B_mast_node7_z*s_B_mast_node7_z - t359)*mast_node7_mass + (s_B_mast_node8_z*s_B_mast_node8_z - t417)*mast_node8_mass + (s_B_mast_node9_z*s_B_mast_node9_z - t475)*mast_node9_mass)*u[5] + (mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*t36 - (mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z)*u[3] - (mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*t35 - (mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z)*u[4] + (mast_node10_mass*t536 + mast_node11_mass*t594 + mast_node2_mass*t72 + mast_node3_mass*t130 + mast_node4_mass*t188 + mast_node5_mass*t246 + mast_node6_mass*t304 + mast_node7_mass*t362 + mast_node8_mass*t420 + mast_node9_mass*t478)*u[6] + (mast_node10_mass*t543 + mast_node11_mass*t601 + mast_node2_mass*t79 + mast_node3_mass*t137 + mast_node4_mass*t195 + mast_node5_mass*t253 + mast_node6_mass*t311 + mast_node7_mass*t369 + mast_node8_mass*t427 + mast_node9_mass*t485)*u[7] + (mast_node10_mass*t549 + mast_node11_mass*t607 + mast_node2_mass*t85 + mast_node3_mass*t143 + mast_node4_mass*t201 + mast_node5_mass*t259 + mast_node6_mass*t317 + mast_node7_mass*t375 + mast_node8_mass*t433 + mast_node9_mass*t491)*u[8] + (mast_node10_mass*t554 + mast_node11_mass*t612 + mast_node2_mass*t90 + mast_node3_mass*t148 + mast_node4_mass*t206 + mast_node5_mass*t264 + mast_node6_mass*t322 + mast_node7_mass*t380 + mast_node8_mass*t438 + mast_node9_mass*t496)*u[9];
-  const T t650 = (mast_node10_mass*t521 + mast_node11_mass*t579 + mast_node2_mass*t57 + mast_node3_mass*t115 + mast_node4_mass*t173 + mast_node5_mass*t231 + mast_node6_mass*t289 + mast_node7_mass*t347 + mast_node8_mass*t405 + mast_node9_mass*t463)*t35 + (mast_node10_mass*t534 + mast_node11_mass*t592 + mast_node2_mass*t70 + mast_node3_mass*t128 + mast_node4_mass*t186 + mast_node5_mass*t244 + mast_node6_mass*t302 + mast_node7_mass*t360 + mast_node8_mass*t418 + mast_node9_mass*t476)*u[3] + (mast_node10_mass*t535 + mast_node11_mass*t593 + mast_node2_mass*t71 + mast_node3_mass*t129 + mast_node4_mass*t187 + mast_node5_mass*t245 + mast_node6_mass*t303 + mast_node7_mass*t361 + mast_node8_mass*t419 + mast_node9_mass*t477)*u[4] + (mast_node10_mass*t536 + mast_node11_mass*t594 + mast_node2_mass*t72 + mast_node3_mass*t130 + mast_node4_mass*t188 + mast_node5_mass*t246 + mast_node6_mass*t304 + mast_node7_mass*t362 + mast_node8_mass*t420 + mast_node9_mass*t478)*u[5] + (mast_node10_mass*t537 + mast_node11_mass*t595 + mast_node2_mass*t73 + mast_node3_mass*t131 + mast_node4_mass*t189 + mast_node5_mass*t247 + mast_node6_mass*t305 + mast_node7_mass*t363 + mast_node8_mass*t421 + mast_node9_mass*t479)*u[6] + (mast_node10_mass*t538 + mast_node11_mass*t596 + mast_node2_mass*t74 + mast_node3_mass*t132 + mast_node4_mass*t190 + mast_node5_mass*t248 + mast_node6_mass*t306 + mast_node7_mass*t364 + mast_node8_mass*t422 + mast_node9_mass*t480)*u[7] + (mast_node10_mass*t539 + mast_node11_mass*t597 + mast_node2_mass*t75 + mast_node3_mass*t133 + mast_node4_mass*t191 + mast_node5_mass*t249 + mast_node6_mass*t307 + mast_node7_mass*t365 + mast_node8_mass*t423 + mast_node9_mass*t481)*u[8] + (mast_node10_mass*t540 + mast_node11_mass*t598 + mast_node2_mass*t76 + mast_node3_mass*t134 + mast_node4_mass*t192 + mast_node5_mass*t250 + mast_node6_mass*t308 + mast_node7_mass*t366 + mast_node8_mass*t424 + mast_node9_mass*t482)*u[9] - k0240019f*t37;
-  const T t651 = (mast_node10_mass*t523 + mast_node11_mass*t581 + mast_node2_mass*t59 + mast_node3_mass*t117 + mast_node4_mass*t175 + mast_node5_mass*t233 + mast_node6_mass*t291 + mast_node7_mass*t349 + mast_node8_mass*t407 + mast_node9_mass*t465)*t35 + (mast_node10_mass*t538 + mast_node11_mass*t596 + mast_node2_mass*t74 + mast_node3_mass*t132 + mast_node4_mass*t190 + mast_node5_mass*t248 + mast_node6_mass*t306 + mast_node7_mass*t364 + mast_node8_mass*t422 + mast_node9_mass*t480)*u[6] + (mast_node10_mass*t541 + mast_node11_mass*t599 + mast_node2_mass*t77 + mast_node3_mass*t135 + mast_node4_mass*t193 + mast_node5_mass*t251 + mast_node6_mass*t309 + mast_node7_mass*t367 + mast_node8_mass*t425 + mast_node9_mass*t483)*u[3] + (mast_node10_mass*t542 + mast_node11_mass*t600 + mast_node2_mass*t78 + mast_node3_mass*t136 + mast_node4_mass*t194 + mast_node5_mass*t252 + mast_node6_mass*t310 + mast_node7_mass*t368 + mast_node8_mass*t426 + mast_node9_mass*t484)*u[4] + (mast_node10_mass*t543 + mast_node11_mass*t601 + mast_node2_mass*t79 + mast_node3_mass*t137 + mast_node4_mass*t195 + mast_node5_mass*t253 + mast_node6_mass*t311 + mast_node7_mass*t369 + mast_node8_mass*t427 + mast_node9_mass*t485)*u[5] + (mast_node10_mass*t544 + mast_node11_mass*t602 + mast_node2_mass*t80 + mast_node3_mass*t138 + mast_node4_mass*t196 + mast_node5_mass*t254 + mast_node6_mass*t312 + mast_node7_mass*t370 + mast_node8_mass*t428 + mast_node9_mass*t486)*u[7] + (mast_node10_mass*t545 + mast_node11_mass*t603 + mast_node2_mass*t81 + mast_node3_mass*t139 + mast_node4_mass*t197 + mast_node5_mass*t255 + mast_node6_mass*t313 + mast_node7_mass*t371 + mast_node8_mass*t429 + mast_node9_mass*t487)*u[8] + (mast_node10_mass*t546 + mast_node11_mass*t604 + mast_node2_mass*t82 + mast_node3_mass*t140 + mast_node4_mass*t198 + mast_node5_mass*t256 + mast_node6_mass*t314 + mast_node7_mass*t372 + mast_node8_mass*t430 + mast_node9_mass*t488)*u[9] + kabdf954e*t36;
-  const T t652 = (mast_node10_mass*t525 + mast_node11_mass*t583 + mast_node2_mass*t61 + mast_node3_mass*t119 + mast_node4_mass*t177 + mast_node5_mass*t235 + mast_node6_mass*t293 + mast_node7_mass*t351 + mast_node8_mass*t409 + mast_node9_mass*t467)*t35 + (mast_node10_mass*t539 + mast_node11_mass*t597 + mast_node2_mass*t75 + mast_node3_mass*t133 + mast_node4_mass*t191 + mast_node5_mass*t249 + mast_node6_mass*t307 + mast_node7_mass*t365 + mast_node8_mass*t423 + mast_node9_mass*t481)*u[6] + (mast_node10_mass*t545 + mast_node11_mass*t603 + mast_node2_mass*t81 + mast_node3_mass*t139 + mast_node4_mass*t197 + mast_node5_mass*t255 + mast_node6_mass*t313 + mast_node7_mass*t371 + mast_node8_mass*t429 + mast_node9_mass*t487)*u[7] + (mast_node10_mass*t547 + mast_node11_mass*t605 + mast_node2_mass*t83 + mast_node3_mass*t141 + mast_node4_mass*t199 + mast_node5_mass*t257 + mast_node6_mass*t315 + mast_node7_mass*t373 + mast_node8_mass*t431 + mast_node9_mass*t489)*u[3] + (mast_node10_mass*t548 + mast_node11_mass*t606 + mast_node2_mass*t84 + mast_node3_mass*t142 + mast_node4_mass*t200 + mast_node5_mass*t258 + mast_node6_mass*t316 + mast_node7_mass*t374 + mast_node8_mass*t432 + mast_node9_mass*t490)*u[4] + (mast_node10_mass*t549 + mast_node11_mass*t607 + mast_node2_mass*t85 + mast_node3_mass*t143 + mast_node4_mass*t201 + mast_node5_mass*t259 + mast_node6_mass*t317 + mast_node7_mass*t375 + mast_node8_mass*t433 + mast_node9_mass*t491)*u[5] + (mast_node10_mass*t550 + mast_node11_mass*t608 + mast_node2_mass*t86 + mast_node3_mass*t144 + mast_node4_mass*t202 + mast_node5_mass*t260 + mast_node6_mass*t318 + mast_node7_mass*t376 + mast_node8_mass*t434 + mast_node9_mass*t492)*u[8] + (mast_node10_mass*t551 + mast_node11_mass*t609 + mast_node2_mass*t87 + mast_node3_mass*t145 + mast_node4_mass*t203 + mast_node5_mass*t261 + mast_node6_mass*t319 + mast_node7_mass*t377 + mast_node8_mass*t435 + mast_node9_mass*t493)*u[9] + k4079da1e*t37;
-  const T t653 = (mast_node10_mass*t527 + mast_node11_mass*t585 + mast_node2_mass*t63 + mast_node3_mass*t121 + mast_node4_mass*t179 + mast_node5_mass*t237 + mast_node6_mass*t295 + mast_node7_mass*t353 + mast_node8_mass*t411 + mast_node9_mass*t469)*t35 + (mast_node10_mass*t540 + mast_node11_mass*t598 + mast_node2_mass*t76 + mast_node3_mass*t134 + mast_node4_mass*t192 + mast_node5_mass*t250 + mast_node6_mass*t308 + mast_node7_mass*t366 + mast_node8_mass*t424 + mast_node9_mass*t482)*u[6] + (mast_node10_mass*t546 + mast_node11_mass*t604 + mast_node2_mass*t82 + mast_node3_mass*t140 + mast_node4_mass*t198 + mast_node5_mass*t256 + mast_node6_mass*t314 + mast_node7_mass*t372 + mast_node8_mass*t430 + mast_node9_mass*t488)*u[7] + (mast_node10_mass*t551 + mast_node11_mass*t609 + mast_node2_mass*t87 + mast_node3_mass*t145 + mast_node4_mass*t203 + mast_node5_mass*t261 + mast_node6_mass*t319 + mast_node7_mass*t377 + mast_node8_mass*t435 + mast_node9_mass*t493)*u[8] + (mast_node10_mass*t552 + mast_node11_mass*t610 + mast_node2_mass*t88 + mast_node3_mass*t146 + mast_node4_mass*t204 + mast_node5_mass*t262 + mast_node6_mass*t320 + mast_node7_mass*t378 + mast_node8_mass*t436 + mast_node9_mass*t494)*u[3] + (mast_node10_mass*t553 + mast_node11_mass*t611 + mast_node2_mass*t89 + mast_node3_mass*t147 + mast_node4_mass*t205 + mast_node5_mass*t263 + mast_node6_mass*t321 + mast_node7_mass*t379 + mast_node8_mass*t437 + mast_node9_mass*t495)*u[4] + (mast_node10_mass*t554 + mast_node11_mass*t612 + mast_node2_mass*t90 + mast_node3_mass*t148 + mast_node4_mass*t206 + mast_node5_mass*t264 + mast_node6_mass*t322 + mast_node7_mass*t380 + mast_node8_mass*t438 + mast_node9_mass*t496)*u[5] + (mast_node10_mass*t555 + mast_node11_mass*t613 + mast_node2_mass*t91 + mast_node3_mass*t149 + mast_node4_mass*t207 + mast_node5_mass*t265 + mast_node6_mass*t323 + mast_node7_mass*t381 + mast_node8_mass*t439 + mast_node9_mass*t497)*u[9] - k3a85681b*t36;
-  const T t654 = t35*t644 + t36*t645 + t37*t646 + t647*u[3] + t648*u[4] + t649*u[5] + t650*u[6] + t651*u[7] + t652*u[8] + t653*u[9];
+  const T t640 = ((bus_J0_xx*u[3] + bus_J0_xy*u[4]) + (bus_J0_xz*u[5] + bus_S0_y*u[2])) - bus_S0_z*u[1];
+  const T t641 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
+  const T t642 = ((bus_J0_xz*u[3] + bus_J0_yz*u[4]) + (bus_J0_zz*u[5] + bus_S0_x*u[1])) - bus_S0_y*u[0];
+  const T t643 = ((t637*u[0] + t638*u[1]) + t639*u[2]) + ((t640*u[3] + t641*u[4]) + t642*u[5]);
+  const T t644 = (((((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*u[4] + ((((mast_node10_mass*t521 + mast_node11_mass*t579) + mast_node2_mass*t57) + (mast_node3_mass*t115 + mast_node4_mass*t173)) + (((mast_node5_mass*t231 + mast_node6_mass*t289) + mast_node7_mass*t347) + (mast_node8_mass*t405 + mast_node9_mass*t463)))*u[6]) + ((((mast_node10_mass*t523 + mast_node11_mass*t581) + mast_node2_mass*t59) + (mast_node3_mass*t117 + mast_node4_mass*t175)) + (((mast_node5_mass*t233 + mast_node6_mass*t291) + mast_node7_mass*t349) + (mast_node8_mass*t407 + mast_node9_mass*t465)))*u[7]) + ((((((mast_node10_mass*t525 + mast_node11_mass*t583) + mast_node2_mass*t61) + (mast_node3_mass*t119 + mast_node4_mass*t177)) + (((mast_node5_mass*t235 + mast_node6_mass*t293) + mast_node7_mass*t351) + (mast_node8_mass*t409 + mast_node9_mass*t467)))*u[8] + ((((mast_node10_mass*t527 + mast_node11_mass*t585) + mast_node2_mass*t63) + (mast_node3_mass*t121 + mast_node4_mass*t179)) + (((mast_node5_mass*t237 + mast_node6_mass*t295) + mast_node7_mass*t353) + (mast_node8_mass*t411 + mast_node9_mass*t469)))*u[9]) + k4c1b0bc9*t35)) - ((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*u[5];
+  const T t645 = ((((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*u[5] + k4c1b0bc9*t36) + kee8c9a7d*u[7]) - (((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*u[3] + k3dbf0db5*u[9]);
+  const T t646 = ((((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*u[3] + k22bda376*u[8]) + k4c1b0bc9*t37) - (((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*u[4] + k2a14daf5*u[6]);
+  const T t647 = (((((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*t37 + ((((mast_node10_mass*t534 + mast_node11_mass*t592) + mast_node2_mass*t70) + (mast_node3_mass*t128 + mast_node4_mass*t186)) + (((mast_node5_mass*t244 + mast_node6_mass*t302) + mast_node7_mass*t360) + (mast_node8_mass*t418 + mast_node9_mass*t476)))*u[6]) + ((((mast_node10_mass*t541 + mast_node11_mass*t599) + mast_node2_mass*t77) + (mast_node3_mass*t135 + mast_node4_mass*t193)) + (((mast_node5_mass*t251 + mast_node6_mass*t309) + mast_node7_mass*t367) + (mast_node8_mass*t425 + mast_node9_mass*t483)))*u[7]) + (((((mast_node10_mass*t547 + mast_node11_mass*t605) + mast_node2_mass*t83) + (mast_node3_mass*t141 + mast_node4_mass*t199)) + (((mast_node5_mass*t257 + mast_node6_mass*t315) + mast_node7_mass*t373) + (mast_node8_mass*t431 + mast_node9_mass*t489)))*u[8] + ((((mast_node10_mass*t552 + mast_node11_mass*t610) + mast_node2_mass*t88) + (mast_node3_mass*t146 + mast_node4_mass*t204)) + (((mast_node5_mass*t262 + mast_node6_mass*t320) + mast_node7_mass*t378) + (mast_node8_mass*t436 + mast_node9_mass*t494)))*u[9])) - (((((((s_B_mast_node10_x*s_B_mast_node10_x - t533)*mast_node10_mass + (s_B_mast_node11_x*s_B_mast_node11_x - t591)*mast_node11_mass) + (s_B_mast_node2_x*s_B_mast_node2_x - t69)*mast_node2_mass) + ((s_B_mast_node3_x*s_B_mast_node3_x - t127)*mast_node3_mass + (s_B_mast_node4_x*s_B_mast_node4_x - t185)*mast_node4_mass)) + ((((s_B_mast_node5_x*s_B_mast_node5_x - t243)*mast_node5_mass + (s_B_mast_node6_x*s_B_mast_node6_x - t301)*mast_node6_mass) + (s_B_mast_node7_x*s_B_mast_node7_x - t359)*mast_node7_mass) + ((s_B_mast_node8_x*s_B_mast_node8_x - t417)*mast_node8_mass + (s_B_mast_node9_x*s_B_mast_node9_x - t475)*mast_node9_mass)))*u[3] + ((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y)))*u[4]) + (((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z)))*u[5] + ((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*t36));
+  const T t648 = (((((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*t35 + ((((mast_node10_mass*t535 + mast_node11_mass*t593) + mast_node2_mass*t71) + (mast_node3_mass*t129 + mast_node4_mass*t187)) + (((mast_node5_mass*t245 + mast_node6_mass*t303) + mast_node7_mass*t361) + (mast_node8_mass*t419 + mast_node9_mass*t477)))*u[6]) + ((((mast_node10_mass*t542 + mast_node11_mass*t600) + mast_node2_mass*t78) + (mast_node3_mass*t136 + mast_node4_mass*t194)) + (((mast_node5_mass*t252 + mast_node6_mass*t310) + mast_node7_mass*t368) + (mast_node8_mass*t426 + mast_node9_mass*t484)))*u[7]) + (((((mast_node10_mass*t548 + mast_node11_mass*t606) + mast_node2_mass*t84) + (mast_node3_mass*t142 + mast_node4_mass*t200)) + (((mast_node5_mass*t258 + mast_node6_mass*t316) + mast_node7_mass*t374) + (mast_node8_mass*t432 + mast_node9_mass*t490)))*u[8] + ((((mast_node10_mass*t553 + mast_node11_mass*t611) + mast_node2_mass*t89) + (mast_node3_mass*t147 + mast_node4_mass*t205)) + (((mast_node5_mass*t263 + mast_node6_mass*t321) + mast_node7_mass*t379) + (mast_node8_mass*t437 + mast_node9_mass*t495)))*u[9])) - (((((((s_B_mast_node10_y*s_B_mast_node10_y - t533)*mast_node10_mass + (s_B_mast_node11_y*s_B_mast_node11_y - t591)*mast_node11_mass) + (s_B_mast_node2_y*s_B_mast_node2_y - t69)*mast_node2_mass) + ((s_B_mast_node3_y*s_B_mast_node3_y - t127)*mast_node3_mass + (s_B_mast_node4_y*s_B_mast_node4_y - t185)*mast_node4_mass)) + ((((s_B_mast_node5_y*s_B_mast_node5_y - t243)*mast_node5_mass + (s_B_mast_node6_y*s_B_mast_node6_y - t301)*mast_node6_mass) + (s_B_mast_node7_y*s_B_mast_node7_y - t359)*mast_node7_mass) + ((s_B_mast_node8_y*s_B_mast_node8_y - t417)*mast_node8_mass + (s_B_mast_node9_y*s_B_mast_node9_y - t475)*mast_node9_mass)))*u[4] + ((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*t37) + (((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y)))*u[3] + ((((mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z)))*u[5]));
+  const T t649 = (((((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*t36 + ((((mast_node10_mass*t536 + mast_node11_mass*t594) + mast_node2_mass*t72) + (mast_node3_mass*t130 + mast_node4_mass*t188)) + (((mast_node5_mass*t246 + mast_node6_mass*t304) + mast_node7_mass*t362) + (mast_node8_mass*t420 + mast_node9_mass*t478)))*u[6]) + ((((mast_node10_mass*t543 + mast_node11_mass*t601) + mast_node2_mass*t79) + (mast_node3_mass*t137 + mast_node4_mass*t195)) + (((mast_node5_mass*t253 + mast_node6_mass*t311) + mast_node7_mass*t369) + (mast_node8_mass*t427 + mast_node9_mass*t485)))*u[7]) + (((((mast_node10_mass*t549 + mast_node11_mass*t607) + mast_node2_mass*t85) + (mast_node3_mass*t143 + mast_node4_mass*t201)) + (((mast_node5_mass*t259 + mast_node6_mass*t317) + mast_node7_mass*t375) + (mast_node8_mass*t433 + mast_node9_mass*t491)))*u[8] + ((((mast_node10_mass*t554 + mast_node11_mass*t612) + mast_node2_mass*t90) + (mast_node3_mass*t148 + mast_node4_mass*t206)) + (((mast_node5_mass*t264 + mast_node6_mass*t322) + mast_node7_mass*t380) + (mast_node8_mass*t438 + mast_node9_mass*t496)))*u[9])) - (((((((s_B_mast_node10_z*s_B_mast_node10_z - t533)*mast_node10_mass + (s_B_mast_node11_z*s_B_mast_node11_z - t591)*mast_node11_mass) + (s_B_mast_node2_z*s_B_mast_node2_z - t69)*mast_node2_mass) + ((s_B_mast_node3_z*s_B_mast_node3_z - t127)*mast_node3_mass + (s_B_mast_node4_z*s_B_mast_node4_z - t185)*mast_node4_mass)) + ((((s_B_mast_node5_z*s_B_mast_node5_z - t243)*mast_node5_mass + (s_B_mast_node6_z*s_B_mast_node6_z - t301)*mast_node6_mass) + (s_B_mast_node7_z*s_B_mast_node7_z - t359)*mast_node7_mass) + ((s_B_mast_node8_z*s_B_mast_node8_z - t417)*mast_node8_mass + (s_B_mast_node9_z*s_B_mast_node9_z - t475)*mast_node9_mass)))*u[5] + ((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z)))*u[3]) + (((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*t35 + ((((mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z)))*u[4]));
+  const T t650 = (((((((mast_node10_mass*t521 + mast_node11_mass*t579) + mast_node2_mass*t57) + (mast_node3_mass*t115 + mast_node4_mass*t173)) + (((mast_node5_mass*t231 + mast_node6_mass*t289) + mast_node7_mass*t347) + (mast_node8_mass*t405 + mast_node9_mass*t463)))*t35 + ((((mast_node10_mass*t534 + mast_node11_mass*t592) + mast_node2_mass*t70) + (mast_node3_mass*t128 + mast_node4_mass*t186)) + (((mast_node5_mass*t244 + mast_node6_mass*t302) + mast_node7_mass*t360) + (mast_node8_mass*t418 + mast_node9_mass*t476)))*u[3]) + (((((mast_node10_mass*t535 + mast_node11_mass*t593) + mast_node2_mass*t71) + (mast_node3_mass*t129 + mast_node4_mass*t187)) + (((mast_node5_mass*t245 + mast_node6_mass*t303) + mast_node7_mass*t361) + (mast_node8_mass*t419 + mast_node9_mass*t477)))*u[4] + ((((mast_node10_mass*t536 + mast_node11_mass*t594) + mast_node2_mass*t72) + (mast_node3_mass*t130 + mast_node4_mass*t188)) + (((mast_node5_mass*t246 + mast_node6_mass*t304) + mast_node7_mass*t362) + (mast_node8_mass*t420 + mast_node9_mass*t478)))*u[5])) + ((((((mast_node10_mass*t537 + mast_node11_mass*t595) + mast_node2_mass*t73) + (mast_node3_mass*t131 + mast_node4_mass*t189)) + (((mast_node5_mass*t247 + mast_node6_mass*t305) + mast_node7_mass*t363) + (mast_node8_mass*t421 + mast_node9_mass*t479)))*u[6] + ((((mast_node10_mass*t538 + mast_node11_mass*t596) + mast_node2_mass*t74) + (mast_node3_mass*t132 + mast_node4_mass*t190)) + (((mast_node5_mass*t248 + mast_node6_mass*t306) + mast_node7_mass*t364) + (mast_node8_mass*t422 + mast_node9_mass*t480)))*u[7]) + (((((mast_node10_mass*t539 + mast_node11_mass*t597) + mast_node2_mass*t75) + (mast_node3_mass*t133 + mast_node4_mass*t191)) + (((mast_node5_mass*t249 + mast_node6_mass*t307) + mast_node7_mass*t365) + (mast_node8_mass*t423 + mast_node9_mass*t481)))*u[8] + ((((mast_node10_mass*t540 + mast_node11_mass*t598) + mast_node2_mass*t76) + (mast_node3_mass*t134 + mast_node4_mass*t192)) + (((mast_node5_mass*t250 + mast_node6_mass*t308) + mast_node7_mass*t366) + (mast_node8_mass*t424 + mast_node9_mass*t482)))*u[9]))) - k2a14daf5*t37;
+  const T t651 = (((((((mast_node10_mass*t523 + mast_node11_mass*t581) + mast_node2_mass*t59) + (mast_node3_mass*t117 + mast_node4_mass*t175)) + (((mast_node5_mass*t233 + mast_node6_mass*t291) + mast_node7_mass*t349) + (mast_node8_mass*t407 + mast_node9_mass*t465)))*t35 + ((((mast_node10_mass*t538 + mast_node11_mass*t596) + mast_node2_mass*t74) + (mast_node3_mass*t132 + mast_node4_mass*t190)) + (((mast_node5_mass*t248 + mast_node6_mass*t306) + mast_node7_mass*t364) + (mast_node8_mass*t422 + mast_node9_mass*t480)))*u[6]) + ((((mast_node10_mass*t541 + mast_node11_mass*t599) + mast_node2_mass*t77) + (mast_node3_mass*t135 + mast_node4_mass*t193)) + (((mast_node5_mass*t251 + mast_node6_mass*t309) + mast_node7_mass*t367) + (mast_node8_mass*t425 + mast_node9_mass*t483)))*u[3]) + (((((mast_node10_mass*t542 + mast_node11_mass*t600) + mast_node2_mass*t78) + (mast_node3_mass*t136 + mast_node4_mass*t194)) + (((mast_node5_mass*t252 + mast_node6_mass*t310) + mast_node7_mass*t368) + (mast_node8_mass*t426 + mast_node9_mass*t484)))*u[4] + ((((mast_node10_mass*t543 + mast_node11_mass*t601) + mast_node2_mass*t79) + (mast_node3_mass*t137 + mast_node4_mass*t195)) + (((mast_node5_mass*t253 + mast_node6_mass*t311) + mast_node7_mass*t369) + (mast_node8_mass*t427 + mast_node9_mass*t485)))*u[5])) + ((((((mast_node10_mass*t544 + mast_node11_mass*t602) + mast_node2_mass*t80) + (mast_node3_mass*t138 + mast_node4_mass*t196)) + (((mast_node5_mass*t254 + mast_node6_mass*t312) + mast_node7_mass*t370) + (mast_node8_mass*t428 + mast_node9_mass*t486)))*u[7] + ((((mast_node10_mass*t545 + mast_node11_mass*t603) + mast_node2_mass*t81) + (mast_node3_mass*t139 + mast_node4_mass*t197)) + (((mast_node5_mass*t255 + mast_node6_mass*t313) + mast_node7_mass*t371) + (mast_node8_mass*t429 + mast_node9_mass*t487)))*u[8]) + (((((mast_node10_mass*t546 + mast_node11_mass*t604) + mast_node2_mass*t82) + (mast_node3_mass*t140 + mast_node4_mass*t198)) + (((mast_node5_mass*t256 + mast_node6_mass*t314) + mast_node7_mass*t372) + (mast_node8_mass*t430 + mast_node9_mass*t488)))*u[9] + kee8c9a7d*t36));
+  const T t652 = (((((((mast_node10_mass*t525 + mast_node11_mass*t583) + mast_node2_mass*t61) + (mast_node3_mass*t119 + mast_node4_mass*t177)) + (((mast_node5_mass*t235 + mast_node6_mass*t293) + mast_node7_mass*t351) + (mast_node8_mass*t409 + mast_node9_mass*t467)))*t35 + ((((mast_node10_mass*t539 + mast_node11_mass*t597) + mast_node2_mass*t75) + (mast_node3_mass*t133 + mast_node4_mass*t191)) + (((mast_node5_mass*t249 + mast_node6_mass*t307) + mast_node7_mass*t365) + (mast_node8_mass*t423 + mast_node9_mass*t481)))*u[6]) + ((((mast_node10_mass*t545 + mast_node11_mass*t603) + mast_node2_mass*t81) + (mast_node3_mass*t139 + mast_node4_mass*t197)) + (((mast_node5_mass*t255 + mast_node6_mass*t313) + mast_node7_mass*t371) + (mast_node8_mass*t429 + mast_node9_mass*t487)))*u[7]) + (((((mast_node10_mass*t547 + mast_node11_mass*t605) + mast_node2_mass*t83) + (mast_node3_mass*t141 + mast_node4_mass*t199)) + (((mast_node5_mass*t257 + mast_node6_mass*t315) + mast_node7_mass*t373) + (mast_node8_mass*t431 + mast_node9_mass*t489)))*u[3] + ((((mast_node10_mass*t548 + mast_node11_mass*t606) + mast_node2_mass*t84) + (mast_node3_mass*t142 + mast_node4_mass*t200)) + (((mast_node5_mass*t258 + mast_node6_mass*t316) + mast_node7_mass*t374) + (mast_node8_mass*t432 + mast_node9_mass*t490)))*u[4])) + ((((((mast_node10_mass*t549 + mast_node11_mass*t607) + mast_node2_mass*t85) + (mast_node3_mass*t143 + mast_node4_mass*t201)) + (((mast_node5_mass*t259 + mast_node6_mass*t317) + mast_node7_mass*t375) + (mast_node8_mass*t433 + mast_node9_mass*t491)))*u[5] + ((((mast_node10_mass*t550 + mast_node11_mass*t608) + mast_node2_mass*t86) + (mast_node3_mass*t144 + mast_node4_mass*t202)) + (((mast_node5_mass*t260 + mast_node6_mass*t318) + mast_node7_mass*t376) + (mast_node8_mass*t434 + mast_node9_mass*t492)))*u[8]) + (((((mast_node10_mass*t551 + mast_node11_mass*t609) + mast_node2_mass*t87) + (mast_node3_mass*t145 + mast_node4_mass*t203)) + (((mast_node5_mass*t261 + mast_node6_mass*t319) + mast_node7_mass*t377) + (mast_node8_mass*t435 + mast_node9_mass*t493)))*u[9] + k22bda376*t37));
+  const T t653 = (((((((mast_node10_mass*t527 + mast_node11_mass*t585) + mast_node2_mass*t63) + (mast_node3_mass*t121 + mast_node4_mass*t179)) + (((mast_node5_mass*t237 + mast_node6_mass*t295) + mast_node7_mass*t353) + (mast_node8_mass*t411 + mast_node9_mass*t469)))*t35 + ((((mast_node10_mass*t540 + mast_node11_mass*t598) + mast_node2_mass*t76) + (mast_node3_mass*t134 + mast_node4_mass*t192)) + (((mast_node5_mass*t250 + mast_node6_mass*t308) + mast_node7_mass*t366) + (mast_node8_mass*t424 + mast_node9_mass*t482)))*u[6]) + (((((mast_node10_mass*t546 + mast_node11_mass*t604) + mast_node2_mass*t82) + (mast_node3_mass*t140 + mast_node4_mass*t198)) + (((mast_node5_mass*t256 + mast_node6_mass*t314) + mast_node7_mass*t372) + (mast_node8_mass*t430 + mast_node9_mass*t488)))*u[7] + ((((mast_node10_mass*t551 + mast_node11_mass*t609) + mast_node2_mass*t87) + (mast_node3_mass*t145 + mast_node4_mass*t203)) + (((mast_node5_mass*t261 + mast_node6_mass*t319) + mast_node7_mass*t377) + (mast_node8_mass*t435 + mast_node9_mass*t493)))*u[8])) + ((((((mast_node10_mass*t552 + mast_node11_mass*t610) + mast_node2_mass*t88) + (mast_node3_mass*t146 + mast_node4_mass*t204)) + (((mast_node5_mass*t262 + mast_node6_mass*t320) + mast_node7_mass*t378) + (mast_node8_mass*t436 + mast_node9_mass*t494)))*u[3] + ((((mast_node10_mass*t553 + mast_node11_mass*t611) + mast_node2_mass*t89) + (mast_node3_mass*t147 + mast_node4_mass*t205)) + (((mast_node5_mass*t263 + mast_node6_mass*t321) + mast_node7_mass*t379) + (mast_node8_mass*t437 + mast_node9_mass*t495)))*u[4]) + (((((mast_node10_mass*t554 + mast_node11_mass*t612) + mast_node2_mass*t90) + (mast_node3_mass*t148 + mast_node4_mass*t206)) + (((mast_node5_mass*t264 + mast_node6_mass*t322) + mast_node7_mass*t380) + (mast_node8_mass*t438 + mast_node9_mass*t496)))*u[5] + ((((mast_node10_mass*t555 + mast_node11_mass*t613) + mast_node2_mass*t91) + (mast_node3_mass*t149 + mast_node4_mass*t207)) + (((mast_node5_mass*t265 + mast_node6_mass*t323) + mast_node7_mass*t381) + (mast_node8_mass*t439 + mast_node9_mass*t497)))*u[9]))) - k3dbf0db5*t36;
+  const T t654 = (((t35*t644 + t36*t645) + t37*t646) + (t647*u[3] + t648*u[4])) + (((t649*u[5] + t650*u[6]) + t651*u[7]) + (t652*u[8] + t653*u[9]));
   const T t655 = t643/2.0 + t654/2.0;
-  const T t656 = mast_K1*q[7]*q[7]/2.0 + mast_K2*q[8]*q[8]/2.0 + mast_K3*q[9]*q[9]/2.0 + mast_K4*q[10]*q[10]/2.0;
+  const T t656 = (mast_K1*q[7]*q[7]/2.0 + mast_K2*q[8]*q[8]/2.0) + (mast_K3*q[9]*q[9]/2.0 + mast_K4*q[10]*q[10]/2.0);
   TV[0] = t655;
   TV[1] = t656;
 }
@@ -2687,7 +2701,7 @@ void momentum(const T* q, const T* u, T* pH) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
   // ---- body bus: outward pass (velocities)
-  const T t0 = (1.0/sqrt(q[3]*q[3] + q[4]*q[4] + q[5]*q[5] + q[6]*q[6]));
+  const T t0 = (1.0/sqrt((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
   const T t1 = q[3]*t0;
   const T t2 = q[4]*t0;
   const T t3 = q[5]*t0;
@@ -2728,7 +2742,7 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t59 = mast_node2_Gammax_2_2*q[8] + mast_node2_Gammax_2_4*q[10];
   const T t61 = mast_node2_Gammax_1_3*q[7] + mast_node2_Gammax_3_3*q[9];
   const T t63 = mast_node2_Gammax_2_4*q[8] + mast_node2_Gammax_4_4*q[10];
-  const T s_B_mast_node2_x = mast_node2_rho_x + q[10]*t63/2.0 + q[7]*t57/2.0 + q[8]*t59/2.0 + q[9]*t61/2.0;
+  const T s_B_mast_node2_x = ((mast_node2_rho_x + q[10]*t63/2.0) + q[7]*t57/2.0) + (q[8]*t59/2.0 + q[9]*t61/2.0);
   const T s_B_mast_node2_y = mast_node2_Phi2_y*q[8] + mast_node2_Phi4_y*q[10];
   const T s_B_mast_node2_z = mast_node2_Phi1_z*q[7] + mast_node2_Phi3_z*q[9];
   const T t69 = s_B_mast_node2_x*s_B_mast_node2_x + s_B_mast_node2_y*s_B_mast_node2_y + s_B_mast_node2_z*s_B_mast_node2_z;
@@ -2749,7 +2763,7 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t117 = mast_node3_Gammax_2_2*q[8] + mast_node3_Gammax_2_4*q[10];
   const T t119 = mast_node3_Gammax_1_3*q[7] + mast_node3_Gammax_3_3*q[9];
   const T t121 = mast_node3_Gammax_2_4*q[8] + mast_node3_Gammax_4_4*q[10];
-  const T s_B_mast_node3_x = mast_node3_rho_x + q[10]*t121/2.0 + q[7]*t115/2.0 + q[8]*t117/2.0 + q[9]*t119/2.0;
+  const T s_B_mast_node3_x = ((mast_node3_rho_x + q[10]*t121/2.0) + q[7]*t115/2.0) + (q[8]*t117/2.0 + q[9]*t119/2.0);
   const T s_B_mast_node3_y = mast_node3_Phi2_y*q[8] + mast_node3_Phi4_y*q[10];
   const T s_B_mast_node3_z = mast_node3_Phi1_z*q[7] + mast_node3_Phi3_z*q[9];
   const T t127 = s_B_mast_node3_x*s_B_mast_node3_x + s_B_mast_node3_y*s_B_mast_node3_y + s_B_mast_node3_z*s_B_mast_node3_z;
@@ -2770,7 +2784,7 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t175 = mast_node4_Gammax_2_2*q[8] + mast_node4_Gammax_2_4*q[10];
   const T t177 = mast_node4_Gammax_1_3*q[7] + mast_node4_Gammax_3_3*q[9];
   const T t179 = mast_node4_Gammax_2_4*q[8] + mast_node4_Gammax_4_4*q[10];
-  const T s_B_mast_node4_x = mast_node4_rho_x + q[10]*t179/2.0 + q[7]*t173/2.0 + q[8]*t175/2.0 + q[9]*t177/2.0;
+  const T s_B_mast_node4_x = ((mast_node4_rho_x + q[10]*t179/2.0) + q[7]*t173/2.0) + (q[8]*t175/2.0 + q[9]*t177/2.0);
   const T s_B_mast_node4_y = mast_node4_Phi2_y*q[8] + mast_node4_Phi4_y*q[10];
   const T s_B_mast_node4_z = mast_node4_Phi1_z*q[7] + mast_node4_Phi3_z*q[9];
   const T t185 = s_B_mast_node4_x*s_B_mast_node4_x + s_B_mast_node4_y*s_B_mast_node4_y + s_B_mast_node4_z*s_B_mast_node4_z;
@@ -2791,7 +2805,7 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t233 = mast_node5_Gammax_2_2*q[8] + mast_node5_Gammax_2_4*q[10];
   const T t235 = mast_node5_Gammax_1_3*q[7] + mast_node5_Gammax_3_3*q[9];
   const T t237 = mast_node5_Gammax_2_4*q[8] + mast_node5_Gammax_4_4*q[10];
-  const T s_B_mast_node5_x = mast_node5_rho_x + q[10]*t237/2.0 + q[7]*t231/2.0 + q[8]*t233/2.0 + q[9]*t235/2.0;
+  const T s_B_mast_node5_x = ((mast_node5_rho_x + q[10]*t237/2.0) + q[7]*t231/2.0) + (q[8]*t233/2.0 + q[9]*t235/2.0);
   const T s_B_mast_node5_y = mast_node5_Phi2_y*q[8] + mast_node5_Phi4_y*q[10];
   const T s_B_mast_node5_z = mast_node5_Phi1_z*q[7] + mast_node5_Phi3_z*q[9];
   const T t243 = s_B_mast_node5_x*s_B_mast_node5_x + s_B_mast_node5_y*s_B_mast_node5_y + s_B_mast_node5_z*s_B_mast_node5_z;
@@ -2812,7 +2826,7 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t291 = mast_node6_Gammax_2_2*q[8] + mast_node6_Gammax_2_4*q[10];
   const T t293 = mast_node6_Gammax_1_3*q[7] + mast_node6_Gammax_3_3*q[9];
   const T t295 = mast_node6_Gammax_2_4*q[8] + mast_node6_Gammax_4_4*q[10];
-  const T s_B_mast_node6_x = mast_node6_rho_x + q[10]*t295/2.0 + q[7]*t289/2.0 + q[8]*t291/2.0 + q[9]*t293/2.0;
+  const T s_B_mast_node6_x = ((mast_node6_rho_x + q[10]*t295/2.0) + q[7]*t289/2.0) + (q[8]*t291/2.0 + q[9]*t293/2.0);
   const T s_B_mast_node6_y = mast_node6_Phi2_y*q[8] + mast_node6_Phi4_y*q[10];
   const T s_B_mast_node6_z = mast_node6_Phi1_z*q[7] + mast_node6_Phi3_z*q[9];
   const T t301 = s_B_mast_node6_x*s_B_mast_node6_x + s_B_mast_node6_y*s_B_mast_node6_y + s_B_mast_node6_z*s_B_mast_node6_z;
@@ -2833,7 +2847,7 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t349 = mast_node7_Gammax_2_2*q[8] + mast_node7_Gammax_2_4*q[10];
   const T t351 = mast_node7_Gammax_1_3*q[7] + mast_node7_Gammax_3_3*q[9];
   const T t353 = mast_node7_Gammax_2_4*q[8] + mast_node7_Gammax_4_4*q[10];
-  const T s_B_mast_node7_x = mast_node7_rho_x + q[10]*t353/2.0 + q[7]*t347/2.0 + q[8]*t349/2.0 + q[9]*t351/2.0;
+  const T s_B_mast_node7_x = ((mast_node7_rho_x + q[10]*t353/2.0) + q[7]*t347/2.0) + (q[8]*t349/2.0 + q[9]*t351/2.0);
   const T s_B_mast_node7_y = mast_node7_Phi2_y*q[8] + mast_node7_Phi4_y*q[10];
   const T s_B_mast_node7_z = mast_node7_Phi1_z*q[7] + mast_node7_Phi3_z*q[9];
   const T t359 = s_B_mast_node7_x*s_B_mast_node7_x + s_B_mast_node7_y*s_B_mast_node7_y + s_B_mast_node7_z*s_B_mast_node7_z;
@@ -2854,7 +2868,7 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t407 = mast_node8_Gammax_2_2*q[8] + mast_node8_Gammax_2_4*q[10];
   const T t409 = mast_node8_Gammax_1_3*q[7] + mast_node8_Gammax_3_3*q[9];
   const T t411 = mast_node8_Gammax_2_4*q[8] + mast_node8_Gammax_4_4*q[10];
-  const T s_B_mast_node8_x = mast_node8_rho_x + q[10]*t411/2.0 + q[7]*t405/2.0 + q[8]*t407/2.0 + q[9]*t409/2.0;
+  const T s_B_mast_node8_x = ((mast_node8_rho_x + q[10]*t411/2.0) + q[7]*t405/2.0) + (q[8]*t407/2.0 + q[9]*t409/2.0);
   const T s_B_mast_node8_y = mast_node8_Phi2_y*q[8] + mast_node8_Phi4_y*q[10];
   const T s_B_mast_node8_z = mast_node8_Phi1_z*q[7] + mast_node8_Phi3_z*q[9];
   const T t417 = s_B_mast_node8_x*s_B_mast_node8_x + s_B_mast_node8_y*s_B_mast_node8_y + s_B_mast_node8_z*s_B_mast_node8_z;
@@ -2875,7 +2889,7 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t465 = mast_node9_Gammax_2_2*q[8] + mast_node9_Gammax_2_4*q[10];
   const T t467 = mast_node9_Gammax_1_3*q[7] + mast_node9_Gammax_3_3*q[9];
   const T t469 = mast_node9_Gammax_2_4*q[8] + mast_node9_Gammax_4_4*q[10];
-  const T s_B_mast_node9_x = mast_node9_rho_x + q[10]*t469/2.0 + q[7]*t463/2.0 + q[8]*t465/2.0 + q[9]*t467/2.0;
+  const T s_B_mast_node9_x = ((mast_node9_rho_x + q[10]*t469/2.0) + q[7]*t463/2.0) + (q[8]*t465/2.0 + q[9]*t467/2.0);
   const T s_B_mast_node9_y = mast_node9_Phi2_y*q[8] + mast_node9_Phi4_y*q[10];
   const T s_B_mast_node9_z = mast_node9_Phi1_z*q[7] + mast_node9_Phi3_z*q[9];
   const T t475 = s_B_mast_node9_x*s_B_mast_node9_x + s_B_mast_node9_y*s_B_mast_node9_y + s_B_mast_node9_z*s_B_mast_node9_z;
@@ -2896,7 +2910,7 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t523 = mast_node10_Gammax_2_2*q[8] + mast_node10_Gammax_2_4*q[10];
   const T t525 = mast_node10_Gammax_1_3*q[7] + mast_node10_Gammax_3_3*q[9];
   const T t527 = mast_node10_Gammax_2_4*q[8] + mast_node10_Gammax_4_4*q[10];
-  const T s_B_mast_node10_x = mast_node10_rho_x + q[10]*t527/2.0 + q[7]*t521/2.0 + q[8]*t523/2.0 + q[9]*t525/2.0;
+  const T s_B_mast_node10_x = ((mast_node10_rho_x + q[10]*t527/2.0) + q[7]*t521/2.0) + (q[8]*t523/2.0 + q[9]*t525/2.0);
   const T s_B_mast_node10_y = mast_node10_Phi2_y*q[8] + mast_node10_Phi4_y*q[10];
   const T s_B_mast_node10_z = mast_node10_Phi1_z*q[7] + mast_node10_Phi3_z*q[9];
   const T t533 = s_B_mast_node10_x*s_B_mast_node10_x + s_B_mast_node10_y*s_B_mast_node10_y + s_B_mast_node10_z*s_B_mast_node10_z;
@@ -2917,7 +2931,7 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t581 = mast_node11_Gammax_2_2*q[8] + mast_node11_Gammax_2_4*q[10];
   const T t583 = mast_node11_Gammax_1_3*q[7] + mast_node11_Gammax_3_3*q[9];
   const T t585 = mast_node11_Gammax_2_4*q[8] + mast_node11_Gammax_4_4*q[10];
-  const T s_B_mast_node11_x = 1.0 + q[10]*t585/2.0 + q[7]*t579/2.0 + q[8]*t581/2.0 + q[9]*t583/2.0;
+  const T s_B_mast_node11_x = ((1.0 + q[10]*t585/2.0) + q[7]*t579/2.0) + (q[8]*t581/2.0 + q[9]*t583/2.0);
   const T s_B_mast_node11_y = mast_node11_Phi2_y*q[8] + mast_node11_Phi4_y*q[10];
   const T s_B_mast_node11_z = mast_node11_Phi1_z*q[7] + mast_node11_Phi3_z*q[9];
   const T t591 = s_B_mast_node11_x*s_B_mast_node11_x + s_B_mast_node11_y*s_B_mast_node11_y + s_B_mast_node11_z*s_B_mast_node11_z;
@@ -2936,9 +2950,9 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t637 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
   const T t638 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
   const T t639 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
-  const T t640 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5] + bus_S0_y*u[2] - bus_S0_z*u[1];
-  const T t641 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5] - bus_S0_x*u[2] + bus_S0_z*u[0];
-  const T t642 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5] + bus_S0_x*u[1] - bus_S0_y*u[0];
+  const T t640 = ((bus_J0_xx*u[3] + bus_J0_xy*u[4]) + (bus_J0_xz*u[5] + bus_S0_y*u[2])) - bus_S0_z*u[1];
+  const T t641 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
+  const T t642 = ((bus_J0_xz*u[3] + bus_J0_yz*u[4]) + (bus_J0_zz*u[5] + bus_S0_x*u[1])) - bus_S0_y*u[0];
   const T t643 = t14*t637 + t15*t638 + t16*t639;
   const T t644 = t17*t637 + t18*t638 + t19*t639;
   const T t645 = t20*t637 + t21*t638 + t22*t639;
@@ -2951,12 +2965,12 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t652 = t646 + t649;
   const T t653 = t647 + t650;
   const T t654 = t648 + t651;
-  const T t655 = -(mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*u[5] + (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*u[4] + (mast_node10_mass*t521 + mast_node11_mass*t579 + mast_node2_mass*t57 + mast_node3_mass*t115 + mast_node4_mass*t173 + mast_node5_mass*t231 + mast_node6_mass*t289 + mast_node7_mass*t347 + mast_node8_mass*t405 + mast_node9_mass*t463)*u[6] + (mast_node10_mass*t523 + mast_node11_mass*t581 + mast_node2_mass*t59 + mast_node3_mass*t117 + mast_node4_mass*t175 + mast_node5_mass*t233 + mast_node6_mass*t291 + mast_node7_mass*t349 + mast_node8_mass*t407 + mast_node9_mass*t465)*u[7] + (mast_node10_mass*t525 + mast_node11_mass*t583 + mast_node2_mass*t61 + mast_node3_mass*t119 + mast_node4_mass*t177 + mast_node5_mass*t235 + mast_node6_mass*t293 + mast_node7_mass*t351 + mast_node8_mass*t409 + mast_node9_mass*t467)*u[8] + (mast_node10_mass*t527 + mast_node11_mass*t585 + mast_node2_mass*t63 + mast_node3_mass*t121 + mast_node4_mass*t179 + mast_node5_mass*t237 + mast_node6_mass*t295 + mast_node7_mass*t353 + mast_node8_mass*t411 + mast_node9_mass*t469)*u[9] + k42b9c281*t35;
-  const T t656 = (mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*u[5] - (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*u[3] - k3a85681b*u[9] + k42b9c281*t36 + kabdf954e*u[7];
-  const T t657 = -(mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*u[4] + (mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*u[3] - k0240019f*u[6] + k4079da1e*u[8] + k42b9c281*t37;
-  const T t658 = -((s_B_mast_node10_x*s_B_mast_node10_x - t533)*mast_node10_mass + (s_B_mast_node11_x*s_B_mast_node11_x - t591)*mast_node11_mass + (s_B_mast_node2_x*s_B_mast_node2_x - t69)*mast_node2_mass + (s_B_mast_node3_x*s_B_mast_node3_x - t127)*mast_node3_mass + (s_B_mast_node4_x*s_B_mast_node4_x - t185)*mast_node4_mass + (s_B_mast_node5_x*s_B_mast_node5_x - t243)*mast_node5_mass + (s_B_mast_node6_x*s_B_mast_node6_x - t301)*mast_node6_mass + (s_B_mast_node7_x*s_B_mast_node7_x - t359)*mast_node7_mass + (s_B_mast_node8_x*s_B_mast_node8_x - t417)*mast_node8_mass + (s_B_mast_node9_x*s_B_mast_node9_x - t475)*mast_node9_mass)*u[3] - (mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y)*u[4] - (mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z)*u[5] + (mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*t37 - (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*t36 + (mast_node10_mass*t534 + mast_node11_mass*t592 + mast_node2_mass*t70 + mast_node3_mass*t128 + mast_node4_mass*t186 + mast_node5_mass*t244 + mast_node6_mass*t302 + mast_node7_mass*t360 + mast_node8_mass*t418 + mast_node9_mass*t476)*u[6] + (mast_node10_mass*t541 + mast_node11_mass*t599 + mast_node2_mass*t77 + mast_node3_mass*t135 + mast_node4_mass*t193 + mast_node5_mass*t251 + mast_node6_mass*t309 + mast_node7_mass*t367 + mast_node8_mass*t425 + mast_node9_mass*t483)*u[7] + (mast_node10_mass*t547 + mast_node11_mass*t605 + mast_node2_mass*t83 + mast_node3_mass*t141 + mast_node4_mass*t199 + mast_node5_mass*t257 + mast_node6_mass*t315 + mast_node7_mass*t373 + mast_node8_mass*t431 + mast_node9_mass*t489)*u[8] + (mast_node10_mass*t552 + mast_node11_mass*t610 + mast_node2_mass*t88 + mast_node3_mass*t146 + mast_node4_mass*t204 + mast_node5_mass*t262 + mast_node6_mass*t320 + mast_node7_mass*t378 + mast_node8_mass*t436 + mast_node9_mass*t494)*u[9];
-  const T t659 = -((s_B_mast_node10_y*s_B_mast_node10_y - t533)*mast_node10_mass + (s_B_mast_node11_y*s_B_mast_node11_y - t591)*mast_node11_mass + (s_B_mast_node2_y*s_B_mast_node2_y - t69)*mast_node2_mass + (s_B_mast_node3_y*s_B_mast_node3_y - t127)*mast_node3_mass + (s_B_mast_node4_y*s_B_mast_node4_y - t185)*mast_node4_mass + (s_B_mast_node5_y*s_B_mast_node5_y - t243)*mast_node5_mass + (s_B_mast_node6_y*s_B_mast_node6_y - t301)*mast_node6_mass + (s_B_mast_node7_y*s_B_mast_node7_y - t359)*mast_node7_mass + (s_B_mast_node8_y*s_B_mast_node8_y - t417)*mast_node8_mass + (s_B_mast_node9_y*s_B_mast_node9_y - t475)*mast_node9_mass)*u[4] - (mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*t37 - (mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y)*u[3] - (mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z)*u[5] + (mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)*t35 + (mast_node10_mass*t535 + mast_node11_mass*t593 + mast_node2_mass*t71 + mast_node3_mass*t129 + mast_node4_mass*t187 + mast_node5_mass*t245 + mast_node6_mass*t303 + mast_node7_mass*t361 + mast_node8_mass*t419 + mast_node9_mass*t477)*u[6] + (mast_node10_mass*t542 + mast_node11_mass*t600 + mast_node2_mass*t78 + mast_node3_mass*t136 + mast_node4_mass*t194 + mast_node5_mass*t252 + mast_node6_mass*t310 + mast_node7_mass*t368 + mast_node8_mass*t426 + mast_node9_mass*t484)*u[7] + (mast_node10_mass*t548 + mast_node11_mass*t606 + mast_node2_mass*t84 + mast_node3_mass*t142 + mast_node4_mass*t200 + mast_node5_mass*t258 + mast_node6_mass*t316 + mast_node7_mass*t374 + mast_node8_mass*t432 + mast_node9_mass*t490)*u[8] + (mast_node10_mass*t553 + mast_node11_mass*t611 + mast_node2_mass*t89 + mast_node3_mass*t147 + mast_node4_mass*t205 + mast_node5_mass*t263 + mast_node6_mass*t321 + mast_node7_mass*t379 + mast_node8_mass*t437 + mast_node9_mass*t495)*u[9];
-  const T t660 = -((s_B_mast_node10_z*s_B_mast_node10_z - t533)*mast_node10_mass + (s_B_mast_node11_z*s_B_mast_node11_z - t591)*mast_node11_mass + (s_B_mast_node2_z*s_B_mast_node2_z - t69)*mast_node2_mass + (s_B_mast_node3_z*s_B_mast_node3_z - t127)*mast_node3_mass + (s_B_mast_node4_z*s_B_mast_node4_z - t185)*mast_node4_mass + (s_B_mast_node5_z*s_B_mast_node5_z - t243)*mast_node5_mass + (s_B_mast_node6_z*s_B_mast_node6_z - t301)*mast_node6_mass + (s_B_mast_node7_z*s_B_mast_node7_z - t359)*mast_node7_mass + (s_B_mast_node8_z*s_B_mast_node8_z - t417)*mast_node8_mass + (s_B_mast_node9_z*s_B_mast_node9_z - t475)*mast_node9_mass)*u[5] + (mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x + mast_node2_mass*s_B_mast_node2_x + mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x + mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x + mast_node7_mass*s_B_mast_node7_x + mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)*t36 - (mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z)*u[3] - (mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y + mast_node2_mass*s_B_mast_node2_y + mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y + mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y + mast_node7_mass*s_B_mast_node7_y + mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)*t35 - (mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z + mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z + mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z + mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z + mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z + mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z)*u[4] + (mast_node10_mass*t536 + mast_node11_mass*t594 + mast_node2_mass*t72 + mast_node3_mass*t130 + mast_node4_mass*t188 + mast_node5_mass*t246 + mast_node6_mass*t304 + mast_node7_mass*t362 + mast_node8_mass*t420 + mast_node9_mass*t478)*u[6] + (mast_node10_mass*t543 + mast_node11_mass*t601 + mast_node2_mass*t79 + mast_node3_mass*t137 + mast_node4_mass*t195 + mast_node5_mass*t253 + mast_node6_mass*t311 + mast_node7_mass*t369 + mast_node8_mass*t427 + mast_node9_mass*t485)*u[7] + (mast_node10_mass*t549 + mast_node11_mass*t607 + mast_node2_mass*t85 + mast_node3_mass*t143 + mast_node4_mass*t201 + mast_node5_mass*t259 + mast_node6_mass*t317 + mast_node7_mass*t375 + mast_node8_mass*t433 + mast_node9_mass*t491)*u[8] + (mast_node10_mass*t554 + mast_node11_mass*t612 + mast_node2_mass*t90 + mast_node3_mass*t148 + mast_node4_mass*t206 + mast_node5_mass*t264 + mast_node6_mass*t322 + mast_node7_mass*t380 + mast_node8_mass*t438 + mast_node9_mass*t496)*u[9];
+  const T t655 = (((((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*u[4] + ((((mast_node10_mass*t521 + mast_node11_mass*t579) + mast_node2_mass*t57) + (mast_node3_mass*t115 + mast_node4_mass*t173)) + (((mast_node5_mass*t231 + mast_node6_mass*t289) + mast_node7_mass*t347) + (mast_node8_mass*t405 + mast_node9_mass*t463)))*u[6]) + ((((mast_node10_mass*t523 + mast_node11_mass*t581) + mast_node2_mass*t59) + (mast_node3_mass*t117 + mast_node4_mass*t175)) + (((mast_node5_mass*t233 + mast_node6_mass*t291) + mast_node7_mass*t349) + (mast_node8_mass*t407 + mast_node9_mass*t465)))*u[7]) + ((((((mast_node10_mass*t525 + mast_node11_mass*t583) + mast_node2_mass*t61) + (mast_node3_mass*t119 + mast_node4_mass*t177)) + (((mast_node5_mass*t235 + mast_node6_mass*t293) + mast_node7_mass*t351) + (mast_node8_mass*t409 + mast_node9_mass*t467)))*u[8] + ((((mast_node10_mass*t527 + mast_node11_mass*t585) + mast_node2_mass*t63) + (mast_node3_mass*t121 + mast_node4_mass*t179)) + (((mast_node5_mass*t237 + mast_node6_mass*t295) + mast_node7_mass*t353) + (mast_node8_mass*t411 + mast_node9_mass*t469)))*u[9]) + k4c1b0bc9*t35)) - ((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*u[5];
+  const T t656 = ((((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*u[5] + k4c1b0bc9*t36) + kee8c9a7d*u[7]) - (((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*u[3] + k3dbf0db5*u[9]);
+  const T t657 = ((((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*u[3] + k22bda376*u[8]) + k4c1b0bc9*t37) - (((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*u[4] + k2a14daf5*u[6]);
+  const T t658 = (((((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*t37 + ((((mast_node10_mass*t534 + mast_node11_mass*t592) + mast_node2_mass*t70) + (mast_node3_mass*t128 + mast_node4_mass*t186)) + (((mast_node5_mass*t244 + mast_node6_mass*t302) + mast_node7_mass*t360) + (mast_node8_mass*t418 + mast_node9_mass*t476)))*u[6]) + ((((mast_node10_mass*t541 + mast_node11_mass*t599) + mast_node2_mass*t77) + (mast_node3_mass*t135 + mast_node4_mass*t193)) + (((mast_node5_mass*t251 + mast_node6_mass*t309) + mast_node7_mass*t367) + (mast_node8_mass*t425 + mast_node9_mass*t483)))*u[7]) + (((((mast_node10_mass*t547 + mast_node11_mass*t605) + mast_node2_mass*t83) + (mast_node3_mass*t141 + mast_node4_mass*t199)) + (((mast_node5_mass*t257 + mast_node6_mass*t315) + mast_node7_mass*t373) + (mast_node8_mass*t431 + mast_node9_mass*t489)))*u[8] + ((((mast_node10_mass*t552 + mast_node11_mass*t610) + mast_node2_mass*t88) + (mast_node3_mass*t146 + mast_node4_mass*t204)) + (((mast_node5_mass*t262 + mast_node6_mass*t320) + mast_node7_mass*t378) + (mast_node8_mass*t436 + mast_node9_mass*t494)))*u[9])) - (((((((s_B_mast_node10_x*s_B_mast_node10_x - t533)*mast_node10_mass + (s_B_mast_node11_x*s_B_mast_node11_x - t591)*mast_node11_mass) + (s_B_mast_node2_x*s_B_mast_node2_x - t69)*mast_node2_mass) + ((s_B_mast_node3_x*s_B_mast_node3_x - t127)*mast_node3_mass + (s_B_mast_node4_x*s_B_mast_node4_x - t185)*mast_node4_mass)) + ((((s_B_mast_node5_x*s_B_mast_node5_x - t243)*mast_node5_mass + (s_B_mast_node6_x*s_B_mast_node6_x - t301)*mast_node6_mass) + (s_B_mast_node7_x*s_B_mast_node7_x - t359)*mast_node7_mass) + ((s_B_mast_node8_x*s_B_mast_node8_x - t417)*mast_node8_mass + (s_B_mast_node9_x*s_B_mast_node9_x - t475)*mast_node9_mass)))*u[3] + ((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y)))*u[4]) + (((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z)))*u[5] + ((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*t36));
+  const T t659 = (((((((mast_node10_mass*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_z)))*t35 + ((((mast_node10_mass*t535 + mast_node11_mass*t593) + mast_node2_mass*t71) + (mast_node3_mass*t129 + mast_node4_mass*t187)) + (((mast_node5_mass*t245 + mast_node6_mass*t303) + mast_node7_mass*t361) + (mast_node8_mass*t419 + mast_node9_mass*t477)))*u[6]) + ((((mast_node10_mass*t542 + mast_node11_mass*t600) + mast_node2_mass*t78) + (mast_node3_mass*t136 + mast_node4_mass*t194)) + (((mast_node5_mass*t252 + mast_node6_mass*t310) + mast_node7_mass*t368) + (mast_node8_mass*t426 + mast_node9_mass*t484)))*u[7]) + (((((mast_node10_mass*t548 + mast_node11_mass*t606) + mast_node2_mass*t84) + (mast_node3_mass*t142 + mast_node4_mass*t200)) + (((mast_node5_mass*t258 + mast_node6_mass*t316) + mast_node7_mass*t374) + (mast_node8_mass*t432 + mast_node9_mass*t490)))*u[8] + ((((mast_node10_mass*t553 + mast_node11_mass*t611) + mast_node2_mass*t89) + (mast_node3_mass*t147 + mast_node4_mass*t205)) + (((mast_node5_mass*t263 + mast_node6_mass*t321) + mast_node7_mass*t379) + (mast_node8_mass*t437 + mast_node9_mass*t495)))*u[9])) - (((((((s_B_mast_node10_y*s_B_mast_node10_y - t533)*mast_node10_mass + (s_B_mast_node11_y*s_B_mast_node11_y - t591)*mast_node11_mass) + (s_B_mast_node2_y*s_B_mast_node2_y - t69)*mast_node2_mass) + ((s_B_mast_node3_y*s_B_mast_node3_y - t127)*mast_node3_mass + (s_B_mast_node4_y*s_B_mast_node4_y - t185)*mast_node4_mass)) + ((((s_B_mast_node5_y*s_B_mast_node5_y - t243)*mast_node5_mass + (s_B_mast_node6_y*s_B_mast_node6_y - t301)*mast_node6_mass) + (s_B_mast_node7_y*s_B_mast_node7_y - t359)*mast_node7_mass) + ((s_B_mast_node8_y*s_B_mast_node8_y - t417)*mast_node8_mass + (s_B_mast_node9_y*s_B_mast_node9_y - t475)*mast_node9_mass)))*u[4] + ((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*t37) + (((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_y)))*u[3] + ((((mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z)))*u[5]));
+  const T t660 = (((((((mast_node10_mass*s_B_mast_node10_x + mast_node11_mass*s_B_mast_node11_x) + mast_node2_mass*s_B_mast_node2_x) + (mast_node3_mass*s_B_mast_node3_x + mast_node4_mass*s_B_mast_node4_x)) + (((mast_node5_mass*s_B_mast_node5_x + mast_node6_mass*s_B_mast_node6_x) + mast_node7_mass*s_B_mast_node7_x) + (mast_node8_mass*s_B_mast_node8_x + mast_node9_mass*s_B_mast_node9_x)))*t36 + ((((mast_node10_mass*t536 + mast_node11_mass*t594) + mast_node2_mass*t72) + (mast_node3_mass*t130 + mast_node4_mass*t188)) + (((mast_node5_mass*t246 + mast_node6_mass*t304) + mast_node7_mass*t362) + (mast_node8_mass*t420 + mast_node9_mass*t478)))*u[6]) + ((((mast_node10_mass*t543 + mast_node11_mass*t601) + mast_node2_mass*t79) + (mast_node3_mass*t137 + mast_node4_mass*t195)) + (((mast_node5_mass*t253 + mast_node6_mass*t311) + mast_node7_mass*t369) + (mast_node8_mass*t427 + mast_node9_mass*t485)))*u[7]) + (((((mast_node10_mass*t549 + mast_node11_mass*t607) + mast_node2_mass*t85) + (mast_node3_mass*t143 + mast_node4_mass*t201)) + (((mast_node5_mass*t259 + mast_node6_mass*t317) + mast_node7_mass*t375) + (mast_node8_mass*t433 + mast_node9_mass*t491)))*u[8] + ((((mast_node10_mass*t554 + mast_node11_mass*t612) + mast_node2_mass*t90) + (mast_node3_mass*t148 + mast_node4_mass*t206)) + (((mast_node5_mass*t264 + mast_node6_mass*t322) + mast_node7_mass*t380) + (mast_node8_mass*t438 + mast_node9_mass*t496)))*u[9])) - (((((((s_B_mast_node10_z*s_B_mast_node10_z - t533)*mast_node10_mass + (s_B_mast_node11_z*s_B_mast_node11_z - t591)*mast_node11_mass) + (s_B_mast_node2_z*s_B_mast_node2_z - t69)*mast_node2_mass) + ((s_B_mast_node3_z*s_B_mast_node3_z - t127)*mast_node3_mass + (s_B_mast_node4_z*s_B_mast_node4_z - t185)*mast_node4_mass)) + ((((s_B_mast_node5_z*s_B_mast_node5_z - t243)*mast_node5_mass + (s_B_mast_node6_z*s_B_mast_node6_z - t301)*mast_node6_mass) + (s_B_mast_node7_z*s_B_mast_node7_z - t359)*mast_node7_mass) + ((s_B_mast_node8_z*s_B_mast_node8_z - t417)*mast_node8_mass + (s_B_mast_node9_z*s_B_mast_node9_z - t475)*mast_node9_mass)))*u[5] + ((((mast_node10_mass*s_B_mast_node10_x*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_x*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_x*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_x*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_x*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_x*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_x*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_x*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_x*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_x*s_B_mast_node9_z)))*u[3]) + (((((mast_node10_mass*s_B_mast_node10_y + mast_node11_mass*s_B_mast_node11_y) + mast_node2_mass*s_B_mast_node2_y) + (mast_node3_mass*s_B_mast_node3_y + mast_node4_mass*s_B_mast_node4_y)) + (((mast_node5_mass*s_B_mast_node5_y + mast_node6_mass*s_B_mast_node6_y) + mast_node7_mass*s_B_mast_node7_y) + (mast_node8_mass*s_B_mast_node8_y + mast_node9_mass*s_B_mast_node9_y)))*t35 + ((((mast_node10_mass*s_B_mast_node10_y*s_B_mast_node10_z + mast_node11_mass*s_B_mast_node11_y*s_B_mast_node11_z) + mast_node2_mass*s_B_mast_node2_y*s_B_mast_node2_z) + (mast_node3_mass*s_B_mast_node3_y*s_B_mast_node3_z + mast_node4_mass*s_B_mast_node4_y*s_B_mast_node4_z)) + (((mast_node5_mass*s_B_mast_node5_y*s_B_mast_node5_z + mast_node6_mass*s_B_mast_node6_y*s_B_mast_node6_z) + mast_node7_mass*s_B_mast_node7_y*s_B_mast_node7_z) + (mast_node8_mass*s_B_mast_node8_y*s_B_mast_node8_z + mast_node9_mass*s_B_mast_node9_y*s_B_mast_node9_z)))*u[4]));
   const T t661 = t14*t655 + t15*t656 + t16*t657;
   const T t662 = t17*t655 + t18*t656 + t19*t657;
   const T t663 = t20*t655 + t21*t656 + t22*t657;

@@ -32,6 +32,20 @@
 #define KANEGEN_NOINLINE __attribute__((noinline))
 #endif
 
+// Function multiversioning (GCC on x86-64): the functions the runtime calls
+// (and the parts of large ones) are compiled twice, for x86-64-v3 (AVX2, FMA:
+// about twice as fast on this code) and for the x86-64 baseline, and the
+// loader picks the one this CPU runs, so the code stays portable. Off with
+// -DKANEGEN_NO_DISPATCH, or when compiling for AVX2 anyway (-march=native).
+#ifndef KANEGEN_DISPATCH
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(__AVX2__) && \
+    !defined(KANEGEN_NO_DISPATCH)
+#define KANEGEN_DISPATCH __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define KANEGEN_DISPATCH
+#endif
+#endif
+
 namespace kanegen_gen::wide_tree {
 
 inline constexpr int nq = 23;
@@ -752,18 +766,18 @@ template <class T>
 void qdot(const T* q, const T* u, T* qdot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
-  const T t0 = 1.0/((q[3]*q[3] + q[4]*q[4] + q[5]*q[5] + q[6]*q[6]));
-  const T t1 = q[3]*q[3] + q[4]*q[4] - q[5]*q[5] - q[6]*q[6];
+  const T t0 = 1.0/(((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
+  const T t1 = (q[3]*q[3] + q[4]*q[4]) - (q[5]*q[5] + q[6]*q[6]);
   const T t2 = -2.0*q[3]*q[6] + 2.0*q[4]*q[5];
   const T t3 = 2.0*q[3]*q[5] + 2.0*q[4]*q[6];
   const T t4 = (t1*u[0] + t2*u[1] + t3*u[2])*t0;
   const T t5 = 2.0*q[3]*q[6] + 2.0*q[4]*q[5];
-  const T t6 = q[3]*q[3] - q[4]*q[4] + q[5]*q[5] - q[6]*q[6];
+  const T t6 = (q[3]*q[3] + q[5]*q[5]) - (q[4]*q[4] + q[6]*q[6]);
   const T t7 = -2.0*q[3]*q[4] + 2.0*q[5]*q[6];
   const T t8 = (t5*u[0] + t6*u[1] + t7*u[2])*t0;
   const T t9 = -2.0*q[3]*q[5] + 2.0*q[4]*q[6];
   const T t10 = 2.0*q[3]*q[4] + 2.0*q[5]*q[6];
-  const T t11 = q[3]*q[3] - q[4]*q[4] - q[5]*q[5] + q[6]*q[6];
+  const T t11 = (q[3]*q[3] + q[6]*q[6]) - (q[4]*q[4] + q[5]*q[5]);
   const T t12 = (t10*u[1] + t11*u[2] + t9*u[0])*t0;
   const T t13 = -q[4]*u[3]/2.0 - q[5]*u[4]/2.0 - q[6]*u[5]/2.0;
   const T t14 = q[3]*u[3]/2.0 + q[5]*u[5]/2.0 - q[6]*u[4]/2.0;
@@ -858,7 +872,7 @@ void mass_matrix(const T* q, T* M) {
   const T t326 = t298*t322 + t299*t321;
   const T t327 = t298*t324 + t299*t323;
   const T t328 = 2.0*app16_p_J_y*t320 + kb0b288e3 + t325;
-  const T t329 = -app16_p_J_x*t320 - app16_p_J_y*t319 - kfa4e222f + t326;
+  const T t329 = t326 - ((app16_p_J_x*t320 + app16_p_J_y*t319) + kfa4e222f);
   const T t330 = -app16_p_J_z*t319 - kfa4e5c16;
   const T t331 = 2.0*app16_p_J_x*t319 + k40d5d0f2 + t327;
   const T t332 = -app16_p_J_z*t320 - k2c1ae18a;
@@ -899,7 +913,7 @@ void mass_matrix(const T* q, T* M) {
   const T t366 = t277*t360 + t278*t359;
   const T t367 = t277*t363 + t278*t362;
   const T t368 = 2.0*app15_p_J_y*t358 + k238ce540 + t365;
-  const T t369 = -app15_p_J_x*t358 - app15_p_J_y*t357 - k4464d665 + t366;
+  const T t369 = t366 - ((app15_p_J_x*t358 + app15_p_J_y*t357) + k4464d665);
   const T t370 = -app15_p_J_z*t357 - k6ab4ab38 + t361;
   const T t371 = 2.0*app15_p_J_x*t357 + ka2cdca31 + t367;
   const T t372 = -app15_p_J_z*t358 - k78c5e22a + t364;
@@ -940,7 +954,7 @@ void mass_matrix(const T* q, T* M) {
   const T t406 = t259*t402 + t260*t401;
   const T t407 = t259*t404 + t260*t403;
   const T t408 = 2.0*app14_p_J_y*t400 + k62bd4355 + t405;
-  const T t409 = -app14_p_J_x*t400 - app14_p_J_y*t399 - k4e66775e + t406;
+  const T t409 = t406 - ((app14_p_J_x*t400 + app14_p_J_y*t399) + k4e66775e);
   const T t410 = -app14_p_J_z*t399 - k4e667183;
   const T t411 = 2.0*app14_p_J_x*t399 + kf6cea03d + t407;
   const T t412 = -app14_p_J_z*t400 - kea31843c;
@@ -981,7 +995,7 @@ void mass_matrix(const T* q, T* M) {
   const T t446 = t245*t442 + t246*t441;
   const T t447 = t245*t444 + t246*t443;
   const T t448 = 2.0*app13_p_J_y*t440 + k493f3cc1 + t445;
-  const T t449 = -app13_p_J_x*t440 - app13_p_J_y*t439 - kcea8c3d7 + t446;
+  const T t449 = t446 - ((app13_p_J_x*t440 + app13_p_J_y*t439) + kcea8c3d7);
   const T t450 = 2.0*app13_p_J_x*t439 + kcea8c064 + t447;
   const T t451 = 2.0*app13_p_J_x*t439 + 2.0*app13_p_J_y*t440 + kbae12506;
   const T t452 = k65a3f7e1 + t439;
@@ -1007,7 +1021,7 @@ void mass_matrix(const T* q, T* M) {
   const T t471 = t224*t465 + t225*t464;
   const T t472 = t224*t468 + t225*t467;
   const T t473 = 2.0*app12_p_J_y*t463 + kcef3e627 + t470;
-  const T t474 = -app12_p_J_x*t463 - app12_p_J_y*t462 - k533baaf4 + t471;
+  const T t474 = t471 - ((app12_p_J_x*t463 + app12_p_J_y*t462) + k533baaf4);
   const T t475 = -app12_p_J_z*t462 + k533482e1 + t466;
   const T t476 = 2.0*app12_p_J_x*t462 + kd301e187 + t472;
   const T t477 = -app12_p_J_z*t463 + k1a292250 + t469;
@@ -1048,7 +1062,7 @@ void mass_matrix(const T* q, T* M) {
   const T t511 = t206*t507 + t207*t506;
   const T t512 = t206*t509 + t207*t508;
   const T t513 = 2.0*app11_p_J_y*t505 + keee37c55 + t510;
-  const T t514 = -app11_p_J_x*t505 - app11_p_J_y*t504 - k30cd4284 + t511;
+  const T t514 = t511 - ((app11_p_J_x*t505 + app11_p_J_y*t504) + k30cd4284);
   const T t515 = -app11_p_J_z*t504 - k30cd4e49;
   const T t516 = 2.0*app11_p_J_x*t504 + k8aaf66ee + t512;
   const T t517 = -app11_p_J_z*t505 - ke4c0536f;
@@ -1089,7 +1103,7 @@ void mass_matrix(const T* q, T* M) {
   const T t551 = t185*t547 + t186*t546;
   const T t552 = t185*t549 + t186*t548;
   const T t553 = 2.0*app10_p_J_y*t545 + k05b7a508 + t550;
-  const T t554 = -app10_p_J_x*t545 - app10_p_J_y*t544 - k526ce8ba + t551;
+  const T t554 = t551 - ((app10_p_J_x*t545 + app10_p_J_y*t544) + k526ce8ba);
   const T t555 = -app10_p_J_z*t544 - k526ce90f;
   const T t556 = 2.0*app10_p_J_x*t544 + k123e673f + t552;
   const T t557 = -app10_p_J_z*t545 - k82f30525;
@@ -1161,7 +1175,7 @@ void mass_matrix(const T* q, T* M) {
   const T t621 = t153*t617 + t154*t616;
   const T t622 = t153*t619 + t154*t618;
   const T t623 = 2.0*app8_p_J_y*t615 + k6d475432 + t620;
-  const T t624 = -app8_p_J_x*t615 - app8_p_J_y*t614 - kf3ed9f9e + t621;
+  const T t624 = t621 - ((app8_p_J_x*t615 + app8_p_J_y*t614) + kf3ed9f9e);
   const T t625 = -app8_p_J_z*t614 - kf3ee6767;
   const T t626 = 2.0*app8_p_J_x*t614 + kc5df6b85 + t622;
   const T t627 = -app8_p_J_z*t615 - kcc39b7f0;
@@ -1202,7 +1216,7 @@ void mass_matrix(const T* q, T* M) {
   const T t661 = t132*t657 + t133*t656;
   const T t662 = t132*t659 + t133*t658;
   const T t663 = 2.0*app7_p_J_y*t655 + k70213ee6 + t660;
-  const T t664 = -app7_p_J_x*t655 - app7_p_J_y*t654 - k7a272588 + t661;
+  const T t664 = t661 - ((app7_p_J_x*t655 + app7_p_J_y*t654) + k7a272588);
   const T t665 = -app7_p_J_z*t654 - k7a272d91;
   const T t666 = 2.0*app7_p_J_x*t654 + kf78a9e17 + t662;
   const T t667 = -app7_p_J_z*t655 - kcc4a0324;
@@ -1245,7 +1259,7 @@ void mass_matrix(const T* q, T* M) {
   const T t703 = t111*t697 + t112*t696;
   const T t704 = t111*t700 + t112*t699;
   const T t705 = 2.0*app6_p_J_y*t695 + k27ab12de + t702;
-  const T t706 = -app6_p_J_x*t695 - app6_p_J_y*t694 - k5b5e4f0e + t703;
+  const T t706 = t703 - ((app6_p_J_x*t695 + app6_p_J_y*t694) + k5b5e4f0e);
   const T t707 = -app6_p_J_z*t694 + kad510176 + t698;
   const T t708 = 2.0*app6_p_J_x*t694 + kfa032c1b + t704;
   const T t709 = -app6_p_J_z*t695 - k77b73ce6 + t701;
@@ -1315,7 +1329,7 @@ void mass_matrix(const T* q, T* M) {
   const T t771 = t76*t767 + t766*t77;
   const T t772 = t76*t769 + t768*t77;
   const T t773 = 2.0*app4_p_J_y*t765 + k83559a3b + t770;
-  const T t774 = -app4_p_J_x*t765 - app4_p_J_y*t764 - k6ac783fe + t771;
+  const T t774 = t771 - ((app4_p_J_x*t765 + app4_p_J_y*t764) + k6ac783fe);
   const T t775 = -app4_p_J_z*t764 - k6ac783e7;
   const T t776 = 2.0*app4_p_J_x*t764 + k37abbdd7 + t772;
   const T t777 = -app4_p_J_z*t765 - k7b3c2e78;
@@ -1358,7 +1372,7 @@ void mass_matrix(const T* q, T* M) {
   const T t813 = t55*t807 + t56*t806;
   const T t814 = t55*t810 + t56*t809;
   const T t815 = 2.0*app3_p_J_y*t805 + kcdd153e0 + t812;
-  const T t816 = -app3_p_J_x*t805 - app3_p_J_y*t804 - kcda7eadb + t813;
+  const T t816 = t813 - ((app3_p_J_x*t805 + app3_p_J_y*t804) + kcda7eadb);
   const T t817 = -app3_p_J_z*t804 - k474da613 + t808;
   const T t818 = 2.0*app3_p_J_x*t804 + kc4342491 + t814;
   const T t819 = -app3_p_J_z*t805 + kda7a603b + t811;
@@ -1399,7 +1413,7 @@ void mass_matrix(const T* q, T* M) {
   const T t853 = t37*t849 + t38*t848;
   const T t854 = t37*t851 + t38*t850;
   const T t855 = 2.0*app2_p_J_y*t847 + k829d5082 + t852;
-  const T t856 = -app2_p_J_x*t847 - app2_p_J_y*t846 - kd3092ae1 + t853;
+  const T t856 = t853 - ((app2_p_J_x*t847 + app2_p_J_y*t846) + kd3092ae1);
   const T t857 = -app2_p_J_z*t846 - kd3092fbc;
   const T t858 = 2.0*app2_p_J_x*t846 + kd64512a2 + t854;
   const T t859 = -app2_p_J_z*t847 - kd6f1e92e;
@@ -1440,7 +1454,7 @@ void mass_matrix(const T* q, T* M) {
   const T t893 = t23*t889 + t24*t888;
   const T t894 = t23*t891 + t24*t890;
   const T t895 = 2.0*app1_p_J_y*t887 + keb4a28fb + t892;
-  const T t896 = -app1_p_J_x*t887 - app1_p_J_y*t886 - ke96767d8 + t893;
+  const T t896 = t893 - ((app1_p_J_x*t887 + app1_p_J_y*t886) + ke96767d8);
   const T t897 = 2.0*app1_p_J_x*t886 + ke967616b + t894;
   const T t898 = 2.0*app1_p_J_x*t886 + 2.0*app1_p_J_y*t887 + k215d1cf1;
   const T t899 = kec4548ac + t886;
@@ -2686,7 +2700,7 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t958 = app3_S0_z*t152 - app3_mass*t156 - t784;
   const T t959 = app3_S0_x*t153 - app3_mass*t146 - t785;
   const T t960 = -app3_J0_xx*t152 + app3_S0_z*t156 - t789;
-  const T t961 = -app3_J0_yy*t153 + app3_S0_x*t146 - app3_S0_z*t155 - t790;
+  const T t961 = app3_S0_x*t146 - ((app3_J0_yy*t153 + app3_S0_z*t155) + t790);
   const T t962 = -app3_J0_xz*t152 - app3_S0_x*t156 - t791;
   // ---- body app4: bias force
   const T t963 = -app4_mass*t204 - t794;
@@ -2707,7 +2721,7 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t976 = app6_S0_z*t286 - app6_mass*t290 - t818;
   const T t977 = app6_S0_x*t287 - app6_mass*t280 - t819;
   const T t978 = -app6_J0_xx*t286 + app6_S0_z*t290 - t823;
-  const T t979 = -app6_J0_yy*t287 + app6_S0_x*t280 - app6_S0_z*t289 - t824;
+  const T t979 = app6_S0_x*t280 - ((app6_J0_yy*t287 + app6_S0_z*t289) + t824);
   const T t980 = -app6_J0_xz*t286 - app6_S0_x*t290 - t825;
   // ---- body app7: bias force
   const T t981 = -app7_mass*t338 - t828;
@@ -2728,7 +2742,7 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t994 = app9_S0_z*t417 - app9_mass*t421 - t852;
   const T t995 = app9_S0_x*t418 - app9_mass*t411 - t853;
   const T t996 = -app9_J0_xx*t417 + app9_S0_z*t421 - t857;
-  const T t997 = -app9_J0_yy*t418 + app9_S0_x*t411 - app9_S0_z*t420 - t858;
+  const T t997 = app9_S0_x*t411 - ((app9_J0_yy*t418 + app9_S0_z*t420) + t858);
   const T t998 = -app9_J0_xz*t417 - app9_S0_x*t421 - t859;
   // ---- body app10: bias force
   const T t999 = -app10_mass*t469 - t862;
@@ -2749,7 +2763,7 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t1012 = app12_S0_z*t561 - app12_mass*t565 - t886;
   const T t1013 = app12_S0_x*t562 - app12_mass*t555 - t887;
   const T t1014 = -app12_J0_xx*t561 + app12_S0_z*t565 - t891;
-  const T t1015 = -app12_J0_yy*t562 + app12_S0_x*t555 - app12_S0_z*t564 - t892;
+  const T t1015 = app12_S0_x*t555 - ((app12_J0_yy*t562 + app12_S0_z*t564) + t892);
   const T t1016 = -app12_J0_xz*t561 - app12_S0_x*t565 - t893;
   // ---- body app13: bias force
   const T t1017 = -app13_mass*t600 - t896;
@@ -2770,7 +2784,7 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t1030 = app15_S0_z*t692 - app15_mass*t696 - t920;
   const T t1031 = app15_S0_x*t693 - app15_mass*t686 - t921;
   const T t1032 = -app15_J0_xx*t692 + app15_S0_z*t696 - t925;
-  const T t1033 = -app15_J0_yy*t693 + app15_S0_x*t686 - app15_S0_z*t695 - t926;
+  const T t1033 = app15_S0_x*t686 - ((app15_J0_yy*t693 + app15_S0_z*t695) + t926);
   const T t1034 = -app15_J0_xz*t692 - app15_S0_x*t696 - t927;
   // ---- body app16: bias force
   const T t1035 = -app16_mass*t744 - t930;
@@ -3745,7 +3759,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t946 = t697*t942 + t698*t941;
   const T t947 = t697*t944 + t698*t943;
   const T t948 = 2.0*app16_p_J_y*t940 + kb0b288e3 + t945;
-  const T t949 = -app16_p_J_x*t940 - app16_p_J_y*t939 - kfa4e222f + t946;
+  const T t949 = t946 - ((app16_p_J_x*t940 + app16_p_J_y*t939) + kfa4e222f);
   const T t950 = -app16_p_J_z*t939 - kfa4e5c16;
   const T t951 = 2.0*app16_p_J_x*t939 + k40d5d0f2 + t947;
   const T t952 = -app16_p_J_z*t940 - k2c1ae18a;
@@ -3786,7 +3800,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t986 = t648*t980 + t649*t979;
   const T t987 = t648*t983 + t649*t982;
   const T t988 = 2.0*app15_p_J_y*t978 + k238ce540 + t985;
-  const T t989 = -app15_p_J_x*t978 - app15_p_J_y*t977 - k4464d665 + t986;
+  const T t989 = t986 - ((app15_p_J_x*t978 + app15_p_J_y*t977) + k4464d665);
   const T t990 = -app15_p_J_z*t977 - k6ab4ab38 + t981;
   const T t991 = 2.0*app15_p_J_x*t977 + ka2cdca31 + t987;
   const T t992 = -app15_p_J_z*t978 - k78c5e22a + t984;
@@ -3827,7 +3841,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1026 = t1021*t603 + t1022*t602;
   const T t1027 = t1023*t603 + t1024*t602;
   const T t1028 = 2.0*app14_p_J_y*t1020 + k62bd4355 + t1025;
-  const T t1029 = -app14_p_J_x*t1020 - app14_p_J_y*t1019 - k4e66775e + t1026;
+  const T t1029 = t1026 - ((app14_p_J_x*t1020 + app14_p_J_y*t1019) + k4e66775e);
   const T t1030 = -app14_p_J_z*t1019 - k4e667183;
   const T t1031 = 2.0*app14_p_J_x*t1019 + kf6cea03d + t1027;
   const T t1032 = -app14_p_J_z*t1020 - kea31843c;
@@ -3868,7 +3882,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1066 = t1061*t567 + t1062*t566;
   const T t1067 = t1063*t567 + t1064*t566;
   const T t1068 = 2.0*app13_p_J_y*t1060 + k493f3cc1 + t1065;
-  const T t1069 = -app13_p_J_x*t1060 - app13_p_J_y*t1059 - kcea8c3d7 + t1066;
+  const T t1069 = t1066 - ((app13_p_J_x*t1060 + app13_p_J_y*t1059) + kcea8c3d7);
   const T t1070 = 2.0*app13_p_J_x*t1059 + kcea8c064 + t1067;
   const T t1071 = 2.0*app13_p_J_x*t1059 + 2.0*app13_p_J_y*t1060 + kbae12506;
   const T t1072 = k65a3f7e1 + t1059;
@@ -3894,7 +3908,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1091 = t1084*t518 + t1085*t517;
   const T t1092 = t1087*t518 + t1088*t517;
   const T t1093 = 2.0*app12_p_J_y*t1083 + kcef3e627 + t1090;
-  const T t1094 = -app12_p_J_x*t1083 - app12_p_J_y*t1082 - k533baaf4 + t1091;
+  const T t1094 = t1091 - ((app12_p_J_x*t1083 + app12_p_J_y*t1082) + k533baaf4);
   const T t1095 = -app12_p_J_z*t1082 + k533482e1 + t1086;
   const T t1096 = 2.0*app12_p_J_x*t1082 + kd301e187 + t1092;
   const T t1097 = -app12_p_J_z*t1083 + k1a292250 + t1089;
@@ -3935,7 +3949,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1131 = t1126*t472 + t1127*t471;
   const T t1132 = t1128*t472 + t1129*t471;
   const T t1133 = 2.0*app11_p_J_y*t1125 + keee37c55 + t1130;
-  const T t1134 = -app11_p_J_x*t1125 - app11_p_J_y*t1124 - k30cd4284 + t1131;
+  const T t1134 = t1131 - ((app11_p_J_x*t1125 + app11_p_J_y*t1124) + k30cd4284);
   const T t1135 = -app11_p_J_z*t1124 - k30cd4e49;
   const T t1136 = 2.0*app11_p_J_x*t1124 + k8aaf66ee + t1132;
   const T t1137 = -app11_p_J_z*t1125 - ke4c0536f;
@@ -3976,7 +3990,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1171 = t1166*t423 + t1167*t422;
   const T t1172 = t1168*t423 + t1169*t422;
   const T t1173 = 2.0*app10_p_J_y*t1165 + k05b7a508 + t1170;
-  const T t1174 = -app10_p_J_x*t1165 - app10_p_J_y*t1164 - k526ce8ba + t1171;
+  const T t1174 = t1171 - ((app10_p_J_x*t1165 + app10_p_J_y*t1164) + k526ce8ba);
   const T t1175 = -app10_p_J_z*t1164 - k526ce90f;
   const T t1176 = 2.0*app10_p_J_x*t1164 + k123e673f + t1172;
   const T t1177 = -app10_p_J_z*t1165 - k82f30525;
@@ -4048,7 +4062,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1241 = t1236*t341 + t1237*t340;
   const T t1242 = t1238*t341 + t1239*t340;
   const T t1243 = 2.0*app8_p_J_y*t1235 + k6d475432 + t1240;
-  const T t1244 = -app8_p_J_x*t1235 - app8_p_J_y*t1234 - kf3ed9f9e + t1241;
+  const T t1244 = t1241 - ((app8_p_J_x*t1235 + app8_p_J_y*t1234) + kf3ed9f9e);
   const T t1245 = -app8_p_J_z*t1234 - kf3ee6767;
   const T t1246 = 2.0*app8_p_J_x*t1234 + kc5df6b85 + t1242;
   const T t1247 = -app8_p_J_z*t1235 - kcc39b7f0;
@@ -4089,7 +4103,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1281 = t1276*t292 + t1277*t291;
   const T t1282 = t1278*t292 + t1279*t291;
   const T t1283 = 2.0*app7_p_J_y*t1275 + k70213ee6 + t1280;
-  const T t1284 = -app7_p_J_x*t1275 - app7_p_J_y*t1274 - k7a272588 + t1281;
+  const T t1284 = t1281 - ((app7_p_J_x*t1275 + app7_p_J_y*t1274) + k7a272588);
   const T t1285 = -app7_p_J_z*t1274 - k7a272d91;
   const T t1286 = 2.0*app7_p_J_x*t1274 + kf78a9e17 + t1282;
   const T t1287 = -app7_p_J_z*t1275 - kcc4a0324;
@@ -4132,7 +4146,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1323 = t1316*t243 + t1317*t242;
   const T t1324 = t1319*t243 + t1320*t242;
   const T t1325 = 2.0*app6_p_J_y*t1315 + k27ab12de + t1322;
-  const T t1326 = -app6_p_J_x*t1315 - app6_p_J_y*t1314 - k5b5e4f0e + t1323;
+  const T t1326 = t1323 - ((app6_p_J_x*t1315 + app6_p_J_y*t1314) + k5b5e4f0e);
   const T t1327 = -app6_p_J_z*t1314 + kad510176 + t1318;
   const T t1328 = 2.0*app6_p_J_x*t1314 + kfa032c1b + t1324;
   const T t1329 = -app6_p_J_z*t1315 - k77b73ce6 + t1321;
@@ -4202,7 +4216,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1391 = t1386*t158 + t1387*t157;
   const T t1392 = t1388*t158 + t1389*t157;
   const T t1393 = 2.0*app4_p_J_y*t1385 + k83559a3b + t1390;
-  const T t1394 = -app4_p_J_x*t1385 - app4_p_J_y*t1384 - k6ac783fe + t1391;
+  const T t1394 = t1391 - ((app4_p_J_x*t1385 + app4_p_J_y*t1384) + k6ac783fe);
   const T t1395 = -app4_p_J_z*t1384 - k6ac783e7;
   const T t1396 = 2.0*app4_p_J_x*t1384 + k37abbdd7 + t1392;
   const T t1397 = -app4_p_J_z*t1385 - k7b3c2e78;
@@ -4245,7 +4259,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1433 = t108*t1427 + t109*t1426;
   const T t1434 = t108*t1430 + t109*t1429;
   const T t1435 = 2.0*app3_p_J_y*t1425 + kcdd153e0 + t1432;
-  const T t1436 = -app3_p_J_x*t1425 - app3_p_J_y*t1424 - kcda7eadb + t1433;
+  const T t1436 = t1433 - ((app3_p_J_x*t1425 + app3_p_J_y*t1424) + kcda7eadb);
   const T t1437 = -app3_p_J_z*t1424 - k474da613 + t1428;
   const T t1438 = 2.0*app3_p_J_x*t1424 + kc4342491 + t1434;
   const T t1439 = -app3_p_J_z*t1425 + kda7a603b + t1431;
@@ -4286,7 +4300,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1473 = t1468*t63 + t1469*t62;
   const T t1474 = t1470*t63 + t1471*t62;
   const T t1475 = 2.0*app2_p_J_y*t1467 + k829d5082 + t1472;
-  const T t1476 = -app2_p_J_x*t1467 - app2_p_J_y*t1466 - kd3092ae1 + t1473;
+  const T t1476 = t1473 - ((app2_p_J_x*t1467 + app2_p_J_y*t1466) + kd3092ae1);
   const T t1477 = -app2_p_J_z*t1466 - kd3092fbc;
   const T t1478 = 2.0*app2_p_J_x*t1466 + kd64512a2 + t1474;
   const T t1479 = -app2_p_J_z*t1467 - kd6f1e92e;
@@ -4327,7 +4341,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1513 = t1508*t27 + t1509*t26;
   const T t1514 = t1510*t27 + t1511*t26;
   const T t1515 = 2.0*app1_p_J_y*t1507 + keb4a28fb + t1512;
-  const T t1516 = -app1_p_J_x*t1507 - app1_p_J_y*t1506 - ke96767d8 + t1513;
+  const T t1516 = t1513 - ((app1_p_J_x*t1507 + app1_p_J_y*t1506) + ke96767d8);
   const T t1517 = 2.0*app1_p_J_x*t1506 + ke967616b + t1514;
   const T t1518 = 2.0*app1_p_J_x*t1506 + 2.0*app1_p_J_y*t1507 + k215d1cf1;
   const T t1519 = kec4548ac + t1506;
@@ -4516,7 +4530,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1682 = app3_S0_z*t152 - app3_mass*t156 - t784;
   const T t1683 = app3_S0_x*t153 - app3_mass*t146 - t785;
   const T t1684 = -app3_J0_xx*t152 + app3_S0_z*t156 - t789;
-  const T t1685 = -app3_J0_yy*t153 + app3_S0_x*t146 - app3_S0_z*t155 - t790;
+  const T t1685 = app3_S0_x*t146 - ((app3_J0_yy*t153 + app3_S0_z*t155) + t790);
   const T t1686 = -app3_J0_xz*t152 - app3_S0_x*t156 - t791;
   // ---- body app4: bias force
   const T t1687 = -app4_mass*t204 - t794;
@@ -4537,7 +4551,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1700 = app6_S0_z*t286 - app6_mass*t290 - t818;
   const T t1701 = app6_S0_x*t287 - app6_mass*t280 - t819;
   const T t1702 = -app6_J0_xx*t286 + app6_S0_z*t290 - t823;
-  const T t1703 = -app6_J0_yy*t287 + app6_S0_x*t280 - app6_S0_z*t289 - t824;
+  const T t1703 = app6_S0_x*t280 - ((app6_J0_yy*t287 + app6_S0_z*t289) + t824);
   const T t1704 = -app6_J0_xz*t286 - app6_S0_x*t290 - t825;
   // ---- body app7: bias force
   const T t1705 = -app7_mass*t338 - t828;
@@ -4558,7 +4572,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1718 = app9_S0_z*t417 - app9_mass*t421 - t852;
   const T t1719 = app9_S0_x*t418 - app9_mass*t411 - t853;
   const T t1720 = -app9_J0_xx*t417 + app9_S0_z*t421 - t857;
-  const T t1721 = -app9_J0_yy*t418 + app9_S0_x*t411 - app9_S0_z*t420 - t858;
+  const T t1721 = app9_S0_x*t411 - ((app9_J0_yy*t418 + app9_S0_z*t420) + t858);
   const T t1722 = -app9_J0_xz*t417 - app9_S0_x*t421 - t859;
   // ---- body app10: bias force
   const T t1723 = -app10_mass*t469 - t862;
@@ -4579,7 +4593,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1736 = app12_S0_z*t561 - app12_mass*t565 - t886;
   const T t1737 = app12_S0_x*t562 - app12_mass*t555 - t887;
   const T t1738 = -app12_J0_xx*t561 + app12_S0_z*t565 - t891;
-  const T t1739 = -app12_J0_yy*t562 + app12_S0_x*t555 - app12_S0_z*t564 - t892;
+  const T t1739 = app12_S0_x*t555 - ((app12_J0_yy*t562 + app12_S0_z*t564) + t892);
   const T t1740 = -app12_J0_xz*t561 - app12_S0_x*t565 - t893;
   // ---- body app13: bias force
   const T t1741 = -app13_mass*t600 - t896;
@@ -4600,7 +4614,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t1754 = app15_S0_z*t692 - app15_mass*t696 - t920;
   const T t1755 = app15_S0_x*t693 - app15_mass*t686 - t921;
   const T t1756 = -app15_J0_xx*t692 + app15_S0_z*t696 - t925;
-  const T t1757 = -app15_J0_yy*t693 + app15_S0_x*t686 - app15_S0_z*t695 - t926;
+  const T t1757 = app15_S0_x*t686 - ((app15_J0_yy*t693 + app15_S0_z*t695) + t926);
   const T t1758 = -app15_J0_xz*t692 - app15_S0_x*t696 - t927;
   // ---- body app16: bias force
   const T t1759 = -app16_mass*t744 - t930;
@@ -5947,112 +5961,112 @@ void energy(const T* q, const T* u, T* TV) {
   const T t939 = -hub_S0_y*u[5] + hub_mass*u[0];
   const T t940 = hub_S0_x*u[5] + hub_mass*u[1];
   const T t941 = -hub_S0_x*u[4] + hub_S0_y*u[3] + hub_mass*u[2];
-  const T t942 = hub_J0_xx*u[3] + hub_J0_xy*u[4] + hub_J0_xz*u[5] + hub_S0_y*u[2];
-  const T t943 = hub_J0_xy*u[3] + hub_J0_yy*u[4] + hub_J0_yz*u[5] - hub_S0_x*u[2];
-  const T t944 = hub_J0_xz*u[3] + hub_J0_yz*u[4] + hub_J0_zz*u[5] + hub_S0_x*u[1] - hub_S0_y*u[0];
-  const T t945 = t939*u[0] + t940*u[1] + t941*u[2] + t942*u[3] + t943*u[4] + t944*u[5];
+  const T t942 = (hub_J0_xx*u[3] + hub_J0_xy*u[4]) + (hub_J0_xz*u[5] + hub_S0_y*u[2]);
+  const T t943 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + hub_J0_yz*u[5]) - hub_S0_x*u[2];
+  const T t944 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + (hub_J0_zz*u[5] + hub_S0_x*u[1])) - hub_S0_y*u[0];
+  const T t945 = ((t939*u[0] + t940*u[1]) + t941*u[2]) + ((t942*u[3] + t943*u[4]) + t944*u[5]);
   const T t946 = app1_mass*t55;
   const T t947 = app1_S0_x*w_B_app1_z + app1_mass*t56;
   const T t948 = -app1_S0_x*t53 + app1_mass*t45;
   const T t949 = app1_J0_yy*t53 - app1_S0_x*t45;
   const T t950 = app1_J0_zz*w_B_app1_z + app1_S0_x*t56;
-  const T t951 = t45*t948 + t52*t763 + t53*t949 + t55*t946 + t56*t947 + t950*w_B_app1_z;
+  const T t951 = ((t45*t948 + t52*t763) + t53*t949) + ((t55*t946 + t56*t947) + t950*w_B_app1_z);
   const T t952 = app2_mass*t101;
   const T t953 = app2_S0_x*w_B_app2_z + app2_mass*t102;
   const T t954 = -app2_S0_x*t99 + app2_mass*t89;
   const T t955 = app2_J0_yy*t99 - app2_S0_x*t89;
   const T t956 = app2_J0_zz*w_B_app2_z + app2_S0_x*t102;
-  const T t957 = t101*t952 + t102*t953 + t774*t98 + t89*t954 + t955*t99 + t956*w_B_app2_z;
+  const T t957 = ((t101*t952 + t102*t953) + t774*t98) + ((t89*t954 + t955*t99) + t956*w_B_app2_z);
   const T t958 = app3_S0_z*t148 + app3_mass*t150;
   const T t959 = app3_S0_x*w_B_app3_z - app3_S0_z*t147 + app3_mass*t151;
   const T t960 = -app3_S0_x*t148 + app3_mass*t138;
   const T t961 = app3_J0_xx*t147 + app3_J0_xz*w_B_app3_z - app3_S0_z*t151;
   const T t962 = app3_J0_yy*t148 - app3_S0_x*t138 + app3_S0_z*t150;
   const T t963 = app3_J0_xz*t147 + app3_J0_zz*w_B_app3_z + app3_S0_x*t151;
-  const T t964 = t138*t960 + t147*t961 + t148*t962 + t150*t958 + t151*t959 + t963*w_B_app3_z;
+  const T t964 = ((t138*t960 + t147*t961) + t148*t962) + ((t150*t958 + t151*t959) + t963*w_B_app3_z);
   const T t965 = app4_mass*t199;
   const T t966 = app4_S0_x*w_B_app4_z + app4_mass*t200;
   const T t967 = -app4_S0_x*t197 + app4_mass*t187;
   const T t968 = app4_J0_yy*t197 - app4_S0_x*t187;
   const T t969 = app4_J0_zz*w_B_app4_z + app4_S0_x*t200;
-  const T t970 = t187*t967 + t196*t797 + t197*t968 + t199*t965 + t200*t966 + t969*w_B_app4_z;
+  const T t970 = ((t187*t967 + t196*t797) + t197*t968) + ((t199*t965 + t200*t966) + t969*w_B_app4_z);
   const T t971 = app5_mass*t235;
   const T t972 = app5_S0_x*w_B_app5_z + app5_mass*t236;
   const T t973 = -app5_S0_x*t233 + app5_mass*t225;
   const T t974 = app5_J0_yy*t233 - app5_S0_x*t225;
   const T t975 = app5_J0_zz*w_B_app5_z + app5_S0_x*t236;
-  const T t976 = t225*t973 + t232*t808 + t233*t974 + t235*t971 + t236*t972 + t975*w_B_app5_z;
+  const T t976 = ((t225*t973 + t232*t808) + t233*t974) + ((t235*t971 + t236*t972) + t975*w_B_app5_z);
   const T t977 = app6_S0_z*t282 + app6_mass*t284;
   const T t978 = app6_S0_x*w_B_app6_z - app6_S0_z*t281 + app6_mass*t285;
   const T t979 = -app6_S0_x*t282 + app6_mass*t272;
   const T t980 = app6_J0_xx*t281 + app6_J0_xz*w_B_app6_z - app6_S0_z*t285;
   const T t981 = app6_J0_yy*t282 - app6_S0_x*t272 + app6_S0_z*t284;
   const T t982 = app6_J0_xz*t281 + app6_J0_zz*w_B_app6_z + app6_S0_x*t285;
-  const T t983 = t272*t979 + t281*t980 + t282*t981 + t284*t977 + t285*t978 + t982*w_B_app6_z;
+  const T t983 = ((t272*t979 + t281*t980) + t282*t981) + ((t284*t977 + t285*t978) + t982*w_B_app6_z);
   const T t984 = app7_mass*t333;
   const T t985 = app7_S0_x*w_B_app7_z + app7_mass*t334;
   const T t986 = -app7_S0_x*t331 + app7_mass*t321;
   const T t987 = app7_J0_yy*t331 - app7_S0_x*t321;
   const T t988 = app7_J0_zz*w_B_app7_z + app7_S0_x*t334;
-  const T t989 = t321*t986 + t330*t831 + t331*t987 + t333*t984 + t334*t985 + t988*w_B_app7_z;
+  const T t989 = ((t321*t986 + t330*t831) + t331*t987) + ((t333*t984 + t334*t985) + t988*w_B_app7_z);
   const T t990 = app8_mass*t379;
   const T t991 = app8_S0_x*w_B_app8_z + app8_mass*t380;
   const T t992 = -app8_S0_x*t377 + app8_mass*t367;
   const T t993 = app8_J0_yy*t377 - app8_S0_x*t367;
   const T t994 = app8_J0_zz*w_B_app8_z + app8_S0_x*t380;
-  const T t995 = t367*t992 + t376*t842 + t377*t993 + t379*t990 + t380*t991 + t994*w_B_app8_z;
+  const T t995 = ((t367*t992 + t376*t842) + t377*t993) + ((t379*t990 + t380*t991) + t994*w_B_app8_z);
   const T t996 = app9_S0_z*t413 + app9_mass*t415;
   const T t997 = app9_S0_x*w_B_app9_z - app9_S0_z*t412 + app9_mass*t416;
   const T t998 = -app9_S0_x*t413 + app9_mass*t405;
   const T t999 = app9_J0_xx*t412 + app9_J0_xz*w_B_app9_z - app9_S0_z*t416;
   const T t1000 = app9_J0_yy*t413 - app9_S0_x*t405 + app9_S0_z*t415;
   const T t1001 = app9_J0_xz*t412 + app9_J0_zz*w_B_app9_z + app9_S0_x*t416;
-  const T t1002 = t1000*t413 + t1001*w_B_app9_z + t405*t998 + t412*t999 + t415*t996 + t416*t997;
+  const T t1002 = ((t1000*t413 + t1001*w_B_app9_z) + t405*t998) + ((t412*t999 + t415*t996) + t416*t997);
   const T t1003 = app10_mass*t464;
   const T t1004 = app10_S0_x*w_B_app10_z + app10_mass*t465;
   const T t1005 = -app10_S0_x*t462 + app10_mass*t452;
   const T t1006 = app10_J0_yy*t462 - app10_S0_x*t452;
   const T t1007 = app10_J0_zz*w_B_app10_z + app10_S0_x*t465;
-  const T t1008 = t1003*t464 + t1004*t465 + t1005*t452 + t1006*t462 + t1007*w_B_app10_z + t461*t865;
+  const T t1008 = ((t1003*t464 + t1004*t465) + t1005*t452) + ((t1006*t462 + t1007*w_B_app10_z) + t461*t865);
   const T t1009 = app11_mass*t510;
   const T t1010 = app11_S0_x*w_B_app11_z + app11_mass*t511;
   const T t1011 = -app11_S0_x*t508 + app11_mass*t498;
   const T t1012 = app11_J0_yy*t508 - app11_S0_x*t498;
   const T t1013 = app11_J0_zz*w_B_app11_z + app11_S0_x*t511;
-  const T t1014 = t1009*t510 + t1010*t511 + t1011*t498 + t1012*t508 + t1013*w_B_app11_z + t507*t876;
+  const T t1014 = ((t1009*t510 + t1010*t511) + t1011*t498) + ((t1012*t508 + t1013*w_B_app11_z) + t507*t876);
   const T t1015 = app12_S0_z*t557 + app12_mass*t559;
   const T t1016 = app12_S0_x*w_B_app12_z - app12_S0_z*t556 + app12_mass*t560;
   const T t1017 = -app12_S0_x*t557 + app12_mass*t547;
   const T t1018 = app12_J0_xx*t556 + app12_J0_xz*w_B_app12_z - app12_S0_z*t560;
   const T t1019 = app12_J0_yy*t557 - app12_S0_x*t547 + app12_S0_z*t559;
   const T t1020 = app12_J0_xz*t556 + app12_J0_zz*w_B_app12_z + app12_S0_x*t560;
-  const T t1021 = t1015*t559 + t1016*t560 + t1017*t547 + t1018*t556 + t1019*t557 + t1020*w_B_app12_z;
+  const T t1021 = ((t1015*t559 + t1016*t560) + t1017*t547) + ((t1018*t556 + t1019*t557) + t1020*w_B_app12_z);
   const T t1022 = app13_mass*t595;
   const T t1023 = app13_S0_x*w_B_app13_z + app13_mass*t596;
   const T t1024 = -app13_S0_x*t593 + app13_mass*t585;
   const T t1025 = app13_J0_yy*t593 - app13_S0_x*t585;
   const T t1026 = app13_J0_zz*w_B_app13_z + app13_S0_x*t596;
-  const T t1027 = t1022*t595 + t1023*t596 + t1024*t585 + t1025*t593 + t1026*w_B_app13_z + t592*t899;
+  const T t1027 = ((t1022*t595 + t1023*t596) + t1024*t585) + ((t1025*t593 + t1026*w_B_app13_z) + t592*t899);
   const T t1028 = app14_mass*t641;
   const T t1029 = app14_S0_x*w_B_app14_z + app14_mass*t642;
   const T t1030 = -app14_S0_x*t639 + app14_mass*t629;
   const T t1031 = app14_J0_yy*t639 - app14_S0_x*t629;
   const T t1032 = app14_J0_zz*w_B_app14_z + app14_S0_x*t642;
-  const T t1033 = t1028*t641 + t1029*t642 + t1030*t629 + t1031*t639 + t1032*w_B_app14_z + t638*t910;
+  const T t1033 = ((t1028*t641 + t1029*t642) + t1030*t629) + ((t1031*t639 + t1032*w_B_app14_z) + t638*t910);
   const T t1034 = app15_S0_z*t688 + app15_mass*t690;
   const T t1035 = app15_S0_x*w_B_app15_z - app15_S0_z*t687 + app15_mass*t691;
   const T t1036 = -app15_S0_x*t688 + app15_mass*t678;
   const T t1037 = app15_J0_xx*t687 + app15_J0_xz*w_B_app15_z - app15_S0_z*t691;
   const T t1038 = app15_J0_yy*t688 - app15_S0_x*t678 + app15_S0_z*t690;
   const T t1039 = app15_J0_xz*t687 + app15_J0_zz*w_B_app15_z + app15_S0_x*t691;
-  const T t1040 = t1034*t690 + t1035*t691 + t1036*t678 + t1037*t687 + t1038*t688 + t1039*w_B_app15_z;
+  const T t1040 = ((t1034*t690 + t1035*t691) + t1036*t678) + ((t1037*t687 + t1038*t688) + t1039*w_B_app15_z);
   const T t1041 = app16_mass*t739;
   const T t1042 = app16_S0_x*w_B_app16_z + app16_mass*t740;
   const T t1043 = -app16_S0_x*t737 + app16_mass*t727;
   const T t1044 = app16_J0_yy*t737 - app16_S0_x*t727;
   const T t1045 = app16_J0_zz*w_B_app16_z + app16_S0_x*t740;
-  const T t1046 = t1041*t739 + t1042*t740 + t1043*t727 + t1044*t737 + t1045*w_B_app16_z + t736*t933;
-  const T t1047 = t1002/2.0 + t1008/2.0 + t1014/2.0 + t1021/2.0 + t1027/2.0 + t1033/2.0 + t1040/2.0 + t1046/2.0 + t945/2.0 + t951/2.0 + t957/2.0 + t964/2.0 + t970/2.0 + t976/2.0 + t983/2.0 + t989/2.0 + t995/2.0;
+  const T t1046 = ((t1041*t739 + t1042*t740) + t1043*t727) + ((t1044*t737 + t1045*w_B_app16_z) + t736*t933);
+  const T t1047 = ((((t1002/2.0 + t1008/2.0) + t1014/2.0) + (t1021/2.0 + t1027/2.0)) + ((t1033/2.0 + t1040/2.0) + (t1046/2.0 + t945/2.0))) + (((t951/2.0 + t957/2.0) + (t964/2.0 + t970/2.0)) + ((t976/2.0 + t983/2.0) + (t989/2.0 + t995/2.0)));
   const T t1048 = app1_k*q[7]*q[7]/2.0;
   const T t1049 = app2_k*q[8]*q[8]/2.0 + t1048;
   const T t1050 = q[9]*q[9]/2.0 + t1049;
@@ -6079,7 +6093,7 @@ void momentum(const T* q, const T* u, T* pH) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
   // ---- body hub: outward pass (velocities)
-  const T t0 = (1.0/sqrt(q[3]*q[3] + q[4]*q[4] + q[5]*q[5] + q[6]*q[6]));
+  const T t0 = (1.0/sqrt((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
   const T t1 = q[3]*t0;
   const T t2 = q[4]*t0;
   const T t3 = q[5]*t0;
@@ -6663,9 +6677,9 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t939 = -hub_S0_y*u[5] + hub_mass*u[0];
   const T t940 = hub_S0_x*u[5] + hub_mass*u[1];
   const T t941 = -hub_S0_x*u[4] + hub_S0_y*u[3] + hub_mass*u[2];
-  const T t942 = hub_J0_xx*u[3] + hub_J0_xy*u[4] + hub_J0_xz*u[5] + hub_S0_y*u[2];
-  const T t943 = hub_J0_xy*u[3] + hub_J0_yy*u[4] + hub_J0_yz*u[5] - hub_S0_x*u[2];
-  const T t944 = hub_J0_xz*u[3] + hub_J0_yz*u[4] + hub_J0_zz*u[5] + hub_S0_x*u[1] - hub_S0_y*u[0];
+  const T t942 = (hub_J0_xx*u[3] + hub_J0_xy*u[4]) + (hub_J0_xz*u[5] + hub_S0_y*u[2]);
+  const T t943 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + hub_J0_yz*u[5]) - hub_S0_x*u[2];
+  const T t944 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + (hub_J0_zz*u[5] + hub_S0_x*u[1])) - hub_S0_y*u[0];
   const T t945 = t14*t939 + t15*t940 + t16*t941;
   const T t946 = t17*t939 + t18*t940 + t19*t941;
   const T t947 = t20*t939 + t21*t940 + t22*t941;

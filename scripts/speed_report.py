@@ -61,7 +61,8 @@ def peer_udot(bindir, model, quick, rows):
         if code == 0:
             j = json.loads(out)
             row.update({k: j.get(k) for k in ("ns_mujoco", "ns_generated", "ns_generated_native", "ns_generic",
-                                               "max_rel_diff_generated", "kanegen_jit_seconds")})
+                                               "max_rel_diff_generated", "kanegen_jit_seconds",
+                                               "backward_error_mujoco", "cond_M")})
             row["nu"] = len(j["u_names"])
         else:
             row["mujoco_error"] = (err.strip().splitlines() or ["?"])[-1]
@@ -76,10 +77,18 @@ def peer_udot(bindir, model, quick, rows):
                 j = json.loads(out)
                 row["ns_simbody"] = j.get("ns_per_eval")
                 row["simbody_diff"] = j.get("max_rel_diff")
+                row["simbody_backward"] = j.get("backward_error")
             else:
                 row["simbody_error"] = (err.strip().splitlines() or ["?"])[-1]
     print(f"  {name}: {row}", file=sys.stderr)
     rows.append(row)
+
+
+def bw(b, r):
+    """The backward error, shown where the forward difference exceeds 1e-12."""
+    if b is None or r.get("max_rel_diff_generated", 0) <= 1e-12:
+        return ""
+    return f" (backward {b:.0e}, cond(M) {r.get('cond_M', float('nan')):.0e})"
 
 
 def fmt_ns(v):
@@ -118,35 +127,70 @@ def work_precision(bindir, img):
 
 
 def simulate_ratios(bindir, quick):
+    """Both engines, the integrator auto picks, over a horizon long enough to time (>= 0.2 s generated)."""
     kanegen = os.path.join(bindir, "kanegen")
     rows = []
     models = sorted(f for f in os.listdir(os.path.join(ROOT, "models")) if f.endswith(".yaml"))
+    wall_re = re.compile(r"rhs evals, \d+ jac evals, ([0-9.e+-]+) s")
     for f in models:
         path = os.path.join(ROOT, "models", f)
-        text = open(path).read()
-        m = re.search(r"bench-t-end:\s*([0-9.e+]+)", text)
-        t_end = float(m.group(1)) if m else 10.0
-        args = ["--t-end", repr(t_end), "--dt-out", repr(t_end / 100), "--no-progress"]
         with tempfile.TemporaryDirectory() as d:
             csv = os.path.join(d, "o.csv")
-            code, _, err = run([kanegen, "simulate", path, "-o", csv] + args)
-            if code != 0:
-                rows.append(dict(model=f[:-5], error=err.strip().splitlines()[-1]))
+
+            def sim(t_end, extra):
+                code, _, err = run([kanegen, "simulate", path, "-o", csv, "--t-end", repr(t_end), "--dt-out",
+                                    repr(t_end / 100), "--no-progress"] + extra)
+                w = wall_re.search(err)
+                return code, err, (float(w.group(1)) if w else None)
+
+            t_end = 10.0
+            code, err, w = sim(t_end, [])
+            if code != 0 or w is None:
+                rows.append(dict(model=f[:-5], error=(err.strip().splitlines() or ["?"])[-1]))
                 continue
             integ = err.split(":")[0].strip()
+            if w < 0.2:
+                t_end = min(t_end * 0.2 / max(w, 1e-4), 1e4)
             walls = {"generated": [], "generic": []}
             for _ in range(1 if quick else 3):
                 for eng in ("generated", "generic"):
-                    code, _, err = run([kanegen, "simulate", path, "-o", csv, "--engine", eng, "--integrator", integ]
-                                       + args)
-                    w = re.search(r"rhs evals, \d+ jac evals, ([0-9.]+) s", err)
-                    if code == 0 and w:
-                        walls[eng].append(float(w.group(1)))
+                    code, _, w = sim(t_end, ["--engine", eng, "--integrator", integ])
+                    if code == 0 and w is not None:
+                        walls[eng].append(w)
         row = dict(model=f[:-5], t_end=t_end, integrator=integ,
                    generated=statistics.median(walls["generated"]) if walls["generated"] else None,
                    generic=statistics.median(walls["generic"]) if walls["generic"] else None)
         print(f"  simulate {row}", file=sys.stderr)
         rows.append(row)
+    return rows
+
+
+def error_estimates(bindir):
+    """simulate's --estimate-error at the defaults against the error kanegen bench measures (its own reference)."""
+    kanegen = os.path.join(bindir, "kanegen")
+    rows = []
+    for f in sorted(f for f in os.listdir(os.path.join(ROOT, "models")) if f.endswith(".yaml")):
+        path = os.path.join(ROOT, "models", f)
+        t_end = 10.0
+        with tempfile.TemporaryDirectory() as d:
+            code, _, err = run([kanegen, "simulate", path, "--t-end", repr(t_end), "--dt-out", repr(t_end / 50),
+                                "--no-progress", "--estimate-error", "-o", os.path.join(d, "o.csv")])
+            est = re.search(r"estimated error ([0-9.e+-]+)", err)
+            integ = err.split(":")[0].strip()
+            drift = re.search(r"accuracy: (.*)", err)
+            code2, _, err2 = run([kanegen, "bench", path, "--engines", "generated", "--integrators", integ,
+                                  "--tolerances", "1e-10", "--repeats", "1", "--no-plot", "--t-end", repr(t_end),
+                                  "--out", d])
+            true = None
+            csvs = [x for x in os.listdir(d) if x.endswith("_work_precision.csv")]
+            if code2 == 0 and csvs:
+                import csv as csvmod
+                for r in csvmod.DictReader(open(os.path.join(d, csvs[0]))):
+                    if r["integrator"] == integ and r["error"]:
+                        true = float(r["error"])
+        rows.append(dict(model=f[:-5], integrator=integ, estimate=float(est.group(1)) if est else None, true=true,
+                         accuracy=drift.group(1) if drift else ""))
+        print(f"  estimate {rows[-1]}", file=sys.stderr)
     return rows
 
 
@@ -220,6 +264,8 @@ def main():
     wp, wp_err = work_precision(bindir, img)
     print("simulate", file=sys.stderr)
     sims = simulate_ratios(bindir, a.quick)
+    print("error estimates", file=sys.stderr)
+    ests = error_estimates(bindir)
     print("per-step overhead", file=sys.stderr)
     over = per_step_overhead(bindir)
     print("compile", file=sys.stderr)
@@ -246,7 +292,9 @@ def main():
           "generated u-dot (JIT at the default flags, and with `--native`, i.e. `-march=native`), kanegen's "
           "generic engine and MuJoCo 2.2's `mj_forward` interleaved in one process; Simbody 3.7 (`realize` "
           "to Acceleration) in its own process right after. u-dot of MuJoCo and Simbody checked against "
-          "kanegen's before timing (largest relative difference in the last columns).", "",
+          "kanegen's before timing: largest relative difference (last columns), accepted up to 1e-12, or, where "
+          "M is ill-conditioned (two correct solvers then differ by up to cond(M)·1e-16), a normwise backward "
+          "error of the peer's u-dot in kanegen's M u-dot = F below 1e-14 (given in brackets with cond(M)).", "",
           "| model | nu | u-dot ops (form) | generated | native | generic | MuJoCo | MuJoCo / generated | "
           "MuJoCo / native | Simbody | Simbody / generated | diff MuJoCo | diff Simbody |",
           "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
@@ -261,8 +309,8 @@ def main():
                  f"{fmt_ns(r.get('ns_mujoco'))} | {ratio(r.get('ns_mujoco'), r.get('ns_generated'))} | "
                  f"{ratio(r.get('ns_mujoco'), r.get('ns_generated_native'))} | {fmt_ns(r.get('ns_simbody'))} | "
                  f"{ratio(r.get('ns_simbody'), r.get('ns_generated'))} | "
-                 f"{r.get('max_rel_diff_generated', float('nan')):.1e} | "
-                 f"{'—' if sd is None else format(sd, '.1e')} |")
+                 f"{r.get('max_rel_diff_generated', float('nan')):.1e}{bw(r.get('backward_error_mujoco'), r)} | "
+                 f"{'—' if sd is None else format(sd, '.1e')}{bw(r.get('simbody_backward'), r)} |")
     L.append("")
     if wp:
         L += ["## Work-precision: chain_8 over 10 s", "",
@@ -284,17 +332,30 @@ def main():
     else:
         L += ["## Work-precision", "", f"not measured: {wp_err.strip()[-300:]}", ""]
     L += ["## `kanegen simulate`: generated against generic engine", "",
-          "Every model in `models/` over its `bench-t-end` (else 10 s), 100 output rows, the integrator that "
-          "`--integrator auto` picks at the default tolerances, then both engines with that integrator "
-          "(integration wall time from the summary, median of alternating runs):", "",
+          "Every model in `models/`, 100 output rows, at the default tolerances with the integrator that "
+          "`--integrator auto` picks, both engines with that integrator, over a horizon long enough that the "
+          "generated run takes about 0.2 s (10 s at least; integration wall time from the summary, median of "
+          "alternating runs):", "",
           "| model | t_end [s] | integrator | generated [s] | generic [s] | generic / generated |",
           "|---|---:|---|---:|---:|---:|"]
     for s in sims:
         if "error" in s:
             L.append(f"| {s['model']} | | failed: {s['error']} | | | |")
             continue
-        L.append(f"| {s['model']} | {s['t_end']:g} | {s['integrator']} | {s['generated']:.4f} | "
-                 f"{s['generic']:.4f} | {ratio(s['generic'], s['generated'])} |")
+        L.append(f"| {s['model']} | {s['t_end']:.4g} | {s['integrator']} | {s['generated']:.4g} | "
+                 f"{s['generic']:.4g} | {ratio(s['generic'], s['generated'])} |")
+    L.append("")
+    L += ["## Error estimate against the error `kanegen bench` measures", "",
+          "Every model in `models/` over 10 s at the defaults (`--integrator auto`, rtol 1e-10, atol 1e-12; 50 "
+          "output intervals): the summary's `--estimate-error` figure against the error that `kanegen bench` "
+          "measures for the same integrator and tolerance against its own reference run (generated engine), "
+          "and the summary's accuracy line:", "",
+          "| model | integrator | estimate | bench error | estimate / bench | summary |", "|---|---|---:|---:|---:|---|"]
+    for e in ests:
+        est, tr = e["estimate"], e["true"]
+        q = "—" if est is None or tr is None or tr == 0 else f"{est / tr:.2g}"
+        L.append(f"| {e['model']} | {e['integrator']} | {'—' if est is None else format(est, '.2e')} | "
+                 f"{'—' if tr is None else format(tr, '.2e')} | {q} | {e['accuracy']} |")
     L.append("")
     c8 = next((r for r in rows if r["model"] == "chain_8"), {})
     u8 = c8.get("ns_generated")

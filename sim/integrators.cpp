@@ -414,7 +414,10 @@ IntegratorStats integrate_sundials(const OdeProblem& problem, const IntegratorOp
       stepper = std::make_unique<DirkStepper>(ctx.get(), y.get(), t0, t_end, opt, data, user_jac);
       break;
     case IntegratorKind::rk4:
-      throw std::logic_error("integrate_sundials called for rk4");
+    case IntegratorKind::dopri5:
+    case IntegratorKind::rkf78:
+    case IntegratorKind::automatic:
+      throw std::logic_error("integrate_sundials called for " + to_string(opt.kind));
   }
 
   Eigen::VectorXd xo(n);
@@ -588,7 +591,7 @@ IntegratorKind integrator_from_string(const std::string& name) {
 }
 
 std::string IntegratorStats::summary() const {
-  return fmt::format("{}: {} steps, {} rhs evals, {} jac evals, {:.3f} s", integrator, steps, rhs_evals, jac_evals,
+  return fmt::format("{}: {} steps, {} rhs evals, {} jac evals, {:.4g} s", integrator, steps, rhs_evals, jac_evals,
                      wall_seconds);
 }
 

@@ -1,5 +1,6 @@
 #include "sim/simulate.hpp"
 
+#include "engine/generated_engine.hpp"
 #include "model/output_file.hpp"
 #include "sim/integrator_choice.hpp"
 #include "sim/work_precision.hpp"
@@ -94,8 +95,54 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
   scratch->x.resize(nq + nu);
   OdeProblem p;
   p.n = nq + nu;
-  p.rhs = [&engine, &model, tau, scratch, failure, nq, nu, stabilize_quaternions](double t, const double* x,
-                                                                                  double* xdot) -> int {
+  // Constraint stabilization of the quaternion norm: + lambda (1 - |q|^2) q,
+  // zero on the unit sphere (so q_dot there is exactly W(q) u of the spec)
+  // and attracting the integrated quaternion back to it at a rate 2 lambda,
+  // lambda = |w| + 1/s: the rotation's own time scale, so it adds no
+  // stiffness. Integration error would otherwise let the norm drift.
+  std::vector<std::pair<int, int>> free_joints;  // (first quaternion q, first angular speed u)
+  if (stabilize_quaternions)
+    for (const Body& b : model.bodies)
+      if (b.joint.type == JointType::free) free_joints.emplace_back(b.q_joint + 3, b.u_joint + 3);
+  auto stabilize = [free_joints, nq](const double* x, double* xdot) {
+    for (const auto& [iq, iw] : free_joints) {
+      const double* quat = x + iq;
+      const double* w = x + nq + iw;
+      const double lambda = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) + 1.0;
+      const double c = lambda * (1.0 - (quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]));
+      for (int k = 0; k < 4; ++k) xdot[iq + k] += c * quat[k];
+    }
+  };
+  if (auto* g = dynamic_cast<GeneratedEngine*>(&engine)) {
+    // the generated code's own entry: x in, x_dot out, nothing copied
+    p.rhs = [g, &engine, tau, scratch, failure, nq, nu, stabilize](double t, const double* x, double* xdot) -> int {
+      for (int i = 0; i < nq + nu; ++i)
+        if (!std::isfinite(x[i])) {
+          if (failure) *failure = fmt::format("non-finite state at t = {:.17g}", t);
+          return -1;
+        }
+      if (g->state_derivative(t, x, tau.data(), xdot) != 0) {
+        Scratch& s = *scratch;  // the engine's own call names the failed pivot
+        s.q = Eigen::Map<const VecX>(x, nq);
+        s.u = Eigen::Map<const VecX>(x + nq, nu);
+        try {
+          engine.udot(t, s.q, s.u, tau, s.udot);
+        } catch (const SingularMassMatrix& e) {
+          if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
+        }
+        return -1;
+      }
+      stabilize(x, xdot);
+      for (int i = nq; i < nq + nu; ++i)
+        if (!std::isfinite(xdot[i])) {
+          if (failure) *failure = fmt::format("non-finite accelerations at t = {:.17g}", t);
+          return 1;  // recoverable: the integrator retries with a smaller step
+        }
+      return 0;
+    };
+  }
+  if (!p.rhs) p.rhs = [&engine, tau, scratch, failure, nq, nu, stabilize](double t, const double* x,
+                                                                           double* xdot) -> int {
     Scratch& s = *scratch;
     s.x = Eigen::Map<const VecX>(x, nq + nu);
     if (!s.x.allFinite()) {
@@ -113,19 +160,9 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
       if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
       return -1;
     }
-    // Constraint stabilization of the quaternion norm: + lambda (1 - |q|^2) q,
-    // zero on the unit sphere (so q_dot there is exactly W(q) u of the spec)
-    // and attracting the integrated quaternion back to it at a rate 2 lambda,
-    // lambda = |w| + 1/s: the rotation's own time scale, so it adds no
-    // stiffness. Integration error would otherwise let the norm drift.
-    for (const Body& b : model.bodies) {
-      if (b.joint.type != JointType::free || !stabilize_quaternions) continue;
-      const auto quat = s.q.segment<4>(b.q_joint + 3);
-      const double lambda = s.u.segment<3>(b.u_joint + 3).norm() + 1.0;
-      s.qdot.segment<4>(b.q_joint + 3) += lambda * (1.0 - quat.squaredNorm()) * quat;
-    }
     Eigen::Map<VecX>(xdot, nq) = s.qdot;
     Eigen::Map<VecX>(xdot + nq, nu) = s.udot;
+    stabilize(x, xdot);
     if (!s.udot.allFinite()) {
       if (failure) *failure = fmt::format("non-finite accelerations at t = {:.17g}", t);
       return 1;  // recoverable: the integrator retries with a smaller step
