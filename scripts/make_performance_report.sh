@@ -27,7 +27,7 @@ if [ ! -f "$BUILD/CMakeCache.txt" ]; then
   cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=Release
 fi
 cmake --build "$BUILD" -j2 --target kanegen
-KANEGEN=$BUILD/kanegen
+KANEGEN=$BUILD/bin/kanegen
 
 if [ -f models/extreme/stiff_appendage.yaml ]; then
   STIFF=(models/extreme/stiff_appendage.yaml --t-end "$STIFF_T_END")

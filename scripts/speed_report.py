@@ -355,7 +355,7 @@ def main():
         est, tr = e["estimate"], e["true"]
         q = "—" if est is None or tr is None or tr == 0 else f"{est / tr:.2g}"
         L.append(f"| {e['model']} | {e['integrator']} | {'—' if est is None else format(est, '.2e')} | "
-                 f"{'—' if tr is None else format(tr, '.2e')} | {q} | {e['accuracy']} |")
+                 f"{'—' if tr is None else format(tr, '.2e')} | {q} | {e['accuracy'].replace('|', chr(92) + '|')} |")
     L.append("")
     c8 = next((r for r in rows if r["model"] == "chain_8"), {})
     u8 = c8.get("ns_generated")
@@ -384,7 +384,8 @@ def main():
     L.append("")
     L += ["## Generated against generic on every model, and pin chains", "",
           "From `build/bin/kanegen_speed_report --chains 2,7,15,30` (bench/speed_report.cpp): axis-aligned pin "
-          "chains (axes cycling z, y, x) and the models of `models/` and `tests/reference/`.", "", sr.strip(), ""]
+          "chains (axes cycling z, y, x) and the models of `models/` and `tests/reference/`.", "",
+          sr.strip().replace("\n## ", "\n### ").replace("## ", "### ", 1), ""]
     pins = {}
     for line in sr.splitlines():
         m = re.match(r"\| (\d+) \| (\d+) \((\w+)\) \| (\d+) \| (\d+) \|", line)

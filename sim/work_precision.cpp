@@ -706,7 +706,10 @@ std::vector<RunRecord> bench_model(const std::string& model_path, const BenchOpt
 // ---- CLI entry --------------------------------------------------------------------
 
 int run_bench(std::vector<std::string> models, BenchOptions opt, const std::string& suite) {
-  for (const std::string& n : opt.integrators)
+  for (const std::string& n : opt.integrators) {
+    if (n == "auto")
+      throw InputError(Diagnostic{"--integrators", 0, "",
+                                  "'auto' picks one method per run (kanegen simulate); name the methods to compare"});
     if (n != "cvode-bdf-fd") {
       try {
         (void)integrator_from_string(n);
@@ -714,6 +717,7 @@ int run_bench(std::vector<std::string> models, BenchOptions opt, const std::stri
         throw InputError(Diagnostic{"--integrators", 0, "", std::string(e.what()) + ", cvode-bdf-fd"});
       }
     }
+  }
   for (const std::string& e : opt.engines)
     if (e != "generated" && e != "generic")
       throw InputError(

@@ -62,8 +62,8 @@ namespace kanegen::bench {
 
 struct BenchOptions {
   std::vector<std::string> engines{"generated", "generic"};
-  std::vector<std::string> integrators{"cvode-bdf",  "cvode-bdf-fd", "cvode-bdf2", "cvode-adams",
-                                       "arkode-erk", "arkode-dirk",  "rk4"};
+  std::vector<std::string> integrators{"rkf78",      "dopri5",      "cvode-bdf", "cvode-bdf-fd", "cvode-bdf2",
+                                       "cvode-adams", "arkode-erk", "arkode-dirk", "rk4"};
   std::vector<double> tolerances;  ///< empty: 1e-4,1e-6,1e-8,1e-10 (quick: 1e-4,1e-7)
   std::vector<double> rk4_steps;   ///< empty: {64,16,4,1} (quick: {32,4}) x mean step of the DP5 reference
   std::optional<double> t_end;    ///< empty: default_t_end(model file)
