@@ -113,7 +113,7 @@ def main():
 
 # ---- report mode -------------------------------------------------------------------
 
-DEFAULT_INTEGRATOR = "cvode-bdf"  # kanegen simulate's default
+DEFAULT_INTEGRATOR = "rkf78"  # what kanegen simulate's --integrator auto picks for non-stiff scenes
 
 
 def time_to_reach(points, target):
@@ -266,7 +266,8 @@ def report(argv):
     faster = ("which was faster than the generic one for every integrator and target measured here"
               if all_ratios and max(all_ratios) < 1 else "see the generated / generic ratios below")
     L.insert(header_at, "Fastest configuration measured for each scene and accuracy target (generated engine, "
-             f"{faster}; in brackets the time with `{DEFAULT_INTEGRATOR}`, the default of `kanegen simulate`):\n")
+             f"{faster}; in brackets the time with `{DEFAULT_INTEGRATOR}`, which `kanegen simulate --integrator auto`, "
+             "the default, picks for non-stiff scenes):\n")
     L.append("")
     L.append("Measured facts behind the advice:\n")
     for f in facts:
