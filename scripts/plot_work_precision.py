@@ -290,34 +290,32 @@ def report(argv):
 GUIDANCE = """Guidance (written from the committed run; the table and facts above are regenerated with
 every run, this text is not: recheck it when they change):
 
-- Use the generated engine whenever the model is fixed for more than one run: with the same algorithm
-  (same integrator and the same kind of Jacobian, e.g. cvode-bdf-fd against cvode-bdf-fd) it took
-  0.09-0.6 of the generic engine's time at equal error, least with the explicit methods (rk4,
-  arkode-erk), whose cost is nothing but right-hand sides. The JIT compile is paid once per model
-  (cached). For the implicit methods on the stiff scene the generated/generic ratios also reflect the
-  exact-versus-finite-difference Jacobian steering the steps differently, in both directions.
+- Use the generated engine whenever the model is fixed for more than one run: with the same
+  integrator it took 0.06-0.53 of the generic engine's time at equal error on the non-stiff scenes,
+  least with the explicit methods, whose cost is nothing but right-hand sides. The JIT compile is paid
+  once per model (cached). On the stiff scene the implicit methods' ratios also reflect the exact
+  versus finite-difference Jacobian steering the steps differently, in both directions.
 - Non-stiff scenes (spinners, slews, flexible appendages with modes up to a few Hz: explorer1,
-  explorer1_rigid): arkode-erk (Dormand-Prince 5(4)). At 1e-4 and 1e-6 it was the fastest or within
-  ~30 % of it (rk4 at a step that happened to suit, cvode-adams at 1e-4), and it is the adaptive
-  method that reaches 1e-8 (0.19 s on explorer1): its error is 100-300 times its tolerance over 200 s,
-  so ask for 1e-10..1e-11 when 1e-8 is needed. rk4 competes only with a step picked by hand.
+  explorer1_rigid): rkf78 (Runge-Kutta-Fehlberg 7(8)) was the fastest at every target it reached, and
+  it is what `--integrator auto` picks there. dopri5 is close at 1e-4; arkode-erk (the same
+  Dormand-Prince 5(4) as dopri5, through SUNDIALS) takes 2-2.5 times dopri5's time for about the same steps;
+  cvode-adams and the BDF methods are slower and less accurate per tolerance. On explorer1 no method
+  reached 1e-8: every tight run stops at about 3e-7, the accuracy of the reference itself over 200 s
+  of a 750 rpm spinner (arkode-erk at 1e-13 on the generic engine).
 - Stiff scenes (lightly damped kHz modes next to slow rigid motion: stiff_appendage): an implicit
-  method at loose tolerance steps over the modes, in tens to hundreds of steps where the explicit
-  methods and cvode-adams need ~27000 steps per simulated second at their stability limit whatever the
-  tolerance: cvode-bdf with the generated exact Jacobian at 1e-4, arkode-dirk or cvode-bdf2 at 1e-6.
-  cvode-bdf is fragile there: from some tolerance on it collapses to the explicit methods' step count,
-  by raising its order to 3-5, which is not A-stable for lightly damped oscillations; cvode-bdf2 (BDF
-  capped at order 2) does not (20x fewer steps on such an oscillator in tests/test_integrators.cpp), and CVODE's
-  stability-limit detection did not help here (more steps, measured). arkode-dirk degrades smoothly.
-  Below 1e-8
-  during the kHz transient only rk4 at the step its stability requires anyway got there.
-- cvode-bdf, the default of `kanegen simulate`, was the fastest only on the stiff scene at 1e-4;
-  elsewhere it took 2-6 times the fastest time at 1e-4 and did not reach 1e-6 on the explorer models
-  within the sweep: its error at a given tolerance is the largest of the adaptive methods. Its exact
-  Jacobian from the generated code did not pay on the non-stiff scenes (0.99-1.4 times the time with
-  finite differences); on the stiff one it is what keeps the large steps.
+  method at loose tolerance steps over the modes, in tens to hundreds of steps, where the explicit
+  methods and cvode-adams need ~27,000 steps per simulated second at their stability limit whatever
+  the tolerance: cvode-bdf with the generated exact Jacobian at 1e-4, arkode-dirk at 1e-6 (at rtol
+  1e-8 it reached 7e-8 in 0.044 s). cvode-bdf is fragile there: from some tolerance on it collapses to the explicit methods'
+  step count by raising its order (orders 3-5 are not A-stable for lightly damped oscillations);
+  cvode-bdf2 (BDF capped at order 2) does not. `--integrator auto` takes this scene for non-stiff
+  (its dominant eigenvalue, -493 + 48,900i, is a lightly damped oscillation that an explicit method
+  resolves in about 7.4e4 steps over 5 s, under the 1e7 at which it switches to cvode-bdf2): rkf78 then takes 0.53 s
+  at any tolerance, accurate to 1.7e-8 at 1e-10; name `--integrator arkode-dirk` when that scene is
+  run often.
 - Tolerances do not translate one-to-one into accuracy: over long runs the error is 10-1000 times the
-  tolerance (nutation phase, modal phase). Measure with `kanegen bench` at the accuracy needed.
+  tolerance (nutation phase, modal phase); hence the default rtol 1e-10. `kanegen simulate
+  --estimate-error` reports the error of a run; measure with `kanegen bench` to choose a method.
 """
 
 
