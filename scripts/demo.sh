@@ -10,7 +10,6 @@ bash scripts/build.sh
 mkdir -p out/explorer1_rigid
 ./build/bin/kanegen check models/explorer1_rigid.yaml
 ./build/bin/kanegen simulate models/explorer1_rigid.yaml --t-end 3000 --dt-out 0.1 \
-  --integrator cvode-adams --rtol 1e-10 --atol 1e-12 \
   -o out/explorer1_rigid/explorer1_rigid.csv
 /usr/bin/python3 scripts/plot_simulation.py out/explorer1_rigid/explorer1_rigid.csv \
   --model models/explorer1_rigid.yaml -o out/explorer1_rigid
