@@ -1,7 +1,12 @@
-// Shared by the benchmarks: a reproducible state near the model's initial one.
+// Shared by the benchmarks: a reproducible state near the model's initial one,
+// and timing of calls interleaved in rounds.
 #pragma once
 
+#include <algorithm>
+#include <chrono>
+#include <functional>
 #include <random>
+#include <vector>
 
 #include "model/model.hpp"
 #include "model/state_io.hpp"
@@ -19,6 +24,42 @@ inline State random_state(const Model& model, unsigned seed, double speed = 1.0)
     if (b.joint.type == JointType::free) s.q.segment<4>(b.q_joint + 3).normalize();
   for (int i = 0; i < model.nu; ++i) s.u(i) = speed * U(rng);
   return s;
+}
+
+/// Calls per batch so that one batch of f takes more than `seconds`
+/// (doubling from 1, at most 2^26).
+template <class F>
+long batch_size(F&& f, double seconds) {
+  using Clock = std::chrono::steady_clock;
+  long n = 1;
+  for (;;) {
+    const auto t0 = Clock::now();
+    for (long i = 0; i < n; ++i) f();
+    if (std::chrono::duration<double>(Clock::now() - t0).count() > seconds || n > (1L << 26)) return n;
+    n *= 2;
+  }
+}
+
+/// Median ns per call of each function, timed interleaved: in each of
+/// `rounds` rounds one batch of each (batches of about `batch_seconds`).
+inline std::vector<double> interleaved_ns_per_call(const std::vector<std::function<void()>>& fns, int rounds,
+                                                   double batch_seconds) {
+  using Clock = std::chrono::steady_clock;
+  std::vector<long> batch;
+  for (const auto& f : fns) batch.push_back(batch_size(f, batch_seconds));
+  std::vector<std::vector<double>> ns(fns.size());
+  for (int r = 0; r < rounds; ++r)
+    for (std::size_t e = 0; e < fns.size(); ++e) {
+      const auto t0 = Clock::now();
+      for (long i = 0; i < batch[e]; ++i) fns[e]();
+      ns[e].push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / batch[e]);
+    }
+  std::vector<double> median;
+  for (auto& v : ns) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    median.push_back(v[v.size() / 2]);
+  }
+  return median;
 }
 
 }  // namespace kanegen::bench

@@ -29,27 +29,6 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 
-/// ns per call of f: median over `repeats` batches sized to ~2 ms each.
-template <class F>
-double ns_per_call(F&& f, int repeats) {
-  int batch = 1;
-  for (;;) {
-    const auto t0 = Clock::now();
-    for (int i = 0; i < batch; ++i) f();
-    const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
-    if (dt > 2e-3 || batch > (1 << 24)) break;
-    batch *= 2;
-  }
-  std::vector<double> v;
-  for (int r = 0; r < repeats; ++r) {
-    const auto t0 = Clock::now();
-    for (int i = 0; i < batch; ++i) f();
-    v.push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / batch);
-  }
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
 struct Row {
   std::string name;
   int bodies, nu;
@@ -81,15 +60,11 @@ Row measure(const Model& model, const JitOptions& jit, int repeats, bool cold) {
   const State s = bench::random_state(model, 1, 0.5);
   VecX ud(model.nu);
   // Interleave the two engines so that machine noise hits both alike.
-  std::vector<double> g, c;
-  for (int k = 0; k < 3; ++k) {
-    g.push_back(ns_per_call([&] { generic.udot(s.q, s.u, s.tau, ud); }, repeats));
-    c.push_back(ns_per_call([&] { generated->udot(s.q, s.u, s.tau, ud); }, repeats));
-  }
-  std::sort(g.begin(), g.end());
-  std::sort(c.begin(), c.end());
-  r.generic_ns = g[1];
-  r.generated_ns = c[1];
+  const auto ns = bench::interleaved_ns_per_call({[&] { generic.udot(s.q, s.u, s.tau, ud); },
+                                                  [&] { generated->udot(s.q, s.u, s.tau, ud); }},
+                                                 3 * repeats, 2e-3);
+  r.generic_ns = ns[0];
+  r.generated_ns = ns[1];
   return r;
 }
 

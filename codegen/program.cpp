@@ -70,15 +70,20 @@ std::vector<bool> Program::liveness(std::set<std::string>& needed) const {
   return live;
 }
 
-std::string Program::emit(const std::string& indent, OpCount& ops) const {
-  std::set<std::string> needed;
-  const std::vector<bool> live = liveness(needed);
+std::string Program::used_preludes(const std::set<std::string>& needed, const std::string& indent) const {
   std::string out;
   for (const Prelude& p : preludes_) {
     bool used = false;
     for (const auto& d : p.defines) used = used || needed.count(d);
     if (used) out += indent + p.text + "\n";
   }
+  return out;
+}
+
+std::string Program::emit(const std::string& indent, OpCount& ops) const {
+  std::set<std::string> needed;
+  const std::vector<bool> live = liveness(needed);
+  std::string out = used_preludes(needed, indent);
   const std::string* pending = nullptr;  // a section marker not yet printed
   for (std::size_t k = 0; k < temps_.size(); ++k) {
     if (!temps_[k].section.empty()) {
@@ -161,12 +166,7 @@ ChunkedBody Program::emit_chunked(const std::string& indent, OpCount& ops, long 
   for (const Stmt& s : stmts_)
     if (s.lhs.empty()) uses(s.value, last);
   // 3. the parts
-  std::string prelude;
-  for (const Prelude& p : preludes_) {
-    bool used = false;
-    for (const auto& d : p.defines) used = used || needed.count(d);
-    if (used) prelude += indent + p.text + "\n";
-  }
+  const std::string prelude = used_preludes(needed, indent);
   ChunkedBody out;
   out.parts.assign(last, prelude);
   std::string main = prelude;

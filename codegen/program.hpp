@@ -70,6 +70,8 @@ class Program {
  private:
   /// Which temporaries some statement needs; `needed` gets their symbols.
   std::vector<bool> liveness(std::set<std::string>& needed) const;
+  /// The preludes that define a symbol in `needed`, one line each.
+  std::string used_preludes(const std::set<std::string>& needed, const std::string& indent) const;
   struct Temp {
     GiNaC::symbol sym;
     ex value;

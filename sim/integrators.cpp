@@ -591,7 +591,7 @@ IntegratorKind integrator_from_string(const std::string& name) {
 }
 
 std::string IntegratorStats::summary() const {
-  return fmt::format("{}: {} steps, {} rhs evals, {} jac evals, {:.4g} s", integrator, steps, rhs_evals, jac_evals,
+  return fmt::format("{}: {} steps, {} rhs evals, {} jac evals, {:.6f} s", integrator, steps, rhs_evals, jac_evals,
                      wall_seconds);
 }
 

@@ -89,10 +89,9 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
   const Model& model = engine.model();
   const int nq = model.nq, nu = model.nu;
   struct Scratch {
-    VecX x, q, u, qdot, udot;
+    VecX q, u, qdot, udot;
   };
   auto scratch = std::make_shared<Scratch>();
-  scratch->x.resize(nq + nu);
   OdeProblem p;
   p.n = nq + nu;
   // Constraint stabilization of the quaternion norm: + lambda (1 - |q|^2) q,
@@ -113,23 +112,20 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
       for (int k = 0; k < 4; ++k) xdot[iq + k] += c * quat[k];
     }
   };
-  if (auto* g = dynamic_cast<GeneratedEngine*>(&engine)) {
-    // the generated code's own entry: x in, x_dot out, nothing copied
-    p.rhs = [g, &engine, tau, scratch, failure, nq, nu, stabilize](double t, const double* x, double* xdot) -> int {
+  // x_dot = f(t, x) around an engine's evaluation `derivative(t, x, xdot)`
+  // (which throws SingularMassMatrix): the state and the accelerations checked,
+  // the quaternion stabilization added.
+  auto rhs_around = [&](auto derivative) {
+    return [derivative, failure, nq, nu, stabilize](double t, const double* x, double* xdot) -> int {
       for (int i = 0; i < nq + nu; ++i)
         if (!std::isfinite(x[i])) {
           if (failure) *failure = fmt::format("non-finite state at t = {:.17g}", t);
           return -1;
         }
-      if (g->state_derivative(t, x, tau.data(), xdot) != 0) {
-        Scratch& s = *scratch;  // the engine's own call names the failed pivot
-        s.q = Eigen::Map<const VecX>(x, nq);
-        s.u = Eigen::Map<const VecX>(x + nq, nu);
-        try {
-          engine.udot(t, s.q, s.u, tau, s.udot);
-        } catch (const SingularMassMatrix& e) {
-          if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
-        }
+      try {
+        derivative(t, x, xdot);
+      } catch (const SingularMassMatrix& e) {
+        if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
         return -1;
       }
       stabilize(x, xdot);
@@ -140,40 +136,32 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
         }
       return 0;
     };
-  }
-  if (!p.rhs) p.rhs = [&engine, tau, scratch, failure, nq, nu, stabilize](double t, const double* x,
-                                                                           double* xdot) -> int {
+  };
+  // The engines normalize quaternions for M and F; q_dot uses the quaternion
+  // as integrated, whose norm the flow quat_dot = 1/2 quat (x) [0, w] preserves.
+  auto through_engine = [&engine, tau, scratch, nq, nu](double t, const double* x, double* xdot) {
     Scratch& s = *scratch;
-    s.x = Eigen::Map<const VecX>(x, nq + nu);
-    if (!s.x.allFinite()) {
-      if (failure) *failure = fmt::format("non-finite state at t = {:.17g}", t);
-      return -1;
-    }
-    // The engines normalize quaternions for M and F; q_dot uses the quaternion
-    // as integrated, whose norm the flow quat_dot = 1/2 quat (x) [0, w] preserves.
-    s.q = s.x.head(nq);
-    s.u = s.x.tail(nu);
-    try {
-      engine.qdot(s.q, s.u, s.qdot);
-      engine.udot(t, s.q, s.u, tau, s.udot);
-    } catch (const SingularMassMatrix& e) {
-      if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
-      return -1;
-    }
+    s.q = Eigen::Map<const VecX>(x, nq);
+    s.u = Eigen::Map<const VecX>(x + nq, nu);
+    engine.qdot(s.q, s.u, s.qdot);
+    engine.udot(t, s.q, s.u, tau, s.udot);
     Eigen::Map<VecX>(xdot, nq) = s.qdot;
     Eigen::Map<VecX>(xdot + nq, nu) = s.udot;
-    stabilize(x, xdot);
-    if (!s.udot.allFinite()) {
-      if (failure) *failure = fmt::format("non-finite accelerations at t = {:.17g}", t);
-      return 1;  // recoverable: the integrator retries with a smaller step
-    }
-    return 0;
   };
+  if (auto* g = dynamic_cast<GeneratedEngine*>(&engine)) {
+    // the generated code's own entry: x in, x_dot out, nothing copied; on a
+    // failed pivot the engine's own call throws the exception that names it
+    p.rhs = rhs_around([g, tau, through_engine](double t, const double* x, double* xdot) {
+      if (g->state_derivative(t, x, tau.data(), xdot) != 0) through_engine(t, x, xdot);
+    });
+  } else {
+    p.rhs = rhs_around(through_engine);
+  }
   p.project = [&model](double* x) { normalize_quaternions(model, x); };
   if (use_jacobian && engine.has_jacobian()) {
     auto J = std::make_shared<MatX>(nq + nu, nq + nu);
-    p.jacobian = [&engine, &model, tau, scratch, J, failure, nq, nu, stabilize_quaternions](
-                     double t, const double* x, const double*, double* out) -> int {
+    p.jacobian = [&engine, tau, scratch, J, failure, nq, nu, free_joints](double t, const double* x, const double*,
+                                                                           double* out) -> int {
       Scratch& s = *scratch;
       s.q = Eigen::Map<const VecX>(x, nq);
       s.u = Eigen::Map<const VecX>(x + nq, nu);
@@ -184,11 +172,10 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
         return -1;
       }
       // plus the derivative of the quaternion stabilization term of the rhs
-      for (const Body& b : model.bodies) {
-        if (b.joint.type != JointType::free || !stabilize_quaternions) continue;
-        const int iq = b.q_joint + 3, iw = nq + b.u_joint + 3;
-        const Eigen::Vector4d quat = s.q.segment<4>(b.q_joint + 3);
-        const Eigen::Vector3d w = s.u.segment<3>(b.u_joint + 3);
+      for (const auto& [iq, iw_u] : free_joints) {
+        const int iw = nq + iw_u;
+        const Eigen::Vector4d quat = s.q.segment<4>(iq);
+        const Eigen::Vector3d w = s.u.segment<3>(iw_u);
         const double lambda = w.norm() + 1.0, c = 1.0 - quat.squaredNorm();
         J->block<4, 4>(iq, iq) += lambda * (c * Eigen::Matrix4d::Identity() - 2.0 * quat * quat.transpose());
         if (w.norm() > 0) J->block<4, 3>(iq, iw) += c * quat * (w / w.norm()).transpose();
@@ -368,26 +355,23 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   }
   bar.finish();
 
-  double total_mass = 0;
-  for (const Body& b : model.bodies) total_mass += b.total_mass;
-  const bench::Drifts d = bench::invariant_drifts(engine, bench::invariants_of(model, initial.tau), sampled.traj,
-                                                  total_mass);
+  const bench::Drifts d = bench::invariant_drifts(engine, bench::invariants_of(model, initial.tau), sampled.traj);
   quality.energy_drift = d.energy;
   quality.H_drift = d.H;
   if (options.estimate_error) {
     // the same method at tolerances 100 times tighter, at the same output times
-    SimulationOptions tight = options;
-    tight.integrator.rtol /= 100;
-    tight.integrator.atol /= 100;
-    tight.integrator.h /= 10;  // rk4: error / 1e4
-    tight.integrator.max_steps = 0;
+    IntegratorOptions tight = options.integrator;
+    tight.rtol /= 100;
+    tight.atol /= 100;
+    tight.h /= 10;  // rk4: error / 1e4
+    tight.max_steps = 0;
     SampledRun ref;
     ref.stride = sampled.stride;
     std::string f2;
     OdeProblem p2 = make_ode_problem(engine, initial.tau, &f2, options.use_jacobian,
                                      options.integrator.kind != IntegratorKind::rk4);
     try {
-      integrate(p2, tight.integrator, initial.t, x0, options.t_end, options.dt_out, [&](double t, const VecX& x) {
+      integrate(p2, tight, initial.t, x0, options.t_end, options.dt_out, [&](double t, const VecX& x) {
         ref.add(t, x, !(t < options.t_end));
         return true;
       });

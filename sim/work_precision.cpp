@@ -238,9 +238,11 @@ struct Curve {
 
 }  // namespace
 
-Drifts invariant_drifts(Engine& g, const InvariantSet& inv, const Trajectory& tr, double total_mass) {
+Drifts invariant_drifts(Engine& g, const InvariantSet& inv, const Trajectory& tr) {
   Drifts d;
   const Model& m = g.model();
+  double total_mass = 0;
+  for (const Body& b : m.bodies) total_mass += b.total_mass;
   if (tr.x.empty()) return d;
   VecX q, u;
   auto split = [&](const VecX& x) {
@@ -410,9 +412,6 @@ std::vector<RunRecord> bench_model(const std::string& model_path, const BenchOpt
   const double t_end = opt.t_end ? *opt.t_end : default_t_end(model_path);
   if (!(t_end > s0.t)) throw InputError(Diagnostic{"--t-end", 0, "", "must be after the initial time"});
   const double dt_out = (t_end - s0.t) / std::max(1, opt.n_outputs);
-  double total_mass = 0;
-  for (const Body& b : model.bodies) total_mass += b.total_mass;
-
   fmt::print(stderr, "bench {}: t_end {} s, nq {}, nu {}\n", model.name, t_end, model.nq, model.nu);
   GenericEngine reference_engine(model);
   const InvariantSet inv = invariants_of(model, s0.tau);
@@ -556,7 +555,7 @@ std::vector<RunRecord> bench_model(const std::string& model_path, const BenchOpt
         } else {
           rec.message = "no reference solution";
         }
-        const Drifts d = invariant_drifts(reference_engine, inv, warm.traj, total_mass);
+        const Drifts d = invariant_drifts(reference_engine, inv, warm.traj);
         rec.energy_drift = d.energy, rec.H_drift = d.H, rec.p_drift = d.p;
         fmt::print(stderr, "  {:<9} {:<13} {:<9.3g} {:>10}  {:>7} steps  error {:.2e}\n", engine_name, c.label, v,
                    short_time(rec.wall_s), rec.steps, rec.error);

@@ -108,11 +108,11 @@ InvariantSet invariants_of(const Model& model, const VecX& tau);
 
 /// Relative drifts of the invariants that hold (NaN for the others) over the
 /// states of a run: energy max|E - E0| / max(T + |V|); |H - H0| / |H0|;
-/// |p - p0| / sqrt(2 m T_max).
+/// |p - p0| / sqrt(2 m T_max) (m: the model's whole mass).
 struct Drifts {
   double energy = NAN, H = NAN, p = NAN;
 };
-Drifts invariant_drifts(Engine& engine, const InvariantSet& inv, const Trajectory& tr, double total_mass);
+Drifts invariant_drifts(Engine& engine, const InvariantSet& inv, const Trajectory& tr);
 
 /// One sweep point.
 struct RunRecord {

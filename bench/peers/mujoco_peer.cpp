@@ -41,6 +41,7 @@
 #include <mujoco/mujoco.h>
 #include <fmt/format.h>
 
+#include "bench_support.hpp"
 #include "codegen/jit_generator.hpp"
 #include "engine/generic_engine.hpp"
 #include "engine/jit.hpp"
@@ -310,37 +311,6 @@ class MujocoPeer {
 
 using Clock = std::chrono::steady_clock;
 
-/// Calls per batch so that one batch of f takes about `seconds`.
-template <class F>
-long batch_for(F&& f, double seconds) {
-  long n = 1;
-  for (;;) {
-    const auto t0 = Clock::now();
-    for (long i = 0; i < n; ++i) f();
-    if (std::chrono::duration<double>(Clock::now() - t0).count() > seconds || n > (1L << 26)) return n;
-    n *= 2;
-  }
-}
-
-/// The engines timed interleaved: per round, one batch of each; medians of ns per call.
-std::vector<double> interleaved_ns(const std::vector<std::function<void()>>& engines, int rounds) {
-  std::vector<long> batch;
-  for (const auto& f : engines) batch.push_back(batch_for(f, 1e-3));
-  std::vector<std::vector<double>> ns(engines.size());
-  for (int r = 0; r < rounds; ++r)
-    for (std::size_t e = 0; e < engines.size(); ++e) {
-      const auto t0 = Clock::now();
-      for (long i = 0; i < batch[e]; ++i) engines[e]();
-      ns[e].push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / batch[e]);
-    }
-  std::vector<double> med;
-  for (auto& v : ns) {
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    med.push_back(v[v.size() / 2]);
-  }
-  return med;
-}
-
 /// Largest normwise backward error accepted as "the same equations": a peer's
 /// u-dot x is checked in kanegen's M x = F. The forward difference of two
 /// correct solvers can reach cond(M) 1e-16 (chain_64: cond(M) ~ 1e4 .. 1e5).
@@ -449,7 +419,7 @@ int main(int argc, char** argv) {
           engines.push_back([&] { generated_native->udot(q, u, tau, ud_nat); });
         }
       }
-      const auto ns = interleaved_ns(engines, rounds);
+      const auto ns = kanegen::bench::interleaved_ns_per_call(engines, rounds, 1e-3);
       j["ns_mujoco"] = ns[0];
       j["ns_generated"] = ns[1];
       j["ns_generic"] = ns[2];
