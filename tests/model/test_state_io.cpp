@@ -8,6 +8,7 @@
 
 #include "model/model_loader.hpp"
 #include "model/state_io.hpp"
+#include "tests/support/test_support.hpp"
 
 using namespace kanegen;
 using Catch::Matchers::Contains;
@@ -21,12 +22,10 @@ namespace {
 const std::string kRef = std::string(KANEGEN_SOURCE_DIR) + "/tests/reference/";
 std::string data_path(const std::string& rel) { return std::string(KANEGEN_SOURCE_DIR) + "/tests/data/" + rel; }
 
-/// Writes `text` to a temporary STATE.json and returns its path.
+/// Writes `text` to a temporary STATE.json (in this test process's own
+/// directory: ctest runs the test cases of this file in parallel) and returns its path.
 std::string write_state(const std::string& text, const std::string& name = "kanegen_test_state.json") {
-  const auto p = std::filesystem::temp_directory_path() / name;
-  std::ofstream f(p);
-  f << text;
-  return p.string();
+  return test::write_temp(name, text);
 }
 
 std::vector<Diagnostic> refusal(const Model& m, const std::string& path) {
