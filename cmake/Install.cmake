@@ -32,6 +32,6 @@ set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGE_CONTACT "kanegen developers")
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Kane's-method equations of motion for multibody spacecraft, generated as C++")
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "g++, libeigen3-dev, libfmt-dev, libyaml-cpp-dev, nlohmann-json3-dev, libcli11-dev, libsundials-dev, libspectra-dev, libginac11")
+    "g++, libeigen3-dev, libfmt-dev, libyaml-cpp-dev, nlohmann-json3-dev, libcli11-dev, libsundials-dev, libspectra-dev, zlib1g-dev, libginac11")
 set(CPACK_GENERATOR DEB)
 include(CPack)

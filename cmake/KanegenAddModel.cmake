@@ -1,4 +1,4 @@
-# kanegen_add_model(<target> <model.yaml> [SOURCES extra.cpp ...] [NO_MAIN])
+# kanegen_add_model(<target> <model.yaml> [CONTROLLER control.cpp] [SOURCES extra.cpp ...] [NO_MAIN])
 #
 # Builds an ahead-of-time simulator: at build time `kanegen generate` writes
 # the model's header, C entry file and manifest to
@@ -9,13 +9,18 @@
 #   <target> [--t-end T] [--dt-out H] [--integrator NAME] [--rtol R] [--atol A]
 #            [--state S.json] [--model M.yaml] [--eval] -o OUT.csv
 # The model file's absolute path is embedded; it is read at start (names,
-# initial state) and must hash to the code compiled in. NO_MAIN leaves main()
+# initial state) and must hash to the code compiled in.
+# CONTROLLER adds a control law to the simulator (docs/gnc.md): the file
+# defines `kanegen::Controller kanegen_controller(const kanegen::Model&)`
+# (sim/controller.hpp), called once at start; its law sets the model's named
+# inputs from the time, state and named outputs, continuously or as a digital
+# controller at a fixed rate (--open-loop runs without it). NO_MAIN leaves main()
 # to SOURCES (call kanegen::aot_simulator_main() or use the header's functions
 # directly). The simulator links kanegen::sim only: no GiNaC, no generator.
 # Works in kanegen's own build and, after find_package(kanegen), in any project.
 
 function(kanegen_add_model target model)
-  cmake_parse_arguments(PARSE_ARGV 2 ARG "NO_MAIN" "" "SOURCES")
+  cmake_parse_arguments(PARSE_ARGV 2 ARG "NO_MAIN" "CONTROLLER" "SOURCES")
   if(ARG_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "kanegen_add_model(${target}): unexpected arguments ${ARG_UNPARSED_ARGUMENTS}")
   endif()
@@ -36,7 +41,17 @@ function(kanegen_add_model target model)
   if(NOT TARGET CLI11::CLI11)
     find_package(CLI11 REQUIRED)
   endif()
-  add_executable(${target} "${_out}/entry.cpp" ${ARG_SOURCES})
+  set(_controller)
+  if(ARG_CONTROLLER)
+    get_filename_component(_controller "${ARG_CONTROLLER}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    if(NOT EXISTS "${_controller}")
+      message(FATAL_ERROR "kanegen_add_model(${target}): controller file ${_controller} does not exist")
+    endif()
+  endif()
+  add_executable(${target} "${_out}/entry.cpp" ${_controller} ${ARG_SOURCES})
+  if(_controller)
+    target_compile_definitions(${target} PRIVATE KANEGEN_HAS_CONTROLLER)
+  endif()
   target_include_directories(${target} PRIVATE "${_out}")
   target_link_libraries(${target} PRIVATE kanegen::sim CLI11::CLI11)
   if(NOT ARG_NO_MAIN)

@@ -50,6 +50,7 @@ const char* arg_name(Arg a) {
     case Arg::u: return "u";
     case Arg::tau: return "tau";
     case Arg::udot_in: return "udot_in";
+    case Arg::inputs: return "inputs";
     case Arg::out: return "out";
   }
   return "?";
@@ -80,6 +81,7 @@ std::string call_arguments(const EmittedFunction& f) {
       case Arg::u: as.push_back("a->u"); break;
       case Arg::tau: as.push_back("a->tau"); break;
       case Arg::udot_in: as.push_back("a->udot"); break;
+      case Arg::inputs: as.push_back("a->inputs"); break;
       case Arg::out: as.push_back("out"); break;
     }
   }
@@ -168,6 +170,10 @@ AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, 
   replace_all(h, "NQ", std::to_string(m.nq));
   replace_all(h, "NU", std::to_string(m.nu));
   replace_all(h, "NBODIES", std::to_string(m.nbodies));
+  replace_all(h, "NW", std::to_string(m.nw));
+  replace_all(h, "NY", std::to_string(m.ny));
+  replace_all(h, "IO_NAMES", (m.input_names.empty() ? "" : "// Inputs w:      " + join(m.input_names, ", ") + "\n") +
+                                 (m.output_names.empty() ? "" : "// Outputs y:     " + join(m.output_names, ", ") + "\n"));
   replace_all(h, "Q_NAMES", join(m.q_names, ", "));
   replace_all(h, "U_NAMES", join(m.u_names, ", "));
   replace_all(h, "OP_COUNTS", op_counts(m));
@@ -213,6 +219,8 @@ AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, 
   replace_all(e, "NQ", std::to_string(m.nq));
   replace_all(e, "NU", std::to_string(m.nu));
   replace_all(e, "NBODIES", std::to_string(m.nbodies));
+  replace_all(e, "NW", std::to_string(m.nw));
+  replace_all(e, "NY", std::to_string(m.ny));
   out.entry = std::move(e);
 
   // ---- manifest
@@ -228,6 +236,10 @@ AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, 
   j["nq"] = m.nq;
   j["nu"] = m.nu;
   j["nbodies"] = m.nbodies;
+  j["nw"] = m.nw;
+  j["ny"] = m.ny;
+  j["inputs"] = m.input_names;
+  j["outputs"] = m.output_names;
   j["udot_form"] = m.udot_form;
   j["takes_time"] = std::any_of(m.functions.begin(), m.functions.end(), [](const EmittedFunction& f) {
     return std::find(f.args.begin(), f.args.end(), Arg::t) != f.args.end();

@@ -28,6 +28,7 @@ enum class Arg {
   u,        ///< const T* u
   tau,      ///< const T* tau: generalized inputs
   udot_in,  ///< const T* udot_in: accelerations (reactions)
+  inputs,   ///< const T* inputs: the named inputs w (only for models that declare some)
   out,      ///< T* <out_name>: the result
 };
 
@@ -56,7 +57,8 @@ struct EmittedModel {
   std::string model_hash;
   std::string generator_hash;
   int nq = 0, nu = 0, nbodies = 0;
-  std::vector<std::string> q_names, u_names;
+  int nw = 0, ny = 0;           ///< named inputs and outputs (docs/gnc.md)
+  std::vector<std::string> q_names, u_names, input_names, output_names;
   std::string constants;        ///< namespace-scope constant declarations, grouped by body
   std::string support_code;     ///< helper functions the bodies call (e.g. prescribed motion), or empty
   std::string udot_form;        ///< "composite" or "articulated"

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <stdexcept>
 
@@ -57,13 +58,43 @@ EmittedFunction function(std::string name, std::string title, std::vector<Arg> a
   return f;
 }
 
+/// What the dual-number functions below share: the duals of every argument
+/// at their values (seeded one direction per pass by the caller), and the
+/// calls of qdot(), udot() and outputs() on them.
+struct DualCalls {
+  bool timed = false, inputs = false;
+  std::string declarations() const {
+    return "  using D = Dual<1>;\n"
+           "  D qd[nq > 0 ? nq : 1], ud[nu > 0 ? nu : 1], td[nu > 0 ? nu : 1], wd[nw > 0 ? nw : 1];\n"
+           "  for (int i = 0; i < nq; ++i) qd[i] = D(q[i]);\n"
+           "  for (int i = 0; i < nu; ++i) { ud[i] = D(u[i]); td[i] = D(tau[i]); }\n" +
+           std::string(inputs ? "  for (int i = 0; i < nw; ++i) wd[i] = D(inputs[i]);\n" : "");
+  }
+  /// The seed of direction c over [q; u; w; tau] set to `v`.
+  static std::string seed(const char* c, const char* v) {
+    return fmt::format(
+        "    if ({0} < nq) qd[{0}].d[0] = {1}; else if ({0} < nq + nu) ud[{0} - nq].d[0] = {1}; "
+        "else if ({0} < nq + nu + nw) wd[{0} - nq - nu].d[0] = {1}; else td[{0} - nq - nu - nw].d[0] = {1};\n",
+        c, v);
+  }
+  std::string call(const std::string& f, const char* out, bool with_tau = true) const {
+    return fmt::format("{}({}qd, ud, {}{}{})", f, timed ? "t, " : "", with_tau ? "td, " : "", inputs ? "wd, " : "",
+                       out);
+  }
+  std::vector<Arg> args() const {
+    std::vector<Arg> a{Arg::q, Arg::u, Arg::tau};
+    if (timed) a.insert(a.begin(), Arg::t);
+    if (inputs) a.push_back(Arg::inputs);
+    a.push_back(Arg::out);
+    return a;
+  }
+};
+
 /// The exact Jacobian of x_dot = [q_dot; u_dot] by forward-mode dual numbers
 /// over qdot() and udot() (the Dual type is part of the header template).
-EmittedFunction jacobian_function(int nq, int nu, bool timed, const OpCount& qdot_ops, const OpCount& udot_ops) {
-  std::vector<Arg> args{Arg::q, Arg::u, Arg::tau, Arg::out};
-  if (timed) args.insert(args.begin(), Arg::t);
+EmittedFunction jacobian_function(int nq, int nu, const DualCalls& d, const OpCount& qdot_ops, const OpCount& udot_ops) {
   EmittedFunction f = function("jacobian", "Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major",
-                               args, "J", (nq + nu) * (nq + nu), true);
+                               d.args(), "J", (nq + nu) * (nq + nu), true);
   f.templated = false;
   f.note =
       "// Forward-mode differentiation of qdot() and udot() with dual numbers, one\n"
@@ -71,25 +102,51 @@ EmittedFunction jacobian_function(int nq, int nu, bool timed, const OpCount& qdo
   // One direction per pass: the code of each pass stays about twice the size of
   // u_dot itself, which keeps compile times low (8 directions per pass compiled
   // 5x slower for a 1.5x faster Jacobian).
-  f.body =
-      "  constexpr int nx = nq + nu;\n"
-      "  using D = Dual<1>;\n"
-      "  D qd[nq > 0 ? nq : 1], ud[nu > 0 ? nu : 1], td[nu > 0 ? nu : 1], qdot_out[nq > 0 ? nq : 1], "
-      "udot_out[nu > 0 ? nu : 1];\n"
-      "  for (int c = 0; c < nx; ++c) {\n"
-      "    for (int i = 0; i < nq; ++i) { qd[i] = D(q[i]); if (i == c) qd[i].d[0] = 1.0; }\n"
-      "    for (int i = 0; i < nu; ++i) { ud[i] = D(u[i]); td[i] = D(tau[i]); if (nq + i == c) ud[i].d[0] = 1.0; }\n"
-      "    qdot(qd, ud, qdot_out);\n"
-      + std::string(timed ? "    const int status = udot(t, qd, ud, td, udot_out);\n"
-                          : "    const int status = udot(qd, ud, td, udot_out);\n") +
-      "    if (status != 0) return status;\n"
-      "    for (int i = 0; i < nq; ++i) J[c * nx + i] = qdot_out[i].d[0];\n"
-      "    for (int i = 0; i < nu; ++i) J[c * nx + nq + i] = udot_out[i].d[0];\n"
-      "  }\n"
-      "  return 0;\n";
+  f.body = "  constexpr int nx = nq + nu;\n" + d.declarations() +
+           "  D qdot_out[nq > 0 ? nq : 1], udot_out[nu > 0 ? nu : 1];\n"
+           "  for (int c = 0; c < nx; ++c) {\n" +
+           DualCalls::seed("c", "1.0") + "    qdot(qd, ud, qdot_out);\n" +
+           "    const int status = " + d.call("udot", "udot_out") + ";\n" + DualCalls::seed("c", "0.0") +
+           "    if (status != 0) return status;\n"
+           "    for (int i = 0; i < nq; ++i) J[c * nx + i] = qdot_out[i].d[0];\n"
+           "    for (int i = 0; i < nu; ++i) J[c * nx + nq + i] = udot_out[i].d[0];\n"
+           "  }\n"
+           "  return 0;\n";
   // A dual operation costs about three double ones; one pass per column.
   const long per_pass = 3 * (qdot_ops.total() + udot_ops.total());
   f.ops.mul = per_pass * (nq + nu);
+  return f;
+}
+
+/// d(u_dot)/dw, nu x nw column-major: the input matrix of the linear model.
+EmittedFunction input_jacobian_function(int nq, int nu, int nw, const DualCalls& d, const OpCount& udot_ops) {
+  EmittedFunction f = function("input_jacobian", "d(u_dot)/dw w.r.t. the named inputs, column-major nu x nw",
+                               d.args(), "B", nu * nw, true);
+  f.templated = false;
+  f.note = "// Forward-mode dual numbers, one input per pass. Returns like udot().\n";
+  f.body = d.declarations() + "  D udot_out[nu > 0 ? nu : 1];\n  for (int c = nq + nu; c < nq + nu + nw; ++c) {\n" +
+           DualCalls::seed("c", "1.0") + "    const int status = " + d.call("udot", "udot_out") + ";\n" +
+           DualCalls::seed("c", "0.0") +
+           "    if (status != 0) return status;\n"
+           "    for (int i = 0; i < nu; ++i) B[(c - nq - nu) * nu + i] = udot_out[i].d[0];\n"
+           "  }\n"
+           "  return 0;\n";
+  f.ops.mul = 3 * udot_ops.total() * nw;
+  (void)nq;
+  return f;
+}
+
+/// dy/d[q; u; w; tau], ny x (nq + 2 nu + nw) column-major: the output matrices C, D.
+EmittedFunction output_jacobian_function(int nq, int nu, int nw, int ny, const DualCalls& d, const OpCount& y_ops) {
+  EmittedFunction f = function("output_jacobian", "dy/d[q; u; w; tau] of the named outputs, column-major",
+                               d.args(), "CD", ny * (nq + 2 * nu + nw));
+  f.templated = false;
+  f.note = "// Forward-mode dual numbers, one direction per pass.\n";
+  f.body = d.declarations() + "  D y_out[ny > 0 ? ny : 1];\n  for (int c = 0; c < nq + 2 * nu + nw; ++c) {\n" +
+           DualCalls::seed("c", "1.0") + "    " + d.call("outputs", "y_out") + ";\n" + DualCalls::seed("c", "0.0") +
+           "    for (int i = 0; i < ny; ++i) CD[c * ny + i] = y_out[i].d[0];\n"
+           "  }\n";
+  f.ops.mul = 3 * y_ops.total() * (nq + 2 * nu + nw);
   return f;
 }
 
@@ -169,6 +226,10 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   out.nbodies = static_cast<int>(model_in.bodies.size());
   out.q_names = model_in.q_names;
   out.u_names = model_in.u_names;
+  out.nw = model_in.nw;
+  out.ny = model_in.ny;
+  out.input_names = model_in.input_names;
+  out.output_names = model_in.output_names;
   auto& fns = out.functions;
   // Functions take t only when the scene has prescribed motion.
   const bool timed = dyn.has_prescribed();
@@ -177,6 +238,15 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     return args;
   };
   if (timed) out.support_code = motion_support_code();
+  // Functions of the forces take the named inputs only when the model declares some.
+  const bool has_inputs = dyn.nw > 0;
+  auto forced = [&](std::vector<Arg> args) {
+    if (has_inputs) args.insert(args.end() - 1, Arg::inputs);
+    return at_t(std::move(args));
+  };
+  const bool attitude = std::any_of(model_in.sensors.begin(), model_in.sensors.end(),
+                                    [](const Sensor& s) { return s.type == SensorType::attitude; });
+  if (attitude) out.support_code += attitude_support_code();
 
   {
     Program p;
@@ -207,7 +277,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     prepare(ctx, true);
     const auto F = compute_forcing(ctx);
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("F[{}]", r), F[r]);
-    EmittedFunction f = function("forcing", "F(q, u, tau)", at_t({Arg::q, Arg::u, Arg::tau, Arg::out}), "F", dyn.nu);
+    EmittedFunction f = function("forcing", "F(q, u, tau)", forced({Arg::q, Arg::u, Arg::tau, Arg::out}), "F", dyn.nu);
     finish(p, C, f, options);
     fns.push_back(std::move(f));
   }
@@ -240,7 +310,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("udot[{}]", r), ud[r]);
     EmittedFunction f = function("udot",
                                  "u_dot: M u_dot = F (form chosen by operation count, see the counts above)",
-                                 at_t({Arg::q, Arg::u, Arg::tau, Arg::out}), "udot", dyn.nu, true);
+                                 forced({Arg::q, Arg::u, Arg::tau, Arg::out}), "udot", dyn.nu, true);
     f.note = "// Returns 0, or k if the pivot of speed k (1-based) is not positive (M singular).\n";
     finish(p, C, f, options);
     (std::string(form) == "composite" ? out.udot_composite_ops : out.udot_articulated_ops) = f.ops;
@@ -298,11 +368,40 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     }
     EmittedFunction f =
         function("reactions", "reactions on each body from its parent: [force; torque about O_B], body axes",
-                 at_t({Arg::q, Arg::u, Arg::udot_in, Arg::out}), "wrenches", 6 * out.nbodies);
+                 forced({Arg::q, Arg::u, Arg::udot_in, Arg::out}), "wrenches", 6 * out.nbodies);
     finish(p, C, f, options);
     fns.push_back(std::move(f));
   }
-  fns.push_back(jacobian_function(dyn.nq, dyn.nu, timed, qdot_ops, udot_ops));
+  const DualCalls dual{timed, has_inputs};
+  fns.push_back(jacobian_function(dyn.nq, dyn.nu, dual, qdot_ops, udot_ops));
+  if (has_inputs) fns.push_back(input_jacobian_function(dyn.nq, dyn.nu, dyn.nw, dual, udot_ops));
+  if (model_in.ny > 0) {
+    // On the unmerged tree (reactions of fixed bodies), sharing the kinematics,
+    // u_dot and the reactions' accelerations with the dynamics.
+    const FramedModel fr = frames(model_in);
+    const StateSymbols xr(fr.model);
+    Program p;
+    KaneContext ctx(fr.model, p, C, xr);
+    ctx.angle_offset = fr.angle_offset;
+    prepare(ctx, true);
+    std::vector<ex> pivots, scales, ud;
+    if (out.udot_form == "composite") {
+      const SMat M = compute_mass_matrix(ctx);
+      const auto F = compute_forcing(ctx);
+      ud = solve_tree_ldlt(ctx, M, F, pivots, scales);
+    } else {
+      ud = compute_udot_articulated(ctx, pivots, scales);
+    }
+    std::vector<std::vector<ex>> acc;
+    const auto W = compute_reactions(ctx, ud, &acc);
+    assign_sensor_outputs(ctx, W, acc, "y");
+    EmittedFunction f = function("outputs", "named outputs y (sensors)",
+                                 forced({Arg::q, Arg::u, Arg::tau, Arg::out}), "y", model_in.ny);
+    finish(p, C, f, options);
+    const OpCount y_ops = f.ops;
+    fns.push_back(std::move(f));
+    fns.push_back(output_jacobian_function(dyn.nq, dyn.nu, dyn.nw, model_in.ny, dual, y_ops));
+  }
 
   // Constants, grouped per body with a comment block.
   for (const std::string& g : C.groups()) {

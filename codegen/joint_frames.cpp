@@ -82,6 +82,7 @@ FramedModel choose_joint_frames(const Model& in) {
     o.joint.R_PJ = Qp.transpose() * b.joint.R_PJ * Q;
     o.joint.p_PJ = Qp.transpose() * b.joint.p_PJ;
     if (reframable(b)) o.joint.axis_J = Vec3::UnitZ();
+    move_ports(out.model.inputs, out.model.sensors, j, j, Vec3::Zero(), Q.transpose());
     o.rigid.com_B = Q.transpose() * b.rigid.com_B;
     o.rigid.I_c_B = Q.transpose() * b.rigid.I_c_B * Q;
     o.rigid.I_c_B = 0.5 * (o.rigid.I_c_B + o.rigid.I_c_B.transpose()).eval();

@@ -133,7 +133,21 @@ std::vector<ex> solve_tree_ldlt(KaneContext& ctx, SMat M, std::vector<ex> b, std
 /// of speed r in its joint's D matrix factorization.
 std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivots, std::vector<ex>& pivot_scales);
 /// 6 entries per body: reaction [force; torque about O_B] (B components).
-std::vector<ex> compute_reactions(KaneContext& ctx, const std::vector<ex>& udot);
+/// `accelerations`, if given, receives each body's accelerations [a_O_B,
+/// alpha_B, eta_ddot] (with gravity as a base acceleration: a_O_B - g_B).
+std::vector<ex> compute_reactions(KaneContext& ctx, const std::vector<ex>& udot,
+                                  std::vector<std::vector<ex>>* accelerations = nullptr);
+/// The wrench of the named inputs on body j [force; torque about O_B], B
+/// components (inputs_outputs.cpp).
+std::array<ex, 6> input_wrench(KaneContext& ctx, int j);
+/// The joint-torque inputs on body j's joint speed.
+ex joint_input(KaneContext& ctx, int j);
+/// Assigns y[...] = the model's sensors, from the reactions (6 per body) and
+/// the bodies' accelerations of compute_reactions.
+void assign_sensor_outputs(KaneContext& ctx, const std::vector<ex>& wrenches,
+                           const std::vector<std::vector<ex>>& accelerations, const std::string& y);
+/// Support code of the attitude outputs (quaternion from a rotation matrix).
+std::string attitude_support_code();
 ex compute_kinetic_energy(KaneContext& ctx);
 ex compute_potential_energy(KaneContext& ctx);
 /// p_N[3], H_N[3]

@@ -33,6 +33,7 @@ Model merge_fixed_bodies(const Model& in) {
       const int p = fixed.parent;
       if (p < 0) continue;  // fixed to ground: kept (it never moves; costs nothing)
       add_rigid(m.bodies[p].rigid, fixed.rigid, fixed.joint.p_PJ, fixed.joint.R_PJ);
+      move_ports(m.inputs, m.sensors, static_cast<int>(j), p, fixed.joint.p_PJ, fixed.joint.R_PJ);
       for (Body& c : m.bodies) {
         if (c.parent != static_cast<int>(j)) continue;
         c.parent = p;
@@ -42,6 +43,10 @@ Model merge_fixed_bodies(const Model& in) {
       m.bodies.erase(m.bodies.begin() + static_cast<long>(j));
       for (Body& c : m.bodies)
         if (c.parent > static_cast<int>(j)) --c.parent;
+      for (Input& in : m.inputs)
+        if (in.body > static_cast<int>(j)) --in.body;
+      for (Sensor& s : m.sensors)
+        if (s.body > static_cast<int>(j)) --s.body;
       changed = true;
       break;
     }

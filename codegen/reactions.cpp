@@ -9,7 +9,8 @@ namespace kanegen::codegen {
 
 using namespace GiNaC;
 
-std::vector<ex> compute_reactions(KaneContext& ctx, const std::vector<ex>& udot) {
+std::vector<ex> compute_reactions(KaneContext& ctx, const std::vector<ex>& udot,
+                                  std::vector<std::vector<ex>>* accelerations) {
   const int nb = static_cast<int>(ctx.model.bodies.size());
   // delta_j = acceleration minus remainder: delta_c = Xe_c delta_p + S_c udot_own
   std::vector<std::vector<ex>> delta(nb), W(nb);
@@ -24,10 +25,17 @@ std::vector<ex> compute_reactions(KaneContext& ctx, const std::vector<ex>& udot)
       for (int r = 0; r < 6 + m; ++r) dl[r] = dl[r] + S[k][r] * udot[cols[k]];
     for (auto& e : dl) e = ctx.A.let(e);
     delta[j] = dl;
-    // wrench = M_b (delta + z_R) + h - g, rows 0-5
+    // wrench = M_b (delta + z_R) + h - g - (the inputs' wrench), rows 0-5
     W[j].resize(6);
+    const std::array<ex, 6> W_in = ctx.model.inputs.empty() ? std::array<ex, 6>{0, 0, 0, 0, 0, 0} : input_wrench(ctx, j);
+    if (accelerations) {
+      std::vector<ex> z(dl);
+      for (int k = 0; k < 3; ++k) z[k] = ctx.A.let(z[k] + s.a_R_B[k]);
+      for (int k = 0; k < 3; ++k) z[3 + k] = ctx.A.let(z[3 + k] + s.alpha_R_B[k]);
+      accelerations->push_back(z);
+    }
     for (int r = 0; r < 6; ++r) {
-      ex sum = s.h_body[r] - s.g_body[r];
+      ex sum = s.h_body[r] - s.g_body[r] - W_in[r];
       for (int k = 0; k < 6 + m; ++k) {
         ex z = dl[k];
         if (k < 3) z = z + s.a_R_B[k];

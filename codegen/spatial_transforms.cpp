@@ -146,6 +146,11 @@ std::vector<std::vector<ex>> compute_bias_forces(KaneContext& ctx) {
       for (int a = 0; a < 3; ++a) sum -= s.M_body(r, a) * s.a_R_B[a] + s.M_body(r, 3 + a) * s.alpha_R_B[a];
       y[j][r] = ctx.A.let(sum);
     }
+    if (!ctx.model.inputs.empty()) {  // the named inputs' wrench on the body
+      const std::array<ex, 6> W_in = input_wrench(ctx, j);
+      for (int r = 0; r < 6; ++r)
+        if (!W_in[r].is_zero()) y[j][r] = ctx.A.let(y[j][r] + W_in[r]);
+    }
   }
   return y;
 }
@@ -155,6 +160,7 @@ ex applied_force(KaneContext& ctx, int j, int own) {
   const int r = b.u_joint + own;
   ex f = ctx.x.tau[r];
   ctx.C.group = b.name;
+  if (own == 0 && !ctx.model.inputs.empty()) f += joint_input(ctx, j);
   if (own < joint_nu(b.joint) && (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic)) {
     const ex kk = ctx.c(b.joint.stiffness, b.name + "_k", "N m/rad or N/m", "joint spring stiffness");
     const ex cc = ctx.c(b.joint.damping, b.name + "_c", "N m s/rad or N s/m", "joint damping");

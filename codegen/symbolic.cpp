@@ -83,6 +83,7 @@ StateSymbols::StateSymbols(const Model& m) {
     tau.push_back(GiNaC::symbol(fmt::format("tau[{}]", i)));
     udot.push_back(GiNaC::symbol(fmt::format("udot_in[{}]", i)));
   }
+  for (int i = 0; i < m.nw; ++i) inputs.push_back(GiNaC::symbol(fmt::format("inputs[{}]", i)));
 }
 
 }  // namespace kanegen::codegen

@@ -76,6 +76,7 @@ class Alg {
 /// Symbols of the state arrays, printed as q[i], u[i], tau[i], udot_in[i].
 struct StateSymbols {
   std::vector<ex> q, u, tau, udot;
+  std::vector<ex> inputs;  ///< the named inputs w (model.nw)
   explicit StateSymbols(const Model& m);
 };
 

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "model/model.hpp"
+#include "dynamics/applied_inputs.hpp"
 #include "dynamics/workspace.hpp"
 
 namespace kanegen {
@@ -24,10 +25,13 @@ void add_elastic_forces(const Model& model, const VecQ& q, const VecU& u, VecF& 
   }
 }
 
-template <class S, class VecQ, class VecU, class VecT>
-void compute_forcing(const Model& model, Workspace<S>& ws, const VecQ& q, const VecU& u, const VecT& tau) {
+/// `w`: the named inputs (model.nw values; dynamics/applied_inputs.hpp).
+template <class S, class VecQ, class VecU, class VecT, class VecW>
+void compute_forcing(const Model& model, Workspace<S>& ws, const VecQ& q, const VecU& u, const VecT& tau,
+                     const VecW& w) {
   for (int r = 0; r < model.nu; ++r) ws.F(r) = S(tau(r));
   add_elastic_forces<S>(model, q, u, ws.F);
+  add_joint_inputs(model, w, ws.F);
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
     const std::vector<int>& chain = model.bodies[i].chain_u;
     BodyWorkspace<S>& s = ws.body[i];
@@ -35,6 +39,12 @@ void compute_forcing(const Model& model, Workspace<S>& ws, const VecQ& q, const 
     s.z_dot = s.g_body - s.h_body;
     s.z_dot.noalias() -= s.M_body.template leftCols<3>() * s.a_R_B;
     s.z_dot.noalias() -= s.M_body.template middleCols<3>(3) * s.alpha_R_B;
+    if (!model.inputs.empty()) {
+      Eigen::Matrix<S, 6, 1> W = Eigen::Matrix<S, 6, 1>::Zero();
+      for (const Input& in : model.inputs)
+        if (in.body == static_cast<int>(i)) add_input_wrench(in, s, w, W);
+      s.z_dot.template head<6>() += W;
+    }
     for (std::size_t c = 0; c < chain.size(); ++c) ws.F(chain[c]) += s.P.col(c).dot(s.z_dot);
   }
 }

@@ -9,12 +9,14 @@
 #pragma once
 
 #include "model/model.hpp"
+#include "dynamics/applied_inputs.hpp"
 #include "dynamics/workspace.hpp"
 
 namespace kanegen {
 
-template <class S, class VecUd>
-void compute_reactions(const Model& model, Workspace<S>& ws, const VecUd& udot) {
+/// `w`: the named inputs (their wrenches are applied, not transmitted by the joint).
+template <class S, class VecUd, class VecW>
+void compute_reactions(const Model& model, Workspace<S>& ws, const VecUd& udot, const VecW& w) {
   const int nb = static_cast<int>(model.bodies.size());
   for (int i = 0; i < nb; ++i) {
     const std::vector<int>& chain = model.bodies[i].chain_u;
@@ -25,6 +27,12 @@ void compute_reactions(const Model& model, Workspace<S>& ws, const VecUd& udot) 
     s.z_dot.template segment<3>(3) += s.alpha_R_B;
     s.wrench_B = (s.M_body.template topRows<6>() * s.z_dot + s.h_body.template head<6>() -
                   s.g_body.template head<6>());
+    for (const Input& in : model.inputs)
+      if (in.body == i) {
+        Eigen::Matrix<S, 6, 1> W = Eigen::Matrix<S, 6, 1>::Zero();
+        add_input_wrench(in, s, w, W);
+        s.wrench_B -= W;
+      }
   }
   for (int i = nb - 1; i >= 0; --i) {  // children are listed after their parents
     const int p = model.bodies[i].parent;

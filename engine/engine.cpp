@@ -62,4 +62,29 @@ bool Engine::jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, M
   return do_jacobian(t, q, u, tau, J);
 }
 
+void Engine::set_inputs(const VecX& w) {
+  if (w.size() != model_.nw)
+    throw std::invalid_argument(fmt::format("{} engine: {} input values for a model with {} named inputs", name(),
+                                            w.size(), model_.nw));
+  w_ = w;
+}
+
+void Engine::outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) {
+  check_sizes(q, {&u, &tau});
+  y.resize(model_.ny);
+  do_outputs(t, q, u, tau, y);
+}
+
+bool Engine::input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B) {
+  check_sizes(q, {&u, &tau});
+  B.resize(model_.nu, model_.nw);
+  return do_input_jacobian(t, q, u, tau, B);
+}
+
+bool Engine::output_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& CD) {
+  check_sizes(q, {&u, &tau});
+  CD.resize(model_.ny, model_.nq + 2 * model_.nu + model_.nw);
+  return do_output_jacobian(t, q, u, tau, CD);
+}
+
 }  // namespace kanegen

@@ -42,7 +42,7 @@ class SingularMassMatrix : public std::runtime_error {
 
 class Engine {
  public:
-  explicit Engine(const Model& model) : model_(model) {}
+  explicit Engine(const Model& model) : model_(model), w_(VecX::Zero(model.nw)) {}
   virtual ~Engine() = default;
   Engine(const Engine&) = delete;
   Engine& operator=(const Engine&) = delete;
@@ -66,6 +66,19 @@ class Engine {
   /// Whether jacobian() gives exact Jacobians.
   virtual bool has_jacobian() const { return false; }
 
+  /// The named inputs w (model().nw values, docs/gnc.md) that forcing, udot,
+  /// reactions, the Jacobians and outputs use from now on; zero until set
+  /// (as MuJoCo's mjData.ctrl). Throws std::invalid_argument on a wrong size.
+  void set_inputs(const VecX& w);
+  const VecX& inputs() const { return w_; }
+  /// The named outputs y (model().ny values) at the state, with the current
+  /// inputs and tau (accelerations and reactions depend on them).
+  void outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y);
+  /// Exact d(u_dot)/dw (nu x nw), if this engine provides it. Throws SingularMassMatrix.
+  bool input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B);
+  /// Exact dy/d[q; u; w; tau] (ny x (nq + 2 nu + nw)), if this engine provides it.
+  bool output_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& CD);
+
   void mass_matrix(const VecX& q, MatX& M) { mass_matrix(0.0, q, M); }
   void forcing(const VecX& q, const VecX& u, const VecX& tau, VecX& F) { forcing(0.0, q, u, tau, F); }
   void udot(const VecX& q, const VecX& u, const VecX& tau, VecX& ud) { udot(0.0, q, u, tau, ud); }
@@ -88,11 +101,21 @@ class Engine {
     (void)t, (void)q, (void)u, (void)tau, (void)J;
     return false;
   }
+  virtual void do_outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) = 0;
+  virtual bool do_input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B) {
+    (void)t, (void)q, (void)u, (void)tau, (void)B;
+    return false;
+  }
+  virtual bool do_output_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& CD) {
+    (void)t, (void)q, (void)u, (void)tau, (void)CD;
+    return false;
+  }
 
  private:
   /// Throws std::invalid_argument unless q has nq entries and each of `nu_sized` nu.
   void check_sizes(const VecX& q, std::initializer_list<const VecX*> nu_sized) const;
   const Model& model_;
+  VecX w_;
 };
 
 }  // namespace kanegen

@@ -8,9 +8,11 @@
  * looks functions up by name (engine/generated_engine.hpp): nothing else in
  * it depends on generated names.
  *
- * Arrays: q[nq], u[nu], tau[nu], udot[nu]; each function's `out` holds
+ * Arrays: q[nq], u[nu], tau[nu], udot[nu], inputs[nw]; each function's `out` holds
  * out_size doubles (M row-major nu x nu; wrenches 6 per body, [force; torque
- * about O_B], body components; Jacobian column-major (nq+nu)^2).
+ * about O_B], body components; Jacobian column-major (nq+nu)^2; outputs
+ * y[ny]; input_jacobian du_dot/dw column-major nu x nw; output_jacobian
+ * dy/d[q; u; w; tau] column-major ny x (nq+2nu+nw)).
  * Return value: 0, or for udot and jacobian the 1-based index of the speed
  * whose pivot in the factorization of M is not positive.
  */
@@ -21,7 +23,7 @@
 extern "C" {
 #endif
 
-#define KANEGEN_GENERATED_API_VERSION 2
+#define KANEGEN_GENERATED_API_VERSION 3
 
 typedef struct KanegenArgs {
   double t;             /* time: used by models with prescribed motion */
@@ -29,6 +31,7 @@ typedef struct KanegenArgs {
   const double* u;
   const double* tau;
   const double* udot;   /* accelerations: input of reactions */
+  const double* inputs; /* the named inputs w[nw] (models that declare inputs) */
 } KanegenArgs;
 
 typedef int (*KanegenFunctionPtr)(const KanegenArgs* args, double* out);
@@ -45,6 +48,7 @@ typedef struct KanegenGeneratedApi {
   const char* model_hash;        /* model/model_hash.hpp */
   const char* generator_hash;    /* hash of the generator that wrote the code */
   int nq, nu, nbodies;
+  int nw, ny;                    /* named inputs and outputs */
   int n_functions;
   const KanegenFunction* functions;
 } KanegenGeneratedApi;

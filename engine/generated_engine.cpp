@@ -11,8 +11,9 @@ namespace kanegen {
 namespace {
 std::string str_or(const char* s) { return s ? std::string(s) : std::string("(null)"); }
 
-KanegenArgs args(double t, const VecX* q, const VecX* u, const VecX* tau, const VecX* udot) {
+KanegenArgs args(double t, const VecX* q, const VecX* u, const VecX* tau, const VecX* udot, const VecX& w) {
   KanegenArgs a{};
+  a.inputs = w.data();
   a.t = t;
   a.q = q ? q->data() : nullptr;
   a.u = u ? u->data() : nullptr;
@@ -30,7 +31,8 @@ GeneratedEngine::GeneratedEngine(const Model& m, const KanegenGeneratedApi* api,
   if (api_->api_version != KANEGEN_GENERATED_API_VERSION)
     throw std::runtime_error(fmt::format("{}: API version {} but this runtime expects {}; regenerate it", who,
                                          api_->api_version, KANEGEN_GENERATED_API_VERSION));
-  if (api_->nq != m.nq || api_->nu != m.nu || api_->nbodies != static_cast<int>(m.bodies.size()))
+  if (api_->nq != m.nq || api_->nu != m.nu || api_->nbodies != static_cast<int>(m.bodies.size()) ||
+      api_->nw != m.nw || api_->ny != m.ny)
     throw std::runtime_error(fmt::format("{}: nq = {}, nu = {}, {} bodies, but the model '{}' has nq = {}, nu = {}, "
                                          "{} bodies; regenerate it",
                                          who, api_->nq, api_->nu, api_->nbodies, m.source_path, m.nq, m.nu,
@@ -51,6 +53,9 @@ GeneratedEngine::GeneratedEngine(const Model& m, const KanegenGeneratedApi* api,
   energy_ = function("energy");
   momentum_ = function("momentum");
   reactions_ = function("reactions");
+  outputs_ = function("outputs");
+  input_jacobian_ = function("input_jacobian");
+  output_jacobian_ = function("output_jacobian");
   if (!qdot_ || !mass_matrix_ || !forcing_ || !udot_)
     throw std::runtime_error(fmt::format("{}: the table lacks one of qdot, mass_matrix, forcing, udot", who));
   M_row_major_.resize(m.nu, m.nu);
@@ -74,30 +79,30 @@ void GeneratedEngine::singular(int pivot) const {
 }
 
 void GeneratedEngine::do_qdot(const VecX& q, const VecX& u, VecX& qd) {
-  const KanegenArgs a = args(0.0, &q, &u, nullptr, nullptr);
+  const KanegenArgs a = args(0.0, &q, &u, nullptr, nullptr, inputs());
   qdot_(&a, qd.data());
 }
 
 void GeneratedEngine::do_mass_matrix(double t, const VecX& q, MatX& M) {
   // The table writes row-major; M is symmetric, but do not rely on it.
-  const KanegenArgs a = args(t, &q, nullptr, nullptr, nullptr);
+  const KanegenArgs a = args(t, &q, nullptr, nullptr, nullptr, inputs());
   mass_matrix_(&a, M_row_major_.data());
   M = M_row_major_.transpose();
 }
 
 void GeneratedEngine::do_forcing(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& F) {
-  const KanegenArgs a = args(t, &q, &u, &tau, nullptr);
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
   forcing_(&a, F.data());
 }
 
 void GeneratedEngine::do_udot(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& ud) {
-  const KanegenArgs a = args(t, &q, &u, &tau, nullptr);
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
   if (const int pivot = udot_(&a, ud.data()); pivot != 0) singular(pivot);
 }
 
 bool GeneratedEngine::do_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& J) {
   if (!jacobian_) return false;
-  const KanegenArgs a = args(t, &q, &u, &tau, nullptr);
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
   if (const int pivot = jacobian_(&a, J.data()); pivot != 0) singular(pivot);
   return true;
 }
@@ -105,7 +110,7 @@ bool GeneratedEngine::do_jacobian(double t, const VecX& q, const VecX& u, const 
 EnergyValues GeneratedEngine::do_energy(double t, const VecX& q, const VecX& u) {
   if (!energy_) missing_output("energy");
   double TV[2] = {0, 0};
-  const KanegenArgs a = args(t, &q, &u, nullptr, nullptr);
+  const KanegenArgs a = args(t, &q, &u, nullptr, nullptr, inputs());
   energy_(&a, TV);
   return {TV[0], TV[1]};
 }
@@ -113,7 +118,7 @@ EnergyValues GeneratedEngine::do_energy(double t, const VecX& q, const VecX& u) 
 MomentumValues GeneratedEngine::do_momentum(double t, const VecX& q, const VecX& u) {
   if (!momentum_) missing_output("momentum");
   double pH[6] = {0, 0, 0, 0, 0, 0};
-  const KanegenArgs a = args(t, &q, &u, nullptr, nullptr);
+  const KanegenArgs a = args(t, &q, &u, nullptr, nullptr, inputs());
   momentum_(&a, pH);
   MomentumValues r;
   r.p_N = Vec3(pH[0], pH[1], pH[2]);
@@ -126,13 +131,36 @@ void GeneratedEngine::do_reactions(double t, const VecX& q, const VecX& u, const
   if (!reactions_) missing_output("reactions");
   const std::size_t nb = model().bodies.size();
   wrenches_.assign(6 * nb, 0.0);
-  const KanegenArgs a = args(t, &q, &u, nullptr, &ud);
+  const KanegenArgs a = args(t, &q, &u, nullptr, &ud, inputs());
   reactions_(&a, wrenches_.data());
   for (std::size_t i = 0; i < nb; ++i) {
     const double* w = &wrenches_[6 * i];
     out[i].force_B = Vec3(w[0], w[1], w[2]);
     out[i].torque_B = Vec3(w[3], w[4], w[5]);
   }
+}
+
+void GeneratedEngine::do_outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) {
+  if (model().ny == 0) return;
+  if (!outputs_) missing_output("outputs (named sensors)");
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
+  outputs_(&a, y.data());
+}
+
+bool GeneratedEngine::do_input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B) {
+  if (model().nw == 0) return true;
+  if (!input_jacobian_) return false;
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
+  if (const int pivot = input_jacobian_(&a, B.data()); pivot != 0) singular(pivot);
+  return true;
+}
+
+bool GeneratedEngine::do_output_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& CD) {
+  if (model().ny == 0) return true;
+  if (!output_jacobian_) return false;
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
+  output_jacobian_(&a, CD.data());
+  return true;
 }
 
 }  // namespace kanegen

@@ -37,7 +37,7 @@ class GeneratedEngine final : public Engine {
   /// then throws the SingularMassMatrix that names it).
   int state_derivative(double t, const double* x, const double* tau, double* xdot) const {
     const int nq = model().nq;
-    const KanegenArgs a{t, x, x + nq, tau, nullptr};
+    const KanegenArgs a{t, x, x + nq, tau, nullptr, inputs().data()};
     qdot_(&a, xdot);
     return udot_(&a, xdot + nq);
   }
@@ -54,6 +54,9 @@ class GeneratedEngine final : public Engine {
   void do_reactions(double t, const VecX& q, const VecX& u, const VecX& udot, std::vector<Reaction>& out) override;
   /// Returns false when the code has no Jacobian (left out of a very large model).
   bool do_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& J) override;
+  void do_outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) override;
+  bool do_input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B) override;
+  bool do_output_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& CD) override;
 
  private:
   [[noreturn]] void missing_output(const char* what) const;
@@ -62,7 +65,8 @@ class GeneratedEngine final : public Engine {
   std::shared_ptr<void> library_;
   std::string library_path_;
   KanegenFunctionPtr qdot_ = nullptr, mass_matrix_ = nullptr, forcing_ = nullptr, udot_ = nullptr,
-                     jacobian_ = nullptr, energy_ = nullptr, momentum_ = nullptr, reactions_ = nullptr;
+                     jacobian_ = nullptr, energy_ = nullptr, momentum_ = nullptr, reactions_ = nullptr,
+                     outputs_ = nullptr, input_jacobian_ = nullptr, output_jacobian_ = nullptr;
   std::vector<double> wrenches_;
   MatX M_row_major_;
 };

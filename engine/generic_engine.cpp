@@ -9,6 +9,7 @@
 #include "dynamics/kinematics.hpp"
 #include "dynamics/mass_matrix.hpp"
 #include "dynamics/reactions.hpp"
+#include "dynamics/sensors.hpp"
 
 namespace kanegen {
 
@@ -30,7 +31,7 @@ void GenericEngine::do_mass_matrix(double t, const VecX& q, MatX& M) {
 
 void GenericEngine::do_forcing(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& F) {
   update(t, q, u);
-  compute_forcing(model(), ws_, q, u, tau);
+  compute_forcing(model(), ws_, q, u, tau, inputs());
   F = ws_.F;
 }
 
@@ -54,7 +55,7 @@ void factorize_mass_matrix(const MatX& M, Eigen::LLT<MatX>& llt) {
 void GenericEngine::do_udot(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& udot) {
   update(t, q, u);
   compute_mass_matrix(model(), ws_);
-  compute_forcing(model(), ws_, q, u, tau);
+  compute_forcing(model(), ws_, q, u, tau, inputs());
   factorize_mass_matrix(ws_.M, llt_);
   udot = llt_.solve(ws_.F);
 }
@@ -73,11 +74,21 @@ MomentumValues GenericEngine::do_momentum(double t, const VecX& q, const VecX& u
 
 void GenericEngine::do_reactions(double t, const VecX& q, const VecX& u, const VecX& udot, std::vector<Reaction>& out) {
   update(t, q, u);
-  compute_reactions(model(), ws_, udot);
+  compute_reactions(model(), ws_, udot, inputs());
   for (std::size_t i = 0; i < out.size(); ++i) {
     out[i].force_B = ws_.body[i].wrench_B.head<3>();
     out[i].torque_B = ws_.body[i].wrench_B.tail<3>();
   }
+}
+
+void GenericEngine::do_outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) {
+  update(t, q, u);
+  compute_mass_matrix(model(), ws_);
+  compute_forcing(model(), ws_, q, u, tau, inputs());
+  factorize_mass_matrix(ws_.M, llt_);
+  ws_.udot = llt_.solve(ws_.F);
+  compute_reactions(model(), ws_, ws_.udot, inputs());
+  compute_sensor_outputs(model(), ws_, y);
 }
 
 }  // namespace kanegen

@@ -25,6 +25,7 @@ class GenericEngine final : public Engine {
   EnergyValues do_energy(double t, const VecX& q, const VecX& u) override;
   MomentumValues do_momentum(double t, const VecX& q, const VecX& u) override;
   void do_reactions(double t, const VecX& q, const VecX& u, const VecX& udot, std::vector<Reaction>& out) override;
+  void do_outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) override;
 
  private:
   void update(double t, const VecX& q, const VecX& u);

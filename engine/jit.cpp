@@ -178,13 +178,17 @@ std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out
       if (name == required) return true;
     return std::find(o.only.begin(), o.only.end(), name) != o.only.end();
   };
+  // the functions that run u_dot (or the outputs) once per direction in dual numbers
+  auto is_dual = [](const std::string& name) {
+    return name == "jacobian" || name == "input_jacobian" || name == "output_jacobian";
+  };
   std::vector<std::string> omitted;
   for (const ManifestFunction& f : manifest.functions)
-    if (!wanted(f.name) || (f.name == "jacobian" && jacobian_left_out)) omitted.push_back("-DKANEGEN_OMIT_" + f.name);
+    if (!wanted(f.name) || (is_dual(f.name) && jacobian_left_out)) omitted.push_back("-DKANEGEN_OMIT_" + f.name);
   add("table", 0, "-O2", omitted);
   for (const ManifestFunction& f : manifest.functions) {
     if (!wanted(f.name)) continue;
-    if (f.name == "jacobian") {
+    if (is_dual(f.name)) {
       if (jacobian_left_out) continue;
       add(f.name, f.ops, udot_ops <= 1500 ? "-O2" : "-O1", {});
     } else {

@@ -51,6 +51,8 @@ namespace kanegen_gen::near_singular {
 inline constexpr int nq = 10;
 inline constexpr int nu = 9;
 inline constexpr int nbodies = 4;
+inline constexpr int nw = 0;  // named inputs
+inline constexpr int ny = 0;  // named outputs
 inline constexpr char model_name[] = "near_singular";
 inline constexpr char model_hash[] = "1da78b109d9b0307";
 
@@ -1230,12 +1232,15 @@ void momentum(const T* q, const T* u, T* pH) {
 inline int jacobian(const double* q, const double* u, const double* tau, double* J) {
   constexpr int nx = nq + nu;
   using D = Dual<1>;
-  D qd[nq > 0 ? nq : 1], ud[nu > 0 ? nu : 1], td[nu > 0 ? nu : 1], qdot_out[nq > 0 ? nq : 1], udot_out[nu > 0 ? nu : 1];
+  D qd[nq > 0 ? nq : 1], ud[nu > 0 ? nu : 1], td[nu > 0 ? nu : 1], wd[nw > 0 ? nw : 1];
+  for (int i = 0; i < nq; ++i) qd[i] = D(q[i]);
+  for (int i = 0; i < nu; ++i) { ud[i] = D(u[i]); td[i] = D(tau[i]); }
+  D qdot_out[nq > 0 ? nq : 1], udot_out[nu > 0 ? nu : 1];
   for (int c = 0; c < nx; ++c) {
-    for (int i = 0; i < nq; ++i) { qd[i] = D(q[i]); if (i == c) qd[i].d[0] = 1.0; }
-    for (int i = 0; i < nu; ++i) { ud[i] = D(u[i]); td[i] = D(tau[i]); if (nq + i == c) ud[i].d[0] = 1.0; }
+    if (c < nq) qd[c].d[0] = 1.0; else if (c < nq + nu) ud[c - nq].d[0] = 1.0; else if (c < nq + nu + nw) wd[c - nq - nu].d[0] = 1.0; else td[c - nq - nu - nw].d[0] = 1.0;
     qdot(qd, ud, qdot_out);
     const int status = udot(qd, ud, td, udot_out);
+    if (c < nq) qd[c].d[0] = 0.0; else if (c < nq + nu) ud[c - nq].d[0] = 0.0; else if (c < nq + nu + nw) wd[c - nq - nu].d[0] = 0.0; else td[c - nq - nu - nw].d[0] = 0.0;
     if (status != 0) return status;
     for (int i = 0; i < nq; ++i) J[c * nx + i] = qdot_out[i].d[0];
     for (int i = 0; i < nu; ++i) J[c * nx + nq + i] = udot_out[i].d[0];

@@ -47,6 +47,8 @@ int Model::body_index(const std::string& n) const {
 }
 int Model::q_index(const std::string& n) const { return find(q_names, n); }
 int Model::u_index(const std::string& n) const { return find(u_names, n); }
+int Model::input_index(const std::string& n) const { return find(input_names, n); }
+int Model::output_index(const std::string& n) const { return find(output_names, n); }
 bool Model::has_flexible() const {
   return std::any_of(bodies.begin(), bodies.end(), [](const Body& b) { return b.flex.has_value(); });
 }
@@ -118,6 +120,20 @@ void finalize_model(Model& model) {
   }
   model.nq = nq;
   model.nu = nu;
+  model.input_names.clear();
+  model.nw = 0;
+  for (Input& in : model.inputs) {
+    in.offset = model.nw;
+    model.nw += in.size();
+    for (auto& n : entry_names(in)) model.input_names.push_back(n);
+  }
+  model.output_names.clear();
+  model.ny = 0;
+  for (Sensor& s : model.sensors) {
+    s.offset = model.ny;
+    model.ny += s.size();
+    for (auto& n : entry_names(s)) model.output_names.push_back(n);
+  }
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
     Body& b = model.bodies[i];
     if (b.parent >= 0) model.bodies[b.parent].children.push_back(static_cast<int>(i));

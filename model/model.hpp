@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "model/inputs_outputs.hpp"
 #include "model/modal_integrals.hpp"
 #include "model/prescribed_motion.hpp"
 
@@ -138,10 +139,20 @@ struct Model {
   VecX q0;                          ///< initial coordinates (quaternions unit)
   VecX u0;                          ///< initial speeds
   Outputs outputs;
+  /// Named inputs (docs/gnc.md): the vector w of nw scalars named input_names.
+  std::vector<Input> inputs;
+  int nw = 0;
+  std::vector<std::string> input_names;
+  /// Named outputs (sensors): the vector y of ny scalars named output_names.
+  std::vector<Sensor> sensors;
+  int ny = 0;
+  std::vector<std::string> output_names;
 
   int body_index(const std::string& name) const;  ///< -1 if absent
   int q_index(const std::string& name) const;     ///< -1 if absent
   int u_index(const std::string& name) const;     ///< -1 if absent
+  int input_index(const std::string& name) const; ///< entry of w, -1 if absent
+  int output_index(const std::string& name) const;///< entry of y, -1 if absent
   /// Coordinates of the prescribed joints, named as the joint coordinate
   /// would be ("hub.angle", "cart.disp"), in body order.
   std::vector<std::string> prescribed_names;
@@ -166,7 +177,8 @@ void snap_roundoff_residues(Body& body);
 /// The same for gravity.
 void snap_roundoff_residues(Vec3& g_N);
 
-/// Fills q/u layout, names, children and chain_u of an otherwise complete
+/// Fills q/u layout, names, children, the offsets and names of the inputs
+/// and sensors, and chain_u of an otherwise complete
 /// model, and the mass integrals of every body. Called by the loader, and by
 /// code that builds models programmatically (benchmarks, tests).
 void finalize_model(Model& model);

@@ -56,6 +56,29 @@ std::string model_fingerprint(const Model& model) {
   w.integer(model.outputs.energy);
   w.integer(model.outputs.momentum);
   w.integer(model.outputs.reactions);
+  if (!model.inputs.empty() || !model.sensors.empty()) {  // older models keep their hash
+    w.key("inputs");
+    w.integer(static_cast<long long>(model.inputs.size()));
+    for (const Input& in : model.inputs) {
+      w.str(in.name);
+      w.str(to_string(in.type));
+      w.integer(in.body);
+      w.mat(in.point_B);
+      w.mat(in.direction_B);
+      w.str(to_string(in.axes));
+      w.mat(in.R_BX);
+    }
+    w.key("sensors");
+    w.integer(static_cast<long long>(model.sensors.size()));
+    for (const Sensor& s : model.sensors) {
+      w.str(s.name);
+      w.str(to_string(s.type));
+      w.integer(s.body);
+      w.mat(s.point_B);
+      w.integer(s.node);
+      w.mat(s.R_BX);
+    }
+  }
   w.key("bodies");
   w.integer(static_cast<long long>(model.bodies.size()));
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {

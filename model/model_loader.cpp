@@ -6,7 +6,9 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -103,7 +105,7 @@ class Loader {
       return;
     }
     if (!ck_.expect_map(root, 1, "(document)")) return;
-    ck_.check_keys(root, "", {"name", "description", "gravity", "bodies", "initial", "outputs"});
+    ck_.check_keys(root, "", {"name", "description", "gravity", "bodies", "initial", "inputs", "outputs"});
 
     const YAML::Node name = root["name"];
     if (!name.IsDefined()) {
@@ -151,15 +153,224 @@ class Loader {
     }
 
     if (root["initial"].IsDefined()) read_initial(root["initial"]);
+    if (root["inputs"].IsDefined()) read_inputs(root["inputs"]);
     if (root["outputs"].IsDefined()) read_outputs(root["outputs"]);
   }
+
+  // ------------------------------------------------- inputs and sensors
+  static constexpr std::size_t kMaxPorts = 1000;
+
+  /// A body named by entry `e`'s `key` (e.g. body: bus); -1 with a fault if absent or unknown.
+  int port_body(const YAML::Node& e, const std::string& f, const char* key) {
+    const YAML::Node n = e[key];
+    const int l = line_of(e);
+    if (!n.IsDefined()) {
+      ck_.error(l, f + "." + key, "missing; expected the name of a body");
+      return -1;
+    }
+    auto s = ck_.string(n, l, f + "." + key);
+    if (!s) return -1;
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < info_.size(); ++i) {
+      if (info_[i].name == *s) return static_cast<int>(i);
+      if (!info_[i].name.empty()) names.push_back(info_[i].name);
+    }
+    ck_.error(n, l, f + "." + key, fmt::format("no body named '{}'{}", *s, did_you_mean(*s, names)));
+    return -1;
+  }
+
+  /// The entry's `name:`: [a-z][a-z0-9_]*, unique in `seen`.
+  std::optional<std::string> port_name(const YAML::Node& e, const std::string& f, std::set<std::string>& seen) {
+    const YAML::Node n = e["name"];
+    if (!n.IsDefined()) {
+      ck_.error(line_of(e), f + ".name", "missing; expected a name matching [a-z][a-z0-9_]*");
+      return std::nullopt;
+    }
+    auto s = ck_.string(n, line_of(e), f + ".name");
+    if (!s) return std::nullopt;
+    const bool ok = !s->empty() && s->size() <= 64 && (*s)[0] >= 'a' && (*s)[0] <= 'z' &&
+                    std::all_of(s->begin(), s->end(), [](char c) {
+                      return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+                    });
+    if (!ok) {
+      ck_.error(n, line_of(e), f + ".name",
+                fmt::format("'{}' is not a valid name; expected [a-z][a-z0-9_]* (at most 64 characters)", *s));
+      return std::nullopt;
+    }
+    if (!seen.insert(*s).second) {
+      ck_.error(n, line_of(e), f + ".name", fmt::format("'{}' is used twice; expected unique names", *s));
+      return std::nullopt;
+    }
+    return s;
+  }
+
+  std::optional<Axes> port_axes(const YAML::Node& e, const std::string& f) {
+    const YAML::Node n = e["axes"];
+    if (!n.IsDefined()) return Axes::body;
+    auto s = ck_.string(n, line_of(e), f + ".axes");
+    if (!s) return std::nullopt;
+    if (*s == "body") return Axes::body;
+    if (*s == "inertial") return Axes::inertial;
+    ck_.error(n, line_of(e), f + ".axes", fmt::format("'{}'; expected body or inertial", *s));
+    return std::nullopt;
+  }
+
+  void read_inputs(const YAML::Node& n) {
+    if (!ck_.expect_seq(n, 1, "inputs")) return;
+    if (n.size() > kMaxPorts) {
+      ck_.error(n, 1, "inputs", fmt::format("{} inputs; expected at most {}", n.size(), kMaxPorts));
+      return;
+    }
+    std::set<std::string> seen;
+    const std::vector<std::string> types = {"thruster", "force", "torque", "joint_torque"};
+    for (std::size_t i = 0; i < n.size(); ++i) {
+      const std::string f = fmt::format("inputs[{}]", i);
+      const YAML::Node e = n[i];
+      if (!ck_.expect_map(e, line_of(n), f)) continue;
+      const int l = line_of(e);
+      auto type = e["type"].IsDefined() ? ck_.string(e["type"], l, f + ".type") : std::nullopt;
+      if (!e["type"].IsDefined()) ck_.error(l, f + ".type", "missing; expected thruster, force, torque or joint_torque");
+      if (!type) continue;
+      Input in;
+      in.line = l;
+      if (*type == "thruster") {
+        in.type = InputType::thruster;
+        ck_.check_keys(e, f, {"name", "type", "body", "point", "direction"});
+      } else if (*type == "force") {
+        in.type = InputType::force;
+        ck_.check_keys(e, f, {"name", "type", "body", "point", "axes"});
+      } else if (*type == "torque") {
+        in.type = InputType::torque;
+        ck_.check_keys(e, f, {"name", "type", "body", "axes"});
+      } else if (*type == "joint_torque") {
+        in.type = InputType::joint_torque;
+        ck_.check_keys(e, f, {"name", "type", "joint"});
+      } else {
+        const std::string hint = did_you_mean(*type, types);
+        ck_.error(e["type"], l, f + ".type",
+                  fmt::format("unknown input type '{}'{}{}expected thruster, force, torque or joint_torque", *type,
+                              hint, hint.empty() ? "; " : " "));
+        continue;
+      }
+      auto name = port_name(e, f, seen);
+      bool ok = name.has_value();
+      if (name) in.name = *name;
+      in.body = port_body(e, f, in.type == InputType::joint_torque ? "joint" : "body");
+      ok = ok && in.body >= 0;
+      if (in.type == InputType::thruster || in.type == InputType::force) {
+        if (e["point"].IsDefined()) {
+          if (auto p = ck_.vec3(e["point"], l, f + ".point")) in.point_B = *p; else ok = false;
+        }
+      }
+      if (in.type == InputType::thruster) {
+        if (!e["direction"].IsDefined()) {
+          ck_.error(l, f + ".direction", "missing; expected the thrust direction, a unit 3-vector in body axes");
+          ok = false;
+        } else if (auto d = ck_.unit(e["direction"], l, f + ".direction", 3, "a unit 3-vector in body axes")) {
+          in.direction_B = *d;
+        } else {
+          ok = false;
+        }
+      }
+      if (in.type == InputType::force || in.type == InputType::torque) {
+        if (auto a = port_axes(e, f)) in.axes = *a; else ok = false;
+      }
+      if (in.type == InputType::joint_torque && in.body >= 0) {
+        const Joint& j = info_[in.body].body.joint;
+        if (info_[in.body].type_known &&
+            ((j.type != JointType::revolute && j.type != JointType::prismatic) || j.prescribed())) {
+          ck_.error(e["joint"], l, f + ".joint",
+                    fmt::format("body '{}' has a {} joint{}; a joint torque needs a revolute or prismatic joint "
+                                "with a degree of freedom",
+                                info_[in.body].name, to_string(j.type), j.prescribed() ? " (prescribed)" : ""));
+          ok = false;
+        }
+      }
+      if (ok) model_.inputs.push_back(in);
+    }
+  }
+
+  /// One sensor entry of `outputs:` (a mapping).
+  void read_sensor(const YAML::Node& e, const std::string& f, std::set<std::string>& seen) {
+    const int l = line_of(e);
+    const std::vector<std::string> types = {"angular_velocity", "attitude",       "position", "velocity",
+                                            "acceleration",     "specific_force", "reaction", "deflection"};
+    if (!e["type"].IsDefined()) {
+      ck_.error(l, f + ".type", "missing; expected one of: " + join(types));
+      return;
+    }
+    auto type = ck_.string(e["type"], l, f + ".type");
+    if (!type) return;
+    Sensor s;
+    s.line = l;
+    const auto it = std::find(types.begin(), types.end(), *type);
+    if (it == types.end()) {
+      const std::string hint = did_you_mean(*type, types);
+      ck_.error(e["type"], l, f + ".type",
+                fmt::format("unknown output type '{}'{}{}expected one of: {}", *type, hint, hint.empty() ? "; " : " ",
+                            join(types)));
+      return;
+    }
+    s.type = static_cast<SensorType>(it - types.begin());
+    const bool point = s.type == SensorType::position || s.type == SensorType::velocity ||
+                       s.type == SensorType::acceleration || s.type == SensorType::specific_force;
+    if (point)
+      ck_.check_keys(e, f, {"name", "type", "body", "point"});
+    else if (s.type == SensorType::deflection)
+      ck_.check_keys(e, f, {"name", "type", "body", "node"});
+    else if (s.type == SensorType::reaction)
+      ck_.check_keys(e, f, {"name", "type", "joint"});
+    else
+      ck_.check_keys(e, f, {"name", "type", "body"});
+    auto name = port_name(e, f, seen);
+    bool ok = name.has_value();
+    if (name) s.name = *name;
+    s.body = port_body(e, f, s.type == SensorType::reaction ? "joint" : "body");
+    ok = ok && s.body >= 0;
+    if (point && e["point"].IsDefined()) {
+      if (auto p = ck_.vec3(e["point"], l, f + ".point")) s.point_B = *p; else ok = false;
+    }
+    if (s.type == SensorType::deflection && s.body >= 0) {
+      const BodyInfo& bi = info_[s.body];
+      if (!bi.has_flex_block) {
+        ck_.error(e["body"], l, f + ".body", fmt::format("body '{}' is not flexible; a deflection needs a flexible body", bi.name));
+        ok = false;
+      } else if (!e["node"].IsDefined()) {
+        ck_.error(l, f + ".node", "missing; expected a node id of the body's modal data");
+        ok = false;
+      } else if (auto id = ck_.integer(e["node"], l, f + ".node")) {
+        if (bi.flex_known && bi.body.flex) {
+          s.node = bi.body.flex->node_index(static_cast<int>(*id));
+          if (s.node < 0) {
+            ck_.error(e["node"], l, f + ".node",
+                      fmt::format("body '{}' has no node {} in {}", bi.name, *id, bi.body.flex->source));
+            ok = false;
+          }
+        } else {
+          ok = false;
+        }
+      } else {
+        ok = false;
+      }
+    }
+    if (ok) model_.sensors.push_back(s);
+  }
+
 
   void read_outputs(const YAML::Node& n) {
     const std::vector<std::string> allowed = {"energy", "momentum", "reactions"};
     if (!ck_.expect_seq(n, 1, "outputs")) return;
-    std::set<std::string> seen;
+    if (n.size() > kMaxPorts) {
+      ck_.error(n, 1, "outputs", fmt::format("{} outputs; expected at most {}", n.size(), kMaxPorts));
+      return;
+    }
+    std::set<std::string> seen, sensor_names = {"energy", "momentum", "reactions"};
     for (std::size_t i = 0; i < n.size(); ++i) {
       const std::string f = fmt::format("outputs[{}]", i);
+      if (n[i].IsMap()) {
+        read_sensor(n[i], f, sensor_names);
+        continue;
+      }
       auto s = ck_.string(n[i], line_of(n), f);
       if (!s) continue;
       if (*s == "energy")
@@ -171,7 +382,8 @@ class Loader {
       else {
         const std::string hint = did_you_mean(*s, allowed);
         ck_.error(n[i], line_of(n), f,
-                  fmt::format("unknown output '{}'{}{}expected any of: energy, momentum, reactions", *s, hint,
+                  fmt::format("unknown output '{}'{}{}expected energy, momentum, reactions or a sensor "
+                              "({{name: ..., type: ..., ...}}, docs/gnc.md)", *s, hint,
                               hint.empty() ? "; " : " "));
         continue;
       }

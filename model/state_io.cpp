@@ -17,6 +17,7 @@ State initial_state(const Model& model) {
   s.q = model.q0.size() == model.nq ? model.q0 : VecX::Zero(model.nq);
   s.u = model.u0.size() == model.nu ? model.u0 : VecX::Zero(model.nu);
   s.tau = VecX::Zero(model.nu);
+  s.w = VecX::Zero(model.nw);
   if (model.q0.size() != model.nq)
     for (const Body& b : model.bodies)
       if (b.joint.type == JointType::free) s.q(b.q_joint + 3) = 1.0;
@@ -93,24 +94,24 @@ State load_state(const Model& model, const std::string& path) {
 
   State s = initial_state(model);
   const auto top = unique_members(root, "");
-  const JsonValue::Member* sections[3] = {nullptr, nullptr, nullptr};
+  const JsonValue::Member* sections[4] = {nullptr, nullptr, nullptr, nullptr};
   for (const auto* m : top) {
     if (m->key == "t") {
       number(*m, "t", s.t);
-    } else if (m->key == "q" || m->key == "u" || m->key == "tau") {
-      sections[m->key == "q" ? 0 : m->key == "u" ? 1 : 2] = m;
+    } else if (m->key == "q" || m->key == "u" || m->key == "tau" || m->key == "inputs") {
+      sections[m->key == "q" ? 0 : m->key == "u" ? 1 : m->key == "tau" ? 2 : 3] = m;
       if (m->key == "q") s.q_line = m->key_line;
     } else {
       err(m->key_line, m->key.empty() ? "''" : m->key,
-          fmt::format("unknown key '{}'; expected only t, q, u, tau", m->key));
+          fmt::format("unknown key '{}'; expected only t, q, u, tau, inputs", m->key));
     }
   }
 
   std::map<std::string, int> given_q;  // name -> line
-  const char* keys[3] = {"q", "u", "tau"};
-  const std::vector<std::string>* names[3] = {&model.q_names, &model.u_names, &model.u_names};
-  VecX* targets[3] = {&s.q, &s.u, &s.tau};
-  for (int k = 0; k < 3; ++k) {
+  const char* keys[4] = {"q", "u", "tau", "inputs"};
+  const std::vector<std::string>* names[4] = {&model.q_names, &model.u_names, &model.u_names, &model.input_names};
+  VecX* targets[4] = {&s.q, &s.u, &s.tau, &s.w};
+  for (int k = 0; k < 4; ++k) {
     const JsonValue::Member* sec = sections[k];
     if (!sec) continue;
     if (sec->value.kind != JsonValue::Kind::object) {
@@ -129,6 +130,8 @@ State load_state(const Model& model, const std::string& path) {
             prescribed ? fmt::format("'{}' is prescribed by its joint's motion: (a known function of time); "
                                      "expected no value for it",
                                      m->key)
+                   : names[k]->empty() ? fmt::format("unknown name '{}'; the model declares no {}", m->key,
+                                                     k == 3 ? "inputs (docs/gnc.md)" : "such names")
                        : fmt::format("unknown name '{}'; expected one of: {}", m->key, hint(m->key, *names[k])));
         continue;
       }

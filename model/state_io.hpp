@@ -13,6 +13,7 @@ struct State {
   VecX q;    ///< nq, quaternions normalized
   VecX u;    ///< nu
   VecX tau;  ///< nu generalized inputs
+  VecX w;    ///< nw named inputs (docs/gnc.md), by name under "inputs"
   int q_line = 0;  ///< line of "q" in the STATE.json it was read from (0: q from the model)
 };
 

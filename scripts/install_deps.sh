@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libeigen3-dev libfmt-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
-  libsundials-dev libginac-dev catch2 libbenchmark-dev libspectra-dev libboost-dev
+  libsundials-dev libginac-dev catch2 libbenchmark-dev libspectra-dev libboost-dev zlib1g-dev
   python3 python3-numpy python3-matplotlib
 )
 missing=()

@@ -1,6 +1,7 @@
 // Cross-check of two engines (generated against generic) at random states:
-// the largest relative differences of q_dot, M, F, u_dot, reactions, energy
-// and momentum, each relative to the largest entry of the reference value.
+// the largest relative differences of q_dot, M, F, u_dot, reactions, energy,
+// momentum and the named outputs (random named inputs too), each relative to
+// the largest entry of the reference value.
 // u_dot is judged by the residual |M u_dot - F| / (|M| |u_dot| + |F|) of the
 // tested engine's u_dot in the reference M and F, since its forward error
 // grows with cond(M) (reference README); its plain relative difference is

@@ -43,6 +43,7 @@ nlohmann::ordered_json eval_report(Engine& engine, const State& state) {
   const Model& model = engine.model();
   VecX qdot, F, udot;
   MatX M;
+  engine.set_inputs(state.w);
   engine.qdot(state.q, state.u, qdot);
   engine.mass_matrix(state.t, state.q, M);
   engine.forcing(state.t, state.q, state.u, state.tau, F);
@@ -87,6 +88,19 @@ nlohmann::ordered_json eval_report(Engine& engine, const State& state) {
     for (std::size_t i = 0; i < R.size(); ++i)
       jr[model.bodies[i].name] = {{"force", vec(R[i].force_B)}, {"torque", vec(R[i].torque_B)}};
     j["reactions"] = jr;
+  }
+  if (model.nw > 0) {
+    nlohmann::ordered_json ji;
+    for (int i = 0; i < model.nw; ++i) ji[model.input_names[i]] = state.w(i);
+    j["inputs"] = ji;
+  }
+  if (model.ny > 0) {
+    VecX y;
+    engine.outputs(state.t, state.q, state.u, state.tau, y);
+    require_finite(y, "outputs", model.output_names, model, state);
+    nlohmann::ordered_json jy;
+    for (int i = 0; i < model.ny; ++i) jy[model.output_names[i]] = y(i);
+    j["outputs"] = jy;
   }
   return j;
 }

@@ -197,6 +197,8 @@ std::vector<std::string> csv_columns(const Model& model) {
   if (model.outputs.reactions)
     for (const Body& b : model.bodies)
       for (const char* s : {".fx", ".fy", ".fz", ".tx", ".ty", ".tz"}) cols.push_back(b.name + s);
+  cols.insert(cols.end(), model.input_names.begin(), model.input_names.end());
+  cols.insert(cols.end(), model.output_names.begin(), model.output_names.end());
   return cols;
 }
 
@@ -251,8 +253,46 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   SampledRun sampled;
   sampled.stride = stride_for(initial, options);
   std::string failure;
-  OdeProblem problem = make_ode_problem(engine, initial.tau, &failure, options.use_jacobian,
+  const Controller& controller = options.controller;
+  const bool digital = controller && controller.period > 0;
+  if (controller && !(controller.period >= 0 && std::isfinite(controller.period)))
+    throw std::invalid_argument(fmt::format("controller period {} s; expected 0 (continuous) or a positive period",
+                                            controller.period));
+  if (digital) {  // samples and output times on one grid
+    const double r = controller.period / options.dt_out, r_inv = options.dt_out / controller.period;
+    if (std::abs(r - std::round(r)) > 1e-9 * r && std::abs(r_inv - std::round(r_inv)) > 1e-9 * r_inv)
+      throw std::invalid_argument(fmt::format("controller period {} s and output step {} s: one must be a multiple "
+                                              "of the other",
+                                              controller.period, options.dt_out));
+  }
+  engine.set_inputs(initial.w);
+  // A continuous controller's feedback is not in the engine's Jacobian: the
+  // implicit methods then difference the right-hand side.
+  OdeProblem problem = make_ode_problem(engine, initial.tau, &failure, options.use_jacobian && !controller,
                                         options.integrator.kind != IntegratorKind::rk4);
+  VecX y(model.ny), w_ctl(model.nw), q_ctl(nq), u_ctl(nu);
+  // the law at (t, x): the outputs with the inputs held so far, then the new inputs
+  auto apply_law = [&](double t, const double* x) {
+    q_ctl = Eigen::Map<const VecX>(x, nq);
+    u_ctl = Eigen::Map<const VecX>(x + nq, nu);
+    normalize_quaternions(model, q_ctl.data());  // the quaternions lie in q
+    if (model.ny > 0) engine.outputs(t, q_ctl, u_ctl, initial.tau, y);
+    w_ctl = engine.inputs();
+    controller.law(t, q_ctl, u_ctl, y, w_ctl);
+    engine.set_inputs(w_ctl);
+  };
+  if (controller && !digital) {
+    auto base = problem.rhs;
+    problem.rhs = [&, base](double t, const double* x, double* xdot) -> int {
+      try {
+        apply_law(t, x);
+      } catch (const SingularMassMatrix& e) {
+        failure = fmt::format("{} at t = {:.17g} (while computing the controller's outputs)", e.what(), t);
+        return -1;
+      }
+      return base(t, x, xdot);
+    };
+  }
   VecX x0(nq + nu);
   x0 << initial.q, initial.u;
 
@@ -319,8 +359,14 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
         for (const Reaction& r : reactions)
           row.insert(row.end(), {r.force_B(0), r.force_B(1), r.force_B(2), r.torque_B(0), r.torque_B(1), r.torque_B(2)});
       }
+      if (controller && !digital) apply_law(t, x.data());  // the inputs at this time
+      row.insert(row.end(), engine.inputs().data(), engine.inputs().data() + model.nw);
+      if (model.ny > 0) {
+        engine.outputs(t, q, u, initial.tau, y);
+        row.insert(row.end(), y.data(), y.data() + model.ny);
+      }
     } catch (const SingularMassMatrix& e) {
-      throw fail_at(t, x, fmt::format("{} (while computing the reactions)", e.what()));
+      throw fail_at(t, x, fmt::format("{} (while computing the reactions or outputs)", e.what()));
     }
     for (std::size_t k = 0; k < row.size(); ++k)
       if (!std::isfinite(row[k]))
@@ -347,7 +393,49 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     project(x);
   };
   try {
-    result.stats = integrate(problem, options.integrator, initial.t, x0, options.t_end, options.dt_out, write);
+    if (!digital) {
+      result.stats = integrate(problem, options.integrator, initial.t, x0, options.t_end, options.dt_out, write);
+    } else {
+      // A digital controller: one integration per sample period, restarted at
+      // each sample with the inputs the law set there (zero-order hold).
+      const double T = controller.period, t0 = initial.t;
+      const double dt_seg = std::min(options.dt_out, T);
+      auto on_output_grid = [&](double t) {
+        const double k = (t - t0) / options.dt_out;
+        return std::abs(k - std::round(k)) <= 1e-9 * std::max(1.0, std::abs(k));
+      };
+      VecX x = x0, x_end = x0;
+      result.stats.integrator = to_string(options.integrator.kind);
+      for (long k = 0;; ++k) {
+        const double t_a = t0 + static_cast<double>(k) * T;
+        if (!(t_a < options.t_end)) break;
+        const double t_b = std::min(t0 + static_cast<double>(k + 1) * T, options.t_end);
+        const bool last = !(t_b < options.t_end) || t_b + 1e-12 * std::max(1.0, std::abs(t_b)) >= options.t_end;
+        try {
+          apply_law(t_a, x.data());
+        } catch (const SingularMassMatrix& e) {
+          throw IntegrationError(fmt::format("{} (while computing the controller's outputs)", e.what()), t_a, x);
+        }
+        const IntegratorStats s =
+            integrate(problem, options.integrator, t_a, x, last ? options.t_end : t_b, dt_seg,
+                      [&](double t, const VecX& xs) {
+                        const bool end = !(t < (last ? options.t_end : t_b));
+                        if (end) x_end = xs;
+                        if (end && last) return write(t, xs);
+                        // a segment's end is the next one's start, written there with its inputs
+                        if (end) return true;
+                        return on_output_grid(t) ? write(t, xs) : true;
+                      });
+        result.stats.steps += s.steps;
+        result.stats.rhs_evals += s.rhs_evals;
+        result.stats.jac_evals += s.jac_evals;
+        result.stats.error_test_failures += s.error_test_failures;
+        result.stats.nonlinear_failures += s.nonlinear_failures;
+        result.stats.wall_seconds += s.wall_seconds;
+        x = x_end;
+        if (last) break;
+      }
+    }
   } catch (const IntegrationError& e) {
     bar.finish();
     if (output_failure || failure.empty()) throw;
@@ -355,10 +443,16 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   }
   bar.finish();
 
-  const bench::Drifts d = bench::invariant_drifts(engine, bench::invariants_of(model, initial.tau), sampled.traj);
-  quality.energy_drift = d.energy;
-  quality.H_drift = d.H;
-  if (options.estimate_error) {
+  // Applied inputs or a controller do work: no invariant holds then.
+  const bool driven = controller || (initial.w.size() && !initial.w.isZero(0.0));
+  if (!driven) {
+    const bench::Drifts d = bench::invariant_drifts(engine, bench::invariants_of(model, initial.tau), sampled.traj);
+    quality.energy_drift = d.energy;
+    quality.H_drift = d.H;
+  }
+  if (options.estimate_error && controller) {
+    quality.error_worst = "no error estimate with a controller in the loop (its state would be run twice)";
+  } else if (options.estimate_error) {
     // the same method at tolerances 100 times tighter, at the same output times
     IntegratorOptions tight = options.integrator;
     tight.rtol /= 100;

@@ -1,5 +1,7 @@
-// Time histories: integrates q_dot = W(q) u, M(q) u_dot = F(q, u, tau) with
-// constant inputs tau from a state, and writes the CSV of interface.md.
+// Time histories: integrates q_dot = W(q) u, M(q) u_dot = F(q, u, tau, w) with
+// constant tau from a state and the named inputs w constant or set by a
+// controller, and writes the CSV of interface.md (plus the named inputs and
+// outputs, docs/gnc.md).
 #pragma once
 
 #include <cmath>
@@ -7,6 +9,7 @@
 #include <string>
 
 #include "engine/engine.hpp"
+#include "sim/controller.hpp"
 #include "sim/integrators.hpp"
 #include "model/state_io.hpp"
 
@@ -21,6 +24,9 @@ struct SimulationOptions {
   /// Also run at rtol/100, atol/100 (same method) and report the difference
   /// of the two runs at the output times as the error estimate.
   bool estimate_error = false;
+  /// A control law setting the named inputs (sim/controller.hpp); without
+  /// one the inputs stay at State::w for the whole run.
+  Controller controller;
 };
 
 /// How far a run can be trusted, for its summary.
@@ -56,7 +62,8 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
 
 /// Column names of the CSV: t, q names, the prescribed coordinates (named as
 /// the joint coordinate would be, e.g. hub.angle), u names, then T V /
-/// Hx Hy Hz / <body>.fx .fy .fz .tx .ty .tz as the model's outputs ask.
+/// Hx Hy Hz / <body>.fx .fy .fz .tx .ty .tz as the model's outputs ask, then
+/// the named inputs and the named outputs.
 std::vector<std::string> csv_columns(const Model& model);
 
 /// Integrates from `initial` to options.t_end writing CSV rows to `csv`.

@@ -27,6 +27,12 @@
 #include "sim/integrators.hpp"
 #include "sim/simulate.hpp"
 
+#ifdef KANEGEN_HAS_CONTROLLER
+#include "sim/controller.hpp"
+/// Defined by the CONTROLLER file of kanegen_add_model() (docs/gnc.md).
+kanegen::Controller kanegen_controller(const kanegen::Model& model);
+#endif
+
 namespace kanegen {
 
 /// Exit status as the kanegen CLI: 0 success, 2 refused input, 1 failure while running.
@@ -43,6 +49,10 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
       ->check(CLI::ExistingFile);
   app.add_option("--model", model_file, "model file the code was generated from")->capture_default_str();
   app.add_flag("--eval", eval, "print the eval JSON at the state instead of simulating");
+#ifdef KANEGEN_HAS_CONTROLLER
+  bool open_loop = false;
+  app.add_flag("--open-loop", open_loop, "run without the compiled-in controller (inputs from --state)");
+#endif
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -67,7 +77,10 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
       std::cout << eval_report(engine, state).dump(1) << '\n';
       return 0;
     }
-    const SimulationOptions opt = cli::simulation_options(sim, state);
+    SimulationOptions opt = cli::simulation_options(sim, state);
+#ifdef KANEGEN_HAS_CONTROLLER
+    if (!open_loop) opt.controller = kanegen_controller(model);
+#endif
     try {
       const SimulationResult r = simulate_to_file(engine, state, opt, sim.output);
       fmt::print(stderr, "{} [generated engine, compiled in], {} rows to {}, max quaternion drift {:.2e}\n{}",

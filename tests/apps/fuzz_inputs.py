@@ -1535,7 +1535,10 @@ def s_motion(rng, seed, sf):
         ("{sine: {amplitude: 0.1}}", "invalid", "sine without frequency"),
     ]
     dof_left = len(seed.u_names) >= 2
-    ok_expect = "invalid" if (has_spring or named_in_initial) else ("valid" if dof_left else "either")
+    # a joint torque input on a prescribed joint is refused (no degree of freedom to drive)
+    inputs = seed.data.get("inputs") if isinstance(seed.data, dict) else None
+    driven = isinstance(inputs, list) and any(isinstance(e, dict) and e.get("joint") == name for e in inputs)
+    ok_expect = "invalid" if (has_spring or named_in_initial or driven) else ("valid" if dof_left else "either")
     options += [("{sine: {amplitude: 0.1, frequency: 1.0}}", ok_expect, "sine"),
                 ("{polynomial: [0.1, 0.2]}", ok_expect, "polynomial"),
                 ("{spinup: {rate: 2.0, duration: 5.0}}", ok_expect, "spinup")]

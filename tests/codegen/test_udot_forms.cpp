@@ -25,7 +25,7 @@ std::unique_ptr<GeneratedEngine> engine_of_form(const Model& model, const std::s
   JitOptions o = test::jit_options();
   o.flags = "-O0 -std=c++20 -fPIC -shared";
   o.only_set = true;
-  o.only = {"energy", "momentum", "reactions"};
+  o.only = {"energy", "momentum", "reactions", "outputs"};
   return jit_load(model, codegen::jit_code_generator(g), o);
 }
 

@@ -1,0 +1,106 @@
+// kanegen linearize MODEL [--state S.json] [--inputs ...] [--outputs ...]
+//     [--format json|npz|mat|csv] [-o OUT]: the continuous-time linear model
+// A, B, C, D about a state (sim/linearize.hpp), with its eigenvalues as
+// frequencies and damping ratios (a table on stderr, and in the JSON).
+#include <fmt/format.h>
+
+#include <iostream>
+
+#include "apps/kanegen/cli_common.hpp"
+#include "model/diagnostics.hpp"
+#include "model/output_file.hpp"
+#include "sim/linearize.hpp"
+#include "sim/matrix_files.hpp"
+
+namespace kanegen::cli {
+
+namespace {
+
+struct Options {
+  std::string model, state, engine = "generated", format = "json", output;
+  std::vector<std::string> inputs, outputs;
+  bool native = false, finite_differences = false, quiet = false;
+};
+
+void print_modes(const LinearModel& lin, const std::vector<LinearMode>& modes) {
+  fmt::print(stderr, "linear model: {} states, {} inputs, {} outputs ({})\n", lin.A.rows(), lin.B.cols(),
+             lin.C.rows(), lin.method);
+  fmt::print(stderr, "{}\n",
+             lin.equilibrium ? "the point is an equilibrium"
+                             : fmt::format("the point is NOT an equilibrium (max |x_dot| = {:.3g}): the result is a "
+                                           "first-order Taylor model about it",
+                                           lin.residual));
+  fmt::print(stderr, "{:>24} {:>24} {:>12} {:>10}  {}\n", "eigenvalue (1/s)", "", "f_n (Hz)", "zeta",
+             "dominant states");
+  for (const LinearMode& m : modes)
+    fmt::print(stderr, "{:>24.10g} {:>+23.10g}i {:>12.6g} {:>10.4g}  {}\n", m.eigenvalue.real(), m.eigenvalue.imag(),
+               m.natural_frequency_hz, m.damping_ratio, fmt::join(m.dominant_states, ", "));
+}
+
+int run(const Options& o) {
+  const Model model = load_checked(o.model);
+  const State state = state_for(model, o.state);
+  if (o.format != "json" && o.output.empty())
+    throw InputError(Diagnostic{"(command line)", 0, "--format",
+                                fmt::format("--format {} writes a file; expected -o OUT as well", o.format)});
+  if (!o.output.empty()) check_output_path(o.output);
+  auto engine = make_engine(model, o.engine, o.native);
+  LinearizeOptions lo;
+  lo.inputs = o.inputs;
+  lo.outputs = o.outputs;
+  lo.finite_differences = o.finite_differences;
+  const LinearModel lin = linearize(*engine, state, lo);
+  const auto modes = linear_modes(lin);
+  if (!o.quiet) print_modes(lin, modes);
+  if (o.format == "json") {
+    const std::string text = to_json(lin, modes).dump(1) + "\n";
+    if (o.output.empty())
+      std::cout << text;
+    else
+      write_file_atomically(o.output, text);
+    return 0;
+  }
+  NamedMatrices nm;
+  nm.matrices = {{"A", lin.A}, {"B", lin.B}, {"C", lin.C}, {"D", lin.D}, {"x0_dot", lin.x0_dot}, {"y0", lin.y0}};
+  nm.names = {{"state_names", lin.state_names}, {"input_names", lin.input_names}, {"output_names", lin.output_names}};
+  if (o.format == "npz")
+    write_npz(o.output, nm);
+  else if (o.format == "mat")
+    write_mat(o.output, nm);
+  else
+    for (const auto& p : write_csv(o.output, nm,
+                                   {{"A", {"state_names", "state_names"}},
+                                    {"B", {"state_names", "input_names"}},
+                                    {"C", {"output_names", "state_names"}},
+                                    {"D", {"output_names", "input_names"}}}))
+      fmt::print(stderr, "wrote {}\n", p);
+  return 0;
+}
+
+}  // namespace
+
+Subcommand add_linearize(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  CLI::App* c = app.add_subcommand(
+      "linearize", "continuous-time A, B, C, D about a state, from exact derivatives of the generated code");
+  add_model_option(c, o->model);
+  c->add_option("--state", o->state, "STATE.json of the operating point (default: the model's initial state)")
+      ->check(CLI::ExistingFile);
+  c->add_option("--inputs", o->inputs,
+                "inputs (columns of B, D): named inputs or their entries, or tau.<speed> (default: every named "
+                "input, else every tau)")
+      ->delimiter(',');
+  c->add_option("--outputs", o->outputs,
+                "outputs (rows of C, D): sensors or their entries (default: every named output, else the state)")
+      ->delimiter(',');
+  c->add_option("--format", o->format, "json (default), npz (numpy), mat (MATLAB) or csv (one file per matrix)")
+      ->check(CLI::IsMember({"json", "npz", "mat", "csv"}));
+  c->add_option("-o,--output", o->output, "output file (csv: the prefix of OUT_A.csv ...); JSON goes to stdout without it");
+  c->add_flag("--finite-differences", o->finite_differences,
+              "central differences instead of the exact derivatives (a cross-check)");
+  c->add_flag("--quiet", o->quiet, "no eigenvalue table on stderr");
+  add_engine_option(c, o->engine, o->native);
+  return {c, [o] { return run(*o); }};
+}
+
+}  // namespace kanegen::cli

@@ -1,0 +1,161 @@
+// The named inputs as applied wrenches and the named outputs (sensors),
+// symbolically: the counterparts of dynamics/applied_inputs.hpp and
+// dynamics/sensors.hpp, under the same names. Ports are carried to the
+// generator's bodies and frames by merge_fixed_bodies and choose_joint_frames
+// (model/inputs_outputs.hpp: move_ports), so here every point and axis is
+// already in the frame of ctx.model's body.
+#include <fmt/format.h>
+
+#include "codegen/kane_context.hpp"
+
+namespace kanegen::codegen {
+
+using namespace GiNaC;
+
+std::array<ex, 6> input_wrench(KaneContext& ctx, int j) {
+  std::array<ex, 6> W{0, 0, 0, 0, 0, 0};
+  const SymBodyWorkspace& s = ctx.body[j];
+  for (const Input& in : ctx.model.inputs) {
+    if (in.body != j || in.type == InputType::joint_torque) continue;
+    ctx.C.group = ctx.model.bodies[j].name;
+    const auto& w = ctx.x.inputs;
+    SV3 f, t;
+    if (in.type == InputType::thruster) {
+      const SV3 d = ctx.cvec(in.direction_B, in.name + "_direction", "", "thrust direction, body axes");
+      f = ctx.A.scale(w[in.offset], d);
+    } else {
+      const SV3 v{{w[in.offset], w[in.offset + 1], w[in.offset + 2]}};
+      const SV3 v_B = in.axes == Axes::inertial
+                          ? ctx.A.mul_t(s.R_NB, v)
+                          : ctx.A.mul(ctx.cmat(in.R_BX, in.name + "_R_BX", "", "input axes in the body frame"), v);
+      (in.type == InputType::force ? f : t) = v_B;
+    }
+    const SV3 p = ctx.cvec(in.point_B, in.name + "_point", "m", "point of application, body components");
+    const SV3 pxf = ctx.A.cross(p, f);
+    for (int a = 0; a < 3; ++a) {
+      W[a] += f[a];
+      W[3 + a] += t[a] + pxf[a];
+    }
+  }
+  for (ex& e : W) e = ctx.A.P.let(e);
+  return W;
+}
+
+ex joint_input(KaneContext& ctx, int j) {
+  ex f = 0;
+  for (const Input& in : ctx.model.inputs)
+    if (in.body == j && in.type == InputType::joint_torque) f += ctx.x.inputs[in.offset];
+  return f;
+}
+
+void assign_sensor_outputs(KaneContext& ctx, const std::vector<ex>& wrenches,
+                           const std::vector<std::vector<ex>>& accelerations, const std::string& y) {
+  const Model& model = ctx.model;
+  for (const Sensor& sn : model.sensors) {
+    const int j = sn.body;
+    const SymBodyWorkspace& s = ctx.body[j];
+    ctx.P.section(fmt::format("output {}: {} of {}", sn.name, to_string(sn.type), model.bodies[j].name));
+    ctx.C.group = model.bodies[j].name;
+    const SM3 R_BX = ctx.cmat(sn.R_BX, sn.name + "_R_BX", "", "output axes in the body frame");
+    const SV3 p = ctx.cvec(sn.point_B, sn.name + "_point", "m", "sensor point, body components");
+    auto put = [&](const SV3& v_B, int offset) {
+      const SV3 v_X = ctx.A.mul_t(R_BX, v_B);
+      for (int a = 0; a < 3; ++a) ctx.P.assign(fmt::format("{}[{}]", y, offset + a), v_X[a]);
+    };
+    auto put_N = [&](const SV3& v_N, int offset) {
+      for (int a = 0; a < 3; ++a) ctx.P.assign(fmt::format("{}[{}]", y, offset + a), v_N[a]);
+    };
+    switch (sn.type) {
+      case SensorType::angular_velocity: put(s.w_B, sn.offset); break;
+      case SensorType::attitude: {
+        const SM3 R = ctx.A.mul(s.R_NB, R_BX);
+        OpCount dummy;
+        std::vector<std::string> e;
+        ex dep = 0;
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) {
+            const ex v = ctx.P.let(R(r, c));
+            e.push_back(print_cpp(v, dummy));
+            dep += v;
+          }
+        ctx.P.statement(fmt::format("attitude_quaternion({}, {} + {});", fmt::join(e, ", "), y, sn.offset), dep);
+        break;
+      }
+      case SensorType::position: put_N(ctx.A.add(s.r_NO_N, ctx.A.mul(s.R_NB, p)), sn.offset); break;
+      case SensorType::velocity: put_N(ctx.A.mul(s.R_NB, ctx.A.add(s.v_O_B, ctx.A.cross(s.w_B, p))), sn.offset); break;
+      case SensorType::acceleration:
+      case SensorType::specific_force: {
+        // With gravity as a base acceleration (kane_context.hpp) the bodies'
+        // accelerations are specific forces a - g; the acceleration adds g back.
+        const auto& z = accelerations[j];
+        const SV3 a_O{{z[0], z[1], z[2]}}, alpha{{z[3], z[4], z[5]}};
+        SV3 a = ctx.A.add(ctx.A.add(a_O, ctx.A.cross(alpha, p)), ctx.A.cross(s.w_B, ctx.A.cross(s.w_B, p)));
+        const bool gib = ctx.gravity_in_base_acceleration;
+        const bool accel = sn.type == SensorType::acceleration;
+        if (gib == accel) {  // acceleration from a - g, or a - g from a
+          const SV3 g_B = ctx.A.mul_t(s.R_NB, ctx.cvec(model.g_N, "g_N", "m/s^2", "gravity"));
+          a = accel ? ctx.A.add(a, g_B) : ctx.A.sub(a, g_B);
+        }
+        put(a, sn.offset);
+        break;
+      }
+      case SensorType::reaction: {
+        const SV3 f{{wrenches[6 * j], wrenches[6 * j + 1], wrenches[6 * j + 2]}};
+        const SV3 t{{wrenches[6 * j + 3], wrenches[6 * j + 4], wrenches[6 * j + 5]}};
+        put(f, sn.offset);
+        put(t, sn.offset + 3);
+        break;
+      }
+      case SensorType::deflection: {
+        const FlexibleData& fd = *model.bodies[j].flex;
+        const int k = sn.node;
+        SV3 d;
+        for (int a = 0; a < 3; ++a) {
+          ex sum = 0;
+          for (int m = 0; m < fd.modes(); ++m)
+            sum += ctx.c(fd.Phi(3 * k + a, m), fmt::format("{}_Phi_{}_{}", sn.name, a, m + 1), "m",
+                         "mode shape at the node") * s.eta[m];
+          if (fd.has_second_order(k) && fd.Gamma[k][a].size())
+            for (int m = 0; m < fd.modes(); ++m)
+              for (int n = 0; n < fd.modes(); ++n)
+                sum += ctx.c(0.5 * fd.Gamma[k][a](m, n), fmt::format("{}_G_{}_{}_{}", sn.name, a, m + 1, n + 1),
+                             "1/m", "half the foreshortening matrix at the node") * s.eta[m] * s.eta[n];
+          d[a] = ctx.P.let(sum);
+        }
+        put(d, sn.offset);
+        break;
+      }
+    }
+  }
+}
+
+std::string attitude_support_code() {
+  return R"(
+// ---- attitude output: quaternion [w, x, y, z] of a rotation matrix, w >= 0 ----
+// (Shepperd's method: the largest of 4w^2, 4x^2, 4y^2, 4z^2 is divided by.)
+template <class T>
+inline void attitude_quaternion(const T& R00, const T& R01, const T& R02, const T& R10, const T& R11, const T& R12,
+                                const T& R20, const T& R21, const T& R22, T* qout) {
+  using std::sqrt;
+  const T tr = R00 + R11 + R22;
+  T w, x, y, z;
+  if (tr > R00 && tr > R11 && tr > R22) {
+    const T s = 2.0 * sqrt(1.0 + tr);
+    w = 0.25 * s, x = (R21 - R12) / s, y = (R02 - R20) / s, z = (R10 - R01) / s;
+  } else if (R00 > R11 && R00 > R22) {
+    const T s = 2.0 * sqrt(1.0 + R00 - R11 - R22);
+    w = (R21 - R12) / s, x = 0.25 * s, y = (R01 + R10) / s, z = (R02 + R20) / s;
+  } else if (R11 > R22) {
+    const T s = 2.0 * sqrt(1.0 + R11 - R00 - R22);
+    w = (R02 - R20) / s, x = (R01 + R10) / s, y = 0.25 * s, z = (R12 + R21) / s;
+  } else {
+    const T s = 2.0 * sqrt(1.0 + R22 - R00 - R11);
+    w = (R10 - R01) / s, x = (R02 + R20) / s, y = (R12 + R21) / s, z = 0.25 * s;
+  }
+  const double sign = 0.0 > w ? -1.0 : 1.0;
+  qout[0] = sign * w, qout[1] = sign * x, qout[2] = sign * y, qout[3] = sign * z;
+}
+)";
+}
+
+}  // namespace kanegen::codegen

@@ -1,0 +1,349 @@
+#include "sim/linearize.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "model/diagnostics.hpp"
+
+namespace kanegen {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925;
+/// |f(x0)| at most this (SI units) counts as an equilibrium.
+constexpr double kEquilibriumTolerance = 1e-9;
+
+/// An input column: a named input's entry or a generalized force.
+struct InputColumn {
+  std::string name;
+  int w = -1;    ///< entry of w, or -1
+  int tau = -1;  ///< entry of tau, or -1
+};
+
+std::vector<InputColumn> input_columns(const Model& model, const std::vector<std::string>& wanted) {
+  std::vector<InputColumn> cols;
+  if (wanted.empty()) {
+    if (model.nw > 0)
+      for (int i = 0; i < model.nw; ++i) cols.push_back({model.input_names[i], i, -1});
+    else
+      for (int i = 0; i < model.nu; ++i) cols.push_back({"tau." + model.u_names[i], -1, i});
+    return cols;
+  }
+  for (const std::string& n : wanted) {
+    if (const int i = model.input_index(n); i >= 0) {
+      cols.push_back({n, i, -1});
+      continue;
+    }
+    if (n.rfind("tau.", 0) == 0)
+      if (const int i = model.u_index(n.substr(4)); i >= 0) {
+        cols.push_back({n, -1, i});
+        continue;
+      }
+    // a vector input by its name: all three entries
+    bool found = false;
+    for (int i = 0; i < model.nw; ++i)
+      if (model.input_names[i].rfind(n + ".", 0) == 0) {
+        cols.push_back({model.input_names[i], i, -1});
+        found = true;
+      }
+    if (!found)
+      throw InputError(Diagnostic{"(command line)", 0, "--inputs",
+                                  fmt::format("unknown input '{}'; expected a named input ({}) or tau.<speed>", n,
+                                              model.input_names.empty() ? std::string("the model declares none")
+                                                                        : fmt::format("{}", fmt::join(model.input_names, ", ")))});
+  }
+  return cols;
+}
+
+std::vector<int> output_rows(const Model& model, const std::vector<std::string>& wanted) {
+  std::vector<int> rows;
+  if (wanted.empty()) {
+    rows.resize(model.ny);
+    std::iota(rows.begin(), rows.end(), 0);
+    return rows;
+  }
+  for (const std::string& n : wanted) {
+    if (const int i = model.output_index(n); i >= 0) {
+      rows.push_back(i);
+      continue;
+    }
+    bool found = false;
+    for (const Sensor& s : model.sensors)
+      if (s.name == n) {
+        for (int k = 0; k < s.size(); ++k) rows.push_back(s.offset + k);
+        found = true;
+      }
+    if (!found)
+      throw InputError(Diagnostic{"(command line)", 0, "--outputs",
+                                  fmt::format("unknown output '{}'; expected a sensor or an entry of one ({})", n,
+                                              model.output_names.empty() ? std::string("the model declares none")
+                                                                         : fmt::format("{}", fmt::join(model.output_names, ", ")))});
+  }
+  return rows;
+}
+
+/// The sensor an output entry belongs to.
+const Sensor& sensor_of(const Model& model, int row) {
+  for (const Sensor& s : model.sensors)
+    if (row >= s.offset && row < s.offset + s.size()) return s;
+  throw std::logic_error("output row without a sensor");
+}
+
+/// x_dot = [q_dot; u_dot] at (q, u) with the engine's current inputs.
+VecX state_derivative(Engine& e, double t, const VecX& q, const VecX& u, const VecX& tau) {
+  VecX qd, ud;
+  e.qdot(q, u, qd);
+  e.udot(t, q, u, tau, ud);
+  VecX x(qd.size() + ud.size());
+  x << qd, ud;
+  return x;
+}
+
+}  // namespace
+
+Eigen::Matrix<double, 4, 3> quaternion_xi(const Eigen::Vector4d& q) {
+  Eigen::Matrix<double, 4, 3> X;
+  const double w = q(0), x = q(1), y = q(2), z = q(3);
+  X << -x, -y, -z,  //
+      w, -z, y,     //
+      z, w, -x,     //
+      -y, x, w;
+  return X;
+}
+
+LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions& options) {
+  const Model& model = engine.model();
+  const int nq = model.nq, nu = model.nu, nx = nq + nu;
+  const std::vector<InputColumn> in_cols = input_columns(model, options.inputs);
+  const bool state_outputs = model.ny == 0 && options.outputs.empty();
+  const std::vector<int> out_rows = state_outputs ? std::vector<int>{} : output_rows(model, options.outputs);
+  engine.set_inputs(state.w);
+  const double t = state.t;
+  const VecX &q0 = state.q, &u0 = state.u, &tau0 = state.tau;
+
+  // ---- full-coordinate derivatives: J = d[q_dot; u_dot]/d[q; u], Bw, Btau, CD
+  MatX J(nx, nx), Bw(nu, model.nw), Btau(nu, nu), CD(model.ny, nq + 2 * nu + model.nw);
+  const bool exact = !options.finite_differences && engine.has_jacobian() &&
+                     engine.jacobian(t, q0, u0, tau0, J) && engine.input_jacobian(t, q0, u0, tau0, Bw) &&
+                     engine.output_jacobian(t, q0, u0, tau0, CD);
+  // d(u_dot)/d(tau) = M^-1, exactly (u_dot is linear in tau).
+  {
+    MatX M;
+    engine.mass_matrix(t, q0, M);
+    Btau = M.llt().solve(MatX::Identity(nu, nu));
+  }
+  VecX y0 = VecX::Zero(model.ny);
+  if (model.ny > 0) engine.outputs(t, q0, u0, tau0, y0);
+  if (!exact) {
+    // central differences, step scaled to each variable
+    const VecX w0 = state.w;
+    VecX x0(nx);
+    x0 << q0, u0;
+    auto step = [](double v) { return 1e-6 * std::max(1.0, std::abs(v)); };
+    for (int c = 0; c < nq + 2 * nu + model.nw; ++c) {
+      VecX q = q0, u = u0, tau = tau0, w = w0;
+      double* v = c < nq ? &q(c) : c < nx ? &u(c - nq) : c < nx + model.nw ? &w(c - nx) : &tau(c - nx - model.nw);
+      const double v0 = *v, h = step(v0);
+      VecX fp, fm, yp(model.ny), ym(model.ny);
+      *v = v0 + h;
+      engine.set_inputs(w);
+      fp = state_derivative(engine, t, q, u, tau);
+      if (model.ny) engine.outputs(t, q, u, tau, yp);
+      *v = v0 - h;
+      engine.set_inputs(w);
+      fm = state_derivative(engine, t, q, u, tau);
+      if (model.ny) engine.outputs(t, q, u, tau, ym);
+      const VecX df = (fp - fm) / (2 * h);
+      if (c < nx) J.col(c) = df;
+      else if (c < nx + model.nw) Bw.col(c - nx) = df.tail(nu);
+      if (model.ny) CD.col(c) = (yp - ym) / (2 * h);
+    }
+    engine.set_inputs(w0);
+  }
+
+  // ---- the tangent space: T_in (nx x n), T_out (n x nx)
+  int nfree = 0;
+  for (const Body& b : model.bodies)
+    if (b.joint.type == JointType::free) ++nfree;
+  const int nqt = nq - nfree, n = nqt + nu;
+  MatX T_in = MatX::Zero(nx, n), T_out = MatX::Zero(n, nx);
+  LinearModel lin;
+  {
+    std::vector<bool> quat_row(nq, false);
+    std::vector<std::string> qt_names;
+    int r = 0;  // tangent row
+    for (int i = 0; i < nq;) {
+      const Body* free_body = nullptr;
+      for (const Body& b : model.bodies)
+        if (b.joint.type == JointType::free && b.q_joint + 3 == i) free_body = &b;
+      if (free_body) {
+        const Eigen::Vector4d qq = q0.segment<4>(i).normalized();
+        const Eigen::Matrix<double, 4, 3> Xi = quaternion_xi(qq);
+        T_in.block(i, r, 4, 3) = 0.5 * Xi;
+        T_out.block(r, i, 3, 4) = 2.0 * Xi.transpose();
+        for (const char* a : {".rx", ".ry", ".rz"}) lin.state_names.push_back("q." + free_body->name + a);
+        i += 4, r += 3;
+      } else {
+        T_in(i, r) = 1.0;
+        T_out(r, i) = 1.0;
+        lin.state_names.push_back("q." + model.q_names[i]);
+        ++i, ++r;
+      }
+    }
+    for (int k = 0; k < nu; ++k) {
+      T_in(nq + k, nqt + k) = 1.0;
+      T_out(nqt + k, nq + k) = 1.0;
+      lin.state_names.push_back("u." + model.u_names[k]);
+    }
+  }
+  lin.A = T_out * J * T_in;
+  const int m = static_cast<int>(in_cols.size());
+  lin.B = MatX::Zero(n, m);
+  for (int k = 0; k < m; ++k) {
+    lin.input_names.push_back(in_cols[k].name);
+    lin.B.col(k).tail(nu) = in_cols[k].w >= 0 ? VecX(Bw.col(in_cols[k].w)) : VecX(Btau.col(in_cols[k].tau));
+  }
+  lin.x0_dot = T_out * state_derivative(engine, t, q0, u0, tau0);
+  lin.residual = lin.x0_dot.size() ? lin.x0_dot.cwiseAbs().maxCoeff() : 0.0;
+  lin.equilibrium = lin.residual <= kEquilibriumTolerance;
+
+  if (state_outputs) {
+    lin.C = MatX::Identity(n, n);
+    lin.D = MatX::Zero(n, m);
+    lin.output_names = lin.state_names;
+    lin.y0 = VecX::Zero(n);
+  } else {
+    // output rows, attitude quaternions turned into small rotations
+    std::vector<MatX> C_rows, D_rows;
+    std::vector<double> y_rows;
+    for (std::size_t k = 0; k < out_rows.size();) {
+      const int row = out_rows[k];
+      const Sensor& s = sensor_of(model, row);
+      auto D_of = [&](const MatX& rows) {
+        MatX Dk(rows.rows(), m);
+        for (int c = 0; c < m; ++c)
+          Dk.col(c) = in_cols[c].w >= 0 ? VecX(rows.col(nx + in_cols[c].w)) : VecX(rows.col(nx + model.nw + in_cols[c].tau));
+        return Dk;
+      };
+      const bool whole_quaternion = s.type == SensorType::attitude && row == s.offset && k + 3 < out_rows.size() &&
+                                    out_rows[k + 3] == s.offset + 3;
+      if (whole_quaternion) {
+        const Eigen::Matrix<double, 3, 4> P = 2.0 * quaternion_xi(y0.segment<4>(s.offset)).transpose();
+        const MatX rows = P * CD.middleRows(s.offset, 4);
+        C_rows.push_back(rows.leftCols(nx) * T_in);
+        D_rows.push_back(D_of(rows));
+        for (const char* a : {".rx", ".ry", ".rz"}) lin.output_names.push_back(s.name + a), y_rows.push_back(0.0);
+        k += 4;
+      } else {
+        if (s.type == SensorType::attitude)
+          throw InputError(Diagnostic{"(command line)", 0, "--outputs",
+                                      fmt::format("'{}': an attitude output is linearized as a whole (a small "
+                                                  "rotation); expected '{}'",
+                                                  model.output_names[row], s.name)});
+        const MatX rows = CD.row(row);
+        C_rows.push_back(rows.leftCols(nx) * T_in);
+        D_rows.push_back(D_of(rows));
+        lin.output_names.push_back(model.output_names[row]);
+        y_rows.push_back(y0(row));
+        ++k;
+      }
+    }
+    const int p = static_cast<int>(lin.output_names.size());
+    lin.C.resize(p, n);
+    lin.D.resize(p, m);
+    int r = 0;
+    for (std::size_t k = 0; k < C_rows.size(); ++k) {
+      lin.C.middleRows(r, C_rows[k].rows()) = C_rows[k];
+      lin.D.middleRows(r, D_rows[k].rows()) = D_rows[k];
+      r += static_cast<int>(C_rows[k].rows());
+    }
+    lin.y0 = Eigen::Map<const VecX>(y_rows.data(), p);
+  }
+  lin.method = exact ? "exact: forward-mode dual numbers through the generated code"
+                     : "central differences (step 1e-6 max(1, |x|)) of the " + engine.name() + " engine";
+  return lin;
+}
+
+std::vector<LinearMode> linear_modes(const LinearModel& lin) {
+  std::vector<LinearMode> out;
+  const int n = static_cast<int>(lin.A.rows());
+  if (n == 0) return out;
+  Eigen::EigenSolver<MatX> es(lin.A, true);
+  const auto& lam = es.eigenvalues();
+  const auto& V = es.eigenvectors();
+  int nqt = 0;
+  for (const auto& s : lin.state_names) nqt += s.rfind("q.", 0) == 0 ? 1 : 0;
+  for (int k = 0; k < n; ++k) {
+    const std::complex<double> l = lam(k);
+    if (l.imag() < 0) continue;
+    LinearMode m;
+    m.eigenvalue = l;
+    const double mag = std::abs(l);
+    m.natural_frequency_hz = mag / kTwoPi;
+    m.damped_frequency_hz = l.imag() / kTwoPi;
+    m.damping_ratio = mag > 0 ? -l.real() / mag : 1.0;
+    std::vector<std::pair<double, int>> part;
+    for (int i = 0; i < n; ++i) {
+      double p = std::abs(V(i, k));
+      if (i >= nqt && mag > 1e-12) p /= mag;
+      part.push_back({p, i});
+    }
+    std::sort(part.begin(), part.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (int i = 0; i < std::min(3, n); ++i)
+      if (part[i].first > 0.1 * part[0].first) m.dominant_states.push_back(lin.state_names[part[i].second]);
+    out.push_back(m);
+  }
+  std::sort(out.begin(), out.end(), [](const LinearMode& a, const LinearMode& b) {
+    return std::abs(a.eigenvalue) < std::abs(b.eigenvalue);
+  });
+  return out;
+}
+
+nlohmann::ordered_json to_json(const LinearModel& lin, const std::vector<LinearMode>& modes) {
+  auto mat = [](const MatX& M) {
+    auto rows = nlohmann::ordered_json::array();
+    for (Eigen::Index r = 0; r < M.rows(); ++r) {
+      auto row = nlohmann::ordered_json::array();
+      for (Eigen::Index c = 0; c < M.cols(); ++c) row.push_back(M(r, c));
+      rows.push_back(row);
+    }
+    return rows;
+  };
+  auto vec = [](const VecX& v) { return std::vector<double>(v.data(), v.data() + v.size()); };
+  nlohmann::ordered_json j;
+  j["method"] = lin.method;
+  j["attitude"] =
+      "each free joint's quaternion is replaced by a small rotation in body axes, q = q0 (x) [1; r/2] "
+      "(states q.<body>.rx, .ry, .rz); attitude outputs likewise (rows <sensor>.rx, .ry, .rz)";
+  j["equilibrium"] = lin.equilibrium;
+  j["residual"] = lin.residual;
+  j["note"] = lin.equilibrium
+                  ? "the point is an equilibrium (max |x_dot| <= 1e-9): x_dot = A dx + B dw"
+                  : fmt::format("the point is not an equilibrium (max |x_dot| = {:.3g}): a first-order Taylor model "
+                                "x_dot = x0_dot + A dx + B dw, y = y0 + C dx + D dw",
+                                lin.residual);
+  j["state_names"] = lin.state_names;
+  j["input_names"] = lin.input_names;
+  j["output_names"] = lin.output_names;
+  j["A"] = mat(lin.A);
+  j["B"] = mat(lin.B);
+  j["C"] = mat(lin.C);
+  j["D"] = mat(lin.D);
+  j["x0_dot"] = vec(lin.x0_dot);
+  j["y0"] = vec(lin.y0);
+  auto jm = nlohmann::ordered_json::array();
+  for (const LinearMode& m : modes)
+    jm.push_back({{"eigenvalue", {m.eigenvalue.real(), m.eigenvalue.imag()}},
+                  {"natural_frequency_hz", m.natural_frequency_hz},
+                  {"damped_frequency_hz", m.damped_frequency_hz},
+                  {"damping_ratio", m.damping_ratio},
+                  {"dominant_states", m.dominant_states}});
+  j["modes"] = jm;
+  return j;
+}
+
+}  // namespace kanegen

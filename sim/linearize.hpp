@@ -1,0 +1,68 @@
+// Continuous-time linear models about a state: x_dot ~ f(x0) + A dx + B dw,
+// y ~ y0 + C dx + D dw, from the exact derivatives of the generated code
+// (dual numbers: Engine::jacobian, input_jacobian, output_jacobian), or from
+// central differences for an engine without them (the generic engine).
+//
+// The state is taken in the tangent space of each free joint's attitude: its
+// quaternion's 4 components are replaced by a small rotation dtheta in body
+// axes, q = q0 (x) [1; dtheta/2], so the linear model has 2 nu states
+// (nq - n_free + nu) and no constraint direction. Attitude outputs likewise
+// become small rotations of the output frame (3 rows instead of 4).
+// docs/gnc.md states the conventions.
+#pragma once
+
+#include <complex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "engine/engine.hpp"
+#include "model/state_io.hpp"
+
+namespace kanegen {
+
+struct LinearizeOptions {
+  /// Inputs of the model, by name: entries of the named inputs w ("thr",
+  /// "mtq.x"), or generalized forces "tau.<speed name>". Empty: every named
+  /// input, or every tau when the model declares none.
+  std::vector<std::string> inputs;
+  /// Outputs, by name: a sensor ("gyro", all its entries) or one entry
+  /// ("gyro.x"). Empty: every named output, or the state itself (C = I) when
+  /// the model declares none.
+  std::vector<std::string> outputs;
+  bool finite_differences = false;  ///< central differences even where exact derivatives exist
+};
+
+struct LinearModel {
+  std::vector<std::string> state_names;   ///< "q.<coordinate>" (attitude: "q.<body>.rx" ...), "u.<speed>"
+  std::vector<std::string> input_names;
+  std::vector<std::string> output_names;  ///< attitude outputs: "<sensor>.rx", ".ry", ".rz"
+  MatX A, B, C, D;
+  VecX x0_dot;        ///< the tangent state's derivative at the point, f(x0)
+  VecX y0;            ///< the outputs at the point (tangent rows: attitude rows are 0)
+  bool equilibrium = false;
+  double residual = 0;  ///< max |f(x0)|
+  std::string method;   ///< how the derivatives were obtained
+};
+
+/// Throws InputError (naming `option`) for unknown input or output names;
+/// SingularMassMatrix at a singular point.
+LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions& options);
+
+/// One eigenvalue of A (conjugate pairs listed once, Im >= 0).
+struct LinearMode {
+  std::complex<double> eigenvalue;
+  double natural_frequency_hz = 0;  ///< |lambda| / 2 pi
+  double damped_frequency_hz = 0;   ///< Im(lambda) / 2 pi
+  double damping_ratio = 0;         ///< -Re(lambda) / |lambda| (1 for lambda = 0 by convention: not oscillating)
+  std::vector<std::string> dominant_states;  ///< largest participation first (speeds weighted by 1/|lambda|)
+};
+std::vector<LinearMode> linear_modes(const LinearModel& lin);
+
+nlohmann::ordered_json to_json(const LinearModel& lin, const std::vector<LinearMode>& modes);
+
+/// Small rotation of a unit quaternion's perturbation: dtheta = 2 Xi(q)^T dq,
+/// with q (x) [0; v] = Xi(q) v (4 x 3).
+Eigen::Matrix<double, 4, 3> quaternion_xi(const Eigen::Vector4d& q);
+
+}  // namespace kanegen
