@@ -446,7 +446,12 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   // Applied inputs or a controller do work: no invariant holds then.
   const bool driven = controller || (initial.w.size() && !initial.w.isZero(0.0));
   if (!driven) {
-    const bench::Drifts d = bench::invariant_drifts(engine, bench::invariants_of(model, initial.tau), sampled.traj);
+    bench::InvariantSet inv = bench::invariants_of(model, initial.tau);
+    if (dynamic_cast<GeneratedEngine*>(&engine)) {  // generated code has what the model's outputs ask for
+      inv.energy = inv.energy && model.outputs.energy;
+      inv.momentum = inv.momentum && model.outputs.momentum && model.outputs.energy;  // T scales the p drift
+    }
+    const bench::Drifts d = bench::invariant_drifts(engine, inv, sampled.traj);
     quality.energy_drift = d.energy;
     quality.H_drift = d.H;
   }
