@@ -51,6 +51,7 @@ const char* arg_name(Arg a) {
     case Arg::tau: return "tau";
     case Arg::udot_in: return "udot_in";
     case Arg::inputs: return "inputs";
+    case Arg::params: return "prm";
     case Arg::out: return "out";
   }
   return "?";
@@ -63,6 +64,8 @@ std::string parameters(const EmittedFunction& f) {
   for (Arg a : f.args) {
     if (a == Arg::t)
       ps.push_back("const double t");
+    else if (a == Arg::params)
+      ps.push_back("const double* prm");
     else if (a == Arg::out)
       ps.push_back(fmt::format("{}* {}", T, f.out_name));
     else
@@ -82,6 +85,7 @@ std::string call_arguments(const EmittedFunction& f) {
       case Arg::tau: as.push_back("a->tau"); break;
       case Arg::udot_in: as.push_back("a->udot"); break;
       case Arg::inputs: as.push_back("a->inputs"); break;
+      case Arg::params: as.push_back("a->params"); break;
       case Arg::out: as.push_back("out"); break;
     }
   }
@@ -172,6 +176,23 @@ AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, 
   replace_all(h, "NBODIES", std::to_string(m.nbodies));
   replace_all(h, "NW", std::to_string(m.nw));
   replace_all(h, "NY", std::to_string(m.ny));
+  {
+    std::string pr = fmt::format("inline constexpr int np = {};  // runtime parameters\n", m.np);
+    if (m.np > 0) {
+      std::vector<std::string> names, units, nominal;
+      for (int i = 0; i < m.np; ++i) {
+        names.push_back("\"" + escaped(m.parameter_names[i]) + "\"");
+        units.push_back("\"" + escaped(m.parameter_units[i]) + "\"");
+        nominal.push_back(fmt::format("{:.17g}", m.parameter_nominal[i]));
+      }
+      pr += "// The runtime parameters: every function but qdot takes their values as prm[np];\n"
+            "// parameter_nominal holds the model's values at generation (docs/sweeps.md).\n";
+      pr += fmt::format("inline constexpr const char* parameter_names[np] = {{{}}};\n", join(names, ", "));
+      pr += fmt::format("inline constexpr const char* parameter_units[np] = {{{}}};\n", join(units, ", "));
+      pr += fmt::format("inline constexpr double parameter_nominal[np] = {{{}}};\n", join(nominal, ", "));
+    }
+    replace_all(h, "PARAMETERS", pr);
+  }
   replace_all(h, "IO_NAMES", (m.input_names.empty() ? "" : "// Inputs w:      " + join(m.input_names, ", ") + "\n") +
                                  (m.output_names.empty() ? "" : "// Outputs y:     " + join(m.output_names, ", ") + "\n"));
   replace_all(h, "Q_NAMES", join(m.q_names, ", "));
@@ -221,6 +242,7 @@ AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, 
   replace_all(e, "NBODIES", std::to_string(m.nbodies));
   replace_all(e, "NW", std::to_string(m.nw));
   replace_all(e, "NY", std::to_string(m.ny));
+  replace_all(e, "NP", std::to_string(m.np));
   out.entry = std::move(e);
 
   // ---- manifest
@@ -240,6 +262,8 @@ AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, 
   j["ny"] = m.ny;
   j["inputs"] = m.input_names;
   j["outputs"] = m.output_names;
+  j["np"] = m.np;
+  j["parameters"] = m.parameter_names;
   j["udot_form"] = m.udot_form;
   j["takes_time"] = std::any_of(m.functions.begin(), m.functions.end(), [](const EmittedFunction& f) {
     return std::find(f.args.begin(), f.args.end(), Arg::t) != f.args.end();

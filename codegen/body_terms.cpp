@@ -213,6 +213,58 @@ void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV
 }
 
 
+/// Body j's mass, first moment S0 and inertia J0 about O (rigid part and
+/// plain nodes, B' components) when some of its rigid part's mass, com or
+/// inertia are runtime parameters (given in the model's frame B): the rigid
+/// part's share formed from the parameters, the nodes' share kept as constants.
+void runtime_rigid_part(KaneContext& ctx, int j, ex& mass, SV3& S0, SM3& J0) {
+  const Body& b = ctx.model.bodies[j];
+  const BodyMassIntegrals& I = b.integrals;
+  const std::string& n = b.name;
+  const Mat3 Q = ctx.R_BBp.empty() ? Mat3::Identity() : ctx.R_BBp[j];
+  // nominal rigid part in B' (the framed model's) and in B (the parameters' frame)
+  const double m0 = b.rigid.mass;
+  const Vec3 c0 = b.rigid.com_B;
+  const Mat3 Jr0 = b.rigid.I_c_B + m0 * (c0.squaredNorm() * Mat3::Identity() - c0 * c0.transpose());
+  const Vec3 c_B = Q * c0;
+  const Mat3 Ic_B = Q * b.rigid.I_c_B * Q.transpose();
+  const ex m = ctx.param(ParameterKind::mass, j, 0).value_or(ctx.c(m0, n + "_rigid_mass", "kg", "rigid part's mass"));
+  SV3 c;  // B components
+  for (int a = 0; a < 3; ++a)
+    c[a] = ctx.param(ParameterKind::com, j, a)
+               .value_or(ctx.c(c_B(a), fmt::format("{}_rigid_com_{}", n, "xyz"[a]), "m", "rigid part's com, model axes"));
+  SM3 Ic;  // B axes
+  const int rc[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+  for (int k = 0; k < 6; ++k) {
+    const int r = rc[k][0], cc = rc[k][1];
+    Ic(r, cc) = Ic(cc, r) =
+        ctx.param(ParameterKind::inertia, j, k)
+            .value_or(ctx.c(Ic_B(r, cc), fmt::format("{}_rigid_I_{}{}", n, "xyz"[r], "xyz"[cc]), "kg m^2",
+                            "rigid part's inertia about its com, model axes"));
+  }
+  Alg& A = ctx.A;
+  SM3 Qt;
+  for (int r = 0; r < 3; ++r)
+    for (int cc = 0; cc < 3; ++cc) Qt(r, cc) = ctx.c(Q(cc, r), fmt::format("{}_R_BpB_{}{}", n, r, cc), "", "model axes in the generator's");
+  const SV3 cp = A.mul(Qt, c);                         // com in B'
+  const SM3 Icp = A.mul(A.mul(Qt, Ic), Qt.transpose());  // inertia about the com in B'
+  // the nodes' share: what the integrals hold besides the nominal rigid part (0 for a rigid body)
+  auto rest = [](double total, double rigid) {
+    const double r = total - rigid;
+    return std::abs(r) <= 1e-14 * std::max(std::abs(total), std::abs(rigid)) ? 0.0 : r;
+  };
+  mass = A.P.let(m + ctx.c(rest(I.mass, m0), n + "_nodes_mass", "kg", "mass of the plain nodes"));
+  const ex c2 = A.P.let(cp[0] * cp[0] + cp[1] * cp[1] + cp[2] * cp[2]);
+  for (int a = 0; a < 3; ++a) {
+    S0[a] = A.P.let(m * cp[a] + ctx.c(rest(I.S0(a), m0 * c0(a)), fmt::format("{}_nodes_S0_{}", n, "xyz"[a]), "kg m",
+                                      "first moment of the plain nodes"));
+    for (int cc = 0; cc < 3; ++cc)
+      J0(a, cc) = A.P.let(Icp(a, cc) + m * ((a == cc ? c2 : ex(0)) - cp[a] * cp[cc]) +
+                          ctx.c(rest(I.J0(a, cc), Jr0(a, cc)), fmt::format("{}_nodes_J0_{}{}", n, "xyz"[std::min(a, cc)], "xyz"[std::max(a, cc)]),
+                                "kg m^2", "inertia of the plain nodes about O"));
+  }
+}
+
 }  // namespace
 
 void compute_body_terms(KaneContext& ctx, bool with_velocity) {
@@ -220,7 +272,7 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
   const Model& model = ctx.model;
   const Vec3& gN = model.g_N;
   ctx.C.group = "model";
-  const SV3 g_N = ctx.cvec(gN, "gravity", "m/s^2", "gravity in N");
+  const SV3 g_N = ctx.gravity(1.0, "gravity", "gravity in N");
   for (std::size_t j = 0; j < model.bodies.size(); ++j) {
     const Body& b = model.bodies[j];
     const BodyMassIntegrals& I = b.integrals;
@@ -229,9 +281,20 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
     const std::string& n = b.name;
     const int m = I.m;
     ctx.P.section(fmt::format("body {}: mass and velocity terms", n));
-    const ex mass = ctx.c(I.mass, n + "_mass", "kg", "mass (rigid part and plain nodes)");
-    const SV3 S0 = ctx.cvec(I.S0, n + "_S0", "kg m", "first mass moment about O (undeformed)");
-    const SM3 J0 = ctx.cmat(I.J0, n + "_J0", "kg m^2", "inertia about O (undeformed)", true);
+    ex mass;
+    SV3 S0;
+    SM3 J0;
+    const bool runtime_rigid = std::any_of(model.parameters.begin(), model.parameters.end(), [&](const RuntimeParameter& p) {
+      return p.body == static_cast<int>(j) &&
+             (p.kind == ParameterKind::mass || p.kind == ParameterKind::com || p.kind == ParameterKind::inertia);
+    });
+    if (runtime_rigid) {
+      runtime_rigid_part(ctx, static_cast<int>(j), mass, S0, J0);
+    } else {
+      mass = ctx.c(I.mass, n + "_mass", "kg", "mass (rigid part and plain nodes)");
+      S0 = ctx.cvec(I.S0, n + "_S0", "kg m", "first mass moment about O (undeformed)");
+      J0 = ctx.cmat(I.J0, n + "_J0", "kg m^2", "inertia about O (undeformed)", true);
+    }
     // Modal integrals.
     std::vector<SV3> Bc(m);
     for (int i = 0; i < m; ++i) Bc[i] = ctx.cvec(I.B.col(i), fmt::format("{}_B{}", n, i + 1), "kg m", "modal participation");
@@ -301,7 +364,7 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
     // Gravity: g_B = R_NB^T g_N; [m g_B; S x g_B; B^T g_B]
     s.g_body.assign(6 + m, ex(0));
     SV3 g_B;
-    const bool gravity_terms = !gN.isZero() && !(with_velocity && ctx.gravity_in_base_acceleration);
+    const bool gravity_terms = ctx.has_gravity() && !(with_velocity && ctx.gravity_in_base_acceleration);
     if (gravity_terms) {
       g_B = A.mul_t(s.R_NB, g_N, ctx.name("g_B", static_cast<int>(j)));
       const SV3 mg = A.scale(mass, g_B), Sg = A.cross(S, g_B);

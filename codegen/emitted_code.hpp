@@ -29,6 +29,7 @@ enum class Arg {
   tau,      ///< const T* tau: generalized inputs
   udot_in,  ///< const T* udot_in: accelerations (reactions)
   inputs,   ///< const T* inputs: the named inputs w (only for models that declare some)
+  params,   ///< const double* prm: the runtime parameters (only for models that declare some)
   out,      ///< T* <out_name>: the result
 };
 
@@ -58,6 +59,9 @@ struct EmittedModel {
   std::string generator_hash;
   int nq = 0, nu = 0, nbodies = 0;
   int nw = 0, ny = 0;           ///< named inputs and outputs (docs/gnc.md)
+  int np = 0;                   ///< runtime parameters (docs/sweeps.md)
+  std::vector<std::string> parameter_names, parameter_units;
+  std::vector<double> parameter_nominal;
   std::vector<std::string> q_names, u_names, input_names, output_names;
   std::string constants;        ///< namespace-scope constant declarations, grouped by body
   std::string support_code;     ///< helper functions the bodies call (e.g. prescribed motion), or empty

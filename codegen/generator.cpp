@@ -62,7 +62,7 @@ EmittedFunction function(std::string name, std::string title, std::vector<Arg> a
 /// at their values (seeded one direction per pass by the caller), and the
 /// calls of qdot(), udot() and outputs() on them.
 struct DualCalls {
-  bool timed = false, inputs = false;
+  bool timed = false, inputs = false, params = false;
   std::string declarations() const {
     return "  using D = Dual<1>;\n"
            "  D qd[nq > 0 ? nq : 1], ud[nu > 0 ? nu : 1], td[nu > 0 ? nu : 1], wd[nw > 0 ? nw : 1];\n"
@@ -78,13 +78,14 @@ struct DualCalls {
         c, v);
   }
   std::string call(const std::string& f, const char* out, bool with_tau = true) const {
-    return fmt::format("{}({}qd, ud, {}{}{})", f, timed ? "t, " : "", with_tau ? "td, " : "", inputs ? "wd, " : "",
-                       out);
+    return fmt::format("{}({}qd, ud, {}{}{}{})", f, timed ? "t, " : "", with_tau ? "td, " : "", inputs ? "wd, " : "",
+                       params ? "prm, " : "", out);
   }
   std::vector<Arg> args() const {
     std::vector<Arg> a{Arg::q, Arg::u, Arg::tau};
     if (timed) a.insert(a.begin(), Arg::t);
     if (inputs) a.push_back(Arg::inputs);
+    if (params) a.push_back(Arg::params);
     a.push_back(Arg::out);
     return a;
   }
@@ -230,11 +231,20 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   out.ny = model_in.ny;
   out.input_names = model_in.input_names;
   out.output_names = model_in.output_names;
+  out.np = static_cast<int>(model_in.parameters.size());
+  for (const RuntimeParameter& p : model_in.parameters) {
+    out.parameter_names.push_back(p.name);
+    out.parameter_units.push_back(p.unit);
+    out.parameter_nominal.push_back(p.nominal);
+  }
   auto& fns = out.functions;
   // Functions take t only when the scene has prescribed motion.
   const bool timed = dyn.has_prescribed();
-  auto at_t = [timed](std::vector<Arg> args) {
+  // ... and the runtime parameters only when the model declares some (all but qdot)
+  const bool has_params = !model_in.parameters.empty();
+  auto at_t = [timed, has_params](std::vector<Arg> args) {
     if (timed) args.insert(args.begin(), Arg::t);
+    if (has_params) args.insert(args.end() - 1, Arg::params);
     return args;
   };
   if (timed) out.support_code = motion_support_code();
@@ -252,6 +262,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     Program p;
     KaneContext ctx(dyn, p, C, x);
     ctx.angle_offset = framed.angle_offset;
+    ctx.R_BBp = framed.R_BBp;
     const auto qd = compute_qdot(ctx);
     for (int i = 0; i < dyn.nq; ++i) p.assign(fmt::format("qdot[{}]", i), qd[i]);
     EmittedFunction f = function("qdot", "q_dot = W(q) u", {Arg::q, Arg::u, Arg::out}, "qdot", dyn.nq);
@@ -262,6 +273,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     Program p;
     KaneContext ctx(dyn, p, C, x);
     ctx.angle_offset = framed.angle_offset;
+    ctx.R_BBp = framed.R_BBp;
     prepare(ctx, false);
     const SMat M = compute_mass_matrix(ctx);
     for (int r = 0; r < dyn.nu; ++r)
@@ -274,6 +286,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     Program p;
     KaneContext ctx(dyn, p, C, x);
     ctx.angle_offset = framed.angle_offset;
+    ctx.R_BBp = framed.R_BBp;
     prepare(ctx, true);
     const auto F = compute_forcing(ctx);
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("F[{}]", r), F[r]);
@@ -289,6 +302,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     Program p;
     KaneContext ctx(dyn, p, C, x);
     ctx.angle_offset = framed.angle_offset;
+    ctx.R_BBp = framed.R_BBp;
     prepare(ctx, true);
     std::vector<ex> pivots, scales, ud;
     if (std::string(form) == "composite") {
@@ -329,6 +343,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     Program p;
     KaneContext ctx(dyn, p, C, x);
     ctx.angle_offset = framed.angle_offset;
+    ctx.R_BBp = framed.R_BBp;
     prepare(ctx, true);
     p.assign("TV[0]", compute_kinetic_energy(ctx));
     p.assign("TV[1]", compute_potential_energy(ctx));
@@ -340,6 +355,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     Program p;
     KaneContext ctx(dyn, p, C, x);
     ctx.angle_offset = framed.angle_offset;
+    ctx.R_BBp = framed.R_BBp;
     prepare(ctx, true);
     const auto pH = compute_momentum(ctx);
     for (int i = 0; i < 6; ++i) p.assign(fmt::format("pH[{}]", i), pH[i]);
@@ -354,6 +370,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     Program p;
     KaneContext ctx(fr.model, p, C, xr);
     ctx.angle_offset = fr.angle_offset;
+    ctx.R_BBp = fr.R_BBp;
     prepare(ctx, true);
     const auto W = compute_reactions(ctx, xr.udot);
     // back to the model's body axes: [R_BB' f; R_BB' t]
@@ -372,7 +389,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     finish(p, C, f, options);
     fns.push_back(std::move(f));
   }
-  const DualCalls dual{timed, has_inputs};
+  const DualCalls dual{timed, has_inputs, has_params};
   fns.push_back(jacobian_function(dyn.nq, dyn.nu, dual, qdot_ops, udot_ops));
   if (has_inputs) fns.push_back(input_jacobian_function(dyn.nq, dyn.nu, dyn.nw, dual, udot_ops));
   if (model_in.ny > 0) {
@@ -383,6 +400,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     Program p;
     KaneContext ctx(fr.model, p, C, xr);
     ctx.angle_offset = fr.angle_offset;
+    ctx.R_BBp = fr.R_BBp;
     prepare(ctx, true);
     std::vector<ex> pivots, scales, ud;
     if (out.udot_form == "composite") {

@@ -93,7 +93,7 @@ void assign_sensor_outputs(KaneContext& ctx, const std::vector<ex>& wrenches,
         const bool gib = ctx.gravity_in_base_acceleration;
         const bool accel = sn.type == SensorType::acceleration;
         if (gib == accel) {  // acceleration from a - g, or a - g from a
-          const SV3 g_B = ctx.A.mul_t(s.R_NB, ctx.cvec(model.g_N, "g_N", "m/s^2", "gravity"));
+          const SV3 g_B = ctx.A.mul_t(s.R_NB, ctx.gravity(1.0, "gravity", "gravity in N"));
           a = accel ? ctx.A.add(a, g_B) : ctx.A.sub(a, g_B);
         }
         put(a, sn.offset);

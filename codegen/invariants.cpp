@@ -31,11 +31,11 @@ ex compute_kinetic_energy(KaneContext& ctx) {
 ex compute_potential_energy(KaneContext& ctx) {
   ex V = 0;
   ctx.C.group = "model";
-  const SV3 g_N = ctx.cvec(ctx.model.g_N, "gravity", "m/s^2", "gravity in N");
+  const SV3 g_N = ctx.gravity(1.0, "gravity", "gravity in N");
   for (std::size_t j = 0; j < ctx.model.bodies.size(); ++j) {
     const Body& b = ctx.model.bodies[j];
     const SymBodyWorkspace& s = ctx.body[j];
-    if (!ctx.model.g_N.isZero()) {
+    if (ctx.has_gravity()) {
       // -g . (m r_O + R_NB S)
       SV3 S{{s.M_body(5, 1), s.M_body(3, 2), s.M_body(4, 0)}};  // from rows 3-5 = S^x
       const SV3 RS = ctx.A.mul(s.R_NB, S);
@@ -43,13 +43,13 @@ ex compute_potential_energy(KaneContext& ctx) {
     }
     ctx.C.group = b.name;
     if ((b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic) && !b.joint.prescribed()) {
-      const ex kk = ctx.c(b.joint.stiffness, b.name + "_k", "N m/rad or N/m", "joint spring stiffness");
-      const ex rest = ctx.c(b.joint.rest, b.name + "_rest", "rad or m", "spring rest value");
+      const auto [kk, cc_unused, rest] = joint_spring(ctx, static_cast<int>(j));
+      (void)cc_unused;
       const ex dq = ctx.A.let(ctx.x.q[b.q_joint] - rest);
       V += kk * dq * dq / 2;
     }
     for (int i = 0; i < b.n_modes(); ++i) {
-      const ex K = ctx.c(b.flex->K(i), fmt::format("{}_K{}", b.name, i + 1), "N m", "modal stiffness");
+      const ex K = modal_stiffness_damping(ctx, static_cast<int>(j), i)[0];
       V += K * s.eta[i] * s.eta[i] / 2;
     }
     V = ctx.A.let(V);

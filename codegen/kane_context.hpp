@@ -26,6 +26,9 @@
 #include "codegen/constants.hpp"
 #include "codegen/symbolic.hpp"
 #include "model/model.hpp"
+#include "model/parameters.hpp"
+
+#include <optional>
 
 namespace kanegen::codegen {
 
@@ -61,6 +64,9 @@ struct KaneContext {
   std::map<int, std::array<ex, 3>> motion_symbols;  ///< body -> f, f_dot, f_ddot (see motion())
   /// Per body: a revolute joint turns by q + angle_offset[j] (joint_frames.hpp); empty: no offsets.
   std::vector<double> angle_offset;
+  /// Per body: axes of the generator's frame B' in the model's frame B
+  /// (joint_frames.hpp), for the runtime parameters given in B; empty: identity.
+  std::vector<Mat3> R_BBp;
   /// Gravity as a fictitious acceleration -g of the ground (Featherstone): with
   /// velocities, every body's remainder acceleration carries -g and no body has
   /// a gravity term g_body, so no R_NB is needed for the dynamics.
@@ -73,6 +79,20 @@ struct KaneContext {
   SV3 cvec(const Vec3& v, const std::string& name, const std::string& unit, const std::string& what);
   SM3 cmat(const Mat3& m, const std::string& name, const std::string& unit, const std::string& what,
            bool symmetric = false);
+  /// The runtime parameter prm[k] of this kind, body and index
+  /// (model/parameters.hpp), or nullopt when the value is folded as a constant.
+  std::optional<ex> param(ParameterKind kind, int body, int index) const {
+    const int k = find_parameter(model.parameters, kind, body, index);
+    return k >= 0 ? std::optional<ex>(x.params[k]) : std::nullopt;
+  }
+  /// Gravity in N components (runtime parameters or named constants), times `sign`.
+  SV3 gravity(double sign, const std::string& name, const std::string& what);
+  /// Whether gravity may be non-zero (a runtime parameter, or a non-zero constant).
+  bool has_gravity() const {
+    return !model.g_N.isZero() || find_parameter(model.parameters, ParameterKind::gravity, -1, 0) >= 0 ||
+           find_parameter(model.parameters, ParameterKind::gravity, -1, 1) >= 0 ||
+           find_parameter(model.parameters, ParameterKind::gravity, -1, 2) >= 0;
+  }
   /// Name of a quantity of body j for the emitted code, e.g. "w_B_ant2".
   std::string name(const std::string& quantity, int j) const { return quantity + "_" + model.bodies[j].name; }
   /// The prescribed coordinate of body j's joint and its two derivatives at t
@@ -113,6 +133,11 @@ SMat transform_inertia_to_parent(KaneContext& ctx, int j, const SMat& I);
 /// y_j = g_j - h_j - M_body z_R for every body (generalized gravity and
 /// velocity forces with the remainder accelerations' inertia forces).
 std::vector<std::vector<ex>> compute_bias_forces(KaneContext& ctx);
+/// Stiffness, damping and rest value of body j's joint spring (runtime parameters or constants).
+std::array<ex, 3> joint_spring(KaneContext& ctx, int j);
+/// Modal stiffness K and damping D of body j's mode i (from runtime frequency
+/// and damping ratio parameters when given: K = w^2 Y, D = 2 zeta w Y).
+std::array<ex, 2> modal_stiffness_damping(KaneContext& ctx, int j, int i);
 /// tau + spring/damper or modal stiffness/damping of body j's own speed `own`.
 ex applied_force(KaneContext& ctx, int j, int own);
 

@@ -12,6 +12,14 @@ using namespace GiNaC;
 
 static const char* kAxis[3] = {"x", "y", "z"};
 
+SV3 KaneContext::gravity(double sign, const std::string& n, const std::string& what) {
+  C.group = "model";
+  SV3 g = cvec(sign * model.g_N, n, "m/s^2", what);
+  for (int a = 0; a < 3; ++a)
+    if (auto p = param(ParameterKind::gravity, -1, a)) g[a] = sign * *p;
+  return g;
+}
+
 SV3 KaneContext::cvec(const Vec3& v, const std::string& n, const std::string& unit, const std::string& what) {
   SV3 r;
   for (int i = 0; i < 3; ++i) r[i] = c(v(i), n + "_" + kAxis[i], unit, what + " " + kAxis[i]);
@@ -92,9 +100,8 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     const SV3 zero;
     const SV3 w_P = has_parent ? p->w_B : zero, v_P = has_parent ? p->v_O_B : zero;
     SV3 minus_g;
-    if (!has_parent && with_velocity && ctx.gravity_in_base_acceleration && !model.g_N.isZero()) {
-      ctx.C.group = "model";
-      minus_g = ctx.cvec(-model.g_N, "minus_gravity", "m/s^2", "-gravity in N: the ground's fictitious acceleration");
+    if (!has_parent && with_velocity && ctx.gravity_in_base_acceleration && ctx.has_gravity()) {
+      minus_g = ctx.gravity(-1.0, "minus_gravity", "-gravity in N: the ground's fictitious acceleration");
       ctx.C.group = b.name;
     }
     const SV3 aR_P = has_parent ? p->a_R_B : minus_g, alR_P = has_parent ? p->alpha_R_B : zero;

@@ -8,6 +8,15 @@ Mat3 point_inertia(double m, const Vec3& r) { return m * (r.squaredNorm() * Mat3
 
 bool mergeable(const Body& b) { return b.joint.type == JointType::fixed && b.joint.node < 0 && !b.flex; }
 
+/// A body whose rigid part holds runtime parameters keeps its own terms (its
+/// parameters are given in its own frame), and so does its parent.
+bool has_rigid_parameters(const Model& m, int j) {
+  for (const RuntimeParameter& p : m.parameters)
+    if (p.body == j && (p.kind == ParameterKind::mass || p.kind == ParameterKind::com || p.kind == ParameterKind::inertia))
+      return true;
+  return false;
+}
+
 /// Adds rigid part `c`, located by (p, R) in the frame of `a`, to `a`.
 void add_rigid(RigidPart& a, const RigidPart& c, const Vec3& p, const Mat3& R) {
   const Vec3 com_c = p + R * c.com_B;
@@ -32,6 +41,7 @@ Model merge_fixed_bodies(const Model& in) {
       const Body fixed = m.bodies[j];
       const int p = fixed.parent;
       if (p < 0) continue;  // fixed to ground: kept (it never moves; costs nothing)
+      if (has_rigid_parameters(m, static_cast<int>(j)) || has_rigid_parameters(m, p)) continue;
       add_rigid(m.bodies[p].rigid, fixed.rigid, fixed.joint.p_PJ, fixed.joint.R_PJ);
       move_ports(m.inputs, m.sensors, static_cast<int>(j), p, fixed.joint.p_PJ, fixed.joint.R_PJ);
       for (Body& c : m.bodies) {
@@ -47,6 +57,8 @@ Model merge_fixed_bodies(const Model& in) {
         if (in.body > static_cast<int>(j)) --in.body;
       for (Sensor& s : m.sensors)
         if (s.body > static_cast<int>(j)) --s.body;
+      for (RuntimeParameter& rp : m.parameters)
+        if (rp.body > static_cast<int>(j)) --rp.body;
       changed = true;
       break;
     }

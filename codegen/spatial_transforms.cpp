@@ -155,6 +155,33 @@ std::vector<std::vector<ex>> compute_bias_forces(KaneContext& ctx) {
   return y;
 }
 
+std::array<ex, 3> joint_spring(KaneContext& ctx, int j) {
+  const Body& b = ctx.model.bodies[j];
+  ctx.C.group = b.name;
+  return {ctx.param(ParameterKind::stiffness, j, 0)
+              .value_or(ctx.c(b.joint.stiffness, b.name + "_k", "N m/rad or N/m", "joint spring stiffness")),
+          ctx.param(ParameterKind::damping, j, 0)
+              .value_or(ctx.c(b.joint.damping, b.name + "_c", "N m s/rad or N s/m", "joint damping")),
+          ctx.param(ParameterKind::rest, j, 0).value_or(ctx.c(b.joint.rest, b.name + "_rest", "rad or m", "spring rest value"))};
+}
+
+std::array<ex, 2> modal_stiffness_damping(KaneContext& ctx, int j, int i) {
+  const Body& b = ctx.model.bodies[j];
+  const FlexibleData& f = *b.flex;
+  ctx.C.group = b.name;
+  const auto fr = ctx.param(ParameterKind::frequency, j, i), zeta = ctx.param(ParameterKind::damping_ratio, j, i);
+  if (!fr && !zeta)
+    return {ctx.c(f.K(i), fmt::format("{}_K{}", b.name, i + 1), "N m", "modal stiffness"),
+            ctx.c(f.D(i), fmt::format("{}_D{}", b.name, i + 1), "N m s", "modal damping")};
+  // K = w^2 Y, D = 2 zeta w Y with w = 2 pi f and the mode's modal mass Y
+  const double w0 = 2.0 * M_PI * f.frequency_hz(i);
+  const ex Y = ctx.c(f.K(i) / (w0 * w0), fmt::format("{}_Y{}", b.name, i + 1), "kg m^2", "modal mass");
+  const ex w = ctx.A.let((fr ? *fr : ctx.c(f.frequency_hz(i), fmt::format("{}_f{}", b.name, i + 1), "Hz", "frequency")) *
+                         ctx.c(2.0 * M_PI, "two_pi", "", "2 pi"));
+  const ex z = zeta ? *zeta : ctx.c(f.damping_ratio(i), fmt::format("{}_zeta{}", b.name, i + 1), "", "damping ratio");
+  return {ctx.A.let(w * w * Y), ctx.A.let(2 * z * w * Y)};
+}
+
 ex applied_force(KaneContext& ctx, int j, int own) {
   const Body& b = ctx.model.bodies[j];
   const int r = b.u_joint + own;
@@ -162,15 +189,12 @@ ex applied_force(KaneContext& ctx, int j, int own) {
   ctx.C.group = b.name;
   if (own == 0 && !ctx.model.inputs.empty()) f += joint_input(ctx, j);
   if (own < joint_nu(b.joint) && (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic)) {
-    const ex kk = ctx.c(b.joint.stiffness, b.name + "_k", "N m/rad or N/m", "joint spring stiffness");
-    const ex cc = ctx.c(b.joint.damping, b.name + "_c", "N m s/rad or N s/m", "joint damping");
-    const ex rest = ctx.c(b.joint.rest, b.name + "_rest", "rad or m", "spring rest value");
+    const auto [kk, cc, rest] = joint_spring(ctx, j);
     f -= kk * (ctx.x.q[b.q_joint] - rest) + cc * ctx.x.u[b.u_joint];
   }
   if (own >= joint_nu(b.joint)) {
     const int i = own - joint_nu(b.joint);
-    const ex K = ctx.c(b.flex->K(i), fmt::format("{}_K{}", b.name, i + 1), "N m", "modal stiffness");
-    const ex D = ctx.c(b.flex->D(i), fmt::format("{}_D{}", b.name, i + 1), "N m s", "modal damping");
+    const auto [K, D] = modal_stiffness_damping(ctx, j, i);
     f -= K * ctx.x.q[b.q_eta + i] + D * ctx.x.u[b.u_eta + i];
   }
   return ctx.A.let(f);

@@ -84,6 +84,7 @@ StateSymbols::StateSymbols(const Model& m) {
     udot.push_back(GiNaC::symbol(fmt::format("udot_in[{}]", i)));
   }
   for (int i = 0; i < m.nw; ++i) inputs.push_back(GiNaC::symbol(fmt::format("inputs[{}]", i)));
+  for (std::size_t i = 0; i < m.parameters.size(); ++i) params.push_back(GiNaC::symbol(fmt::format("prm[{}]", i)));
 }
 
 }  // namespace kanegen::codegen

@@ -77,6 +77,7 @@ class Alg {
 struct StateSymbols {
   std::vector<ex> q, u, tau, udot;
   std::vector<ex> inputs;  ///< the named inputs w (model.nw)
+  std::vector<ex> params;  ///< the runtime parameters prm (model.parameters)
   explicit StateSymbols(const Model& m);
 };
 

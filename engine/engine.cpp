@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "model/parameters.hpp"
+
 namespace kanegen {
 
 void Engine::check_sizes(const VecX& q, std::initializer_list<const VecX*> nu_sized) const {
@@ -67,6 +69,22 @@ void Engine::set_inputs(const VecX& w) {
     throw std::invalid_argument(fmt::format("{} engine: {} input values for a model with {} named inputs", name(),
                                             w.size(), model_.nw));
   w_ = w;
+}
+
+VecX Engine::nominal_parameters(const Model& model) {
+  VecX p(static_cast<Eigen::Index>(model.parameters.size()));
+  for (std::size_t k = 0; k < model.parameters.size(); ++k) p(static_cast<Eigen::Index>(k)) = model.parameters[k].nominal;
+  return p;
+}
+
+void Engine::set_parameters(const VecX& p) {
+  if (p.size() != static_cast<Eigen::Index>(model_.parameters.size()))
+    throw std::invalid_argument(fmt::format("{} engine: {} parameter values for a model with {} runtime parameters",
+                                            name(), p.size(), model_.parameters.size()));
+  Model m = model_;
+  apply_parameters(m, model_.parameters, p);  // throws for a value out of its domain
+  do_set_parameters(m);
+  p_ = p;
 }
 
 void Engine::outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) {

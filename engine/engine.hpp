@@ -42,7 +42,7 @@ class SingularMassMatrix : public std::runtime_error {
 
 class Engine {
  public:
-  explicit Engine(const Model& model) : model_(model), w_(VecX::Zero(model.nw)) {}
+  explicit Engine(const Model& model) : model_(model), w_(VecX::Zero(model.nw)), p_(nominal_parameters(model)) {}
   virtual ~Engine() = default;
   Engine(const Engine&) = delete;
   Engine& operator=(const Engine&) = delete;
@@ -71,6 +71,13 @@ class Engine {
   /// (as MuJoCo's mjData.ctrl). Throws std::invalid_argument on a wrong size.
   void set_inputs(const VecX& w);
   const VecX& inputs() const { return w_; }
+  /// Values of the model's runtime parameters (model().parameters, in order;
+  /// docs/sweeps.md), used by every evaluation from now on; the nominal values
+  /// until set. Throws std::invalid_argument on a wrong size or a value out of
+  /// its domain (a negative mass, ...); the values are unchanged then.
+  void set_parameters(const VecX& p);
+  const VecX& parameters() const { return p_; }
+  static VecX nominal_parameters(const Model& model);
   /// The named outputs y (model().ny values) at the state, with the current
   /// inputs and tau (accelerations and reactions depend on them).
   void outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y);
@@ -102,6 +109,8 @@ class Engine {
     return false;
   }
   virtual void do_outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) = 0;
+  /// Called by set_parameters() with the new values (validated by applying them to a copy of the model).
+  virtual void do_set_parameters(const Model& with_values) { (void)with_values; }
   virtual bool do_input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B) {
     (void)t, (void)q, (void)u, (void)tau, (void)B;
     return false;
@@ -116,6 +125,7 @@ class Engine {
   void check_sizes(const VecX& q, std::initializer_list<const VecX*> nu_sized) const;
   const Model& model_;
   VecX w_;
+  VecX p_;
 };
 
 }  // namespace kanegen

@@ -23,7 +23,7 @@
 extern "C" {
 #endif
 
-#define KANEGEN_GENERATED_API_VERSION 3
+#define KANEGEN_GENERATED_API_VERSION 4
 
 typedef struct KanegenArgs {
   double t;             /* time: used by models with prescribed motion */
@@ -32,6 +32,7 @@ typedef struct KanegenArgs {
   const double* tau;
   const double* udot;   /* accelerations: input of reactions */
   const double* inputs; /* the named inputs w[nw] (models that declare inputs) */
+  const double* params; /* the runtime parameters prm[np] (models that declare some) */
 } KanegenArgs;
 
 typedef int (*KanegenFunctionPtr)(const KanegenArgs* args, double* out);
@@ -49,6 +50,7 @@ typedef struct KanegenGeneratedApi {
   const char* generator_hash;    /* hash of the generator that wrote the code */
   int nq, nu, nbodies;
   int nw, ny;                    /* named inputs and outputs */
+  int np;                        /* runtime parameters */
   int n_functions;
   const KanegenFunction* functions;
 } KanegenGeneratedApi;

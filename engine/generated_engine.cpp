@@ -11,9 +11,11 @@ namespace kanegen {
 namespace {
 std::string str_or(const char* s) { return s ? std::string(s) : std::string("(null)"); }
 
-KanegenArgs args(double t, const VecX* q, const VecX* u, const VecX* tau, const VecX* udot, const VecX& w) {
+KanegenArgs args(double t, const VecX* q, const VecX* u, const VecX* tau, const VecX* udot, const VecX& w,
+                 const VecX& p) {
   KanegenArgs a{};
   a.inputs = w.data();
+  a.params = p.data();
   a.t = t;
   a.q = q ? q->data() : nullptr;
   a.u = u ? u->data() : nullptr;
@@ -32,7 +34,7 @@ GeneratedEngine::GeneratedEngine(const Model& m, const KanegenGeneratedApi* api,
     throw std::runtime_error(fmt::format("{}: API version {} but this runtime expects {}; regenerate it", who,
                                          api_->api_version, KANEGEN_GENERATED_API_VERSION));
   if (api_->nq != m.nq || api_->nu != m.nu || api_->nbodies != static_cast<int>(m.bodies.size()) ||
-      api_->nw != m.nw || api_->ny != m.ny)
+      api_->nw != m.nw || api_->ny != m.ny || api_->np != static_cast<int>(m.parameters.size()))
     throw std::runtime_error(fmt::format("{}: nq = {}, nu = {}, {} bodies, but the model '{}' has nq = {}, nu = {}, "
                                          "{} bodies; regenerate it",
                                          who, api_->nq, api_->nu, api_->nbodies, m.source_path, m.nq, m.nu,
@@ -79,30 +81,30 @@ void GeneratedEngine::singular(int pivot) const {
 }
 
 void GeneratedEngine::do_qdot(const VecX& q, const VecX& u, VecX& qd) {
-  const KanegenArgs a = args(0.0, &q, &u, nullptr, nullptr, inputs());
+  const KanegenArgs a = args(0.0, &q, &u, nullptr, nullptr, inputs(), parameters());
   qdot_(&a, qd.data());
 }
 
 void GeneratedEngine::do_mass_matrix(double t, const VecX& q, MatX& M) {
   // The table writes row-major; M is symmetric, but do not rely on it.
-  const KanegenArgs a = args(t, &q, nullptr, nullptr, nullptr, inputs());
+  const KanegenArgs a = args(t, &q, nullptr, nullptr, nullptr, inputs(), parameters());
   mass_matrix_(&a, M_row_major_.data());
   M = M_row_major_.transpose();
 }
 
 void GeneratedEngine::do_forcing(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& F) {
-  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs(), parameters());
   forcing_(&a, F.data());
 }
 
 void GeneratedEngine::do_udot(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& ud) {
-  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs(), parameters());
   if (const int pivot = udot_(&a, ud.data()); pivot != 0) singular(pivot);
 }
 
 bool GeneratedEngine::do_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& J) {
   if (!jacobian_) return false;
-  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs(), parameters());
   if (const int pivot = jacobian_(&a, J.data()); pivot != 0) singular(pivot);
   return true;
 }
@@ -110,7 +112,7 @@ bool GeneratedEngine::do_jacobian(double t, const VecX& q, const VecX& u, const 
 EnergyValues GeneratedEngine::do_energy(double t, const VecX& q, const VecX& u) {
   if (!energy_) missing_output("energy");
   double TV[2] = {0, 0};
-  const KanegenArgs a = args(t, &q, &u, nullptr, nullptr, inputs());
+  const KanegenArgs a = args(t, &q, &u, nullptr, nullptr, inputs(), parameters());
   energy_(&a, TV);
   return {TV[0], TV[1]};
 }
@@ -118,7 +120,7 @@ EnergyValues GeneratedEngine::do_energy(double t, const VecX& q, const VecX& u) 
 MomentumValues GeneratedEngine::do_momentum(double t, const VecX& q, const VecX& u) {
   if (!momentum_) missing_output("momentum");
   double pH[6] = {0, 0, 0, 0, 0, 0};
-  const KanegenArgs a = args(t, &q, &u, nullptr, nullptr, inputs());
+  const KanegenArgs a = args(t, &q, &u, nullptr, nullptr, inputs(), parameters());
   momentum_(&a, pH);
   MomentumValues r;
   r.p_N = Vec3(pH[0], pH[1], pH[2]);
@@ -131,7 +133,7 @@ void GeneratedEngine::do_reactions(double t, const VecX& q, const VecX& u, const
   if (!reactions_) missing_output("reactions");
   const std::size_t nb = model().bodies.size();
   wrenches_.assign(6 * nb, 0.0);
-  const KanegenArgs a = args(t, &q, &u, nullptr, &ud, inputs());
+  const KanegenArgs a = args(t, &q, &u, nullptr, &ud, inputs(), parameters());
   reactions_(&a, wrenches_.data());
   for (std::size_t i = 0; i < nb; ++i) {
     const double* w = &wrenches_[6 * i];
@@ -143,14 +145,14 @@ void GeneratedEngine::do_reactions(double t, const VecX& q, const VecX& u, const
 void GeneratedEngine::do_outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) {
   if (model().ny == 0) return;
   if (!outputs_) missing_output("outputs (named sensors)");
-  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs(), parameters());
   outputs_(&a, y.data());
 }
 
 bool GeneratedEngine::do_input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B) {
   if (model().nw == 0) return true;
   if (!input_jacobian_) return false;
-  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs(), parameters());
   if (const int pivot = input_jacobian_(&a, B.data()); pivot != 0) singular(pivot);
   return true;
 }
@@ -158,7 +160,7 @@ bool GeneratedEngine::do_input_jacobian(double t, const VecX& q, const VecX& u, 
 bool GeneratedEngine::do_output_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& CD) {
   if (model().ny == 0) return true;
   if (!output_jacobian_) return false;
-  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs());
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs(), parameters());
   output_jacobian_(&a, CD.data());
   return true;
 }

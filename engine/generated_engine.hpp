@@ -37,7 +37,7 @@ class GeneratedEngine final : public Engine {
   /// then throws the SingularMassMatrix that names it).
   int state_derivative(double t, const double* x, const double* tau, double* xdot) const {
     const int nq = model().nq;
-    const KanegenArgs a{t, x, x + nq, tau, nullptr, inputs().data()};
+    const KanegenArgs a{t, x, x + nq, tau, nullptr, inputs().data(), parameters().data()};
     qdot_(&a, xdot);
     return udot_(&a, xdot + nq);
   }

@@ -26,9 +26,13 @@ class GenericEngine final : public Engine {
   MomentumValues do_momentum(double t, const VecX& q, const VecX& u) override;
   void do_reactions(double t, const VecX& q, const VecX& u, const VecX& udot, std::vector<Reaction>& out) override;
   void do_outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) override;
+  void do_set_parameters(const Model& with_values) override;
 
  private:
   void update(double t, const VecX& q, const VecX& u);
+  /// The model with the current runtime parameter values written in: what every evaluation reads.
+  const Model& m() const { return with_parameters_; }
+  Model with_parameters_;
   Workspace<double> ws_;
   Eigen::LLT<MatX> llt_;
   VecX zero_u_;

@@ -36,6 +36,7 @@ Manifest parse_manifest(const std::string& text, const std::string& what) {
     m.nbodies = j.at("nbodies").get<int>();
     m.nw = j.value("nw", 0);
     m.ny = j.value("ny", 0);
+    m.np = j.value("np", 0);
     m.udot_form = j.value("udot_form", "");
     for (const auto& f : j.at("functions"))
       m.functions.push_back({f.at("name").get<std::string>(), f.at("ops").get<long>(), f.at("out_size").get<int>()});

@@ -19,6 +19,7 @@ struct Manifest {
   std::string model_hash, generator_hash, generator_version;
   int nq = 0, nu = 0, nbodies = 0;
   int nw = 0, ny = 0;  ///< named inputs and outputs
+  int np = 0;          ///< runtime parameters
   std::string udot_form;
   std::vector<ManifestFunction> functions;
   const ManifestFunction* find(const std::string& name) const;

@@ -54,6 +54,7 @@ inline constexpr int nu = 12;
 inline constexpr int nbodies = 8;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "branched_tree";
 inline constexpr char model_hash[] = "fd8e6c5e0b0db8cb";
 

@@ -53,6 +53,7 @@ inline constexpr int nu = 5;
 inline constexpr int nbodies = 5;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "chain5_prismatic";
 inline constexpr char model_hash[] = "bbdf5ca96f97e60f";
 

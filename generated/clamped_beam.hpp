@@ -54,6 +54,7 @@ inline constexpr int nu = 4;
 inline constexpr int nbodies = 1;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "clamped_beam";
 inline constexpr char model_hash[] = "666a428200ee3e44";
 

@@ -53,6 +53,7 @@ inline constexpr int nu = 38;
 inline constexpr int nbodies = 33;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "deep_chain";
 inline constexpr char model_hash[] = "542f98b41d32c83d";
 

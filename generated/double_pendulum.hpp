@@ -54,6 +54,7 @@ inline constexpr int nu = 2;
 inline constexpr int nbodies = 2;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "double_pendulum";
 inline constexpr char model_hash[] = "3037921e9cab978a";
 

@@ -54,6 +54,7 @@ inline constexpr int nu = 10;
 inline constexpr int nbodies = 5;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "explorer1_rigid";
 inline constexpr char model_hash[] = "7c8ebf78f50d6ee5";
 

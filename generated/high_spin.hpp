@@ -53,6 +53,7 @@ inline constexpr int nu = 8;
 inline constexpr int nbodies = 3;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "high_spin";
 inline constexpr char model_hash[] = "90e7a9cd49816362";
 

@@ -53,6 +53,7 @@ inline constexpr int nu = 9;
 inline constexpr int nbodies = 4;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "near_singular";
 inline constexpr char model_hash[] = "1da78b109d9b0307";
 

@@ -53,6 +53,7 @@ inline constexpr int nu = 7;
 inline constexpr int nbodies = 2;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "near_zero_inertia";
 inline constexpr char model_hash[] = "7dec74aced06e7dc";
 

@@ -57,6 +57,7 @@ inline constexpr int nu = 15;
 inline constexpr int nbodies = 6;
 inline constexpr int nw = 3;  // named inputs
 inline constexpr int ny = 13;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "slew_spacecraft";
 inline constexpr char model_hash[] = "3b6f5c851e13cde4";
 

@@ -54,6 +54,7 @@ inline constexpr int nu = 21;
 inline constexpr int nbodies = 5;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "spacecraft_arrays";
 inline constexpr char model_hash[] = "fc6457cf4c82aa2d";
 

@@ -53,6 +53,7 @@ inline constexpr int nu = 10;
 inline constexpr int nbodies = 2;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "stiff_appendage";
 inline constexpr char model_hash[] = "6a43ae410fc1e2b7";
 

@@ -53,6 +53,7 @@ inline constexpr int nu = 22;
 inline constexpr int nbodies = 17;
 inline constexpr int nw = 0;  // named inputs
 inline constexpr int ny = 0;  // named outputs
+inline constexpr int np = 0;  // runtime parameters
 inline constexpr char model_name[] = "wide_tree";
 inline constexpr char model_hash[] = "9c968a6180170575";
 

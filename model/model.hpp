@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "model/inputs_outputs.hpp"
+#include "model/runtime_parameter.hpp"
 #include "model/modal_integrals.hpp"
 #include "model/prescribed_motion.hpp"
 
@@ -147,6 +148,9 @@ struct Model {
   std::vector<Sensor> sensors;
   int ny = 0;
   std::vector<std::string> output_names;
+  /// Runtime parameters (model/parameters.hpp): kept symbolic by the
+  /// generator; scalar entries, nominal values from the model.
+  std::vector<RuntimeParameter> parameters;
 
   int body_index(const std::string& name) const;  ///< -1 if absent
   int q_index(const std::string& name) const;     ///< -1 if absent

@@ -171,6 +171,35 @@ std::uint64_t fnv1a64(std::string_view bytes) {
 
 std::string fnv1a64_hex(std::string_view bytes) { return fmt::format("{:016x}", fnv1a64(bytes)); }
 
-std::string model_hash(const Model& model) { return fnv1a64_hex(model_fingerprint(model)); }
+std::string model_hash(const Model& model) {
+  if (model.parameters.empty()) return fnv1a64_hex(model_fingerprint(model));
+  // Runtime parameters: their names count, their values do not (the
+  // generated code reads them at run time): hash the model with each one
+  // at a fixed placeholder value.
+  Model m = model;
+  for (const RuntimeParameter& p : m.parameters) {
+    if (p.kind == ParameterKind::gravity) {
+      m.g_N(p.index) = 0;
+      continue;
+    }
+    Body& b = m.bodies[p.body];
+    switch (p.kind) {
+      case ParameterKind::mass: b.rigid.mass = 0; break;
+      case ParameterKind::com: b.rigid.com_B(p.index) = 0; break;
+      case ParameterKind::inertia: b.rigid.I_c_B.setZero(); break;
+      case ParameterKind::stiffness: b.joint.stiffness = 0; break;
+      case ParameterKind::damping: b.joint.damping = 0; break;
+      case ParameterKind::rest: b.joint.rest = 0; break;
+      case ParameterKind::frequency:
+      case ParameterKind::damping_ratio:
+        b.flex->frequency_hz(p.index) = b.flex->damping_ratio(p.index) = b.flex->K(p.index) = b.flex->D(p.index) = 0;
+        break;
+      case ParameterKind::gravity: break;
+    }
+  }
+  std::string f = model_fingerprint(m) + "runtime parameters";
+  for (const RuntimeParameter& p : m.parameters) f += " " + p.name;
+  return fnv1a64_hex(f);
+}
 
 }  // namespace kanegen

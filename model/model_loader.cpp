@@ -15,6 +15,7 @@
 
 #include "model/beam.hpp"
 #include "model/modal_data.hpp"
+#include "model/parameters.hpp"
 #include "model/rotation.hpp"
 #include "model/yaml_check.hpp"
 
@@ -96,6 +97,7 @@ class Loader {
     int line;
   };
   std::map<std::string, Given> init_q_, init_u_;
+  std::vector<std::pair<std::string, int>> parameter_names_;  ///< `parameters:` entries and their lines
 
   // ------------------------------------------------------------------ root
   void read_root(const YAML::Node& root) {
@@ -105,7 +107,7 @@ class Loader {
       return;
     }
     if (!ck_.expect_map(root, 1, "(document)")) return;
-    ck_.check_keys(root, "", {"name", "description", "gravity", "bodies", "initial", "inputs", "outputs"});
+    ck_.check_keys(root, "", {"name", "description", "gravity", "bodies", "initial", "inputs", "outputs", "parameters"});
 
     const YAML::Node name = root["name"];
     if (!name.IsDefined()) {
@@ -154,6 +156,12 @@ class Loader {
 
     if (root["initial"].IsDefined()) read_initial(root["initial"]);
     if (root["inputs"].IsDefined()) read_inputs(root["inputs"]);
+    if (root["parameters"].IsDefined() && ck_.expect_seq(root["parameters"], 1, "parameters")) {
+      const YAML::Node ps = root["parameters"];
+      for (std::size_t i = 0; i < ps.size(); ++i)
+        if (auto s = ck_.string(ps[i], line_of(ps), fmt::format("parameters[{}]", i)))
+          parameter_names_.push_back({*s, line_of(ps[i]) ? line_of(ps[i]) : line_of(ps)});
+    }
     if (root["outputs"].IsDefined()) read_outputs(root["outputs"]);
   }
 
@@ -1237,6 +1245,20 @@ class Loader {
       const int k = model_.u_index(name);
       if (k >= 0) model_.u0(k) = g.value;
     }
+    std::vector<Diagnostic> bad;
+    for (std::size_t i = 0; i < parameter_names_.size(); ++i) {
+      const auto& [name, line] = parameter_names_[i];
+      try {
+        for (RuntimeParameter& p : expand_parameter(model_, name)) {
+          if (find_parameter(model_.parameters, p.kind, p.body, p.index) >= 0)
+            throw std::invalid_argument(fmt::format("'{}' is named twice", p.name));
+          model_.parameters.push_back(p);
+        }
+      } catch (const std::invalid_argument& e) {
+        bad.push_back(Diagnostic{path_, line, fmt::format("parameters[{}]", i), e.what()});
+      }
+    }
+    if (!bad.empty()) throw InputError(bad);
     return std::move(model_);
   }
 };

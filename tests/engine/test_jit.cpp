@@ -270,7 +270,7 @@ TEST_CASE("generated engine refuses a table that does not match the model", "[ji
   };
   auto ud = +[](const KanegenArgs*, double*) { return 1; };
   const KanegenFunction fns[] = {{"qdot", qd, 1}, {"mass_matrix", mm, 1}, {"forcing", fo, 1}, {"udot", ud, 1}};
-  KanegenGeneratedApi api{KANEGEN_GENERATED_API_VERSION, "pendulum_handwritten", hash.c_str(), "gen-a", 1, 1, 1, 0, 0, 4, fns};
+  KanegenGeneratedApi api{KANEGEN_GENERATED_API_VERSION, "pendulum_handwritten", hash.c_str(), "gen-a", 1, 1, 1, 0, 0, 0, 4, fns};
   {
     GeneratedEngine e(model, &api);
     VecX q = VecX::Zero(1), u = VecX::Zero(1), out;

@@ -43,7 +43,7 @@ const KanegenFunction kFunctions[] = {
     {"momentum", &f_momentum, 6},
 };
 const KanegenGeneratedApi kApi = {KANEGEN_GENERATED_API_VERSION, "pendulum_handwritten", "@MODEL_HASH@", "@GENERATOR_HASH@",
-                                  1, 1, 1, 0, 0, 7, kFunctions};
+                                  1, 1, 1, 0, 0, 0, 7, kFunctions};
 }  // namespace
 extern "C" __attribute__((visibility("default"))) const KanegenGeneratedApi* kanegen_api_pendulum_handwritten(void) {
   return &kApi;

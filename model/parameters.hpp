@@ -1,0 +1,41 @@
+// Runtime parameters (docs/sweeps.md): model values that the generated code
+// keeps as inputs instead of folding them into constants, so that a
+// dispersed run changes them without a new compile. A model names them under
+// `parameters:` (or a sweep file does, for the parameters it disperses); each
+// name expands to scalar entries:
+//   <body>.mass [kg]          <body>.com -> .com.x .y .z [m]
+//   <body>.inertia -> .inertia.xx .yy .zz .xy .xz .yz [kg m^2] (about the com, body axes;
+//                             the rigid part of a flexible body)
+//   <body>.stiffness [N m/rad or N/m]  <body>.damping [N m s/rad or N s/m]  <body>.rest [rad or m]
+//   <body>.frequency -> .frequency1 ... [Hz]   <body>.damping_ratio -> .damping_ratio1 ... (modal)
+//   gravity -> gravity.x .y .z [m/s^2]
+// Both engines take the same values: the generic engine evaluates the model
+// with them written in (apply_parameters), the generated code reads them
+// from its parameter array.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "model/model.hpp"
+
+namespace kanegen {
+
+/// The scalar parameters a name stands for (see the header comment); throws
+/// std::invalid_argument naming what is wrong (unknown body, no such joint
+/// spring on a fixed joint, no modes, ...).
+std::vector<RuntimeParameter> expand_parameter(const Model& model, const std::string& name);
+
+/// The parameter's current value in `model`.
+double parameter_value(const Model& model, const RuntimeParameter& p);
+
+/// Writes `values` (one per parameter) into `model` and refreshes what
+/// depends on them (mass integrals, modal stiffness and damping). Throws
+/// std::invalid_argument for a value outside its domain (a negative mass, a
+/// non-positive frequency, an inertia that is not positive semi-definite, ...).
+void apply_parameters(Model& model, const std::vector<RuntimeParameter>& params, const VecX& values);
+
+/// The model's runtime parameter of this kind, body and index, or -1.
+int find_parameter(const std::vector<RuntimeParameter>& params, ParameterKind kind, int body, int index);
+
+}  // namespace kanegen
