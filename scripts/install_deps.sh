@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libfmt-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libsundials-dev libginac-dev catch2 libbenchmark-dev libspectra-dev libboost-dev zlib1g-dev
   python3 python3-numpy python3-scipy python3-matplotlib python3-dev pybind11-dev python3-pybind11
+  libopenmpi-dev openmpi-bin
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -32,6 +32,7 @@ Subcommand add_eval(CLI::App& app);
 Subcommand add_simulate(CLI::App& app);
 Subcommand add_bench(CLI::App& app);
 Subcommand add_linearize(CLI::App& app);
+Subcommand add_sweep(CLI::App& app);
 
 /// load_model() plus the check that M is not singular at the initial state.
 Model load_checked(const std::string& path);

@@ -17,7 +17,8 @@ int main(int argc, char** argv) {
   const std::vector<cli::Subcommand> commands = {cli::add_check(app),      cli::add_generate(app),
                                                  cli::add_modes(app),      cli::add_crosscheck(app),
                                                  cli::add_eval(app),       cli::add_simulate(app),
-                                                 cli::add_bench(app),      cli::add_linearize(app)};
+                                                 cli::add_bench(app),      cli::add_linearize(app),
+                                                 cli::add_sweep(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

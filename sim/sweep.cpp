@@ -1,0 +1,431 @@
+#include "sim/sweep.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "model/diagnostics.hpp"
+#include "model/model_hash.hpp"
+#include "model/model_loader.hpp"
+#include "model/output_file.hpp"
+#include "model/parameters.hpp"
+#include "model/state_io.hpp"
+#include "sim/simulate.hpp"
+
+namespace kanegen {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+std::string g17(double x) { return std::isnan(x) ? "nan" : fmt::format("{:.17g}", x); }
+
+std::vector<double> parse_numbers(const std::string& s) {
+  std::vector<double> v;
+  const char* p = s.c_str();
+  while (*p) {
+    char* end = nullptr;
+    const double x = std::strtod(p, &end);
+    if (end == p) break;
+    v.push_back(x);
+    p = end;
+    while (*p == ' ') ++p;
+  }
+  return v;
+}
+
+std::string join_numbers(const std::vector<double>& v) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? " " : "") + g17(v[i]);
+  return s;
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::size_t a = 0;
+  for (;;) {
+    const std::size_t b = s.find(sep, a);
+    out.push_back(s.substr(a, b == std::string::npos ? std::string::npos : b - a));
+    if (b == std::string::npos) return out;
+    a = b + 1;
+  }
+}
+
+std::string csv_quoted(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string r = "\"";
+  for (char c : s) r += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
+  return r + "\"";
+}
+
+/// Percentile p (0..100) of sorted values, linear interpolation (numpy's default).
+double percentile(const std::vector<double>& sorted, double p) {
+  if (sorted.empty()) return kNaN;
+  const double pos = p / 100.0 * static_cast<double>(sorted.size() - 1);
+  const std::size_t i = static_cast<std::size_t>(std::floor(pos));
+  const double f = pos - static_cast<double>(i);
+  return i + 1 < sorted.size() ? sorted[i] * (1 - f) + sorted[i + 1] * f : sorted[i];
+}
+
+}  // namespace
+
+SweepPlan plan_sweep(const SweepSpec& spec) {
+  SweepPlan plan;
+  plan.spec = spec;
+  plan.model = load_model(spec.model_path);
+  std::vector<Diagnostic> bad;
+  auto fault = [&](int line, const std::string& field, const std::string& msg) {
+    bad.push_back(Diagnostic{spec.path, line, field, msg});
+  };
+  for (std::size_t i = 0; i < spec.dispersions.size(); ++i) {
+    const Dispersion& d = spec.dispersions[i];
+    const std::string f = fmt::format("dispersions[{}].parameter", i);
+    SweepPlan::Target t;
+    if (d.target.rfind("q.", 0) == 0 || d.target.rfind("u.", 0) == 0) {
+      const bool q = d.target[0] == 'q';
+      const int k = q ? plan.model.q_index(d.target.substr(2)) : plan.model.u_index(d.target.substr(2));
+      if (k < 0) {
+        fault(d.line, f, fmt::format("'{}': the model has no {} named '{}'", d.target, q ? "coordinate" : "speed", d.target.substr(2)));
+        continue;
+      }
+      t.kind = q ? SweepPlan::Target::Kind::q : SweepPlan::Target::Kind::u;
+      t.index = k;
+      t.nominal = q ? plan.model.q0(k) : plan.model.u0(k);
+    } else {
+      std::vector<RuntimeParameter> ps;
+      try {
+        ps = expand_parameter(plan.model, d.target);
+      } catch (const std::invalid_argument& e) {
+        fault(d.line, f, e.what());
+        continue;
+      }
+      if (ps.size() != 1) {
+        fault(d.line, f, fmt::format("'{}' stands for {} values; expected one (e.g. {})", d.target, ps.size(), ps[0].name));
+        continue;
+      }
+      int k = find_parameter(plan.model.parameters, ps[0].kind, ps[0].body, ps[0].index);
+      if (k < 0) {
+        plan.model.parameters.push_back(ps[0]);  // the sweep makes it a runtime parameter
+        k = static_cast<int>(plan.model.parameters.size()) - 1;
+      }
+      t.index = k;
+      t.nominal = ps[0].nominal;
+    }
+    for (std::size_t j = 0; j < i; ++j)
+      if (spec.dispersions[j].target == d.target) fault(d.line, f, fmt::format("'{}' is dispersed twice", d.target));
+    plan.targets.push_back(t);
+  }
+  plan.columns = csv_columns(plan.model);
+  auto column = [&](const std::string& c, int line, const std::string& field) {
+    // q.<name> / u.<name>: a coordinate or a speed (a revolute joint's are both called <body>.angle)
+    const Model& m = plan.model;
+    if (c.rfind("q.", 0) == 0 && m.q_index(c.substr(2)) >= 0) return 1 + m.q_index(c.substr(2));
+    if (c.rfind("u.", 0) == 0 && m.u_index(c.substr(2)) >= 0)
+      return 1 + m.nq + static_cast<int>(m.prescribed_names.size()) + m.u_index(c.substr(2));
+    const auto it = std::find(plan.columns.begin(), plan.columns.end(), c);
+    if (it == plan.columns.end()) {
+      fault(line, field, fmt::format("no column '{}' in the runs' output; expected one of: {}", c, fmt::join(plan.columns, ", ")));
+      return -1;
+    }
+    return static_cast<int>(it - plan.columns.begin());
+  };
+  for (std::size_t i = 0; i < spec.metrics.size(); ++i)
+    plan.metric_columns.push_back(column(spec.metrics[i].column, spec.metrics[i].line, fmt::format("metrics[{}].column", i)));
+  for (std::size_t i = 0; i < spec.envelopes.size(); ++i)
+    plan.envelope_columns.push_back(column(spec.envelopes[i], 1, fmt::format("envelopes[{}]", i)));
+  try {
+    (void)integrator_from_string(spec.integrator);
+  } catch (const std::invalid_argument& e) {
+    fault(1, "integrator", e.what());
+  }
+  if (!bad.empty()) throw InputError(bad);
+  return plan;
+}
+
+std::string sweep_identity(const SweepPlan& plan) {
+  return fnv1a64_hex(plan.spec.text + model_hash(plan.model)).substr(0, 8);
+}
+
+std::vector<double> draw(const SweepPlan& plan, long index) {
+  std::mt19937_64 rng(splitmix64(plan.spec.seed ^ splitmix64(static_cast<std::uint64_t>(index))));
+  std::vector<double> out;
+  for (std::size_t i = 0; i < plan.spec.dispersions.size(); ++i) {
+    const Dispersion& d = plan.spec.dispersions[i];
+    const double nominal = plan.targets[i].nominal;
+    double dev = 0.0;
+    switch (d.kind) {
+      case Dispersion::Kind::normal: dev = std::normal_distribution<double>(0.0, d.sigma)(rng); break;
+      case Dispersion::Kind::truncated_normal: {
+        std::normal_distribution<double> N(0.0, d.sigma);
+        int tries = 0;
+        do dev = N(rng);
+        while ((dev < d.low || dev > d.high) && ++tries < 10000);
+        dev = std::clamp(dev, d.low, d.high);
+        break;
+      }
+      case Dispersion::Kind::uniform: dev = std::uniform_real_distribution<double>(d.low, d.high)(rng); break;
+      case Dispersion::Kind::choice: {
+        const double v = d.values[std::uniform_int_distribution<std::size_t>(0, d.values.size() - 1)(rng)];
+        out.push_back(d.relative ? nominal * v : v);
+        continue;
+      }
+    }
+    out.push_back(d.relative ? nominal * (1.0 + dev) : nominal + dev);
+  }
+  return out;
+}
+
+RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostream* csv) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Model& model = plan.model;
+  RunResult r;
+  r.index = index;
+  r.values = draw(plan, index);
+  r.metrics.assign(plan.spec.metrics.size(), kNaN);
+  VecX p = Engine::nominal_parameters(model);
+  State s = initial_state(model);
+  for (std::size_t i = 0; i < plan.targets.size(); ++i) {
+    const auto& t = plan.targets[i];
+    (t.kind == SweepPlan::Target::Kind::parameter ? p(t.index) : t.kind == SweepPlan::Target::Kind::q ? s.q(t.index) : s.u(t.index)) = r.values[i];
+  }
+  for (const Body& b : model.bodies)
+    if (b.joint.type == JointType::free) s.q.segment<4>(b.q_joint + 3).normalize();
+  SimulationOptions o;
+  o.t_end = plan.spec.t_end;
+  o.dt_out = plan.spec.dt_out;
+  o.integrator.kind = integrator_from_string(plan.spec.integrator);
+  o.integrator.rtol = plan.spec.rtol;
+  o.integrator.atol = plan.spec.atol;
+  std::ostringstream out;
+  try {
+    engine.set_parameters(p);
+    const SimulationResult sr = simulate(engine, s, o, out);
+    r.integration_s = sr.stats.wall_seconds;
+  } catch (const std::exception& e) {
+    std::string why = e.what();
+    why = why.substr(0, why.find('\n'));
+    if (why.size() > 300) why = why.substr(0, 300) + "...";
+    r.status = "failed: " + why;
+  }
+  if (r.ok()) {
+    const std::string text = out.str();
+    if (csv) *csv << text;
+    std::istringstream in(text);
+    std::string line;
+    std::getline(in, line);  // header
+    const auto& ms = plan.spec.metrics;
+    std::vector<double> row;
+    std::vector<bool> seen(ms.size(), false);
+    r.envelopes.assign(plan.envelope_columns.size(), {});
+    while (std::getline(in, line)) {
+      row.clear();
+      const char* c = line.c_str();
+      for (;;) {
+        char* end = nullptr;
+        row.push_back(std::strtod(c, &end));
+        if (*end != ',') break;
+        c = end + 1;
+      }
+      for (std::size_t k = 0; k < ms.size(); ++k) {
+        const double v = row[plan.metric_columns[k]];
+        double& m = r.metrics[k];
+        switch (ms[k].stat) {
+          case Metric::Stat::final: m = v; break;
+          case Metric::Stat::min: m = seen[k] ? std::min(m, v) : v; break;
+          case Metric::Stat::max: m = seen[k] ? std::max(m, v) : v; break;
+          case Metric::Stat::absmax: m = seen[k] ? std::max(m, std::abs(v)) : std::abs(v); break;
+          case Metric::Stat::first_time:
+            if (std::isnan(m) && (ms[k].above ? v > ms[k].threshold : v < ms[k].threshold)) m = row[0];
+            break;
+        }
+        seen[k] = true;
+      }
+      for (std::size_t k = 0; k < plan.envelope_columns.size(); ++k) r.envelopes[k].push_back(row[plan.envelope_columns[k]]);
+    }
+  }
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+std::string serialize(const RunResult& r) {
+  std::string status = r.status;
+  std::replace(status.begin(), status.end(), '\t', ' ');
+  std::replace(status.begin(), status.end(), '\n', ' ');
+  std::string s = fmt::format("{}\t{}\t{}\t{}\t{}\t{}\t", r.index, status, join_numbers(r.values), join_numbers(r.metrics),
+                              g17(r.wall_s), g17(r.integration_s));
+  for (std::size_t k = 0; k < r.envelopes.size(); ++k) s += (k ? "|" : "") + join_numbers(r.envelopes[k]);
+  return s + "\tend";  // a line cut short (an interrupted write) lacks it
+}
+
+RunResult deserialize(const std::string& line) {
+  const auto f = split(line, '\t');
+  if (f.size() != 8 || f[7] != "end") throw std::runtime_error("malformed or incomplete sweep result line");
+  RunResult r;
+  r.index = std::stol(f[0]);
+  r.status = f[1];
+  r.values = parse_numbers(f[2]);
+  r.metrics = parse_numbers(f[3]);
+  r.wall_s = std::strtod(f[4].c_str(), nullptr);
+  r.integration_s = std::strtod(f[5].c_str(), nullptr);
+  if (!f[6].empty())
+    for (const auto& e : split(f[6], '|')) r.envelopes.push_back(parse_numbers(e));
+  return r;
+}
+
+void run_on_threads(const SweepPlan& plan, const std::vector<long>& indices, int threads,
+                    const std::function<std::unique_ptr<Engine>(const Model&)>& make_engine,
+                    const std::function<void(RunResult&&)>& done) {
+  threads = std::max(1, std::min<int>(threads, static_cast<int>(indices.size())));
+  // engines made here, one after the other (the JIT compiles and caches once)
+  std::vector<std::unique_ptr<Engine>> engines;
+  for (int k = 0; k < threads; ++k) engines.push_back(make_engine(plan.model));
+  std::atomic<std::size_t> next{0};
+  std::mutex m;
+  std::exception_ptr error;
+  auto work = [&](Engine* e) {
+    try {
+      for (std::size_t i; (i = next++) < indices.size();) {
+        RunResult r = run_one(*e, plan, indices[i]);
+        std::lock_guard<std::mutex> lock(m);
+        done(std::move(r));
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(m);
+      if (!error) error = std::current_exception();
+      next = indices.size();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int k = 1; k < threads; ++k) pool.emplace_back(work, engines[k].get());
+  work(engines[0].get());
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+void write_sweep_outputs(const SweepPlan& plan, const std::vector<RunResult>& results, const std::string& dir) {
+  namespace fs = std::filesystem;
+  fs::create_directories(dir);
+  const auto& spec = plan.spec;
+  // ---- runs.csv
+  std::string t = "run,status";
+  for (const auto& d : spec.dispersions) t += "," + d.target;
+  for (const auto& m : spec.metrics) t += "," + m.name;
+  t += "\n";
+  std::string timing = "run,wall_s,integration_s\n";
+  for (const RunResult& r : results) {
+    t += fmt::format("{},{}", r.index, csv_quoted(r.status));
+    for (double v : r.values) t += "," + g17(v);
+    for (double v : r.metrics) t += "," + g17(v);
+    t += "\n";
+    timing += fmt::format("{},{:.6f},{:.6f}\n", r.index, r.wall_s, r.integration_s);
+  }
+  write_file_atomically((fs::path(dir) / "runs.csv").string(), t);
+  write_file_atomically((fs::path(dir) / "timing.csv").string(), timing);
+
+  // ---- summary: every dispersed value and metric over the successful runs
+  long failed = 0;
+  nlohmann::ordered_json failures = nlohmann::ordered_json::array();
+  for (const RunResult& r : results)
+    if (!r.ok()) {
+      ++failed;
+      if (failures.size() < 20) failures.push_back({{"run", r.index}, {"status", r.status}});
+    }
+  nlohmann::ordered_json j;
+  j["sweep"] = spec.path;
+  j["identity"] = sweep_identity(plan);
+  j["model"] = plan.model.name;
+  j["runs"] = results.size();
+  j["failed"] = failed;
+  j["failures"] = failures;
+  std::string md = fmt::format("# Sweep {} ({} runs, {} failed)\n\n| quantity | n | mean | std | min (run) | p5 | p50 | p95 | max (run) | not reached |\n|---|---|---|---|---|---|---|---|---|---|\n",
+                               spec.path, results.size(), failed);
+  auto stats = [&](const std::string& name, auto value_of) {
+    std::vector<std::pair<double, long>> v;
+    long missing = 0;
+    for (const RunResult& r : results) {
+      if (!r.ok()) continue;
+      const double x = value_of(r);
+      if (std::isnan(x)) ++missing;
+      else v.push_back({x, r.index});
+    }
+    std::sort(v.begin(), v.end());
+    std::vector<double> xs;
+    double mean = 0, var = 0;
+    for (const auto& [x, i] : v) xs.push_back(x), mean += x;
+    if (!xs.empty()) mean /= static_cast<double>(xs.size());
+    for (double x : xs) var += (x - mean) * (x - mean);
+    const double sd = xs.size() > 1 ? std::sqrt(var / static_cast<double>(xs.size() - 1)) : 0.0;
+    nlohmann::ordered_json s;
+    s["n"] = xs.size();
+    s["not_reached"] = missing;
+    if (!xs.empty()) {
+      s["mean"] = mean;
+      s["std"] = sd;
+      s["min"] = {{"value", v.front().first}, {"run", v.front().second}};
+      s["p5"] = percentile(xs, 5);
+      s["p50"] = percentile(xs, 50);
+      s["p95"] = percentile(xs, 95);
+      s["max"] = {{"value", v.back().first}, {"run", v.back().second}};
+      auto worst = nlohmann::ordered_json::array();
+      for (std::size_t k = 0; k < std::min<std::size_t>(5, v.size()); ++k)
+        worst.push_back({{"run", v[v.size() - 1 - k].second}, {"value", v[v.size() - 1 - k].first}});
+      s["largest"] = worst;
+      md += fmt::format("| {} | {} | {:.6g} | {:.3g} | {:.6g} ({}) | {:.6g} | {:.6g} | {:.6g} | {:.6g} ({}) | {} |\n", name,
+                        xs.size(), mean, sd, v.front().first, v.front().second, percentile(xs, 5), percentile(xs, 50),
+                        percentile(xs, 95), v.back().first, v.back().second, missing);
+    } else {
+      md += fmt::format("| {} | 0 | | | | | | | | {} |\n", name, missing);
+    }
+    return s;
+  };
+  nlohmann::ordered_json jp, jm;
+  for (std::size_t i = 0; i < spec.dispersions.size(); ++i)
+    jp[spec.dispersions[i].target] = stats(spec.dispersions[i].target, [i](const RunResult& r) { return r.values[i]; });
+  for (std::size_t i = 0; i < spec.metrics.size(); ++i)
+    jm[spec.metrics[i].name] = stats(spec.metrics[i].name, [i](const RunResult& r) { return r.metrics[i]; });
+  j["dispersions"] = jp;
+  j["metrics"] = jm;
+  if (failed) {
+    md += "\nFailed runs (first 20):\n\n";
+    for (const auto& f : failures) md += fmt::format("- run {}: {}\n", f["run"].get<long>(), f["status"].get<std::string>());
+  }
+  write_file_atomically((fs::path(dir) / "summary.json").string(), j.dump(1) + "\n");
+  write_file_atomically((fs::path(dir) / "summary.md").string(), md);
+
+  // ---- percentile envelopes over the successful runs
+  for (std::size_t k = 0; k < plan.envelope_columns.size(); ++k) {
+    std::size_t rows = 0;
+    for (const RunResult& r : results)
+      if (r.ok() && k < r.envelopes.size()) rows = std::max(rows, r.envelopes[k].size());
+    std::string e = "t,min,p5,p50,p95,max\n";
+    for (std::size_t i = 0; i < rows; ++i) {
+      std::vector<double> xs;
+      for (const RunResult& r : results)
+        if (r.ok() && k < r.envelopes.size() && i < r.envelopes[k].size()) xs.push_back(r.envelopes[k][i]);
+      std::sort(xs.begin(), xs.end());
+      const double tt = std::min(spec.t_end, static_cast<double>(i) * spec.dt_out);
+      e += fmt::format("{},{},{},{},{},{}\n", g17(tt), g17(xs.front()), g17(percentile(xs, 5)), g17(percentile(xs, 50)),
+                       g17(percentile(xs, 95)), g17(xs.back()));
+    }
+    write_file_atomically((fs::path(dir) / ("envelope_" + spec.envelopes[k] + ".csv")).string(), e);
+  }
+}
+
+}  // namespace kanegen

@@ -1,0 +1,78 @@
+// Monte Carlo sweeps (docs/sweeps.md): runs of one model with dispersed
+// runtime parameters and initial state, each run's draws a function of the
+// base seed and the run index only (not of the scheduling), metrics per run,
+// and the outputs: the table of runs, a summary, percentile envelopes. The
+// scheduling (threads here; MPI ranks and shards in apps/kanegen/cmd_sweep)
+// only decides who runs which index; the results are sorted by index, so
+// they are byte-identical however the runs were spread.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "engine/engine.hpp"
+#include "model/sweep_spec.hpp"
+
+namespace kanegen {
+
+/// A sweep resolved against its model.
+struct SweepPlan {
+  SweepSpec spec;
+  Model model;  ///< with the dispersed parameters among its runtime parameters
+  struct Target {
+    enum class Kind { parameter, q, u } kind = Kind::parameter;
+    int index = 0;  ///< into model.parameters, q or u
+    double nominal = 0.0;
+  };
+  std::vector<Target> targets;       ///< one per dispersion
+  std::vector<std::string> columns;  ///< a run's CSV columns
+  std::vector<int> metric_columns, envelope_columns;
+};
+
+/// Loads the model and checks the dispersions, metrics and envelopes against
+/// it; throws InputError naming the sweep file's line and field.
+SweepPlan plan_sweep(const SweepSpec& spec);
+
+struct RunResult {
+  long index = 0;
+  std::string status = "ok";      ///< "ok", or "failed: <reason>"
+  std::vector<double> values;     ///< the dispersed values (absolute), one per dispersion
+  std::vector<double> metrics;    ///< NaN: failed, or a first_time condition that never held
+  double wall_s = 0.0, integration_s = 0.0;
+  std::vector<std::vector<double>> envelopes;  ///< per envelope column: its values at the output times
+  bool ok() const { return status == "ok"; }
+};
+
+/// The dispersed values of run `index` (pure: the base seed and the index).
+std::vector<double> draw(const SweepPlan& plan, long index);
+
+/// Runs one case on `engine` (made for plan.model); a failure is recorded in
+/// the result, never thrown. With `csv`, the run's full time history.
+RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostream* csv = nullptr);
+
+/// One result as one line of text and back (exact: 17 digits), for resuming
+/// and for sending between processes.
+std::string serialize(const RunResult& r);
+RunResult deserialize(const std::string& line);
+
+/// Runs `indices` on `threads` threads, each with its own engine from
+/// `make_engine`, calling `done` (serialized, from one thread at a time) with
+/// each result.
+void run_on_threads(const SweepPlan& plan, const std::vector<long>& indices, int threads,
+                    const std::function<std::unique_ptr<Engine>(const Model&)>& make_engine,
+                    const std::function<void(RunResult&&)>& done);
+
+/// Writes runs.csv (one row per run, by index: parameters, metrics, status),
+/// timing.csv (wall and integration time per run: these alone depend on the
+/// machine), summary.json, summary.md and envelope_<column>.csv into `dir`.
+/// `results` must be sorted by index.
+void write_sweep_outputs(const SweepPlan& plan, const std::vector<RunResult>& results, const std::string& dir);
+
+/// An 8-hex-digit identity of the sweep file's text: results of another
+/// sweep are never resumed or merged with these.
+std::string sweep_identity(const SweepPlan& plan);
+
+}  // namespace kanegen
