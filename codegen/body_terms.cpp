@@ -270,7 +270,6 @@ void runtime_rigid_part(KaneContext& ctx, int j, ex& mass, SV3& S0, SM3& J0) {
 void compute_body_terms(KaneContext& ctx, bool with_velocity) {
   Alg& A = ctx.A;
   const Model& model = ctx.model;
-  const Vec3& gN = model.g_N;
   ctx.C.group = "model";
   const SV3 g_N = ctx.gravity(1.0, "gravity", "gravity in N");
   for (std::size_t j = 0; j < model.bodies.size(); ++j) {

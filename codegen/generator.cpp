@@ -58,6 +58,16 @@ EmittedFunction function(std::string name, std::string title, std::vector<Arg> a
   return f;
 }
 
+/// u_dot in the composite-inertia form (M by composite inertias, F by the
+/// inward pass, L^T D L along the tree) or the articulated-body form.
+std::vector<ex> compute_udot(KaneContext& ctx, const std::string& form, std::vector<ex>& pivots,
+                             std::vector<ex>& scales) {
+  if (form != "composite") return compute_udot_articulated(ctx, pivots, scales);
+  const SMat M = compute_mass_matrix(ctx);  // M first: the order of the emitted code
+  const std::vector<ex> F = compute_forcing(ctx);
+  return solve_tree_ldlt(ctx, M, F, pivots, scales);
+}
+
 /// What the dual-number functions below share: the duals of every argument
 /// at their values (seeded one direction per pass by the caller), and the
 /// calls of qdot(), udot() and outputs() on them.
@@ -260,9 +270,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
 
   {
     Program p;
-    KaneContext ctx(dyn, p, C, x);
-    ctx.angle_offset = framed.angle_offset;
-    ctx.R_BBp = framed.R_BBp;
+    KaneContext ctx(framed, p, C, x);
     const auto qd = compute_qdot(ctx);
     for (int i = 0; i < dyn.nq; ++i) p.assign(fmt::format("qdot[{}]", i), qd[i]);
     EmittedFunction f = function("qdot", "q_dot = W(q) u", {Arg::q, Arg::u, Arg::out}, "qdot", dyn.nq);
@@ -271,9 +279,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   }
   {
     Program p;
-    KaneContext ctx(dyn, p, C, x);
-    ctx.angle_offset = framed.angle_offset;
-    ctx.R_BBp = framed.R_BBp;
+    KaneContext ctx(framed, p, C, x);
     prepare(ctx, false);
     const SMat M = compute_mass_matrix(ctx);
     for (int r = 0; r < dyn.nu; ++r)
@@ -284,9 +290,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   }
   {
     Program p;
-    KaneContext ctx(dyn, p, C, x);
-    ctx.angle_offset = framed.angle_offset;
-    ctx.R_BBp = framed.R_BBp;
+    KaneContext ctx(framed, p, C, x);
     prepare(ctx, true);
     const auto F = compute_forcing(ctx);
     for (int r = 0; r < dyn.nu; ++r) p.assign(fmt::format("F[{}]", r), F[r]);
@@ -300,18 +304,10 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   EmittedFunction udot;
   for (const char* form : {"composite", "articulated"}) {
     Program p;
-    KaneContext ctx(dyn, p, C, x);
-    ctx.angle_offset = framed.angle_offset;
-    ctx.R_BBp = framed.R_BBp;
+    KaneContext ctx(framed, p, C, x);
     prepare(ctx, true);
-    std::vector<ex> pivots, scales, ud;
-    if (std::string(form) == "composite") {
-      const SMat M = compute_mass_matrix(ctx);
-      const auto F = compute_forcing(ctx);
-      ud = solve_tree_ldlt(ctx, M, F, pivots, scales);
-    } else {
-      ud = compute_udot_articulated(ctx, pivots, scales);
-    }
+    std::vector<ex> pivots, scales;
+    const std::vector<ex> ud = compute_udot(ctx, form, pivots, scales);
     OpCount dummy;
     for (std::size_t r = 0; r < pivots.size(); ++r) {
       if (GiNaC::is_a<GiNaC::numeric>(pivots[r]) && GiNaC::ex_to<GiNaC::numeric>(pivots[r]).is_positive()) continue;
@@ -341,9 +337,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   const auto& outs = model_in.outputs;
   if (outs.energy) {
     Program p;
-    KaneContext ctx(dyn, p, C, x);
-    ctx.angle_offset = framed.angle_offset;
-    ctx.R_BBp = framed.R_BBp;
+    KaneContext ctx(framed, p, C, x);
     prepare(ctx, true);
     p.assign("TV[0]", compute_kinetic_energy(ctx));
     p.assign("TV[1]", compute_potential_energy(ctx));
@@ -353,9 +347,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
   }
   if (outs.momentum) {
     Program p;
-    KaneContext ctx(dyn, p, C, x);
-    ctx.angle_offset = framed.angle_offset;
-    ctx.R_BBp = framed.R_BBp;
+    KaneContext ctx(framed, p, C, x);
     prepare(ctx, true);
     const auto pH = compute_momentum(ctx);
     for (int i = 0; i < 6; ++i) p.assign(fmt::format("pH[{}]", i), pH[i]);
@@ -368,9 +360,7 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     const FramedModel fr = frames(model_in);
     const StateSymbols xr(fr.model);
     Program p;
-    KaneContext ctx(fr.model, p, C, xr);
-    ctx.angle_offset = fr.angle_offset;
-    ctx.R_BBp = fr.R_BBp;
+    KaneContext ctx(fr, p, C, xr);
     prepare(ctx, true);
     const auto W = compute_reactions(ctx, xr.udot);
     // back to the model's body axes: [R_BB' f; R_BB' t]
@@ -398,18 +388,10 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     const FramedModel fr = frames(model_in);
     const StateSymbols xr(fr.model);
     Program p;
-    KaneContext ctx(fr.model, p, C, xr);
-    ctx.angle_offset = fr.angle_offset;
-    ctx.R_BBp = fr.R_BBp;
+    KaneContext ctx(fr, p, C, xr);
     prepare(ctx, true);
-    std::vector<ex> pivots, scales, ud;
-    if (out.udot_form == "composite") {
-      const SMat M = compute_mass_matrix(ctx);
-      const auto F = compute_forcing(ctx);
-      ud = solve_tree_ldlt(ctx, M, F, pivots, scales);
-    } else {
-      ud = compute_udot_articulated(ctx, pivots, scales);
-    }
+    std::vector<ex> pivots, scales;
+    const std::vector<ex> ud = compute_udot(ctx, out.udot_form, pivots, scales);
     std::vector<std::vector<ex>> acc;
     const auto W = compute_reactions(ctx, ud, &acc);
     assign_sensor_outputs(ctx, W, acc, "y");

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "codegen/constants.hpp"
+#include "codegen/joint_frames.hpp"
 #include "codegen/symbolic.hpp"
 #include "model/model.hpp"
 #include "model/parameters.hpp"
@@ -53,6 +54,12 @@ struct KaneContext {
   KaneContext(const Model& model, Program& program, Constants& constants, const StateSymbols& x)
       : model(model), P(program), C(constants), x(x), A(program), body(model.bodies.size()) {
     program.fold = [&constants](const ex& e) { return constants.fold(e); };
+  }
+  /// The context of a model with the generator's frames (joint_frames.hpp).
+  KaneContext(const FramedModel& framed, Program& program, Constants& constants, const StateSymbols& x)
+      : KaneContext(framed.model, program, constants, x) {
+    angle_offset = framed.angle_offset;
+    R_BBp = framed.R_BBp;
   }
 
   const Model& model;

@@ -88,7 +88,7 @@ SweepSpec load_sweep_spec(const std::string& path) {
       const YAML::Node e = ds[i];
       if (!ck.expect_map(e, line_of(ds), f)) continue;
       const int l = line_of(e);
-      ck.check_keys(e, f, {"parameter", "distribution", "sigma", "low", "high", "values", "relative"});
+      ck.check_keys(e, f, {"parameter", "distribution", "mean", "sigma", "low", "high", "values", "relative"});
       Dispersion d;
       d.line = l;
       if (!e["parameter"].IsDefined()) ck.error(l, f + ".parameter", "missing; expected a runtime parameter (bus.mass, ...) or q.<name> / u.<name>");
@@ -113,13 +113,14 @@ SweepSpec load_sweep_spec(const std::string& path) {
       };
       const bool normal = d.kind == Dispersion::Kind::normal || d.kind == Dispersion::Kind::truncated_normal;
       num("sigma", d.sigma, normal);
+      num("mean", d.mean, false);
       num("low", d.low, d.kind == Dispersion::Kind::uniform || d.kind == Dispersion::Kind::truncated_normal);
       num("high", d.high, d.kind == Dispersion::Kind::uniform || d.kind == Dispersion::Kind::truncated_normal);
       if (normal && !(d.sigma >= 0)) ck.error(e["sigma"], l, f + ".sigma", "negative; expected sigma >= 0");
       if ((d.kind == Dispersion::Kind::uniform || d.kind == Dispersion::Kind::truncated_normal) && !(d.low < d.high))
         ck.error(e, l, f, fmt::format("low {} is not below high {}", d.low, d.high));
-      if (d.kind == Dispersion::Kind::truncated_normal && !(d.low <= 0 && d.high >= 0))
-        ck.error(e, l, f, "the truncation interval [low, high] must contain 0 (the nominal value)");
+      if (d.kind == Dispersion::Kind::truncated_normal && !(d.low <= d.mean && d.high >= d.mean))
+        ck.error(e, l, f, "the truncation interval [low, high] must contain the mean (default 0)");
       if (d.kind == Dispersion::Kind::choice) {
         if (!e["values"].IsDefined()) ck.error(l, f + ".values", "missing; a choice needs a list of values");
         else if (ck.expect_seq(e["values"], l, f + ".values")) {

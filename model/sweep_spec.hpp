@@ -15,6 +15,7 @@ struct Dispersion {
   std::string target;          ///< a runtime parameter name (bus.mass, ant1.damping, ...) or q.<name> / u.<name>
   int line = 0;
   Kind kind = Kind::normal;
+  double mean = 0.0;           ///< normal, truncated normal: the deviation's mean
   double sigma = 0.0;          ///< normal, truncated normal
   double low = 0.0, high = 0.0;  ///< uniform; truncated normal: the truncation interval (of the deviation)
   std::vector<double> values;  ///< choice

@@ -171,9 +171,9 @@ std::vector<double> draw(const SweepPlan& plan, long index) {
     const double nominal = plan.targets[i].nominal;
     double dev = 0.0;
     switch (d.kind) {
-      case Dispersion::Kind::normal: dev = std::normal_distribution<double>(0.0, d.sigma)(rng); break;
+      case Dispersion::Kind::normal: dev = std::normal_distribution<double>(d.mean, d.sigma)(rng); break;
       case Dispersion::Kind::truncated_normal: {
-        std::normal_distribution<double> N(0.0, d.sigma);
+        std::normal_distribution<double> N(d.mean, d.sigma);
         int tries = 0;
         do dev = N(rng);
         while ((dev < d.low || dev > d.high) && ++tries < 10000);

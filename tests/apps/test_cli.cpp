@@ -19,14 +19,18 @@ struct Run {
   std::string out;  // stdout and stderr
 };
 
-Run run(const std::string& args, const std::string& env = "") {
-  const std::string cmd = env + " " + std::string(KANEGEN_BINARY) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
+/// A shell command's exit status and output.
+Run shell(const std::string& cmd) {
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
   std::string out;
   char buf[4096];
   for (std::size_t n; (n = fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
   const int st = pclose(p);
   return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+Run run(const std::string& args, const std::string& env = "") {
+  return shell(env + " " + std::string(KANEGEN_BINARY) + " " + args);
 }
 
 std::string src(const std::string& rel) { return kanegen::test::source_path(rel); }
@@ -40,7 +44,7 @@ fs::path temp_dir() {
 }  // namespace
 
 TEST_CASE("cli: every subcommand has --help", "[cli]") {
-  for (const char* sub : {"check", "eval", "simulate", "generate", "crosscheck", "modes"}) {
+  for (const char* sub : {"check", "eval", "simulate", "generate", "crosscheck", "modes", "linearize", "sweep"}) {
     INFO(sub);
     const Run r = run(std::string(sub) + " --help");
     CHECK(r.status == 0);
@@ -126,4 +130,25 @@ TEST_CASE("cli: generate writes a header, modes writes a modal file that loads b
   CHECK(run("modes " + src("models/spacecraft_arrays.yaml") + " --body boom -o " + modal).status == 0);
   CHECK(fs::exists(modal));
   CHECK(run("modes " + src("models/spacecraft_arrays.yaml") + " --body nosuchbody -o " + modal).status == 2);
+}
+
+TEST_CASE("cli: linearize prints A and its modes, writes npz, refuses unknown names", "[cli][linearize]") {
+  const fs::path d = temp_dir();
+  const std::string state = (d / "hang.json").string();
+  std::ofstream(state) << R"({"q": {"bob.angle": 1.5707963267948966}})";
+  const Run r = run("linearize " + src("models/pendulum.yaml") + " --state " + state);
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("\"equilibrium\": true") != std::string::npos);
+  CHECK(r.out.find("-9.81") != std::string::npos);             // A[1][0] = -g/L
+  CHECK(r.out.find("0.498488") != std::string::npos);           // sqrt(g/L)/2pi, the modes table
+  const std::string npz = (d / "lin.npz").string();
+  CHECK(run("linearize " + src("models/pendulum.yaml") + " --state " + state + " --format npz -o " + npz + " --quiet").status == 0);
+  const Run py = shell("/usr/bin/python3 -c \"import numpy; z = numpy.load('" + npz +
+                       "'); print(z['A'][1][0], list(z['state_names']))\"");
+  CHECK(py.out.find("-9.81 ['q.bob.angle', 'u.bob.angle']") != std::string::npos);
+  const Run bad = run("linearize " + src("models/pendulum.yaml") + " --inputs nosuch");
+  CHECK(bad.status == 2);
+  CHECK(bad.out.find("--inputs") != std::string::npos);
+  CHECK(run("linearize " + src("models/pendulum.yaml") + " --format mat").status == 2);  // a file format needs -o
+  CHECK(!fs::exists(d / "lin.mat"));
 }
