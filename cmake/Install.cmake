@@ -14,6 +14,7 @@ foreach(dir model dynamics engine sim apps/aot apps/common)
 endforeach()
 install(FILES ${KANEGEN_TEMPLATES} DESTINATION ${CMAKE_INSTALL_DATADIR}/kanegen/templates)
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/scripts/plot_work_precision.py ${PROJECT_SOURCE_DIR}/scripts/plot_simulation.py
+                 ${PROJECT_SOURCE_DIR}/scripts/plot_sweep.py
         DESTINATION ${CMAKE_INSTALL_DATADIR}/kanegen/scripts)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/models/ DESTINATION ${CMAKE_INSTALL_DATADIR}/kanegen/models)
 

@@ -59,6 +59,7 @@ EX = os.path.join(ROOT, "examples/sweep/explorer1_transition.yaml")
 out = os.path.join(ROOT, "examples/sweep/explorer1_transition.out")
 ex_wall = None
 if not args.skip_explorer:
+    shutil.rmtree(out, ignore_errors=True)  # a fresh run (not a resume of an earlier one)
     t0 = time.perf_counter()
     subprocess.run([KG, "sweep", EX, "-o", out, "--threads", "2", "--no-progress"], check=True)
     ex_wall = time.perf_counter() - t0

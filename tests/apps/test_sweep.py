@@ -63,6 +63,10 @@ try:
           "two shards")
     check(sweep(SWEEP, "--merge", s0, s1, "-o", dm).returncode == 0 and same(d1, dm), "shards merged: identical tables")
 
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "plot_sweep.py"), d1], capture_output=True, text=True)
+    check(r.returncode == 0 and os.path.getsize(os.path.join(d1, "histograms.png")) > 10000 and
+          os.path.exists(os.path.join(d1, "envelope_link1.angle.png")), "plot_sweep.py draws the histograms and envelopes")
+
     rows = list(csv.DictReader(open(os.path.join(d1, "runs.csv"))))
     check(len(rows) == 1000 and [int(r["run"]) for r in rows] == list(range(1000)), "1000 rows, by run index")
     check(all(r["status"] == "ok" for r in rows), "every run ok")
