@@ -1,5 +1,6 @@
 #include "codegen/joint_frames.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace kanegen::codegen {
@@ -89,8 +90,11 @@ FramedModel choose_joint_frames(const Model& in) {
     // Denavit-Hartenberg: when the parent's x axis is normal to this revolute
     // axis, R_PJ = Rx(alpha) Rz(delta), and Rz(delta) joins the joint rotation.
     const Mat3& C = o.joint.R_PJ;
+    const bool misaligned = std::any_of(in.parameters.begin(), in.parameters.end(), [j](const RuntimeParameter& p) {
+      return p.body == j && p.kind == ParameterKind::misalignment;
+    });
     if (reframable(b) && b.joint.type == JointType::revolute && b.parent >= 0 && reframable(in.bodies[b.parent]) &&
-        std::abs(C(0, 2)) < 1e-12) {
+        std::abs(C(0, 2)) < 1e-12 && !misaligned) {
       const double alpha = std::atan2(-C(1, 2), C(2, 2));
       const Mat3 Rz = rot_x(alpha).transpose() * C;
       out.angle_offset[j] = std::atan2(Rz(1, 0), Rz(0, 0));

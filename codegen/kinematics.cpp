@@ -12,6 +12,47 @@ using namespace GiNaC;
 
 static const char* kAxis[3] = {"x", "y", "z"};
 
+namespace {
+
+/// Q^T Rz(z) Ry(y) Rx(x) Q: the misalignment of body j's joint frame (runtime
+/// parameters, model axes) in the generator's frame B' (Q = R_BB').
+SM3 misalignment_rotation(KaneContext& ctx, int j) {
+  Alg& A = ctx.A;
+  const std::string& n = ctx.model.bodies[j].name;
+  ex c[3], s[3];
+  for (int a = 0; a < 3; ++a) {
+    const ex th = ctx.param(ParameterKind::misalignment, j, a).value_or(ex(0));
+    c[a] = A.let(cos(th)), s[a] = A.let(sin(th));
+  }
+  SM3 Rx = SM3::identity(), Ry = SM3::identity(), Rz = SM3::identity();
+  Rx(1, 1) = c[0], Rx(1, 2) = -s[0], Rx(2, 1) = s[0], Rx(2, 2) = c[0];
+  Ry(0, 0) = c[1], Ry(0, 2) = s[1], Ry(2, 0) = -s[1], Ry(2, 2) = c[1];
+  Rz(0, 0) = c[2], Rz(0, 1) = -s[2], Rz(1, 0) = s[2], Rz(1, 1) = c[2];
+  const SM3 R = A.mul(Rz, A.mul(Ry, Rx));
+  const Mat3 Q = ctx.R_BBp.empty() ? Mat3::Identity() : ctx.R_BBp[j];
+  if (Q.isIdentity(0.0)) return R;
+  const SM3 Qs = ctx.cmat(Q, n + "_R_BBp", "", "the generator's body axes in the model's");
+  return A.mul(Qs.transpose(), A.mul(R, Qs));
+}
+
+/// Qp^T p: body j's joint origin (runtime parameters, the parent's model axes) in the parent's frame P'.
+SV3 joint_position(KaneContext& ctx, int j) {
+  const Body& b = ctx.model.bodies[j];
+  const Mat3 Qp = ctx.R_BBp.empty() || b.parent < 0 ? Mat3::Identity() : ctx.R_BBp[b.parent];
+  const Vec3 p0 = Qp * b.joint.p_PJ;  // the nominal position in the parent's model axes
+  SV3 p;
+  for (int a = 0; a < 3; ++a)
+    p[a] = ctx.param(ParameterKind::position, j, a)
+               .value_or(ctx.c(p0(a), fmt::format("{}_p_PJ_model_{}", b.name, kAxis[a]), "m", "joint origin, parent's model axes"));
+  if (Qp.isIdentity(0.0)) return p;
+  SM3 Qt;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) Qt(r, c) = ctx.c(Qp(c, r), fmt::format("{}_R_PpP_{}{}", b.name, r, c), "", "parent's model axes in its generator frame");
+  return ctx.A.mul(Qt, p);
+}
+
+}  // namespace
+
 SV3 KaneContext::gravity(double sign, const std::string& n, const std::string& what) {
   C.group = "model";
   SV3 g = cvec(sign * model.g_N, n, "m/s^2", what);
@@ -108,6 +149,14 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
 
     // Joint frame.
     SM3 R_PJ = ctx.cmat(b.joint.R_PJ, n + "_R_PJ", "", "joint frame orientation in the parent");
+    // runtime parameters of the joint's placement (model/parameters.hpp), given in the model's frames
+    const bool misaligned = ctx.param(ParameterKind::misalignment, static_cast<int>(j), 0) ||
+                            ctx.param(ParameterKind::misalignment, static_cast<int>(j), 1) ||
+                            ctx.param(ParameterKind::misalignment, static_cast<int>(j), 2);
+    const bool moved = ctx.param(ParameterKind::position, static_cast<int>(j), 0) ||
+                       ctx.param(ParameterKind::position, static_cast<int>(j), 1) ||
+                       ctx.param(ParameterKind::position, static_cast<int>(j), 2);
+    if (misaligned) R_PJ = A.mul(R_PJ, misalignment_rotation(ctx, static_cast<int>(j)));
     SV3 p_PJ;
     SV3 w_J, w_J_dot_R, v_node, a_node_R;
     std::vector<SV3> H_cols, Phi_cols;  // per parent mode
@@ -210,6 +259,8 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
         const ex f = A.let(-2 * A.dot(g, g_dot) * inv);
         w_J_dot_R = A.scale(f, w_J);
       }
+    } else if (moved) {
+      p_PJ = joint_position(ctx, static_cast<int>(j));
     } else {
       p_PJ = ctx.cvec(b.joint.p_PJ, n + "_p_PJ", "m", "joint frame origin in the parent");
     }
@@ -282,7 +333,7 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     s.R_JB = R_JB;
     const SM3 R_JP = R_PJ.transpose(), R_BJ = R_JB.transpose();
     // O_J from O_P in J components: a model constant unless O_J is a node of a flexible parent
-    const SV3 p_J = b.joint.node >= 0 ? A.mul(R_JP, p_PJ)
+    const SV3 p_J = b.joint.node >= 0 || misaligned || moved ? A.mul(R_JP, p_PJ)
                                       : ctx.cvec(b.joint.R_PJ.transpose() * b.joint.p_PJ, n + "_p_J", "m",
                                                  "joint origin from the parent's origin, joint axes");
     s.p_BP_J = A.add(p_J, e_J);

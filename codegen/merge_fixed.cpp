@@ -8,11 +8,13 @@ Mat3 point_inertia(double m, const Vec3& r) { return m * (r.squaredNorm() * Mat3
 
 bool mergeable(const Body& b) { return b.joint.type == JointType::fixed && b.joint.node < 0 && !b.flex; }
 
-/// A body whose rigid part holds runtime parameters keeps its own terms (its
-/// parameters are given in its own frame), and so does its parent.
-bool has_rigid_parameters(const Model& m, int j) {
+/// A body whose rigid part or joint placement holds runtime parameters keeps
+/// its own terms (its parameters are given in its own frame), and its parent
+/// keeps its own when its rigid part holds some.
+bool has_parameters(const Model& m, int j, bool placement) {
   for (const RuntimeParameter& p : m.parameters)
-    if (p.body == j && (p.kind == ParameterKind::mass || p.kind == ParameterKind::com || p.kind == ParameterKind::inertia))
+    if (p.body == j && (p.kind == ParameterKind::mass || p.kind == ParameterKind::com || p.kind == ParameterKind::inertia ||
+                        (placement && (p.kind == ParameterKind::position || p.kind == ParameterKind::misalignment))))
       return true;
   return false;
 }
@@ -41,7 +43,7 @@ Model merge_fixed_bodies(const Model& in) {
       const Body fixed = m.bodies[j];
       const int p = fixed.parent;
       if (p < 0) continue;  // fixed to ground: kept (it never moves; costs nothing)
-      if (has_rigid_parameters(m, static_cast<int>(j)) || has_rigid_parameters(m, p)) continue;
+      if (has_parameters(m, static_cast<int>(j), true) || has_parameters(m, p, false)) continue;
       add_rigid(m.bodies[p].rigid, fixed.rigid, fixed.joint.p_PJ, fixed.joint.R_PJ);
       move_ports(m.inputs, m.sensors, static_cast<int>(j), p, fixed.joint.p_PJ, fixed.joint.R_PJ);
       for (Body& c : m.bodies) {

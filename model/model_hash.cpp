@@ -194,6 +194,8 @@ std::string model_hash(const Model& model) {
       case ParameterKind::damping_ratio:
         b.flex->frequency_hz(p.index) = b.flex->damping_ratio(p.index) = b.flex->K(p.index) = b.flex->D(p.index) = 0;
         break;
+      case ParameterKind::position: b.joint.p_PJ(p.index) = 0; break;
+      case ParameterKind::misalignment: break;  // nominal 0: the rotation is the model's
       case ParameterKind::gravity: break;
     }
   }

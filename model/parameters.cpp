@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "model/modal_integrals.hpp"
+#include "model/rotation.hpp"
 
 namespace kanegen {
 
@@ -52,6 +53,18 @@ std::vector<RuntimeParameter> expand_parameter(const Model& model, const std::st
     for (int k = 0; k < 6; ++k)
       if (what == "inertia" || what == std::string("inertia.") + kInertia[k])
         add(body + ".inertia." + kInertia[k], "kg m^2", ParameterKind::inertia, b, k);
+  } else if (what == "position" || what.rfind("position.", 0) == 0 || what == "misalignment" ||
+             what.rfind("misalignment.", 0) == 0) {
+    const bool pos = what.rfind("position", 0) == 0;
+    if (j.node >= 0)
+      throw std::invalid_argument(fmt::format("'{}': body '{}' is attached at a node of its parent, which places and "
+                                              "turns its joint; expected a joint on a body frame",
+                                              name, body));
+    const std::string stem = pos ? "position" : "misalignment";
+    for (int a = 0; a < 3; ++a)
+      if (what == stem || what == stem + "." + kAxis[a])
+        add(body + "." + stem + "." + kAxis[a], pos ? "m" : "rad", pos ? ParameterKind::position : ParameterKind::misalignment,
+            b, a);
   } else if (what == "stiffness" || what == "damping" || what == "rest") {
     if (!spring)
       throw std::invalid_argument(fmt::format("'{}': body '{}' has a {} joint{}; a joint spring needs a revolute or "
@@ -90,6 +103,8 @@ double parameter_value(const Model& model, const RuntimeParameter& p) {
     case ParameterKind::rest: return b.joint.rest;
     case ParameterKind::frequency: return b.flex->frequency_hz(p.index);
     case ParameterKind::damping_ratio: return b.flex->damping_ratio(p.index);
+    case ParameterKind::position: return b.joint.p_PJ(p.index);
+    case ParameterKind::misalignment: return 0.0;  // relative to the model's rotation
     case ParameterKind::gravity: break;
   }
   return 0.0;
@@ -105,6 +120,8 @@ void apply_parameters(Model& model, const std::vector<RuntimeParameter>& params,
   if (values.size() != static_cast<Eigen::Index>(params.size()))
     throw std::invalid_argument(fmt::format("{} parameter values for {} parameters", values.size(), params.size()));
   std::vector<bool> rigid_changed(model.bodies.size(), false), modes_changed(model.bodies.size(), false);
+  std::vector<Vec3> misalignment(model.bodies.size(), Vec3::Zero());
+  std::vector<bool> misaligned(model.bodies.size(), false);
   for (std::size_t k = 0; k < params.size(); ++k) {
     const RuntimeParameter& p = params[k];
     const double v = values(static_cast<Eigen::Index>(k));
@@ -142,6 +159,11 @@ void apply_parameters(Model& model, const std::vector<RuntimeParameter>& params,
         b.joint.damping = v;
         break;
       case ParameterKind::rest: b.joint.rest = v; break;
+      case ParameterKind::position: b.joint.p_PJ(p.index) = v; break;
+      case ParameterKind::misalignment:
+        misalignment[p.body](p.index) = v;
+        misaligned[p.body] = true;
+        break;
       case ParameterKind::frequency:
       case ParameterKind::damping_ratio: {
         FlexibleData& f = *b.flex;
@@ -175,6 +197,12 @@ void apply_parameters(Model& model, const std::vector<RuntimeParameter>& params,
       for (const auto& n : b.flex->nodes) b.total_mass += n.mass;
   }
   (void)modes_changed;
+  // the model's rotation (as given: apply_parameters always starts from the loaded model), then the misalignment
+  for (std::size_t i = 0; i < model.bodies.size(); ++i)
+    if (misaligned[i]) {
+      const Vec3& m = misalignment[i];
+      model.bodies[i].joint.R_PJ = model.bodies[i].joint.R_PJ * rpy_R(m(0), m(1), m(2));
+    }
 }
 
 }  // namespace kanegen

@@ -9,6 +9,9 @@
 //   <body>.stiffness [N m/rad or N/m]  <body>.damping [N m s/rad or N s/m]  <body>.rest [rad or m]
 //   <body>.frequency -> .frequency1 ... [Hz]   <body>.damping_ratio -> .damping_ratio1 ... (modal)
 //   gravity -> gravity.x .y .z [m/s^2]
+//   <body>.position -> .position.x .y .z [m]   (the joint frame's origin in the parent frame)
+//   <body>.misalignment -> .misalignment.x .y .z [rad]: the joint frame turned by
+//                             Rz(z) Ry(y) Rx(x) after its nominal rotation (nominal 0)
 // Both engines take the same values: the generic engine evaluates the model
 // with them written in (apply_parameters), the generated code reads them
 // from its parameter array.

@@ -6,7 +6,11 @@
 
 namespace kanegen {
 
-enum class ParameterKind { mass, com, inertia, stiffness, damping, rest, frequency, damping_ratio, gravity };
+enum class ParameterKind {
+  mass, com, inertia, stiffness, damping, rest, frequency, damping_ratio, gravity,
+  position,      ///< the joint frame's origin in the parent frame (model components), index 0-2
+  misalignment,  ///< the joint frame turned by Rz(z) Ry(y) Rx(x) after its nominal rotation, index 0-2 (rad)
+};
 
 struct RuntimeParameter {
   std::string name;   ///< scalar entry, e.g. "bus.inertia.xy", "ant1.frequency2", "gravity.z"

@@ -26,7 +26,8 @@ std::string read(const std::string& path) {
 
 const char* kParameters = R"(
 parameters: [bus.mass, bus.com, bus.inertia, tracker.mass, tracker.inertia.xy, arm.stiffness, arm.damping, arm.rest,
-             arm.com.x, boom.frequency, boom.damping_ratio2, gravity]
+             arm.com.x, boom.frequency, boom.damping_ratio2, gravity, tracker.misalignment, arm.position,
+             arm.misalignment.z, boom.position.y]
 )";
 
 }  // namespace
@@ -34,7 +35,7 @@ parameters: [bus.mass, bus.com, bus.inertia, tracker.mass, tracker.inertia.xy, a
 TEST_CASE("runtime parameters: generated at changed values equals generic on the changed model", "[parameters][generated]") {
   const std::string base = read(test::source_path("tests/data/good/gnc_ports.yaml"));
   const Model model = load_model(test::write_temp("params.yaml", base + kParameters));
-  REQUIRE(model.parameters.size() == 1 + 3 + 6 + 1 + 1 + 3 + 1 + 3 + 1 + 3);
+  REQUIRE(model.parameters.size() == 1 + 3 + 6 + 1 + 1 + 3 + 1 + 3 + 1 + 3 + 3 + 3 + 1 + 1);
   auto generated = test::generated_engine(model);
   GenericEngine generic(model);
   std::mt19937 rng(5);
@@ -44,7 +45,10 @@ TEST_CASE("runtime parameters: generated at changed values equals generic on the
     for (Eigen::Index k = 0; k < p.size(); ++k) {
       const RuntimeParameter& rp = model.parameters[static_cast<std::size_t>(k)];
       // scale every value; off-diagonal inertia and com components by less, to stay physical
-      p(k) = rp.kind == ParameterKind::inertia && rp.index >= 3 ? p(k) * 0.5 : p(k) * U(rng) + (p(k) == 0 ? 0.05 : 0.0);
+      if (rp.kind == ParameterKind::misalignment)
+        p(k) = 0.02 * (U(rng) - 1.0);  // a few milliradians to a degree
+      else
+        p(k) = rp.kind == ParameterKind::inertia && rp.index >= 3 ? p(k) * 0.5 : p(k) * U(rng) + (p(k) == 0 ? 0.05 : 0.0);
     }
     INFO("trial " << trial);
     generated->set_parameters(p);
