@@ -248,7 +248,7 @@ Subcommand add_sweep(CLI::App& app) {
   c->add_option("sweep", o->sweep, "SWEEP.yaml")->required()->check(CLI::ExistingFile);
   c->add_option("-o,--output", o->output, "output directory (default SWEEP.out/); with --run, the run's CSV");
   c->add_option("--threads", o->threads, "threads (default: every core; 1 per rank under mpirun unless given)");
-  c->add_option("--run", o->run, "replay one run alone and write its full time history");
+  c->add_option("--run", o->run, "replay one run alone and write its full time history")->check(CLI::Range(0L, 100000000L));
   c->add_option("--shard", o->shard, "i/N: the runs k with k mod N = i (a batch scheduler's job array)");
   c->add_option("--merge", o->merge, "merge the results of shards (their output directories) into -o")->expected(1, -1);
   c->add_flag("--no-progress", o->no_progress, "no progress line on stderr");
