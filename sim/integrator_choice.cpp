@@ -46,6 +46,7 @@ MatX jacobian_at(const OdeProblem& p, double t0, const VecX& x0) {
 
 /// The eigenvalue of largest modulus.
 std::complex<double> dominant_eigenvalue(const MatX& J) {
+  if (J.rows() == 0) return 0.0;  // no degree of freedom
   if (J.rows() <= kMaxDenseEigen) {
     const Eigen::EigenSolver<MatX> es(J, false);
     if (es.info() == Eigen::Success) {

@@ -597,7 +597,7 @@ std::string IntegratorStats::summary() const {
 
 IntegratorStats integrate(const OdeProblem& problem, const IntegratorOptions& options, double t0,
                           const Eigen::VectorXd& x0, double t_end, double dt_out, const OutputFn& output) {
-  if (problem.n <= 0) throw std::invalid_argument(fmt::format("integrate: problem size n = {} must be positive", problem.n));
+  if (problem.n < 0) throw std::invalid_argument(fmt::format("integrate: problem size n = {} is negative", problem.n));
   if (x0.size() != problem.n)
     throw std::invalid_argument(
         fmt::format("integrate: initial state has {} components, problem has n = {}", x0.size(), problem.n));
@@ -612,7 +612,15 @@ IntegratorStats integrate(const OdeProblem& problem, const IntegratorOptions& op
   IntegratorStats stats;
   stats.integrator = to_string(options.kind);
 
-  if (t_end == t0) {
+  if (problem.n == 0) {
+    // nothing to integrate (a model without degrees of freedom, e.g. only
+    // prescribed motion): the (empty) state at every output time
+    OutputSchedule schedule(t0, t_end, dt_out);
+    const Eigen::VectorXd empty;
+    if (!output || output(t0, empty))
+      for (double t; t_end > t0 && schedule.next(t);)
+        if (output && !output(t, empty)) break;
+  } else if (t_end == t0) {
     Eigen::VectorXd xo = x0;
     if (problem.project) problem.project(xo.data());
     if (output) output(t0, xo);
