@@ -12,11 +12,47 @@ namespace kanegen::codegen {
 
 using namespace GiNaC;
 
-std::array<ex, 6> input_wrench(KaneContext& ctx, int j) {
-  std::array<ex, 6> W{0, 0, 0, 0, 0, 0};
+std::vector<ex> input_wrench(KaneContext& ctx, int j) {
+  const Body& b = ctx.model.bodies[j];
+  const int m = b.n_modes();
+  std::vector<ex> W(6 + m, ex(0));
   const SymBodyWorkspace& s = ctx.body[j];
   for (const Input& in : ctx.model.inputs) {
     if (in.body != j || in.type == InputType::joint_torque) continue;
+    if (in.node >= 0) {  // a force at a node: at its displaced position, with modal rows Phi~^T f
+      ctx.C.group = b.name;
+      const FlexibleData& fd = *b.flex;
+      const int k = in.node;
+      const auto& w = ctx.x.inputs;
+      const SV3 v{{w[in.offset], w[in.offset + 1], w[in.offset + 2]}};
+      const SV3 f_B = in.axes == Axes::inertial
+                          ? ctx.A.mul_t(s.R_NB, v)
+                          : ctx.A.mul(ctx.cmat(in.R_BX, in.name + "_R_BX", "", "input axes in the body frame"), v);
+      SV3 s_k = ctx.cvec(fd.nodes[k].rho_B, in.name + "_rho", "m", "the node's undeformed position");
+      std::vector<SV3> Phi_t(m);
+      for (int i = 0; i < m; ++i)
+        Phi_t[i] = ctx.cvec(fd.Phi.block(3 * k, i, 3, 1), fmt::format("{}_Phi{}", in.name, i + 1), "m",
+                            "mode shape at the node");
+      for (int a = 0; a < 3; ++a) {
+        ex sum = s_k[a];
+        for (int i = 0; i < m; ++i) sum += Phi_t[i][a] * s.eta[i];
+        if (fd.has_second_order(k) && fd.Gamma[k][a].size())
+          for (int i = 0; i < m; ++i) {
+            ex Ge = 0;  // (Gamma^a eta)_i
+            for (int l = 0; l < m; ++l)
+              Ge += ctx.c(fd.Gamma[k][a](i, l), fmt::format("{}_G_{}_{}_{}", in.name, a, i + 1, l + 1), "1/m",
+                          "foreshortening matrix at the node") * s.eta[l];
+            Ge = ctx.A.let(Ge);
+            sum += Ge * s.eta[i] / 2;
+            Phi_t[i][a] = ctx.A.let(Phi_t[i][a] + Ge);
+          }
+        s_k[a] = ctx.A.let(sum);
+      }
+      const SV3 sxf = ctx.A.cross(s_k, f_B);
+      for (int a = 0; a < 3; ++a) W[a] += f_B[a], W[3 + a] += sxf[a];
+      for (int i = 0; i < m; ++i) W[6 + i] += ctx.A.dot(Phi_t[i], f_B);
+      continue;
+    }
     ctx.C.group = ctx.model.bodies[j].name;
     const auto& w = ctx.x.inputs;
     SV3 f, t;
@@ -38,7 +74,7 @@ std::array<ex, 6> input_wrench(KaneContext& ctx, int j) {
     }
   }
   for (ex& e : W) e = ctx.A.P.let(e);
-  return W;
+  return W;  // [force; torque about O_B; modal forces]
 }
 
 ex joint_input(KaneContext& ctx, int j) {

@@ -169,9 +169,10 @@ std::vector<ex> compute_udot_articulated(KaneContext& ctx, std::vector<ex>& pivo
 /// alpha_B, eta_ddot] (with gravity as a base acceleration: a_O_B - g_B).
 std::vector<ex> compute_reactions(KaneContext& ctx, const std::vector<ex>& udot,
                                   std::vector<std::vector<ex>>* accelerations = nullptr);
-/// The wrench of the named inputs on body j [force; torque about O_B], B
-/// components (inputs_outputs.cpp).
-std::array<ex, 6> input_wrench(KaneContext& ctx, int j);
+/// The generalized forces of the named inputs on body j's velocity
+/// coordinates (6 + m): [force; torque about O_B] in B components, then the
+/// modal forces of inputs at its nodes (inputs_outputs.cpp).
+std::vector<ex> input_wrench(KaneContext& ctx, int j);
 /// The joint-torque inputs on body j's joint speed.
 ex joint_input(KaneContext& ctx, int j);
 /// Assigns y[...] = the model's sensors, from the reactions (6 per body) and

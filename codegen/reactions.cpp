@@ -27,7 +27,7 @@ std::vector<ex> compute_reactions(KaneContext& ctx, const std::vector<ex>& udot,
     delta[j] = dl;
     // wrench = M_b (delta + z_R) + h - g - (the inputs' wrench), rows 0-5
     W[j].resize(6);
-    const std::array<ex, 6> W_in = ctx.model.inputs.empty() ? std::array<ex, 6>{0, 0, 0, 0, 0, 0} : input_wrench(ctx, j);
+    const std::vector<ex> W_in = ctx.model.inputs.empty() ? std::vector<ex>(6, ex(0)) : input_wrench(ctx, j);
     if (accelerations) {
       std::vector<ex> z(dl);
       for (int k = 0; k < 3; ++k) z[k] = ctx.A.let(z[k] + s.a_R_B[k]);

@@ -147,8 +147,8 @@ std::vector<std::vector<ex>> compute_bias_forces(KaneContext& ctx) {
       y[j][r] = ctx.A.let(sum);
     }
     if (!ctx.model.inputs.empty()) {  // the named inputs' wrench on the body
-      const std::array<ex, 6> W_in = input_wrench(ctx, j);
-      for (int r = 0; r < 6; ++r)
+      const std::vector<ex> W_in = input_wrench(ctx, j);
+      for (std::size_t r = 0; r < W_in.size(); ++r)
         if (!W_in[r].is_zero()) y[j][r] = ctx.A.let(y[j][r] + W_in[r]);
     }
   }

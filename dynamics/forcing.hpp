@@ -39,12 +39,9 @@ void compute_forcing(const Model& model, Workspace<S>& ws, const VecQ& q, const 
     s.z_dot = s.g_body - s.h_body;
     s.z_dot.noalias() -= s.M_body.template leftCols<3>() * s.a_R_B;
     s.z_dot.noalias() -= s.M_body.template middleCols<3>(3) * s.alpha_R_B;
-    if (!model.inputs.empty()) {
-      Eigen::Matrix<S, 6, 1> W = Eigen::Matrix<S, 6, 1>::Zero();
-      for (const Input& in : model.inputs)
-        if (in.body == static_cast<int>(i)) add_input_wrench(in, s, w, W);
-      s.z_dot.template head<6>() += W;
-    }
+    for (const Input& in : model.inputs)
+      if (in.body == static_cast<int>(i) && in.type != InputType::joint_torque)
+        add_input_generalized_force(in, model.bodies[i], s, w, s.z_dot);
     for (std::size_t c = 0; c < chain.size(); ++c) ws.F(chain[c]) += s.P.col(c).dot(s.z_dot);
   }
 }

@@ -28,10 +28,10 @@ void compute_reactions(const Model& model, Workspace<S>& ws, const VecUd& udot, 
     s.wrench_B = (s.M_body.template topRows<6>() * s.z_dot + s.h_body.template head<6>() -
                   s.g_body.template head<6>());
     for (const Input& in : model.inputs)
-      if (in.body == i) {
-        Eigen::Matrix<S, 6, 1> W = Eigen::Matrix<S, 6, 1>::Zero();
-        add_input_wrench(in, s, w, W);
-        s.wrench_B -= W;
+      if (in.body == i && in.type != InputType::joint_torque) {
+        Eigen::Matrix<S, Eigen::Dynamic, 1> Y = Eigen::Matrix<S, Eigen::Dynamic, 1>::Zero(6 + model.bodies[i].n_modes());
+        add_input_generalized_force(in, model.bodies[i], s, w, Y);
+        s.wrench_B -= Y.template head<6>();
       }
   }
   for (int i = nb - 1; i >= 0; --i) {  // children are listed after their parents

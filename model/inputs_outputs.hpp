@@ -39,6 +39,7 @@ struct Input {
   InputType type = InputType::thruster;
   int body = -1;                                 ///< body the wrench acts on (joint_torque: the joint's body)
   Eigen::Vector3d point_B = Eigen::Vector3d::Zero();      ///< point of application, body components
+  int node = -1;  ///< force on a flexible body: applied at this node (index), displaced with it; else -1
   Eigen::Vector3d direction_B = Eigen::Vector3d::UnitX(); ///< thruster: unit direction, body components
   Axes axes = Axes::body;                        ///< force, torque: axes of the three components
   Eigen::Matrix3d R_BX = Eigen::Matrix3d::Identity();     ///< body-axes components: x_B = R_BX x_input

@@ -67,6 +67,7 @@ std::string model_fingerprint(const Model& model) {
       w.mat(in.direction_B);
       w.str(to_string(in.axes));
       w.mat(in.R_BX);
+      if (in.node >= 0) w.integer(in.node);  // older models keep their hash
     }
     w.key("sensors");
     w.integer(static_cast<long long>(model.sensors.size()));

@@ -246,7 +246,7 @@ class Loader {
         ck_.check_keys(e, f, {"name", "type", "body", "point", "direction"});
       } else if (*type == "force") {
         in.type = InputType::force;
-        ck_.check_keys(e, f, {"name", "type", "body", "point", "axes"});
+        ck_.check_keys(e, f, {"name", "type", "body", "point", "node", "axes"});
       } else if (*type == "torque") {
         in.type = InputType::torque;
         ck_.check_keys(e, f, {"name", "type", "body", "axes"});
@@ -265,6 +265,28 @@ class Loader {
       if (name) in.name = *name;
       in.body = port_body(e, f, in.type == InputType::joint_torque ? "joint" : "body");
       ok = ok && in.body >= 0;
+      if (in.type == InputType::force && e["node"].IsDefined() && in.body >= 0) {
+        const BodyInfo& bi = info_[in.body];
+        if (e["point"].IsDefined()) {
+          ck_.error(e["node"], l, f + ".node", "given with point; expected one of point (a body point) or node");
+          ok = false;
+        } else if (!bi.has_flex_block) {
+          ck_.error(e["node"], l, f + ".node", fmt::format("body '{}' is not flexible; a node needs a flexible body", bi.name));
+          ok = false;
+        } else if (auto id = ck_.integer(e["node"], l, f + ".node")) {
+          if (bi.flex_known && bi.body.flex) {
+            in.node = bi.body.flex->node_index(static_cast<int>(*id));
+            if (in.node < 0) {
+              ck_.error(e["node"], l, f + ".node", fmt::format("body '{}' has no node {} in {}", bi.name, *id, bi.body.flex->source));
+              ok = false;
+            }
+          } else {
+            ok = false;
+          }
+        } else {
+          ok = false;
+        }
+      }
       if (in.type == InputType::thruster || in.type == InputType::force) {
         if (e["point"].IsDefined()) {
           if (auto p = ck_.vec3(e["point"], l, f + ".point")) in.point_B = *p; else ok = false;

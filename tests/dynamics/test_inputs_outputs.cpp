@@ -149,3 +149,74 @@ TEST_CASE("crosscheck: generated outputs and inputs agree with the generic engin
   }
   REQUIRE(r.worst.count("outputs"));
 }
+
+TEST_CASE("inputs: a force at a flexible body's node delivers its power, foreshortening included", "[inputs][physics][flexible]") {
+  // The node's inertial velocity by a central difference of its position
+  // r = r_O + R_NB (rho_k + deflection) along the motion (from the sensors),
+  // against the generalized power of the force, both engines.
+  const std::string yaml = R"(
+name: node_force
+bodies:
+  - {name: bus, parent: ground, joint: {type: free}, mass: 30, inertia: [3, 4, 5, 0.1, 0, 0]}
+  - name: boom
+    parent: bus
+    joint: {type: revolute, axis: [0, 0, 1], position: [0.5, 0, 0]}
+    flexible:
+      beam: {length: 2.0, direction: x, mass_per_length: 0.5, EI: [20.0, 30.0], elements: 6, modes: 3}
+      damping_ratio: 0.01
+initial:
+  q: {bus.qw: 0.9, bus.qx: 0.3, bus.qy: 0.1, bus.qz: -0.3, boom.angle: 0.4, boom.eta1: 0.05, boom.eta2: -0.03, boom.eta3: 0.02}
+  u: {bus.vx: 0.2, bus.wx: 0.3, bus.wy: -0.2, bus.wz: 0.5, boom.angle: 0.7, boom.eta1: 0.4, boom.eta2: -0.3, boom.eta3: 0.2}
+inputs:
+  - {name: f_body, type: force, body: boom, node: 7, axes: body}
+  - {name: f_inertial, type: force, body: boom, node: 5, axes: inertial}
+outputs:
+  - {name: origin, type: position, body: boom}
+  - {name: att, type: attitude, body: boom}
+  - {name: d7, type: deflection, body: boom, node: 7}
+  - {name: d5, type: deflection, body: boom, node: 5}
+)";
+  const Model model = load_model(test::write_temp("node_force.yaml", yaml));
+  const FlexibleData& fd = *model.bodies[1].flex;
+  REQUIRE(fd.has_second_order(fd.node_index(7)));  // the built-in beam carries foreshortening
+  GenericEngine generic(model);
+  auto generated = test::generated_engine(model);
+  for (Engine* e : {static_cast<Engine*>(&generic), static_cast<Engine*>(generated.get())}) {
+    INFO(e->name());
+    const VecX& q = model.q0;
+    const VecX& u = model.u0;
+    const VecX tau = VecX::Zero(model.nu);
+    e->set_inputs(VecX::Zero(model.nw));
+    VecX qd, ud, F0, F1;
+    e->qdot(q, u, qd);
+    e->udot(q, u, tau, ud);
+    e->forcing(q, u, tau, F0);
+    // the node's inertial position from the outputs
+    auto node_position = [&](const VecX& qq, const VecX& uu, int id, const std::string& d) {
+      VecX y;
+      e->outputs(0.0, qq, uu, tau, y);
+      const Eigen::Vector4d a = y.segment<4>(model.output_index("att.qw"));
+      const Mat3 R = Eigen::Quaterniond(a(0), a(1), a(2), a(3)).toRotationMatrix();
+      const Vec3 rho = fd.nodes[fd.node_index(id)].rho_B;
+      return Vec3(y.segment<3>(model.output_index("origin.x")) + R * (rho + y.segment<3>(model.output_index(d + ".x"))));
+    };
+    const double h = 1e-6;
+    for (const auto& [input, id, d] : {std::tuple{"f_body", 7, "d7"}, std::tuple{"f_inertial", 5, "d5"}}) {
+      INFO(input);
+      const Vec3 v_N = (node_position(q + h * qd, u + h * ud, id, d) - node_position(q - h * qd, u - h * ud, id, d)) / (2 * h);
+      e->set_inputs(VecX::Zero(model.nw));
+      VecX y;
+      e->outputs(0.0, q, u, tau, y);
+      const Eigen::Vector4d a = y.segment<4>(model.output_index("att.qw"));
+      const Mat3 R = Eigen::Quaterniond(a(0), a(1), a(2), a(3)).toRotationMatrix();
+      const Vec3 f(1.3, -0.7, 2.1);
+      VecX w = VecX::Zero(model.nw);
+      w.segment<3>(model.input_index(std::string(input) + ".x")) = f;
+      e->set_inputs(w);
+      e->forcing(q, u, tau, F1);
+      const Vec3 f_N = std::string(input) == "f_body" ? Vec3(R * f) : f;
+      const double power = f_N.dot(v_N), generalized = (F1 - F0).dot(u);
+      CHECK(std::abs(generalized - power) <= 1e-7 * (1 + std::abs(power)));
+    }
+  }
+}
