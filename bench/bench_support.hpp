@@ -20,8 +20,7 @@ inline State random_state(const Model& model, unsigned seed, double speed = 1.0)
   std::uniform_real_distribution<double> U(-1, 1);
   State s = initial_state(model);
   for (int i = 0; i < model.nq; ++i) s.q(i) += 0.3 * U(rng);
-  for (const Body& b : model.bodies)
-    if (b.joint.type == JointType::free) s.q.segment<4>(b.q_joint + 3).normalize();
+  for (const auto& slot : model.quaternions) s.q.segment<4>(slot.q).normalize();
   for (int i = 0; i < model.nu; ++i) s.u(i) = speed * U(rng);
   return s;
 }

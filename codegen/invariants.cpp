@@ -42,10 +42,11 @@ ex compute_potential_energy(KaneContext& ctx) {
       for (int a = 0; a < 3; ++a) V -= g_N[a] * (s.M_body(0, 0) * s.r_NO_N[a] + RS[a]);
     }
     ctx.C.group = b.name;
-    if ((b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic) && !b.joint.prescribed()) {
-      const auto [kk, cc_unused, rest] = joint_spring(ctx, static_cast<int>(j));
+    for (const SpringSlot& sl : spring_slots(b.joint)) {
+      if (sl.q < 0) continue;
+      const auto [kk, cc_unused, rest] = joint_spring(ctx, static_cast<int>(j), sl.value);
       (void)cc_unused;
-      const ex dq = ctx.A.let(ctx.x.q[b.q_joint] - rest);
+      const ex dq = ctx.A.let(ctx.x.q[b.q_joint + sl.q] - rest);
       V += kk * dq * dq / 2;
     }
     for (int i = 0; i < b.n_modes(); ++i) {

@@ -45,6 +45,10 @@ struct SymBodyWorkspace {
   /// Partials of [v_O_B; w_B] w.r.t. the parent's modal speeds, one 6-vector per
   /// parent mode (a child attached at a node of a flexible parent).
   std::vector<std::array<ex, 6>> P_node;
+  /// A joint formed by the joint module (model/joints/joint_kinematics.hpp:
+  /// universal, gimbal, cylindrical, planar, ball): its motion subspace, one
+  /// [linear; angular] 6-vector per speed in B components (q-dependent).
+  std::vector<std::array<ex, 6>> S_joint;
   SMat M_body;                    ///< (6+m)^2 generalized mass in z
   std::vector<ex> h_body, g_body; ///< 6+m velocity terms, generalized gravity
 };
@@ -141,7 +145,9 @@ SMat transform_inertia_to_parent(KaneContext& ctx, int j, const SMat& I);
 /// velocity forces with the remainder accelerations' inertia forces).
 std::vector<std::vector<ex>> compute_bias_forces(KaneContext& ctx);
 /// Stiffness, damping and rest value of body j's joint spring (runtime parameters or constants).
-std::array<ex, 3> joint_spring(KaneContext& ctx, int j);
+/// Spring stiffness, damping and rest of coordinate k of body j's joint (runtime
+/// parameters or named constants).
+std::array<ex, 3> joint_spring(KaneContext& ctx, int j, int k);
 /// Modal stiffness K and damping D of body j's mode i (from runtime frequency
 /// and damping ratio parameters when given: K = w^2 Y, D = 2 zeta w Y).
 std::array<ex, 2> modal_stiffness_damping(KaneContext& ctx, int j, int i);

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include "codegen/kane_context.hpp"
+#include "model/joints/joint_kinematics.hpp"
 
 namespace kanegen::codegen {
 
@@ -33,6 +34,15 @@ std::vector<ex> compute_qdot(KaneContext& ctx) {
         qd[q0 + 4] = ctx.A.let((w * wx + y * wz - z * wy) / 2);
         qd[q0 + 5] = ctx.A.let((w * wy - xq * wz + z * wx) / 2);
         qd[q0 + 6] = ctx.A.let((w * wz + xq * wy - y * wx) / 2);
+        break;
+      }
+      default: {  // the joint module's q_dot (model/joints/joint_kinematics.hpp)
+        const JointTraits& jt = joint_traits(b.joint.type);
+        std::vector<ex> qj(jt.nq()), uj(jt.nu()), qdj(jt.nq());
+        for (int k = 0; k < jt.nq(); ++k) qj[k] = ctx.x.q[b.q_joint + k];
+        for (int k = 0; k < jt.nu(); ++k) uj[k] = ctx.x.u[b.u_joint + k];
+        joints::joint_qdot<ex>(b.primitives, qj.data(), uj.data(), qdj.data());
+        for (int k = 0; k < jt.nq(); ++k) qd[b.q_joint + k] = ctx.A.let(qdj[k]);
         break;
       }
     }

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "codegen/kane_context.hpp"
+#include "model/joints/joint_kinematics.hpp"
 
 namespace kanegen::codegen {
 
@@ -272,6 +273,8 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     SM3 R_JB = SM3::identity();
     SV3 e_J;                   // O_B - O_J, J components
     SV3 e_dot_B, w_rel_B;      // rates of e and of B relative to J, B components
+    SV3 bias_w_B, bias_v_B;    // the motion subspace's rate S_dot u (joint module joints), B components
+    s.S_joint.clear();
     const SV3 axis = ctx.cvec(b.joint.axis_J, n + "_axis", "", "joint axis");
     ex q_j = 0, u_j = 0, f_ddot = 0;
     if (b.joint.prescribed()) {
@@ -307,6 +310,36 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
         if (with_velocity) e_dot_B = A.scale(u_j, axis);
         break;
       case JointType::fixed: break;
+      case JointType::universal:
+      case JointType::gimbal:
+      case JointType::cylindrical:
+      case JointType::planar:
+      case JointType::ball: {
+        // the joint module's kinematics, in symbols (the generic engine runs the same template in numbers)
+        const JointTraits& jt = joint_traits(b.joint.type);
+        std::vector<ex> qj(jt.nq()), uj(jt.nu());
+        for (int k = 0; k < jt.nq(); ++k) qj[k] = ctx.x.q[b.q_joint + k];
+        for (int k = 0; k < jt.nu(); ++k) uj[k] = ctx.x.u[b.u_joint + k];
+        std::vector<joints::Vec<ex>> axes;
+        for (std::size_t k = 0; k < b.primitives.size(); ++k) {
+          const SV3 a = ctx.cvec(b.primitives[k].axis, fmt::format("{}_axis{}", n, k + 1), "",
+                                 fmt::format("joint axis {}", k + 1));
+          axes.push_back({a[0], a[1], a[2]});
+        }
+        const auto jm = joints::joint_motion<ex>(b.primitives, axes, jt.nu(), qj.data(), uj.data(), with_velocity,
+                                                 [&](const ex& x) { return A.let(x); });
+        for (int r = 0; r < 3; ++r) {
+          for (int cc = 0; cc < 3; ++cc) R_JB(r, cc) = jm.R_JB[r][cc];
+          e_J[r] = jm.e_J[r];
+          if (with_velocity) {
+            e_dot_B[r] = jm.e_dot_B[r], w_rel_B[r] = jm.w_rel_B[r];
+            bias_w_B[r] = jm.bias_w_B[r], bias_v_B[r] = jm.bias_v_B[r];
+          }
+        }
+        for (int c = 0; c < jt.nu(); ++c)
+          s.S_joint.push_back({jm.Sv[c][0], jm.Sv[c][1], jm.Sv[c][2], jm.Sw[c][0], jm.Sw[c][1], jm.Sw[c][2]});
+        break;
+      }
       case JointType::free: {
         const auto& q = ctx.x.q;
         const int q0 = b.q_joint;
@@ -398,6 +431,10 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     a = A.add(a, A.cross(wJ, A.cross(wJ, e_J)));
     a = A.add(a, anode);
     s.a_R_B = A.add(A.mul(R_BJ, a), A.cross(A.add(A.scale(2, wt), w_rel_B), e_dot_B), ctx.name("a_R_B", j));
+    if (!s.S_joint.empty()) {
+      s.alpha_R_B = A.add(s.alpha_R_B, bias_w_B, ctx.name("alpha_R_B", j));
+      s.a_R_B = A.add(s.a_R_B, bias_v_B, ctx.name("a_R_B", j));
+    }
     if (b.joint.prescribed()) {  // the known acceleration along the joint's column (axis in B = axis in J)
       SV3& target = b.joint.type == JointType::revolute ? s.alpha_R_B : s.a_R_B;
       target = A.add(target, A.scale(f_ddot, axis), ctx.name(b.joint.type == JointType::revolute ? "alpha_R_B" : "a_R_B", j));

@@ -43,6 +43,13 @@ std::vector<std::vector<ex>> motion_subspace(KaneContext& ctx, int j) {
         S.push_back(col);
       }
       break;
+    default:  // the joint module's columns, formed by the outward pass (kinematics.cpp)
+      for (const auto& c6 : ctx.body[j].S_joint) {
+        std::vector<ex> col(6 + m, ex(0));
+        for (int r = 0; r < 6; ++r) col[r] = c6[r];
+        S.push_back(col);
+      }
+      break;
   }
   for (int i = 0; i < m; ++i) {
     std::vector<ex> col(6 + m, ex(0));
@@ -155,14 +162,16 @@ std::vector<std::vector<ex>> compute_bias_forces(KaneContext& ctx) {
   return y;
 }
 
-std::array<ex, 3> joint_spring(KaneContext& ctx, int j) {
+std::array<ex, 3> joint_spring(KaneContext& ctx, int j, int k) {
   const Body& b = ctx.model.bodies[j];
   ctx.C.group = b.name;
-  return {ctx.param(ParameterKind::stiffness, j, 0)
-              .value_or(ctx.c(b.joint.stiffness, b.name + "_k", "N m/rad or N/m", "joint spring stiffness")),
-          ctx.param(ParameterKind::damping, j, 0)
-              .value_or(ctx.c(b.joint.damping, b.name + "_c", "N m s/rad or N s/m", "joint damping")),
-          ctx.param(ParameterKind::rest, j, 0).value_or(ctx.c(b.joint.rest, b.name + "_rest", "rad or m", "spring rest value"))};
+  const std::string sfx = joint_traits(b.joint.type).springs > 1 ? std::to_string(k + 1) : "";
+  return {ctx.param(ParameterKind::stiffness, j, k)
+              .value_or(ctx.c(b.joint.stiffness[k], b.name + "_k" + sfx, "N m/rad or N/m", "joint spring stiffness")),
+          ctx.param(ParameterKind::damping, j, k)
+              .value_or(ctx.c(b.joint.damping[k], b.name + "_c" + sfx, "N m s/rad or N s/m", "joint damping")),
+          ctx.param(ParameterKind::rest, j, k)
+              .value_or(ctx.c(b.joint.rest[k], b.name + "_rest" + sfx, "rad or m", "spring rest value"))};
 }
 
 std::array<ex, 2> modal_stiffness_damping(KaneContext& ctx, int j, int i) {
@@ -188,9 +197,11 @@ ex applied_force(KaneContext& ctx, int j, int own) {
   ex f = ctx.x.tau[r];
   ctx.C.group = b.name;
   if (own == 0 && !ctx.model.inputs.empty()) f += joint_input(ctx, j);
-  if (own < joint_nu(b.joint) && (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic)) {
-    const auto [kk, cc, rest] = joint_spring(ctx, j);
-    f -= kk * (ctx.x.q[b.q_joint] - rest) + cc * ctx.x.u[b.u_joint];
+  for (const SpringSlot& sl : spring_slots(b.joint)) {
+    if (sl.u != own) continue;
+    const auto [kk, cc, rest] = joint_spring(ctx, j, sl.value);
+    f -= cc * ctx.x.u[b.u_joint + own];
+    if (sl.q >= 0) f -= kk * (ctx.x.q[b.q_joint + sl.q] - rest);
   }
   if (own >= joint_nu(b.joint)) {
     const int i = own - joint_nu(b.joint);

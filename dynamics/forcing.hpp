@@ -17,9 +17,13 @@ template <class S, class VecF, class VecQ, class VecU>
 void add_elastic_forces(const Model& model, const VecQ& q, const VecU& u, VecF& F) {
   for (const Body& b : model.bodies) {
     const Joint& j = b.joint;
-    if ((j.type == JointType::revolute || j.type == JointType::prismatic) && !j.prescribed() &&
-        (j.stiffness != 0 || j.damping != 0))
-      F(b.u_joint) -= S(j.stiffness) * (S(q(b.q_joint)) - S(j.rest)) + S(j.damping) * S(u(b.u_joint));
+    for (const SpringSlot& sl : spring_slots(j)) {
+      const int k = sl.value;
+      if (j.stiffness[k] == 0 && j.damping[k] == 0) continue;
+      S f = S(j.damping[k]) * S(u(b.u_joint + sl.u));
+      if (sl.q >= 0) f += S(j.stiffness[k]) * (S(q(b.q_joint + sl.q)) - S(j.rest[k]));
+      F(b.u_joint + sl.u) -= f;
+    }
     for (int k = 0; k < b.n_modes(); ++k)
       F(b.u_eta + k) -= S(b.flex->K(k)) * S(q(b.q_eta + k)) + S(b.flex->D(k)) * S(u(b.u_eta + k));
   }

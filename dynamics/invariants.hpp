@@ -45,10 +45,11 @@ Energy<S> compute_energy(const Model& model, Workspace<S>& ws, const VecQ& q) {
     E.T += S(0.5) * s.z.dot(s.Mz);
     E.V -= g_N.dot(S(b.total_mass) * s.r_NO_N + s.R_NB * s.S_B);
     const Joint& j = b.joint;
-    if ((j.type == JointType::revolute || j.type == JointType::prismatic) && !j.prescribed()) {
-      const S dq = S(q(b.q_joint)) - S(j.rest);
-      E.V += S(0.5 * j.stiffness) * dq * dq;
-    }
+    for (const SpringSlot& sl : spring_slots(j))
+      if (sl.q >= 0) {
+        const S dq = S(q(b.q_joint + sl.q)) - S(j.rest[sl.value]);
+        E.V += S(0.5 * j.stiffness[sl.value]) * dq * dq;
+      }
     for (int k = 0; k < b.n_modes(); ++k) E.V += S(0.5 * b.flex->K(k)) * s.eta(k) * s.eta(k);
   }
   return E;

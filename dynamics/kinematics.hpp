@@ -29,6 +29,7 @@
 
 #include "model/model.hpp"
 #include "model/rotation.hpp"
+#include "model/joints/joint_kinematics.hpp"
 #include "dynamics/workspace.hpp"
 
 namespace kanegen {
@@ -96,45 +97,37 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, double t, const Ve
       v_node = Phi_t * p->eta_dot;
     }
 
-    // Joint motion; a prescribed joint's coordinate, rate and acceleration
-    // come from its motion at t.
-    S q_j = S(0), u_j = S(0), f_ddot = S(0);
+    // Joint motion, asked of the joint's traits (model/joints/joint_kinematics.hpp):
+    // R_JB, the offset e_J, the motion subspace (B components) and its rate.
+    // A prescribed joint moves with its motion's value and rate at t; its known
+    // acceleration times its column joins the remainders below.
+    const int nu_j = joint_traits(b.joint.type).nu();
+    S qj[7], uj[6];
+    MotionValue mv{};
     if (b.joint.prescribed()) {
-      const MotionValue mv = b.joint.motion->at(t);
-      q_j = S(mv.f), u_j = S(mv.f_dot), f_ddot = S(mv.f_ddot);
-    } else if (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic) {
-      q_j = S(q(b.q_joint)), u_j = S(u(b.u_joint));
+      mv = b.joint.motion->at(t);
+      qj[0] = S(mv.f), uj[0] = S(mv.f_dot);
+    } else {
+      for (int k = 0; k < joint_nq(b.joint); ++k) qj[k] = S(q(b.q_joint + k));
+      for (int k = 0; k < nu_j; ++k) uj[k] = S(u(b.u_joint + k));
     }
-    M3<S> R_JB = I3;
-    V3<S> e = V3<S>::Zero();      // O_B - origin of J, P components
-    V3<S> e_dot = V3<S>::Zero();  // its rate seen in J, P components
-    V3<S> w_rel = V3<S>::Zero();  // angular velocity of B relative to J, P components
-    const V3<S> a_J = b.joint.axis_J.cast<S>();
-    switch (b.joint.type) {
-      case JointType::revolute:
-        R_JB = axis_angle_R<S>(b.joint.axis_J, q_j);
-        w_rel = R_PJ * a_J * u_j;
-        break;
-      case JointType::prismatic:
-        e = R_PJ * a_J * q_j;
-        e_dot = R_PJ * a_J * u_j;
-        break;
-      case JointType::fixed: break;
-      case JointType::free: {
-        V4<S> quat(S(q(b.q_joint + 3)), S(q(b.q_joint + 4)), S(q(b.q_joint + 5)), S(q(b.q_joint + 6)));
-        quat /= sqrt(quat.dot(quat));
-        R_JB = quat_to_R<S>(quat);
-        const V3<S> xyz(S(q(b.q_joint)), S(q(b.q_joint + 1)), S(q(b.q_joint + 2)));
-        e = R_PJ * xyz;
-        const M3<S> R_PB = R_PJ * R_JB;
-        const V3<S> v(S(u(b.u_joint)), S(u(b.u_joint + 1)), S(u(b.u_joint + 2)));
-        const V3<S> w(S(u(b.u_joint + 3)), S(u(b.u_joint + 4)), S(u(b.u_joint + 5)));
-        e_dot = R_PB * v;
-        w_rel = R_PB * w;
-        break;
-      }
+    const auto& prims = b.primitives;
+    const auto jm = joints::joint_motion<S>(prims, ws.primitive_axes[i], nu_j, qj, uj, true, [](const S& x) { return x; });
+    M3<S> R_JB;
+    V3<S> e_J, w_rel_B, e_dot_B, bias_w_B, bias_v_B;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) R_JB(r, c) = jm.R_JB[r][c];
+      e_J(r) = jm.e_J[r], w_rel_B(r) = jm.w_rel_B[r], e_dot_B(r) = jm.e_dot_B[r];
+      bias_w_B(r) = jm.bias_w_B[r], bias_v_B(r) = jm.bias_v_B[r];
     }
-    s.R_PB = R_PJ * R_JB;
+    if (b.joint.prescribed())
+      for (int r = 0; r < 3; ++r)
+        bias_w_B(r) += jm.Sw[0][r] * S(mv.f_ddot), bias_v_B(r) += jm.Sv[0][r] * S(mv.f_ddot);
+    const M3<S> R_PB_j = R_PJ * R_JB;
+    const V3<S> e = R_PJ * e_J;                 // O_B - origin of J, P components
+    const V3<S> e_dot = R_PB_j * e_dot_B;       // its rate seen in J, P components
+    const V3<S> w_rel = R_PB_j * w_rel_B;       // angular velocity of B relative to J, P components
+    s.R_PB = R_PB_j;
     s.p_PO_P = p_PJ + e;
     const M3<S> R_BP = s.R_PB.transpose();
     const V3<S>& d = s.p_PO_P;
@@ -147,10 +140,9 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, double t, const Ve
     s.alpha_R_B = R_BP * (alR_P + w_P.cross(w_BP) + w_J_dot_R + w_J.cross(w_rel));
     s.a_R_B = R_BP * (aR_P + alR_P.cross(d) + w_P.cross(w_P.cross(d)) + S(2) * w_P.cross(v_rel) +
                       w_J_dot_R.cross(e) + w_J.cross(w_J.cross(e)) + w_J.cross(e_dot) + w_BP.cross(e_dot) + a_node_R);
-    if (b.joint.prescribed()) {  // the known acceleration along the joint's column (axis in B = axis in J)
-      if (b.joint.type == JointType::revolute) s.alpha_R_B += a_J * f_ddot;
-      else s.a_R_B += a_J * f_ddot;
-    }
+    // the motion subspace's own rate (zero for constant columns)
+    s.alpha_R_B += bias_w_B;
+    s.a_R_B += bias_v_B;
     if (has_parent) {
       s.R_NB = p->R_NB * s.R_PB;
       s.r_NO_N = p->r_NO_N + p->R_NB * d;
@@ -176,13 +168,10 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, double t, const Ve
         s.P.block(3, c0, 3, m_P).noalias() += R_BP * H;
       }
     }
-    // ... then the joint's own columns (axis in B equals axis in J for both joints) ...
-    switch (b.joint.prescribed() ? JointType::fixed : b.joint.type) {
-      case JointType::revolute: s.P.block(3, k_P, 3, 1) = a_J; break;
-      case JointType::prismatic: s.P.block(0, k_P, 3, 1) = a_J; break;
-      case JointType::fixed: break;
-      case JointType::free: s.P.block(0, k_P, 6, 6).setIdentity(); break;
-    }
+    // ... then the joint's own columns (its motion subspace, B components) ...
+    if (!b.joint.prescribed())
+      for (int c = 0; c < nu_j; ++c)
+        for (int r = 0; r < 3; ++r) s.P(r, k_P + c) = jm.Sv[c][r], s.P(3 + r, k_P + c) = jm.Sw[c][r];
     // ... and the body's own modal speeds.
     const int c_eta = k_P + joint_nu(b.joint);
     for (int k = 0; k < m; ++k) s.P(6 + k, c_eta + k) = S(1);

@@ -9,6 +9,7 @@
 
 #include "model/model.hpp"
 #include "model/rotation.hpp"
+#include "model/joints/joint_kinematics.hpp"
 
 namespace kanegen {
 
@@ -84,12 +85,19 @@ struct Workspace {
       for (auto& row : w.Q)
         for (auto& v : row) v = VecS::Zero(m);
     }
+    for (const Body& b : model.bodies) {
+      std::vector<joints::Vec<S>> axes;
+      for (const auto& p : b.primitives) axes.push_back({S(p.axis(0)), S(p.axis(1)), S(p.axis(2))});
+      primitive_axes.push_back(std::move(axes));
+    }
     M = MatS::Zero(model.nu, model.nu);
     F = VecS::Zero(model.nu);
     udot = VecS::Zero(model.nu);
   }
 
   std::vector<BodyWorkspace<S>> body;
+  /// Per body: the axes of its joint's primitives (Body::primitives) as S.
+  std::vector<std::vector<joints::Vec<S>>> primitive_axes;
   MatS M;      ///< nu x nu mass matrix
   VecS F;      ///< nu forcing
   VecS udot;   ///< nu accelerations

@@ -6,28 +6,10 @@
 
 namespace kanegen {
 
-const char* to_string(JointType t) {
-  switch (t) {
-    case JointType::revolute: return "revolute";
-    case JointType::prismatic: return "prismatic";
-    case JointType::fixed: return "fixed";
-    case JointType::free: return "free";
-  }
-  return "?";
-}
+const char* to_string(JointType t) { return joint_traits(t).name.c_str(); }
 
-int joint_nq(const Joint& j) {
-  if (j.prescribed()) return 0;
-  switch (j.type) {
-    case JointType::revolute:
-    case JointType::prismatic: return 1;
-    case JointType::fixed: return 0;
-    case JointType::free: return 7;
-  }
-  return 0;
-}
-
-int joint_nu(const Joint& j) { return j.type == JointType::free ? 6 : joint_nq(j); }
+int joint_nq(const Joint& j) { return j.prescribed() ? 0 : joint_traits(j.type).nq(); }
+int joint_nu(const Joint& j) { return j.prescribed() ? 0 : joint_traits(j.type).nu(); }
 
 int FlexibleData::node_index(int id) const {
   for (std::size_t k = 0; k < nodes.size(); ++k)
@@ -47,6 +29,10 @@ int Model::body_index(const std::string& n) const {
 }
 int Model::q_index(const std::string& n) const { return find(q_names, n); }
 int Model::u_index(const std::string& n) const { return find(u_names, n); }
+int Model::speed_index(const std::string& n) const {
+  const int k = find(u_names, n);
+  return k >= 0 || n.empty() ? k : find(legacy_u_names, n);
+}
 int Model::input_index(const std::string& n) const { return find(input_names, n); }
 int Model::output_index(const std::string& n) const { return find(output_names, n); }
 bool Model::has_flexible() const {
@@ -82,6 +68,7 @@ void finalize_model(Model& model) {
   model.q_names.clear();
   model.u_names.clear();
   model.prescribed_names.clear();
+  model.quaternions.clear();
   int nq = 0, nu = 0;
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
     Body& b = model.bodies[i];
@@ -90,22 +77,15 @@ void finalize_model(Model& model) {
     b.q_joint = nq;
     b.u_joint = nu;
     const std::string& n = b.name;
-    if (b.joint.prescribed())
-      model.prescribed_names.push_back(n + (b.joint.type == JointType::revolute ? ".angle" : ".disp"));
-    switch (b.joint.prescribed() ? JointType::fixed : b.joint.type) {
-      case JointType::revolute:
-        model.q_names.push_back(n + ".angle");
-        model.u_names.push_back(n + ".angle");
-        break;
-      case JointType::prismatic:
-        model.q_names.push_back(n + ".disp");
-        model.u_names.push_back(n + ".disp");
-        break;
-      case JointType::fixed: break;
-      case JointType::free:
-        for (const char* s : {".x", ".y", ".z", ".qw", ".qx", ".qy", ".qz"}) model.q_names.push_back(n + s);
-        for (const char* s : {".vx", ".vy", ".vz", ".wx", ".wy", ".wz"}) model.u_names.push_back(n + s);
-        break;
+    const JointTraits& jt = joint_traits(b.joint.type);
+    b.primitives = jt.primitives(b.joint);
+    if (b.joint.prescribed()) {
+      model.prescribed_names.push_back(n + "." + jt.coordinates[0]);
+    } else {
+      for (const auto& c : jt.coordinates) model.q_names.push_back(n + "." + c);
+      for (const auto& c : jt.speeds) model.u_names.push_back(n + "." + c);
+      if (jt.has_quaternion())
+        model.quaternions.push_back({static_cast<int>(i), nq + jt.quaternion, nu + jt.angular_speeds});
     }
     nq += joint_nq(b.joint);
     nu += joint_nu(b.joint);
@@ -113,13 +93,19 @@ void finalize_model(Model& model) {
     b.u_eta = nu;
     for (int k = 1; k <= b.n_modes(); ++k) {
       model.q_names.push_back(n + ".eta" + std::to_string(k));
-      model.u_names.push_back(n + ".eta" + std::to_string(k));
+      model.u_names.push_back(n + ".eta" + std::to_string(k) + "_rate");
     }
     nq += b.n_modes();
     nu += b.n_modes();
   }
   model.nq = nq;
   model.nu = nu;
+  model.legacy_u_names.clear();
+  for (const std::string& n : model.u_names) {
+    const std::string suffix = "_rate";
+    const bool rate = n.size() > suffix.size() && n.compare(n.size() - suffix.size(), suffix.size(), suffix) == 0;
+    model.legacy_u_names.push_back(rate ? n.substr(0, n.size() - suffix.size()) : std::string());
+  }
   model.input_names.clear();
   model.nw = 0;
   for (Input& in : model.inputs) {
@@ -152,8 +138,7 @@ void finalize_model(Model& model) {
   }
   if (model.q0.size() != nq) {
     model.q0 = VecX::Zero(nq);
-    for (const Body& b : model.bodies)
-      if (b.joint.type == JointType::free) model.q0(b.q_joint + 3) = 1.0;
+    for (const auto& slot : model.quaternions) model.q0(slot.q) = 1.0;
   }
   if (model.u0.size() != nu) model.u0 = VecX::Zero(nu);
 }

@@ -20,35 +20,18 @@
 #include "model/runtime_parameter.hpp"
 #include "model/modal_integrals.hpp"
 #include "model/prescribed_motion.hpp"
+#include "model/joints/joint.hpp"
+#include "model/joints/joint_traits.hpp"
 
 namespace kanegen {
 
-using Vec3 = Eigen::Vector3d;
-using Mat3 = Eigen::Matrix3d;
 using VecX = Eigen::VectorXd;
 using MatX = Eigen::MatrixXd;
 
-enum class JointType { revolute, prismatic, fixed, free };
-
 const char* to_string(JointType t);
 
-struct Joint {
-  JointType type = JointType::fixed;
-  Vec3 axis_J = Vec3::UnitZ();      ///< unit axis in the joint frame (revolute, prismatic)
-  Vec3 p_PJ = Vec3::Zero();         ///< joint frame origin in parent frame (used when node < 0)
-  Mat3 R_PJ = Mat3::Identity();     ///< joint frame orientation in parent (the `rotation:`)
-  int node = -1;                    ///< index into the parent's FlexibleData::nodes, or -1
-  double stiffness = 0.0;           ///< spring on the joint coordinate
-  double damping = 0.0;             ///< damper on the joint coordinate
-  double rest = 0.0;                ///< spring rest value
-  /// Prescribed motion (revolute, prismatic): the coordinate is a known
-  /// function of time, not a degree of freedom (no q, no u, no input).
-  std::optional<PrescribedMotion> motion;
-  bool prescribed() const { return motion.has_value(); }
-};
-
 /// Number of generalized coordinates / speeds the joint contributes (0 for a
-/// prescribed joint).
+/// prescribed joint): its traits' (model/joints/joint_traits.hpp).
 int joint_nq(const Joint& j);
 int joint_nu(const Joint& j);
 
@@ -101,6 +84,8 @@ struct Body {
   int parent = -1;                  ///< index of the parent body, -1 for ground
   std::vector<int> children;
   Joint joint;
+  /// The joint's motions from J to B (its traits' primitives(joint)), formed once by finalize_model.
+  std::vector<JointPrimitive> primitives;
   RigidPart rigid;
   std::optional<FlexibleData> flex;
   BodyMassIntegrals integrals;      ///< mass data of the rigid part and the plain nodes (modal_integrals.hpp)
@@ -137,6 +122,18 @@ struct Model {
   int nu = 0;
   std::vector<std::string> q_names;
   std::vector<std::string> u_names;
+  /// Per speed: its name before 2026-12-01 (a coordinate's rate had the
+  /// coordinate's name), or "" where it is the same; accepted on input where
+  /// a speed is named (model-format.md, Joints).
+  std::vector<std::string> legacy_u_names;
+  /// Unit quaternions in q (free and ball joints): where each sits and the
+  /// angular speeds that turn it, in body order (JointTraits::quaternion).
+  struct QuaternionSlot {
+    int body = -1;
+    int q = 0;  ///< q index of its w component
+    int u = 0;  ///< u index of the first of its three angular speeds (B components)
+  };
+  std::vector<QuaternionSlot> quaternions;
   VecX q0;                          ///< initial coordinates (quaternions unit)
   VecX u0;                          ///< initial speeds
   Outputs outputs;
@@ -154,7 +151,10 @@ struct Model {
 
   int body_index(const std::string& name) const;  ///< -1 if absent
   int q_index(const std::string& name) const;     ///< -1 if absent
-  int u_index(const std::string& name) const;     ///< -1 if absent
+  int u_index(const std::string& name) const;     ///< -1 if absent (current names only)
+  /// A speed named in a speed context: its current name, or its older name
+  /// (legacy_u_names); -1 if neither.
+  int speed_index(const std::string& name) const;
   int input_index(const std::string& name) const; ///< entry of w, -1 if absent
   int output_index(const std::string& name) const;///< entry of y, -1 if absent
   /// Coordinates of the prescribed joints, named as the joint coordinate

@@ -1,5 +1,7 @@
 #include "model/model_hash.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include <iterator>
@@ -105,10 +107,17 @@ std::string model_fingerprint(const Model& model) {
     w.mat(j.R_PJ);
     w.key(" node");
     w.integer(j.node);
+    if (!j.axes_J.empty()) {  // universal, gimbal (absent from the older joints' hash)
+      w.key(" axes");
+      for (const Vec3& a : j.axes_J) w.mat(a);
+    }
     w.key(" spring");
-    w.num(j.stiffness);
-    w.num(j.damping);
-    w.num(j.rest);
+    const int n_springs = std::max(1, joint_traits(j.type).springs);  // one entry for the one-coordinate joints, as before
+    for (int k = 0; k < n_springs; ++k) {
+      w.num(j.stiffness[k]);
+      w.num(j.damping[k]);
+      w.num(j.rest[k]);
+    }
     if (j.motion) {
       const PrescribedMotion& mo = *j.motion;
       w.key(" motion");
@@ -188,9 +197,9 @@ std::string model_hash(const Model& model) {
       case ParameterKind::mass: b.rigid.mass = 0; break;
       case ParameterKind::com: b.rigid.com_B(p.index) = 0; break;
       case ParameterKind::inertia: b.rigid.I_c_B.setZero(); break;
-      case ParameterKind::stiffness: b.joint.stiffness = 0; break;
-      case ParameterKind::damping: b.joint.damping = 0; break;
-      case ParameterKind::rest: b.joint.rest = 0; break;
+      case ParameterKind::stiffness: b.joint.stiffness[p.index] = 0; break;
+      case ParameterKind::damping: b.joint.damping[p.index] = 0; break;
+      case ParameterKind::rest: b.joint.rest[p.index] = 0; break;
       case ParameterKind::frequency:
       case ParameterKind::damping_ratio:
         b.flex->frequency_hz(p.index) = b.flex->damping_ratio(p.index) = b.flex->K(p.index) = b.flex->D(p.index) = 0;

@@ -564,82 +564,26 @@ class Loader {
     const std::string f = fmt::format("bodies[{}].joint", i);
     if (!ck_.expect_map(j, bi.line, f)) return;
     const int l = kl ? kl : line_of(j);
-    ck_.check_keys(j, f, {"type", "axis", "position", "node", "rotation", "stiffness", "damping", "rest", "motion"});
+    ck_.check_keys(j, f, {"type", "axis", "axes", "sequence", "position", "node", "rotation", "stiffness", "damping",
+                          "rest", "motion"});
+    std::vector<std::string> type_names;
+    for (const JointTraits* t : all_joint_traits()) type_names.push_back(t->name);
 
     const YAML::Node type = j["type"];
     if (!type.IsDefined()) {
-      ck_.error(l, f + ".type", "missing; expected one of revolute, prismatic, fixed, free");
+      ck_.error(l, f + ".type", fmt::format("missing; expected one of {}", join(type_names)));
     } else if (auto s = ck_.string(type, l, f + ".type")) {
-      const std::vector<std::string> types = {"revolute", "prismatic", "fixed", "free"};
-      bi.type_known = true;
-      if (*s == "revolute")
-        joint.type = JointType::revolute;
-      else if (*s == "prismatic")
-        joint.type = JointType::prismatic;
-      else if (*s == "fixed")
-        joint.type = JointType::fixed;
-      else if (*s == "free")
-        joint.type = JointType::free;
-      else {
-        bi.type_known = false;
-        const std::string hint = did_you_mean(*s, types);
-        ck_.error(type, l, f + ".type",
-                  fmt::format("unknown joint type '{}'{}{}expected one of revolute, prismatic, fixed, free", *s, hint,
-                              hint.empty() ? "; " : " "));
-      }
-    }
-    const bool one_dof =
-        bi.type_known && (joint.type == JointType::revolute || joint.type == JointType::prismatic);
-    const std::string tname = bi.type_known ? to_string(joint.type) : "";
-
-    // axis
-    const YAML::Node axis = j["axis"];
-    if (one_dof) {
-      if (!axis.IsDefined())
-        ck_.error(l, f + ".axis", fmt::format("missing; a {} joint needs a unit 3-vector axis", tname));
-      else if (auto a = ck_.unit(axis, l, f + ".axis", 3, "a unit 3-vector"))
-        joint.axis_J = Vec3(*a);
-    } else if (bi.type_known && axis.IsDefined()) {
-      ck_.error(axis, l, f + ".axis",
-                fmt::format("not allowed on a {} joint; expected axis only on revolute and prismatic joints", tname));
-    }
-
-    // spring / damper
-    for (const char* key : {"stiffness", "damping", "rest"}) {
-      const YAML::Node n = j[key];
-      if (!n.IsDefined()) continue;
-      const std::string fk = f + "." + key;
-      if (bi.type_known && !one_dof) {
-        ck_.error(n, l, fk,
-                  fmt::format("not allowed on a {} joint; expected {} only on revolute and prismatic joints", tname,
-                              key));
-        continue;
-      }
-      std::string k = key;
-      if (k == "rest") {
-        if (auto x = ck_.number(n, l, fk)) joint.rest = *x;
-      } else if (auto x = ck_.nonneg(n, l, fk, key)) {
-        (k == "stiffness" ? joint.stiffness : joint.damping) = *x;
-      }
-    }
-
-    // prescribed motion
-    const YAML::Node motion = j["motion"];
-    if (motion.IsDefined()) {
-      if (bi.type_known && !one_dof) {
-        ck_.error(motion, l, f + ".motion",
-                  fmt::format("not allowed on a {} joint; expected motion only on revolute and prismatic joints",
-                              tname));
+      if (const JointTraits* t = joint_traits_named(*s)) {
+        bi.type_known = true;
+        joint.type = t->type;
       } else {
-        for (const char* key : {"stiffness", "damping", "rest"})
-          if (j[key].IsDefined())
-            ck_.error(j[key], l, f + "." + key,
-                      fmt::format("not allowed with motion: (a prescribed coordinate is no degree of freedom); "
-                                  "expected either motion or {}",
-                                  key));
-        if (auto m = read_motion(motion, key_line(j, "motion"), f + ".motion")) joint.motion = *m;
+        const std::string hint = did_you_mean(*s, type_names);
+        ck_.error(type, l, f + ".type",
+                  fmt::format("unknown joint type '{}'{}{}expected one of {}", *s, hint, hint.empty() ? "; " : " ",
+                              join(type_names)));
       }
     }
+    if (bi.type_known) read_joint_keys(j, joint, l, f);
 
     // position / node
     const YAML::Node position = j["position"];
@@ -659,6 +603,121 @@ class Loader {
     if (rot.IsDefined()) {
       if (auto R = read_rotation(rot, key_line(j, "rotation"), f + ".rotation")) joint.R_PJ = *R;
     }
+  }
+
+  /// The keys of a joint entry whose type is known: axes, springs, motion (JointTraits).
+  void read_joint_keys(const YAML::Node& j, Joint& joint, int l, const std::string& f) {
+    const JointTraits& jt = joint_traits(joint.type);
+    const std::string& tname = jt.name;
+    auto types_with = [&](auto pred) {
+      std::vector<std::string> names;
+      for (const JointTraits* t : all_joint_traits())
+        if (pred(*t)) names.push_back(t->name);
+      return join(names, ", ");
+    };
+    auto not_allowed = [&](const char* key, const std::string& which) {
+      ck_.error(j[key], l, f + "." + key,
+                fmt::format("not allowed on a {} joint; expected {} only on {} joints", tname, key, which));
+    };
+
+    // axis / axes / sequence
+    const YAML::Node axis = j["axis"];
+    if (jt.axes == JointTraits::Axes::one) {
+      if (!axis.IsDefined())
+        ck_.error(l, f + ".axis", fmt::format("missing; a {} joint needs a unit 3-vector axis", tname));
+      else if (auto a = ck_.unit(axis, l, f + ".axis", 3, "a unit 3-vector"))
+        joint.axis_J = Vec3(*a);
+    } else if (axis.IsDefined()) {
+      not_allowed("axis", types_with([](const JointTraits& t) { return t.axes == JointTraits::Axes::one; }));
+    }
+    const YAML::Node axes = j["axes"], sequence = j["sequence"];
+    if (jt.axes == JointTraits::Axes::list) {
+      joint.axes_J = jt.default_axes;
+      if (axes.IsDefined() && sequence.IsDefined()) {
+        ck_.error(sequence, l, f + ".sequence", "both axes and sequence given; expected one of them");
+      } else if (axes.IsDefined()) {
+        if (!axes.IsSequence() || static_cast<int>(axes.size()) != jt.n_axes) {
+          ck_.error(axes, l, f + ".axes",
+                    fmt::format("got {}; expected a list of {} unit 3-vectors", describe(axes), jt.n_axes));
+        } else {
+          for (int k = 0; k < jt.n_axes; ++k)
+            if (auto a = ck_.unit(axes[k], l, fmt::format("{}.axes[{}]", f, k), 3, "a unit 3-vector"))
+              joint.axes_J[k] = Vec3(*a);
+        }
+      } else if (sequence.IsDefined()) {
+        if (!jt.sequence) {
+          not_allowed("sequence", types_with([](const JointTraits& t) { return t.sequence; }));
+        } else if (auto seq = ck_.string(sequence, l, f + ".sequence")) {
+          const bool ok = static_cast<int>(seq->size()) == jt.n_axes &&
+                          seq->find_first_not_of("xyz") == std::string::npos;
+          if (!ok)
+            ck_.error(sequence, l, f + ".sequence",
+                      fmt::format("'{}'; expected {} letters from x, y, z (e.g. zyx)", *seq, jt.n_axes));
+          else
+            for (int k = 0; k < jt.n_axes; ++k) joint.axes_J[k] = Vec3::Unit((*seq)[k] - 'x');
+        }
+      }
+      for (int k = 0; k + 1 < jt.n_axes; ++k)
+        if (std::abs(joint.axes_J[k].dot(joint.axes_J[k + 1])) >= 1.0 - 1e-6)
+          ck_.error(axes.IsDefined() ? axes : sequence, l, f + (axes.IsDefined() ? ".axes" : ".sequence"),
+                    fmt::format("axes {} and {} are parallel; expected consecutive axes that are not parallel "
+                                "(|a{}.a{}| < 1 - 1e-6)",
+                                k + 1, k + 2, k + 1, k + 2));
+    } else {
+      if (axes.IsDefined())
+        not_allowed("axes", types_with([](const JointTraits& t) { return t.axes == JointTraits::Axes::list; }));
+      if (sequence.IsDefined()) not_allowed("sequence", types_with([](const JointTraits& t) { return t.sequence; }));
+    }
+
+    // spring / damper: a number (every coordinate) or one per coordinate
+    for (const char* key : {"stiffness", "damping", "rest"}) {
+      const YAML::Node n = j[key];
+      if (!n.IsDefined()) continue;
+      const std::string fk = f + "." + key;
+      const bool ball_damping = jt.damping_only && std::string(key) == "damping";
+      if (jt.springs == 0 && !ball_damping) {
+        if (jt.damping_only)
+          ck_.error(n, l, fk, fmt::format("not allowed on a {} joint; expected damping only (a {} joint has no spring)",
+                                          tname, tname));
+        else
+          not_allowed(key, types_with([](const JointTraits& t) { return t.springs > 0; }));
+        continue;
+      }
+      const int count = ball_damping ? 1 : jt.springs;
+      auto& target = std::string(key) == "rest" ? joint.rest : std::string(key) == "stiffness" ? joint.stiffness : joint.damping;
+      auto read_one = [&](const YAML::Node& x, const std::string& fx) -> std::optional<double> {
+        return std::string(key) == "rest" ? ck_.number(x, l, fx) : ck_.nonneg(x, l, fx, key);
+      };
+      if (n.IsSequence() && !ball_damping) {
+        if (static_cast<int>(n.size()) != count) {
+          ck_.error(n, l, fk,
+                    fmt::format("{} entries; expected a number or a list of {} (one per coordinate: {})", n.size(),
+                                count, join(std::vector<std::string>(jt.coordinates.begin(), jt.coordinates.begin() + count))));
+          continue;
+        }
+        for (int k = 0; k < count; ++k)
+          if (auto x = read_one(n[k], fmt::format("{}[{}]", fk, k))) target[k] = *x;
+      } else if (auto x = read_one(n, fk)) {
+        for (int k = 0; k < count; ++k) target[k] = *x;
+      }
+    }
+
+    // prescribed motion
+    const YAML::Node motion = j["motion"];
+    if (motion.IsDefined()) {
+      if (!jt.prescribable) {
+        not_allowed("motion", types_with([](const JointTraits& t) { return t.prescribable; }));
+      } else {
+        for (const char* key : {"stiffness", "damping", "rest"})
+          if (j[key].IsDefined())
+            ck_.error(j[key], l, f + "." + key,
+                      fmt::format("not allowed with motion: (a prescribed coordinate is no degree of freedom); "
+                                  "expected either motion or {}",
+                                  key));
+        if (auto m = read_motion(motion, key_line(j, "motion"), f + ".motion")) joint.motion = *m;
+      }
+    }
+
   }
 
   /// motion: {polynomial: [...]} | {sine: {...}} | {spinup: {...}}
@@ -1116,20 +1175,12 @@ class Loader {
     if (bi.name.empty()) return names;
     const std::string& n = bi.name;
     if (bi.type_known && !bi.body.joint.prescribed()) {
-      switch (bi.body.joint.type) {
-        case JointType::revolute: names.push_back(n + ".angle"); break;
-        case JointType::prismatic: names.push_back(n + ".disp"); break;
-        case JointType::fixed: break;
-        case JointType::free:
-          if (speeds)
-            for (const char* s : {".vx", ".vy", ".vz", ".wx", ".wy", ".wz"}) names.push_back(n + s);
-          else
-            for (const char* s : {".x", ".y", ".z", ".qw", ".qx", ".qy", ".qz"}) names.push_back(n + s);
-          break;
-      }
+      const JointTraits& jt = joint_traits(bi.body.joint.type);
+      for (const auto& c : speeds ? jt.speeds : jt.coordinates) names.push_back(n + "." + c);
     }
     if (bi.body.flex)
-      for (int k = 1; k <= bi.body.flex->modes(); ++k) names.push_back(n + ".eta" + std::to_string(k));
+      for (int k = 1; k <= bi.body.flex->modes(); ++k)
+        names.push_back(n + ".eta" + std::to_string(k) + (speeds ? "_rate" : ""));
     return names;
   }
 
@@ -1137,7 +1188,7 @@ class Loader {
   bool prescribed_coordinate(const std::string& name) const {
     for (const BodyInfo& bi : info_)
       if (!bi.name.empty() && bi.type_known && bi.body.joint.prescribed() &&
-          name == bi.name + (bi.body.joint.type == JointType::revolute ? ".angle" : ".disp"))
+          name == bi.name + "." + joint_traits(bi.body.joint.type).coordinates[0])
         return true;
     return false;
   }
@@ -1167,9 +1218,13 @@ class Loader {
           ck_.error(kl, f, "a key must be a coordinate name");
           continue;
         }
-        const std::string name = it->first.Scalar();
+        std::string name = it->first.Scalar();
         const std::string fk = f + "." + name;
         auto x = ck_.number(it->second, kl, fk);
+        // an older speed name (a coordinate's name for its rate) means the rate
+        if (speeds && std::find(known.begin(), known.end(), name) == known.end() &&
+            std::find(known.begin(), known.end(), name + "_rate") != known.end())
+          name += "_rate";
         if (std::find(known.begin(), known.end(), name) == known.end()) {
           if (prescribed_coordinate(name)) {
             ck_.error(kl, fk,
@@ -1189,7 +1244,7 @@ class Loader {
           continue;
         }
         if (given.count(name)) {
-          ck_.error(kl, fk, fmt::format("'{}' given twice; expected it once", name));
+          ck_.error(kl, fk, fmt::format("'{}' given twice (also under its older or newer name); expected it once", name));
           continue;
         }
         if (x) given[name] = Given{*x, kl};
@@ -1197,10 +1252,11 @@ class Loader {
       if (speeds) continue;
       // quaternions: all four components or none; unit to 1e-6
       for (const BodyInfo& bi : info_) {
-        if (bi.name.empty() || !bi.type_known || bi.body.joint.type != JointType::free) continue;
+        if (bi.name.empty() || !bi.type_known || !joint_traits(bi.body.joint.type).has_quaternion()) continue;
+        const JointTraits& jt = joint_traits(bi.body.joint.type);
         std::vector<std::string> comp, have, lack;
-        for (const char* s : {".qw", ".qx", ".qy", ".qz"}) {
-          comp.push_back(bi.name + s);
+        for (int k = 0; k < 4; ++k) {
+          comp.push_back(bi.name + "." + jt.coordinates[jt.quaternion + k]);
           (given.count(comp.back()) ? have : lack).push_back(comp.back());
         }
         if (have.empty()) continue;
@@ -1232,10 +1288,7 @@ class Loader {
     long nu = 0;
     for (const BodyInfo& bi : info_) {
       const Joint& j = bi.body.joint;
-      if (!j.prescribed()) {
-        if (j.type == JointType::revolute || j.type == JointType::prismatic) nu += 1;
-        if (j.type == JointType::free) nu += 6;
-      }
+      if (bi.type_known) nu += joint_nu(j);
       if (bi.body.flex) nu += bi.body.flex->modes();
     }
     if (nu > kMaxSpeeds)
@@ -1257,14 +1310,13 @@ class Loader {
     finalize_model(model_);
     model_.q0 = VecX::Zero(model_.nq);
     model_.u0 = VecX::Zero(model_.nu);
-    for (const Body& b : model_.bodies)
-      if (b.joint.type == JointType::free) model_.q0(b.q_joint + 3) = 1.0;
+    for (const auto& slot : model_.quaternions) model_.q0(slot.q) = 1.0;
     for (const auto& [name, g] : init_q_) {
       const int k = model_.q_index(name);
       if (k >= 0) model_.q0(k) = g.value;
     }
     for (const auto& [name, g] : init_u_) {
-      const int k = model_.u_index(name);
+      const int k = model_.speed_index(name);
       if (k >= 0) model_.u0(k) = g.value;
     }
     std::vector<Diagnostic> bad;

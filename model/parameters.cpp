@@ -42,7 +42,8 @@ std::vector<RuntimeParameter> expand_parameter(const Model& model, const std::st
   if (b < 0) throw std::invalid_argument(fmt::format("'{}': no body named '{}'", name, body));
   const Body& B = model.bodies[b];
   const Joint& j = B.joint;
-  const bool spring = (j.type == JointType::revolute || j.type == JointType::prismatic) && !j.prescribed();
+  const JointTraits& jt = joint_traits(j.type);
+  const int n_springs = j.prescribed() ? 0 : jt.springs;
   if (what == "mass") {
     add(name, "kg", ParameterKind::mass, b, 0);
   } else if (what == "com" || what.rfind("com.", 0) == 0) {
@@ -65,15 +66,31 @@ std::vector<RuntimeParameter> expand_parameter(const Model& model, const std::st
       if (what == stem || what == stem + "." + kAxis[a])
         add(body + "." + stem + "." + kAxis[a], pos ? "m" : "rad", pos ? ParameterKind::position : ParameterKind::misalignment,
             b, a);
-  } else if (what == "stiffness" || what == "damping" || what == "rest") {
-    if (!spring)
-      throw std::invalid_argument(fmt::format("'{}': body '{}' has a {} joint{}; a joint spring needs a revolute or "
-                                              "prismatic joint with a degree of freedom",
+  } else if (what.rfind("stiffness", 0) == 0 || what.rfind("damping", 0) == 0 || what.rfind("rest", 0) == 0) {
+    // <body>.stiffness (every coordinate; the name itself on a one-coordinate
+    // joint) or <body>.stiffness.<coordinate>; a ball joint: <body>.damping
+    const std::string stem = what.substr(0, what.find('.'));
+    const std::string coord = what.size() > stem.size() ? what.substr(stem.size() + 1) : "";
+    const ParameterKind kind = stem == "stiffness" ? ParameterKind::stiffness : stem == "damping" ? ParameterKind::damping
+                                                                                                   : ParameterKind::rest;
+    if (stem != "stiffness" && stem != "damping" && stem != "rest") {
+      // falls through to the refusal below
+    } else if (jt.damping_only && !j.prescribed() && stem == "damping" && coord.empty()) {
+      add(name, "N m s/rad", kind, b, 0);
+    } else if (n_springs == 0) {
+      throw std::invalid_argument(fmt::format("'{}': body '{}' has a {} joint{}; a joint spring needs a joint with "
+                                              "spring coordinates (revolute, prismatic, universal, gimbal, "
+                                              "cylindrical, planar; a ball joint takes damping only)",
                                               name, body, to_string(j.type), j.prescribed() ? " (prescribed)" : ""));
-    const bool rev = j.type == JointType::revolute;
-    add(name, what == "stiffness" ? (rev ? "N m/rad" : "N/m") : what == "damping" ? (rev ? "N m s/rad" : "N s/m") : (rev ? "rad" : "m"),
-        what == "stiffness" ? ParameterKind::stiffness : what == "damping" ? ParameterKind::damping : ParameterKind::rest,
-        b, 0);
+    } else {
+      for (int k = 0; k < n_springs; ++k) {
+        if (!coord.empty() && coord != jt.coordinates[k]) continue;
+        const bool rad = jt.units[k] == "rad";
+        const char* unit = stem == "stiffness" ? (rad ? "N m/rad" : "N/m") : stem == "damping" ? (rad ? "N m s/rad" : "N s/m")
+                                                                                                : (rad ? "rad" : "m");
+        add(n_springs == 1 ? body + "." + stem : body + "." + stem + "." + jt.coordinates[k], unit, kind, b, k);
+      }
+    }
   } else if (what.rfind("frequency", 0) == 0 || what.rfind("damping_ratio", 0) == 0) {
     const bool freq = what.rfind("frequency", 0) == 0;
     const std::string stem = freq ? "frequency" : "damping_ratio";
@@ -98,9 +115,9 @@ double parameter_value(const Model& model, const RuntimeParameter& p) {
     case ParameterKind::mass: return b.rigid.mass;
     case ParameterKind::com: return b.rigid.com_B(p.index);
     case ParameterKind::inertia: return b.rigid.I_c_B(kInertiaRC[p.index][0], kInertiaRC[p.index][1]);
-    case ParameterKind::stiffness: return b.joint.stiffness;
-    case ParameterKind::damping: return b.joint.damping;
-    case ParameterKind::rest: return b.joint.rest;
+    case ParameterKind::stiffness: return b.joint.stiffness[p.index];
+    case ParameterKind::damping: return b.joint.damping[p.index];
+    case ParameterKind::rest: return b.joint.rest[p.index];
     case ParameterKind::frequency: return b.flex->frequency_hz(p.index);
     case ParameterKind::damping_ratio: return b.flex->damping_ratio(p.index);
     case ParameterKind::position: return b.joint.p_PJ(p.index);
@@ -152,13 +169,13 @@ void apply_parameters(Model& model, const std::vector<RuntimeParameter>& params,
       }
       case ParameterKind::stiffness:
         if (v < 0) throw bad("a stiffness >= 0");
-        b.joint.stiffness = v;
+        b.joint.stiffness[p.index] = v;
         break;
       case ParameterKind::damping:
         if (v < 0) throw bad("a damping >= 0");
-        b.joint.damping = v;
+        b.joint.damping[p.index] = v;
         break;
-      case ParameterKind::rest: b.joint.rest = v; break;
+      case ParameterKind::rest: b.joint.rest[p.index] = v; break;
       case ParameterKind::position: b.joint.p_PJ(p.index) = v; break;
       case ParameterKind::misalignment:
         misalignment[p.body](p.index) = v;

@@ -19,8 +19,7 @@ State initial_state(const Model& model) {
   s.tau = VecX::Zero(model.nu);
   s.w = VecX::Zero(model.nw);
   if (model.q0.size() != model.nq)
-    for (const Body& b : model.bodies)
-      if (b.joint.type == JointType::free) s.q(b.q_joint + 3) = 1.0;
+    for (const auto& slot : model.quaternions) s.q(slot.q) = 1.0;
   return s;
 }
 
@@ -119,9 +118,18 @@ State load_state(const Model& model, const std::string& path) {
           fmt::format("got {}; expected an object {{name: number}}", sec->value.kind_name()));
       continue;
     }
+    std::map<int, std::string> speed_given;  // u, tau: a speed named once, by its name or its older one
     for (const auto* m : unique_members(sec->value, keys[k])) {
       const std::string field = std::string(keys[k]) + "." + m->key;
-      const int idx = find_name(*names[k], m->key);
+      const int idx = k == 1 || k == 2 ? model.speed_index(m->key) : find_name(*names[k], m->key);
+      if (idx >= 0 && (k == 1 || k == 2)) {
+        if (auto it = speed_given.find(idx); it != speed_given.end()) {
+          err(m->key_line, field,
+              fmt::format("'{}' and '{}' name the same speed; expected it once", it->second, m->key));
+          continue;
+        }
+        speed_given[idx] = m->key;
+      }
       if (idx < 0) {
         const bool prescribed =
             k == 0 && std::find(model.prescribed_names.begin(), model.prescribed_names.end(), m->key) !=
@@ -145,11 +153,11 @@ State load_state(const Model& model, const std::string& path) {
   // Quaternions: all four components or none; any non-zero norm is
   // normalized, robustly (scaled by the largest component first, so that
   // tiny and huge components neither underflow nor overflow).
-  for (const Body& b : model.bodies) {
-    if (b.joint.type != JointType::free) continue;
-    const char* comp[4] = {".qw", ".qx", ".qy", ".qz"};
-    std::vector<std::string> have, lack;
-    for (const char* c : comp) (given_q.count(b.name + c) ? have : lack).push_back(b.name + c);
+  for (const auto& slot : model.quaternions) {
+    const Body& b = model.bodies[slot.body];
+    std::vector<std::string> comp, have, lack;
+    for (int c = 0; c < 4; ++c) comp.push_back(model.q_names[slot.q + c]);
+    for (const auto& c : comp) (given_q.count(c) ? have : lack).push_back(c);
     if (have.empty()) continue;
     const int line = given_q[have[0]];
     if (!lack.empty()) {
@@ -160,7 +168,7 @@ State load_state(const Model& model, const std::string& path) {
                       b.name, l, b.name));
       continue;
     }
-    auto q = s.q.segment<4>(b.q_joint + 3);
+    auto q = s.q.segment<4>(slot.q);
     const double scale = q.cwiseAbs().maxCoeff();
     if (!(scale > 0.0)) {
       err(line, "q." + b.name + ".qw",

@@ -62,12 +62,11 @@ class PyModel {
     fill(u, model_->u_names, s.u, "u");
     fill(tau, model_->u_names, s.tau, "tau");
     fill(inputs, model_->input_names, s.w, "inputs");
-    for (const Body& b : model_->bodies)
-      if (b.joint.type == JointType::free) {
-        auto quat = s.q.segment<4>(b.q_joint + 3);
-        if (!(quat.norm() > 0)) throw py::value_error("q: quaternion of '" + b.name + "' is zero");
-        quat.normalize();
-      }
+    for (const auto& slot : model_->quaternions) {
+      auto quat = s.q.segment<4>(slot.q);
+      if (!(quat.norm() > 0)) throw py::value_error("q: quaternion of '" + model_->bodies[slot.body].name + "' is zero");
+      quat.normalize();
+    }
     return s;
   }
 

@@ -41,17 +41,8 @@ CrosscheckResult crosscheck(Engine& tested, Engine& reference, int samples, unsi
     // Prescribed motion: times before, during and after a spin-up.
     const double t = model.has_prescribed() ? 10.0 + 11.0 * U(rng) : 0.0;
     for (const Body& b : model.bodies) {
-      switch (b.joint.prescribed() ? JointType::fixed : b.joint.type) {
-        case JointType::revolute: q(b.q_joint) = M_PI * U(rng); break;
-        case JointType::prismatic: q(b.q_joint) = U(rng); break;
-        case JointType::fixed: break;
-        case JointType::free: {
-          for (int k = 0; k < 3; ++k) q(b.q_joint + k) = U(rng);
-          Eigen::Vector4d quat(N(rng), N(rng), N(rng), N(rng));
-          q.segment<4>(b.q_joint + 3) = quat.normalized();
-          break;
-        }
-      }
+      if (!b.joint.prescribed())
+        random_coordinates(b.joint, [&] { return U(rng); }, [&] { return N(rng); }, q.data() + b.q_joint);
       for (int k = 0; k < b.n_modes(); ++k) q(b.q_eta + k) = 0.1 * U(rng);
     }
     for (int i = 0; i < model.nu; ++i) u(i) = U(rng), tau(i) = U(rng);

@@ -166,9 +166,7 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
   }
 
   // ---- the tangent space: T_in (nx x n), T_out (n x nx)
-  int nfree = 0;
-  for (const Body& b : model.bodies)
-    if (b.joint.type == JointType::free) ++nfree;
+  const int nfree = static_cast<int>(model.quaternions.size());  // one tangent row fewer per quaternion
   const int nqt = nq - nfree, n = nqt + nu;
   MatX T_in = MatX::Zero(nx, n), T_out = MatX::Zero(n, nx);
   LinearModel lin;
@@ -178,8 +176,8 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
     int r = 0;  // tangent row
     for (int i = 0; i < nq;) {
       const Body* free_body = nullptr;
-      for (const Body& b : model.bodies)
-        if (b.joint.type == JointType::free && b.q_joint + 3 == i) free_body = &b;
+      for (const auto& slot : model.quaternions)
+        if (slot.q == i) free_body = &model.bodies[slot.body];
       if (free_body) {
         const Eigen::Vector4d qq = q0.segment<4>(i).normalized();
         const Eigen::Matrix<double, 4, 3> Xi = quaternion_xi(qq);

@@ -26,17 +26,16 @@ struct QuatDrift {
   int body = -1;       ///< index of its body, -1 if none drifted
 };
 
-/// Normalizes every free joint's quaternion in x = [q; u] in place; returns
+/// Normalizes every quaternion (free and ball joints) in x = [q; u] in place; returns
 /// the largest | |quat| - 1 | found (and, if `worst` is given, where).
 double normalize_quaternions(const Model& model, double* x, QuatDrift* worst = nullptr) {
   double drift = 0.0;
-  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
-    const Body& b = model.bodies[i];
-    if (b.joint.type != JointType::free) continue;
-    double* quat = x + b.q_joint + 3;
+  for (const auto& slot : model.quaternions) {
+    const int i = slot.body;
+    double* quat = x + slot.q;
     const double n = std::sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]);
     const double d = std::isfinite(n) ? std::abs(n - 1.0) : std::numeric_limits<double>::infinity();
-    if (worst && d > worst->drift) *worst = QuatDrift{d, n, static_cast<int>(i)};
+    if (worst && d > worst->drift) *worst = QuatDrift{d, n, i};
     drift = std::max(drift, d);
     if (n > 0)
       for (int k = 0; k < 4; ++k) quat[k] /= n;
@@ -101,8 +100,7 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
   // stiffness. Integration error would otherwise let the norm drift.
   std::vector<std::pair<int, int>> free_joints;  // (first quaternion q, first angular speed u)
   if (stabilize_quaternions)
-    for (const Body& b : model.bodies)
-      if (b.joint.type == JointType::free) free_joints.emplace_back(b.q_joint + 3, b.u_joint + 3);
+    for (const auto& slot : model.quaternions) free_joints.emplace_back(slot.q, slot.u);
   auto stabilize = [free_joints, nq](const double* x, double* xdot) {
     for (const auto& [iq, iw] : free_joints) {
       const double* quat = x + iq;

@@ -205,8 +205,7 @@ RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostrea
     const auto& t = plan.targets[i];
     (t.kind == SweepPlan::Target::Kind::parameter ? p(t.index) : t.kind == SweepPlan::Target::Kind::q ? s.q(t.index) : s.u(t.index)) = r.values[i];
   }
-  for (const Body& b : model.bodies)
-    if (b.joint.type == JointType::free) s.q.segment<4>(b.q_joint + 3).normalize();
+  for (const auto& slot : model.quaternions) s.q.segment<4>(slot.q).normalize();
   SimulationOptions o;
   o.t_end = plan.spec.t_end;
   o.dt_out = plan.spec.dt_out;

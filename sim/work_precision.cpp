@@ -59,14 +59,11 @@ std::vector<Kind> component_kinds(const Model& m) {
   std::vector<Kind> k(m.nq + m.nu, Kind::none);
   for (const Body& b : m.bodies) {
     const int q = b.q_joint, u = m.nq + b.u_joint;
-    switch (b.joint.type) {
-      case JointType::free:
-        for (int i = 0; i < 3; ++i) k[q + i] = Kind::length, k[u + i] = Kind::velocity, k[u + 3 + i] = Kind::angular_rate;
-        for (int i = 0; i < 4; ++i) k[q + 3 + i] = Kind::attitude;
-        break;
-      case JointType::revolute: k[q] = Kind::angle, k[u] = Kind::angular_rate; break;
-      case JointType::prismatic: k[q] = Kind::length, k[u] = Kind::velocity; break;
-      case JointType::fixed: break;
+    if (!b.joint.prescribed()) {
+      const JointTraits& t = joint_traits(b.joint.type);
+      for (int i = 0; i < t.nq(); ++i)
+        k[q + i] = t.units[i] == "rad" ? Kind::angle : t.units[i] == "m" ? Kind::length : Kind::attitude;
+      for (int i = 0; i < t.nu(); ++i) k[u + i] = speed_is_angular(t, i) ? Kind::angular_rate : Kind::velocity;
     }
     for (int i = 0; i < b.n_modes(); ++i) k[b.q_eta + i] = Kind::deflection, k[m.nq + b.u_eta + i] = Kind::deflection_rate;
   }
@@ -310,8 +307,7 @@ ErrorMeasure trajectory_error(const Model& model, const Trajectory& run, const T
         scale[kinds[i]] = std::max(scale[kinds[i]], unit(i) * std::abs(x(i)));
   for (auto& [k, s] : scale) s = std::max(s, kind_floor(k, L));
   std::map<int, std::string> attitude_body;  // q index of each free joint's quaternion -> body name
-  for (const Body& b : model.bodies)
-    if (b.joint.type == JointType::free) attitude_body[b.q_joint + 3] = b.name;
+  for (const auto& slot : model.quaternions) attitude_body[slot.q] = model.bodies[slot.body].name;
 
   ErrorMeasure e;
   for (std::size_t k = 0; k < run.x.size(); ++k) {
@@ -345,8 +341,8 @@ InvariantSet invariants_of(const Model& model, const VecX& tau) {
   const bool no_input = tau.size() == 0 || tau.isZero(0.0);
   bool dissipation = false, grounded = false;
   for (const Body& b : model.bodies) {
-    if ((b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic) && b.joint.damping != 0)
-      dissipation = true;
+    for (const SpringSlot& sl : spring_slots(b.joint))
+      if (b.joint.damping[sl.value] != 0) dissipation = true;
     if (b.flex && b.flex->D.size() > 0 && !b.flex->D.isZero(0.0)) dissipation = true;
     if (b.parent < 0 && b.joint.type != JointType::free) grounded = true;
   }

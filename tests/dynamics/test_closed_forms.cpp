@@ -92,7 +92,7 @@ TEST_CASE("reaction torque along every revolute axis equals spring + damper + in
         const Joint& j = b.joint;
         INFO(name << " body " << b.name);
         const double q = s.q(b.q_joint), u = s.u(b.u_joint), tau = s.tau(b.u_joint);
-        const double transmitted = -j.stiffness * (q - j.rest) - j.damping * u + tau;
+        const double transmitted = -j.stiffness[0] * (q - j.rest[0]) - j.damping[0] * u + tau;
         // The joint axis in B equals the axis in J for revolute and prismatic joints.
         if (j.type == JointType::revolute) CHECK(R[i].torque_B.dot(j.axis_J) == Approx(transmitted).margin(1e-11));
         if (j.type == JointType::prismatic) CHECK(R[i].force_B.dot(j.axis_J) == Approx(transmitted).margin(1e-11));

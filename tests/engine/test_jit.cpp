@@ -62,9 +62,9 @@ Model make_handwritten_pendulum() {
   b.parent = -1;
   b.joint.type = JointType::revolute;
   b.joint.axis_J = Vec3::UnitY();
-  b.joint.stiffness = kK;
-  b.joint.damping = kC;
-  b.joint.rest = kRest;
+  b.joint.stiffness[0] = kK;
+  b.joint.damping[0] = kC;
+  b.joint.rest[0] = kRest;
   b.rigid.mass = kM;
   b.rigid.com_B = Vec3(kL, 0, 0);
   b.rigid.I_c_B = Vec3(0, kIyy, 0).asDiagonal();
@@ -201,9 +201,9 @@ TEST_CASE("model hash: stable for the same model, sensitive to every parameter",
   CHECK(differs([](Model& m) { m.bodies[0].rigid.mass = std::nextafter(m.bodies[0].rigid.mass, 10.0); }));
   CHECK(differs([](Model& m) { m.bodies[1].rigid.com_B.y() += 1e-15; }));
   CHECK(differs([](Model& m) { m.bodies[1].rigid.I_c_B(0, 1) += 1e-9; }));
-  CHECK(differs([](Model& m) { m.bodies[0].joint.stiffness += 1e-9; }));
-  CHECK(differs([](Model& m) { m.bodies[0].joint.damping += 1e-9; }));
-  CHECK(differs([](Model& m) { m.bodies[0].joint.rest += 1e-9; }));
+  CHECK(differs([](Model& m) { m.bodies[0].joint.stiffness[0] += 1e-9; }));
+  CHECK(differs([](Model& m) { m.bodies[0].joint.damping[0] += 1e-9; }));
+  CHECK(differs([](Model& m) { m.bodies[0].joint.rest[0] += 1e-9; }));
   CHECK(differs([](Model& m) { m.bodies[1].joint.axis_J.x() += 1e-12; }));
   CHECK(differs([](Model& m) { m.bodies[1].joint.p_PJ.z() += 1e-12; }));
   CHECK(differs([](Model& m) { m.bodies[1].joint.R_PJ(2, 1) += 1e-12; }));
@@ -449,7 +449,7 @@ TEST_CASE("jit_load: generate, compile, cache by model, flags and generator", "[
   o2.flags = "-O1 -std=c++20 -fPIC -shared";
   CHECK(jit_library_path(model, fake.hash, o2) != path);
   Model other = model;
-  other.bodies[0].joint.damping = 0.3;
+  other.bodies[0].joint.damping[0] = 0.3;
   CHECK(jit_library_path(other, fake.hash, opts) != path);
   CHECK(jit_library_path(model, "another-generator", opts) != path);
   CHECK(jit_cache_key(model, fake.hash, opts) == jit_cache_key(make_handwritten_pendulum(), fake.hash, opts));

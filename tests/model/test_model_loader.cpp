@@ -314,9 +314,9 @@ TEST_CASE("loader: rotation forms and inertia forms of the reference models", "[
     R << 0, 0, 1, 1, 0, 0, 0, 1, 0;
     CHECK(m.bodies[2].joint.R_PJ == R);  // matrix: used as given
     CHECK(m.bodies[1].joint.type == JointType::prismatic);
-    CHECK(m.bodies[1].joint.stiffness == 40.0);
-    CHECK(m.bodies[1].joint.damping == 1.2);
-    CHECK(m.bodies[1].joint.rest == 0.15);
+    CHECK(m.bodies[1].joint.stiffness[0] == 40.0);
+    CHECK(m.bodies[1].joint.damping[0] == 1.2);
+    CHECK(m.bodies[1].joint.rest[0] == 0.15);
     CHECK(m.bodies[1].joint.p_PJ == Vec3(0.3, 0.0, 0.1));
     CHECK(m.g_N == Vec3(0, 0, -9.81));
   }

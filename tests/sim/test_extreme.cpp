@@ -316,7 +316,7 @@ TEST_CASE("mass_ratio: a 1e6 mass ratio integrates with E errors far below the s
   // relative to the arm): 4e-5 J against 0.98 J in all.
   const Body& sensor = model.bodies[model.body_index("sensor")];
   const double theta0 = model.q0(sensor.q_joint);
-  const double E_sensor = 0.5 * sensor.joint.stiffness * theta0 * theta0;
+  const double E_sensor = 0.5 * sensor.joint.stiffness[0] * theta0 * theta0;
   REQUIRE(E_sensor == Approx(4e-5));
   RunSpec spec;
   spec.t_end = 10.0;  // 14 sensor periods; the bench runs 100 s
