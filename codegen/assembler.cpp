@@ -129,9 +129,9 @@ std::string function_text(const EmittedFunction& f) {
     if (a != Arg::out) unused.push_back(fmt::format("(void){};", arg_name(a)));
   if (!unused.empty() && f.templated) s += "  " + join(unused, " ") + "\n";
   if (!f.parts.empty()) {
-    // the workspace: per thread, sized once
-    s += fmt::format("  thread_local std::vector<T> workspace;\n  workspace.resize({});\n  T* w = workspace.data();\n",
-                     std::max(1, f.workspace));
+    // the parts' workspace: a fixed-size array on the caller's stack (the
+    // Jacobian's dual numbers carry one direction, so it stays small)
+    s += fmt::format("  T w[{}];\n", std::max(1, f.workspace));
     for (std::size_t i = 0; i < f.parts.size(); ++i)
       s += fmt::format("  {}_part{}({}, w);\n", f.name, i, argument_names(f));
   }

@@ -77,10 +77,11 @@ std::vector<ex> input_wrench(KaneContext& ctx, int j) {
   return W;  // [force; torque about O_B; modal forces]
 }
 
-ex joint_input(KaneContext& ctx, int j) {
+ex joint_input(KaneContext& ctx, int j, int own) {
   ex f = 0;
   for (const Input& in : ctx.model.inputs)
-    if (in.body == j && in.type == InputType::joint_torque) f += ctx.x.inputs[in.offset];
+    if (in.body == j && in.type == InputType::joint_torque && own >= in.speed && own < in.speed + in.speeds)
+      f += ctx.x.inputs[in.offset + own - in.speed];
   return f;
 }
 

@@ -180,7 +180,7 @@ std::vector<ex> compute_reactions(KaneContext& ctx, const std::vector<ex>& udot,
 /// modal forces of inputs at its nodes (inputs_outputs.cpp).
 std::vector<ex> input_wrench(KaneContext& ctx, int j);
 /// The joint-torque inputs on body j's joint speed.
-ex joint_input(KaneContext& ctx, int j);
+ex joint_input(KaneContext& ctx, int j, int own);
 /// Assigns y[...] = the model's sensors, from the reactions (6 per body) and
 /// the bodies' accelerations of compute_reactions.
 void assign_sensor_outputs(KaneContext& ctx, const std::vector<ex>& wrenches,

@@ -196,7 +196,7 @@ ex applied_force(KaneContext& ctx, int j, int own) {
   const int r = b.u_joint + own;
   ex f = ctx.x.tau[r];
   ctx.C.group = b.name;
-  if (own == 0 && !ctx.model.inputs.empty()) f += joint_input(ctx, j);
+  if (own < joint_nu(b.joint) && !ctx.model.inputs.empty()) f += joint_input(ctx, j, own);
   for (const SpringSlot& sl : spring_slots(b.joint)) {
     if (sl.u != own) continue;
     const auto [kk, cc, rest] = joint_spring(ctx, j, sl.value);

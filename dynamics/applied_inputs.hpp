@@ -68,7 +68,8 @@ void add_input_generalized_force(const Input& in, const Body& b, const BodyWorks
 template <class VecW, class VecF>
 void add_joint_inputs(const Model& model, const VecW& w, VecF& F) {
   for (const Input& in : model.inputs)
-    if (in.type == InputType::joint_torque) F(model.bodies[in.body].u_joint) += w(in.offset);
+    if (in.type == InputType::joint_torque)
+      for (int k = 0; k < in.speeds; ++k) F(model.bodies[in.body].u_joint + in.speed + k) += w(in.offset + k);
 }
 
 }  // namespace kanegen

@@ -28,7 +28,36 @@ int first_singular_speed(const MatX& M) {
 
 }  // namespace
 
+int gimbal_locked_body(const Model& model, const double* q, double limit, double* measure) {
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const Body& b = model.bodies[i];
+    if (!joint_traits(b.joint.type).can_lock_up || b.joint.prescribed()) continue;
+    const double m = joint_lock_measure(b.joint, q + b.q_joint);
+    if (!(m > limit)) {
+      if (measure) *measure = m;
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+std::string gimbal_lock_message(const Model& model, int body, const double* q, double measure) {
+  const Body& b = model.bodies[body];
+  std::string angles;
+  for (int k = 0; k < joint_nq(b.joint); ++k)
+    angles += fmt::format("{}{} = {:.17g}", k ? ", " : "", model.q_names[b.q_joint + k], q[b.q_joint + k]);
+  return fmt::format("the {} joint of '{}' is in gimbal lock (|det Gamma| = {:.3g}: its rotation axes are linearly "
+                     "dependent) at {}",
+                     to_string(b.joint.type), b.name, measure, angles);
+}
+
 void check_mass_matrix_at_initial_state(const Model& model) {
+  double measure = 0;
+  if (const int lb = gimbal_locked_body(model, model.q0.data(), kGimbalLockRefuse, &measure); lb >= 0)
+    throw InputError(Diagnostic{model.source_path, model.bodies[lb].line, fmt::format("bodies[{}].joint", lb),
+                                gimbal_lock_message(model, lb, model.q0.data(), measure) +
+                                    " in the initial state; expected initial angles away from gimbal lock (or a ball "
+                                    "joint, which has none)"});
   GenericEngine engine(model);
   MatX M;
   engine.mass_matrix(model.q0, M);

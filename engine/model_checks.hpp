@@ -7,7 +7,16 @@
 
 namespace kanegen {
 
-/// Throws InputError naming the model file if M(q0) is singular.
+/// Throws InputError naming the model file if M(q0) is singular or a gimbal
+/// is in gimbal lock at q0.
 void check_mass_matrix_at_initial_state(const Model& model);
+
+/// The first body whose joint is within `limit` of gimbal lock at q
+/// (|det Gamma| <= limit, model/joints/joint_traits.hpp), or -1; its measure
+/// in `measure`.
+int gimbal_locked_body(const Model& model, const double* q, double limit, double* measure = nullptr);
+
+/// "joint of 'name' (gimbal) is in gimbal lock: |det Gamma| = ..., angles [..]" for messages.
+std::string gimbal_lock_message(const Model& model, int body, const double* q, double measure);
 
 }  // namespace kanegen

@@ -47,6 +47,11 @@ const char* to_string(Axes a) { return a == Axes::body ? "body" : "inertial"; }
 
 std::vector<std::string> entry_names(const Input& in) {
   if (in.size() == 1) return {in.name};
+  if (in.type == InputType::joint_torque) {
+    std::vector<std::string> names;
+    for (const auto& s : in.speed_names) names.push_back(in.name + "." + s);
+    return names;
+  }
   return {in.name + ".x", in.name + ".y", in.name + ".z"};
 }
 

@@ -28,7 +28,7 @@ enum class InputType {
   thruster,      ///< scalar force along a body-fixed direction at a body point
   force,         ///< 3-vector force at a body point, in body or inertial axes
   torque,        ///< 3-vector torque on a body, in body or inertial axes
-  joint_torque,  ///< scalar generalized force on a revolute or prismatic joint's speed
+  joint_torque,  ///< generalized forces on a joint's speeds: one (`coordinate:`) or all of them
 };
 
 enum class Axes { body, inertial };
@@ -44,7 +44,14 @@ struct Input {
   Axes axes = Axes::body;                        ///< force, torque: axes of the three components
   Eigen::Matrix3d R_BX = Eigen::Matrix3d::Identity();     ///< body-axes components: x_B = R_BX x_input
   int offset = 0;                                ///< first entry in w
-  int size() const { return type == InputType::force || type == InputType::torque ? 3 : 1; }
+  /// joint_torque: the joint's speeds it drives, speed .. speed + speeds - 1
+  /// (within the joint); names of its entries when more than one.
+  int speed = 0;
+  int speeds = 1;
+  std::vector<std::string> speed_names;
+  int size() const {
+    return type == InputType::force || type == InputType::torque ? 3 : type == InputType::joint_torque ? speeds : 1;
+  }
 };
 
 enum class SensorType {

@@ -252,7 +252,7 @@ class Loader {
         ck_.check_keys(e, f, {"name", "type", "body", "axes"});
       } else if (*type == "joint_torque") {
         in.type = InputType::joint_torque;
-        ck_.check_keys(e, f, {"name", "type", "joint"});
+        ck_.check_keys(e, f, {"name", "type", "joint", "coordinate"});
       } else {
         const std::string hint = did_you_mean(*type, types);
         ck_.error(e["type"], l, f + ".type",
@@ -305,15 +305,35 @@ class Loader {
       if (in.type == InputType::force || in.type == InputType::torque) {
         if (auto a = port_axes(e, f)) in.axes = *a; else ok = false;
       }
-      if (in.type == InputType::joint_torque && in.body >= 0) {
+      if (in.type == InputType::joint_torque && in.body >= 0 && info_[in.body].type_known) {
+        // one scalar per speed of the joint, or the speed of one `coordinate:`;
+        // a ball's (and a free joint's angular) speeds: a torque in B axes
         const Joint& j = info_[in.body].body.joint;
-        if (info_[in.body].type_known &&
-            ((j.type != JointType::revolute && j.type != JointType::prismatic) || j.prescribed())) {
+        const JointTraits& jt = joint_traits(j.type);
+        if (jt.nu() == 0 || j.prescribed()) {
           ck_.error(e["joint"], l, f + ".joint",
-                    fmt::format("body '{}' has a {} joint{}; a joint torque needs a revolute or prismatic joint "
-                                "with a degree of freedom",
+                    fmt::format("body '{}' has a {} joint{}; a joint torque needs a joint with degrees of freedom",
                                 info_[in.body].name, to_string(j.type), j.prescribed() ? " (prescribed)" : ""));
           ok = false;
+        } else if (e["coordinate"].IsDefined()) {
+          const auto c = ck_.string(e["coordinate"], l, f + ".coordinate");
+          std::vector<std::string> rates;  // coordinates whose rate is a speed
+          for (int k = 0; k < jt.nu(); ++k)
+            if (k < jt.nq() && jt.speeds[k] == jt.coordinates[k] + "_rate") rates.push_back(jt.coordinates[k]);
+          const auto it = c ? std::find(rates.begin(), rates.end(), *c) : rates.end();
+          if (c && it == rates.end()) {
+            ck_.error(e["coordinate"], l, f + ".coordinate",
+                      fmt::format("'{}' is no coordinate of the {} joint of '{}'; expected one of: {}", *c,
+                                  to_string(j.type), info_[in.body].name, rates.empty() ? "(none)" : join(rates)));
+            ok = false;
+          } else if (c) {
+            in.speed = static_cast<int>(it - rates.begin());
+          } else {
+            ok = false;
+          }
+        } else {
+          in.speeds = jt.nu();
+          if (in.speeds > 1) in.speed_names = jt.speeds;
         }
       }
       if (ok) model_.inputs.push_back(in);

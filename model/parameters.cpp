@@ -66,16 +66,15 @@ std::vector<RuntimeParameter> expand_parameter(const Model& model, const std::st
       if (what == stem || what == stem + "." + kAxis[a])
         add(body + "." + stem + "." + kAxis[a], pos ? "m" : "rad", pos ? ParameterKind::position : ParameterKind::misalignment,
             b, a);
-  } else if (what.rfind("stiffness", 0) == 0 || what.rfind("damping", 0) == 0 || what.rfind("rest", 0) == 0) {
+  } else if (const std::string stem0 = what.substr(0, what.find('.'));
+             stem0 == "stiffness" || stem0 == "damping" || stem0 == "rest") {
     // <body>.stiffness (every coordinate; the name itself on a one-coordinate
     // joint) or <body>.stiffness.<coordinate>; a ball joint: <body>.damping
     const std::string stem = what.substr(0, what.find('.'));
     const std::string coord = what.size() > stem.size() ? what.substr(stem.size() + 1) : "";
     const ParameterKind kind = stem == "stiffness" ? ParameterKind::stiffness : stem == "damping" ? ParameterKind::damping
                                                                                                    : ParameterKind::rest;
-    if (stem != "stiffness" && stem != "damping" && stem != "rest") {
-      // falls through to the refusal below
-    } else if (jt.damping_only && !j.prescribed() && stem == "damping" && coord.empty()) {
+    if (jt.damping_only && !j.prescribed() && stem == "damping" && coord.empty()) {
       add(name, "N m s/rad", kind, b, 0);
     } else if (n_springs == 0) {
       throw std::invalid_argument(fmt::format("'{}': body '{}' has a {} joint{}; a joint spring needs a joint with "

@@ -59,8 +59,8 @@ class PyModel {
     State s = initial_state(*model_);
     s.t = t;
     fill(q, model_->q_names, s.q, "q");
-    fill(u, model_->u_names, s.u, "u");
-    fill(tau, model_->u_names, s.tau, "tau");
+    fill(u, model_->u_names, s.u, "u", model_.get());
+    fill(tau, model_->u_names, s.tau, "tau", model_.get());
     fill(inputs, model_->input_names, s.w, "inputs");
     for (const auto& slot : model_->quaternions) {
       auto quat = s.q.segment<4>(slot.q);
@@ -71,14 +71,21 @@ class PyModel {
   }
 
  private:
-  static void fill(const py::object& v, const std::vector<std::string>& names, VecX& out, const char* what) {
+  /// `speeds`: the model when the names are speeds (the older names accepted, model-format.md).
+  static void fill(const py::object& v, const std::vector<std::string>& names, VecX& out, const char* what,
+                   const Model* speeds = nullptr) {
     if (v.is_none()) return;
     if (py::isinstance<py::dict>(v)) {
+      std::vector<std::string> given(out.size());
       for (auto item : v.cast<py::dict>()) {
         const std::string n = py::str(item.first);
         const auto it = std::find(names.begin(), names.end(), n);
-        if (it == names.end()) throw py::key_error(std::string(what) + ": unknown name '" + n + "'");
-        out(it - names.begin()) = item.second.cast<double>();
+        const int k = speeds ? speeds->speed_index(n) : it == names.end() ? -1 : static_cast<int>(it - names.begin());
+        if (k < 0) throw py::key_error(std::string(what) + ": unknown name '" + n + "'");
+        if (!given[k].empty())
+          throw py::key_error(std::string(what) + ": '" + given[k] + "' and '" + n + "' name the same speed");
+        given[k] = n;
+        out(k) = item.second.cast<double>();
       }
       return;
     }
@@ -126,7 +133,8 @@ py::dict linear_dict(const LinearModel& lin) {
   return d;
 }
 
-/// The CSV of a run as {column: array}, plus "columns" (their order).
+/// The CSV of a run as {column: array}, plus "columns" (their order); a
+/// repeated column name is refused (it would hide the other column).
 py::dict columns_of(const std::string& csv) {
   std::istringstream in(csv);
   std::string header, line;
@@ -147,9 +155,27 @@ py::dict columns_of(const std::string& csv) {
     }
   }
   py::dict d;
-  for (std::size_t c = 0; c < cols.size(); ++c) d[py::str(cols[c])] = py::array_t<double>(data[c].size(), data[c].data());
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    if (d.contains(py::str(cols[c]))) throw std::runtime_error("simulate: column '" + cols[c] + "' named twice");
+    d[py::str(cols[c])] = py::array_t<double>(data[c].size(), data[c].data());
+  }
   d["columns"] = cols;
   return d;
+}
+
+/// The named groups of a run's columns: "q", "u", "inputs", "outputs" as
+/// {name: array} (each name once), beside the flat columns.
+void add_groups(py::dict& d, const Model& m) {
+  auto group = [&](const std::vector<std::string>& names) {
+    py::dict g;
+    for (const auto& n : names)
+      if (d.contains(py::str(n))) g[py::str(n)] = d[py::str(n)];
+    return g;
+  };
+  d["q"] = group(m.q_names);
+  d["u"] = group(m.u_names);
+  d["inputs"] = group(m.input_names);
+  d["outputs"] = group(m.output_names);
 }
 
 template <class F>
@@ -276,6 +302,7 @@ PYBIND11_MODULE(kanegen, m) {
               std::ostringstream csv;
               const SimulationResult r = simulate(p.engine(), s, o, csv);
               py::dict d = columns_of(csv.str());
+              add_groups(d, p.model());
               d["summary"] = r.stats.summary();
               d["rhs_evals"] = r.stats.rhs_evals;
               d["steps"] = r.stats.steps;

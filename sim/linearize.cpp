@@ -39,8 +39,8 @@ std::vector<InputColumn> input_columns(const Model& model, const std::vector<std
       continue;
     }
     if (n.rfind("tau.", 0) == 0)
-      if (const int i = model.u_index(n.substr(4)); i >= 0) {
-        cols.push_back({n, -1, i});
+      if (const int i = model.speed_index(n.substr(4)); i >= 0) {  // the older speed names too
+        cols.push_back({"tau." + model.u_names[i], -1, i});
         continue;
       }
     // a vector input by its name: all three entries

@@ -1,5 +1,7 @@
 #include "sim/simulate.hpp"
 
+#include "engine/model_checks.hpp"
+
 #include "engine/generated_engine.hpp"
 #include "model/output_file.hpp"
 #include "sim/integrator_choice.hpp"
@@ -113,11 +115,20 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
   // x_dot = f(t, x) around an engine's evaluation `derivative(t, x, xdot)`
   // (which throws SingularMassMatrix): the state and the accelerations checked,
   // the quaternion stabilization added.
+  // A gimbal reaching gimbal lock (dynamics.md: |det Gamma| <= 1e-6) stops the run.
+  bool has_gimbal = false;
+  for (const Body& b : model.bodies) has_gimbal = has_gimbal || joint_traits(b.joint.type).can_lock_up;
   auto rhs_around = [&](auto derivative) {
-    return [derivative, failure, nq, nu, stabilize](double t, const double* x, double* xdot) -> int {
+    return [derivative, failure, nq, nu, stabilize, has_gimbal, &model](double t, const double* x, double* xdot) -> int {
       for (int i = 0; i < nq + nu; ++i)
         if (!std::isfinite(x[i])) {
           if (failure) *failure = fmt::format("non-finite state at t = {:.17g}", t);
+          return -1;
+        }
+      double measure = 0;
+      if (has_gimbal)
+        if (const int lb = gimbal_locked_body(model, x, kGimbalLockStop, &measure); lb >= 0) {
+          if (failure) *failure = fmt::format("{} at t = {:.17g}", gimbal_lock_message(model, lb, x, measure), t);
           return -1;
         }
       try {

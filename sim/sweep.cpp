@@ -100,7 +100,7 @@ SweepPlan plan_sweep(const SweepSpec& spec) {
     SweepPlan::Target t;
     if (d.target.rfind("q.", 0) == 0 || d.target.rfind("u.", 0) == 0) {
       const bool q = d.target[0] == 'q';
-      const int k = q ? plan.model.q_index(d.target.substr(2)) : plan.model.u_index(d.target.substr(2));
+      const int k = q ? plan.model.q_index(d.target.substr(2)) : plan.model.speed_index(d.target.substr(2));
       if (k < 0) {
         fault(d.line, f, fmt::format("'{}': the model has no {} named '{}'", d.target, q ? "coordinate" : "speed", d.target.substr(2)));
         continue;
@@ -137,8 +137,8 @@ SweepPlan plan_sweep(const SweepSpec& spec) {
     // q.<name> / u.<name>: a coordinate or a speed (a revolute joint's are both called <body>.angle)
     const Model& m = plan.model;
     if (c.rfind("q.", 0) == 0 && m.q_index(c.substr(2)) >= 0) return 1 + m.q_index(c.substr(2));
-    if (c.rfind("u.", 0) == 0 && m.u_index(c.substr(2)) >= 0)
-      return 1 + m.nq + static_cast<int>(m.prescribed_names.size()) + m.u_index(c.substr(2));
+    if (c.rfind("u.", 0) == 0 && m.speed_index(c.substr(2)) >= 0)
+      return 1 + m.nq + static_cast<int>(m.prescribed_names.size()) + m.speed_index(c.substr(2));
     const auto it = std::find(plan.columns.begin(), plan.columns.end(), c);
     if (it == plan.columns.end()) {
       fault(line, field, fmt::format("no column '{}' in the runs' output; expected one of: {}", c, fmt::join(plan.columns, ", ")));

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "apps/kanegen/cli_common.hpp"
+#include "engine/model_checks.hpp"
 #include "model/diagnostics.hpp"
 #include "sim/eval_report.hpp"
 
@@ -19,6 +20,11 @@ struct Options {
 int run(const Options& o) {
   const Model model = load_checked(o.model);
   const State state = state_for(model, o.state);
+  double measure = 0;
+  if (const int lb = gimbal_locked_body(model, state.q.data(), kGimbalLockRefuse, &measure); lb >= 0)
+    throw InputError(Diagnostic{o.state.empty() ? o.model : o.state, state.q_line > 0 ? state.q_line : 1, "q",
+                                gimbal_lock_message(model, lb, state.q.data(), measure) +
+                                    "; M is singular there. Expected angles away from gimbal lock"});
   auto engine = make_engine(model, o.engine, o.native);
   nlohmann::ordered_json j;
   try {

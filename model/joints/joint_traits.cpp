@@ -45,14 +45,14 @@ bool speed_is_angular(const JointTraits& t, int i) {
   return i < static_cast<int>(t.units.size()) && t.units[i] == "rad";
 }
 
-std::vector<SpringSlot> spring_slots(const Joint& j) {
-  std::vector<SpringSlot> slots;
-  if (j.prescribed()) return slots;
+SpringSlots spring_slots(const Joint& j) {
+  SpringSlots s;
+  if (j.prescribed()) return s;
   const JointTraits& t = joint_traits(j.type);
-  for (int i = 0; i < t.springs; ++i) slots.push_back({i, i, i});
+  for (int i = 0; i < t.springs; ++i) s.slot[s.n++] = {i, i, i};
   if (t.damping_only)
-    for (int k = 0; k < 3; ++k) slots.push_back({0, -1, t.angular_speeds + k});
-  return slots;
+    for (int k = 0; k < 3; ++k) s.slot[s.n++] = {0, -1, t.angular_speeds + k};
+  return s;
 }
 
 double joint_lock_measure(const Joint& j, const double* q) {

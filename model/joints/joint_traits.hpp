@@ -6,6 +6,7 @@
 // folder (revolute.cpp, ..., ball.cpp) and one line of joint_traits.cpp.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -60,8 +61,15 @@ struct SpringSlot {
   int q = 0;
   int u = 0;
 };
+/// At most three terms, held without allocation (the engines ask per evaluation).
+struct SpringSlots {
+  std::array<SpringSlot, 3> slot{};
+  int n = 0;
+  const SpringSlot* begin() const { return slot.data(); }
+  const SpringSlot* end() const { return slot.data() + n; }
+};
 /// The joint's spring-damper terms (none for a prescribed joint).
-std::vector<SpringSlot> spring_slots(const Joint& j);
+SpringSlots spring_slots(const Joint& j);
 
 /// Kind of the joint's speed i: an angular rate (rad/s) or not (m/s).
 bool speed_is_angular(const JointTraits& t, int i);

@@ -1,6 +1,7 @@
 // The command line as users and outside checks drive it (interface.md):
 // exit statuses, messages naming file, line and field, outputs by name.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -8,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "model/model_loader.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -151,4 +153,78 @@ TEST_CASE("cli: linearize prints A and its modes, writes npz, refuses unknown na
   CHECK(bad.out.find("--inputs") != std::string::npos);
   CHECK(run("linearize " + src("models/pendulum.yaml") + " --format mat").status == 2);  // a file format needs -o
   CHECK(!fs::exists(d / "lin.mat"));
+}
+
+namespace {
+
+const char* kGimbalPendulum = R"(name: gimbal_pendulum
+gravity: [0, 0, -9.81]
+bodies:
+  - name: bob
+    parent: ground
+    joint: {type: gimbal, sequence: zyx}
+    mass: 1.0
+    com: [0, 0, -1.0]
+    inertia: [0.01, 0.02, 0.03, 0, 0, 0]
+initial:
+  q: {bob.angle2: 0.3}
+  u: {bob.angle2: 1.0}
+)";
+
+}  // namespace
+
+TEST_CASE("cli: gimbal lock is refused at a state and stops a run, naming the joint", "[cli][joints]") {
+  const fs::path d = temp_dir();
+  const std::string model = kanegen::test::write_temp("gimbal_pendulum.yaml", kGimbalPendulum);
+  // zyx locks where the middle angle is +-pi/2
+  std::ofstream(d / "locked.json") << R"({"q": {"bob.angle2": 1.5707963267948966}})";
+  const Run e = run("eval " + model + " --engine generic --state " + (d / "locked.json").string());
+  CHECK(e.status == 2);
+  CHECK(e.out.find("locked.json:1: q:") != std::string::npos);
+  CHECK(e.out.find("gimbal joint of 'bob' is in gimbal lock") != std::string::npos);
+  // a run whose middle angle is driven through pi/2 stops with the time and the state
+  std::ofstream(d / "fast.json") << R"({"q": {"bob.angle2": 1.4}, "u": {"bob.angle2_rate": 3.0}})";
+  const fs::path csv = d / "gimbal.csv";
+  const Run s = run("simulate " + model + " --engine generic --t-end 2 --state " + (d / "fast.json").string() +
+                    " -o " + csv.string());
+  INFO(s.out);
+  CHECK(s.status == 1);
+  CHECK(s.out.find("gimbal lock") != std::string::npos);
+  CHECK(s.out.find("'bob'") != std::string::npos);
+  CHECK(s.out.find("t = ") != std::string::npos);
+  CHECK(!fs::exists(csv));
+}
+
+TEST_CASE("cli: no CSV header of any model repeats a name; the older speed names are accepted on input", "[cli][joints]") {
+  const fs::path d = temp_dir();
+  for (const std::string& f : kanegen::test::model_files()) {
+    const kanegen::Model m = kanegen::load_model(f);
+    std::vector<std::string> names = m.q_names;
+    names.insert(names.end(), m.u_names.begin(), m.u_names.end());
+    names.insert(names.end(), m.input_names.begin(), m.input_names.end());
+    names.insert(names.end(), m.output_names.begin(), m.output_names.end());
+    std::sort(names.begin(), names.end());
+    INFO(f);
+    CHECK(std::adjacent_find(names.begin(), names.end()) == names.end());
+  }
+  // a short run's header, read back
+  const fs::path csv = d / "dp.csv";
+  const Run r = run("simulate " + src("models/double_pendulum.yaml") + " --engine generic --t-end 0.01 --dt-out 0.01 -o " +
+                    csv.string());
+  REQUIRE(r.status == 0);
+  std::ifstream in(csv);
+  std::string header;
+  std::getline(in, header);
+  CHECK(header.rfind("t,link1.angle,link2.angle,link1.angle_rate,link2.angle_rate", 0) == 0);
+  // STATE.json: the older name means the rate; naming it both ways is refused
+  std::ofstream(d / "old.json") << R"({"u": {"link1.angle": 0.5}})";
+  std::ofstream(d / "both.json") << R"({"u": {"link1.angle": 0.5, "link1.angle_rate": 0.5}})";
+  const Run old = run("eval " + src("models/double_pendulum.yaml") + " --engine generic --state " + (d / "old.json").string());
+  REQUIRE(old.status == 0);
+  const auto j = nlohmann::json::parse(old.out);
+  CHECK(j["u"][0].get<double>() == 0.5);
+  CHECK(j["u_names"][0] == "link1.angle_rate");
+  const Run both = run("eval " + src("models/double_pendulum.yaml") + " --engine generic --state " + (d / "both.json").string());
+  CHECK(both.status == 2);
+  CHECK(both.out.find("name the same speed") != std::string::npos);
 }

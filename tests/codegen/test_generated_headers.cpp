@@ -48,7 +48,9 @@ TEST_CASE("generated/ headers regenerate byte-identically", "[generated][generat
   fs::remove_all(tmp);
 }
 
-TEST_CASE("generated headers compile standalone with only <cmath>, every function instantiated", "[generated][generator]") {
+TEST_CASE("generated headers compile standalone with only <cmath>, every function instantiated, calling no "
+          "allocation and holding no thread-local state",
+          "[generated][generator]") {
   // -fsyntax-only alone would leave the function templates uninstantiated:
   // each is explicitly instantiated for double and for the dual numbers.
   const std::regex ns_re(R"(namespace (kanegen_gen::[A-Za-z0-9_]+) \{)");
@@ -73,8 +75,25 @@ TEST_CASE("generated headers compile standalone with only <cmath>, every functio
     CHECK(functions >= 4);  // qdot, mass_matrix, forcing, udot (and the requested outputs)
     const fs::path src = fs::temp_directory_path() / ("kanegen_instantiate_" + std::to_string(getpid()) + ".cpp");
     std::ofstream(src) << tu;
-    const std::string cmd = "c++ -std=c++17 -fsyntax-only -Wall -Wextra -Werror " + src.string() + " 2>&1";
-    CHECK(std::system(cmd.c_str()) == 0);
+    // the one include
+    for (std::size_t at = text.find("#include"); at != std::string::npos; at = text.find("#include", at + 1))
+      CHECK(text.compare(at, 17, "#include <cmath>\n") == 0);
+    // compiled without exceptions; the object's undefined symbols name no
+    // allocation function and no thread-local storage
+    const fs::path obj = fs::path(src).replace_extension(".o");
+    const std::string cmd = "c++ -std=c++17 -O0 -fno-exceptions -c -Wall -Wextra -Werror " + src.string() + " -o " +
+                            obj.string() + " 2>&1";
+    REQUIRE(std::system(cmd.c_str()) == 0);
+    const fs::path syms = fs::path(src).replace_extension(".syms");
+    REQUIRE(std::system(("nm -u " + obj.string() + " > " + syms.string()).c_str()) == 0);
+    const std::string undefined = slurp(syms.string());
+    for (const char* bad : {"malloc", "calloc", "realloc", "_Znwm", "_Znam", "_ZdlPv", "_ZdaPv", "__tls_get_addr",
+                            "__cxa_thread_atexit", "__cxa_allocate_exception", "aligned_alloc", "posix_memalign"}) {
+      INFO(bad << " in\n" << undefined);
+      CHECK(undefined.find(bad) == std::string::npos);
+    }
     fs::remove(src);
+    fs::remove(obj);
+    fs::remove(syms);
   }
 }

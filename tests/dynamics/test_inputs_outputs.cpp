@@ -92,7 +92,7 @@ outputs:
       if (n.rfind("fb.", 0) == 0) power = 1.7 * (R_arm * Vec3::Unit(n.back() - 'x')).dot(v_arm);
       if (n.rfind("tin.", 0) == 0) power = 1.7 * Vec3::Unit(n.back() - 'x').dot(R_bus * w_bus);
       if (n.rfind("tb.", 0) == 0) power = 1.7 * Vec3::Unit(n.back() - 'x').dot(w_trk);
-      if (n == "motor") power = 1.7 * u(model.u_index("arm.angle"));
+      if (n == "motor") power = 1.7 * u(model.u_index("arm.angle_rate"));
       (void)e_k;
       CHECK(std::abs(generalized_power - power) <= 1e-12 * (1 + std::abs(power)));
     }

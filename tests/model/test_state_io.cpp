@@ -64,7 +64,7 @@ TEST_CASE("state: reference states load in model order, quaternions normalized",
       REQUIRE(static_cast<int>(u.size()) == m.nu);
       for (int i = 0; i < m.nq; ++i) CHECK(s.q(i) == Approx(q[i]).epsilon(1e-15).margin(1e-300));
       for (int i = 0; i < m.nu; ++i) CHECK(s.u(i) == u[i]);
-      for (const auto& [k, v] : in["tau"].items()) CHECK(s.tau(m.u_index(k)) == v.get<double>());
+      for (const auto& [k, v] : in["tau"].items()) CHECK(s.tau(m.speed_index(k)) == v.get<double>());  // older names
       CHECK(s.t == in["t"].get<double>());
     }
   }
@@ -88,8 +88,8 @@ TEST_CASE("state: names not given take the model's initial value, tau 0", "[stat
   CHECK(s.q(m.q_index("rotor.qy")) == Approx(0.6).epsilon(1e-15));  // any non-zero norm normalized
   CHECK(s.q(m.q_index("rotor.qz")) == Approx(0.8).epsilon(1e-15));
   CHECK(s.u == m.u0);
-  CHECK(s.tau(m.u_index("b.disp")) == 0.7);
-  CHECK(s.tau(m.u_index("a.angle")) == 0.0);
+  CHECK(s.tau(m.u_index("b.disp_rate")) == 0.7);
+  CHECK(s.tau(m.u_index("a.angle_rate")) == 0.0);
 }
 
 TEST_CASE("state: unknown names refused with the field", "[state]") {

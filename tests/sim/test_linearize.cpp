@@ -63,7 +63,7 @@ TEST_CASE("linearize: a pendulum's A and B are the closed form", "[linearize]") 
     CHECK(std::abs(lin.A(1, 0) - (-9.81 * std::sin(theta))) <= 1e-13);
     CHECK(std::abs(lin.A(1, 1)) <= 1e-15);
     REQUIRE(lin.B.cols() == 1);
-    CHECK(lin.input_names[0] == "tau.bob.angle");
+    CHECK(lin.input_names[0] == "tau.bob.angle_rate");
     CHECK(std::abs(lin.B(1, 0) - 1.0) <= 1e-15);
     CHECK(lin.equilibrium == (theta == M_PI / 2));
     // hanging: the small-oscillation frequency sqrt(g/L)
