@@ -310,12 +310,8 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
         if (with_velocity) e_dot_B = A.scale(u_j, axis);
         break;
       case JointType::fixed: break;
-      case JointType::universal:
-      case JointType::gimbal:
-      case JointType::cylindrical:
-      case JointType::planar:
-      case JointType::ball: {
-        // the joint module's kinematics, in symbols (the generic engine runs the same template in numbers)
+      default: {
+        // every other joint type: the joint module's kinematics, in symbols (the generic engine runs the same template in numbers)
         const JointTraits& jt = joint_traits(b.joint.type);
         std::vector<ex> qj(jt.nq()), uj(jt.nu());
         for (int k = 0; k < jt.nq(); ++k) qj[k] = ctx.x.q[b.q_joint + k];

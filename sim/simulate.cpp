@@ -333,6 +333,11 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
                                         to_string(options.integrator.kind), t, what),
                             t, x);
   };
+  std::vector<int> gimbals, gimbal_sign;  // bodies on joints that can lock up, and det Gamma's sign at the last row
+  for (std::size_t i = 0; i < model.bodies.size(); ++i)
+    if (joint_traits(model.bodies[i].joint.type).can_lock_up && !model.bodies[i].joint.prescribed())
+      gimbals.push_back(static_cast<int>(i)), gimbal_sign.push_back(0);
+  double last_row_t = initial.t;
   auto column_of = [&](std::size_t k) { return k < cols.size() ? cols[k] : fmt::format("column {}", k); };
 
   auto write = [&](double t, const VecX& x) -> bool {
@@ -347,6 +352,17 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
                                 rk4 ? ", after one step" : ", the limit for this rtol",
                                 rk4 ? "reduce the step (--h)" : "tighten --rtol/--atol"));
     }
+    // a gimbal whose det Gamma changed sign since the last row passed through gimbal lock
+    for (std::size_t g = 0; g < gimbals.size(); ++g) {
+      const Body& b = model.bodies[gimbals[g]];
+      const double det = joint_lock_determinant(b.joint, x.data() + b.q_joint);
+      if (gimbal_sign[g] != 0 && det * gimbal_sign[g] < 0)
+        throw fail_at(t, x, fmt::format("the {} joint of '{}' passed through gimbal lock (det Gamma changed sign "
+                                        "since t = {:.17g}; now {:.3g})",
+                                        to_string(b.joint.type), b.name, last_row_t, det));
+      gimbal_sign[g] = det > 0 ? 1 : det < 0 ? -1 : 0;
+    }
+    last_row_t = t;
     q = x.head(nq);
     u = x.tail(nu);
     row.assign(x.data(), x.data() + nq);

@@ -55,7 +55,9 @@ SpringSlots spring_slots(const Joint& j) {
   return s;
 }
 
-double joint_lock_measure(const Joint& j, const double* q) {
+double joint_lock_measure(const Joint& j, const double* q) { return std::abs(joint_lock_determinant(j, q)); }
+
+double joint_lock_determinant(const Joint& j, const double* q) {
   const JointTraits& t = joint_traits(j.type);
   if (!t.can_lock_up) return 1.0;
   const auto prims = t.primitives(j);
@@ -65,8 +67,8 @@ double joint_lock_measure(const Joint& j, const double* q) {
   const auto& a = jm.Sw[0];
   const auto& b = jm.Sw[1];
   const auto& c = jm.Sw[2];
-  return std::abs(a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-                  a[2] * (b[0] * c[1] - b[1] * c[0]));
+  return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+         a[2] * (b[0] * c[1] - b[1] * c[0]);
 }
 
 }  // namespace kanegen

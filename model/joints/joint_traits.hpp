@@ -95,6 +95,9 @@ void random_coordinates(const Joint& j, Uniform&& uniform, Normal&& normal, doub
 /// Gimbal lock measure |det Gamma(q)| (unit axes) of a joint whose traits can
 /// lock up; 1 for every other joint. q: the joint's own coordinates.
 double joint_lock_measure(const Joint& j, const double* q);
+/// det Gamma(q) with its sign (it changes sign where a motion passes through
+/// gimbal lock); 1 for a joint that cannot lock up.
+double joint_lock_determinant(const Joint& j, const double* q);
 /// Below these the joint is in gimbal lock: a state is refused (eval, check)
 /// or a run stops (simulate) (dynamics.md).
 inline constexpr double kGimbalLockRefuse = 1e-9;

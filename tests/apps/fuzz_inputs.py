@@ -623,9 +623,14 @@ def state_expectation(text, info):
         v = obj[sec]
         if not isinstance(v, dict):
             return "invalid"
+        seen = set()
         for name, x in v.items():
-            if name not in names or not isnum(x):
+            # a speed may be named by its older name (a rate under its coordinate's name)
+            if sec != "q" and name not in names and name + "_rate" in names:
+                name = name + "_rate"
+            if name not in names or not isnum(x) or name in seen:
                 return "invalid"
+            seen.add(name)
             if not (sec == "q" and name in quat):
                 huge |= abs(float(x)) > HUGE
     q = obj.get("q", {})
@@ -1168,6 +1173,14 @@ def rename_body_edits(doc, old, new):
             k, v = get(b, key)
             if isinstance(v, yaml.ScalarNode) and v.value == old:
                 edits.append((v.start_mark.index, v.end_mark.index, new))
+    for section in ("inputs", "outputs"):  # named inputs and sensors refer to bodies and joints too
+        _, seq = get(doc.root, section)
+        if isinstance(seq, yaml.SequenceNode):
+            for e in seq.value:
+                for key in ("body", "joint"):
+                    k, v = get(e, key)
+                    if isinstance(v, yaml.ScalarNode) and v.value == old:
+                        edits.append((v.start_mark.index, v.end_mark.index, new))
     _, init = get(doc.root, "initial")
     if isinstance(init, yaml.MappingNode):
         for _, sec in init.value:

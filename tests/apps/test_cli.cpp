@@ -147,7 +147,7 @@ TEST_CASE("cli: linearize prints A and its modes, writes npz, refuses unknown na
   CHECK(run("linearize " + src("models/pendulum.yaml") + " --state " + state + " --format npz -o " + npz + " --quiet").status == 0);
   const Run py = shell("/usr/bin/python3 -c \"import numpy; z = numpy.load('" + npz +
                        "'); print(z['A'][1][0], list(z['state_names']))\"");
-  CHECK(py.out.find("-9.81 ['q.bob.angle', 'u.bob.angle']") != std::string::npos);
+  CHECK(py.out.find("-9.81 ['q.bob.angle', 'u.bob.angle_rate']") != std::string::npos);
   const Run bad = run("linearize " + src("models/pendulum.yaml") + " --inputs nosuch");
   CHECK(bad.status == 2);
   CHECK(bad.out.find("--inputs") != std::string::npos);

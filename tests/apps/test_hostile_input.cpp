@@ -395,7 +395,7 @@ bodies:
   INFO(r.out);
   CHECK(r.status == 2);
   CHECK(r.out.find("g.yaml:9: bodies[1] (ring):") != std::string::npos);
-  CHECK(r.out.find("'ring.angle'") != std::string::npos);
+  CHECK(r.out.find("'ring.angle_rate'") != std::string::npos);
   CHECK(r.out.find("ring, bob") != std::string::npos);
 }
 

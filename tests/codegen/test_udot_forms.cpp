@@ -101,7 +101,7 @@ TEST_CASE("a singular mass matrix names the speed whose pivot failed, in both fo
       FAIL("no SingularMassMatrix");
     } catch (const SingularMassMatrix& err) {
       CHECK(err.speed == m.u_index("leaf.angle_rate"));
-      CHECK(std::string(err.what()).find("'leaf.angle'") != std::string::npos);
+      CHECK(std::string(err.what()).find("'leaf.angle_rate'") != std::string::npos);
     }
   }
 }
