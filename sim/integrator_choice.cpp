@@ -44,16 +44,35 @@ MatX jacobian_at(const OdeProblem& p, double t0, const VecX& x0) {
   return J;
 }
 
-/// The eigenvalue of largest modulus.
-std::complex<double> dominant_eigenvalue(const MatX& J) {
-  if (J.rows() == 0) return 0.0;  // no degree of freedom
+/// Steps per period an explicit Runge-Kutta method of order p takes to follow
+/// an oscillation at relative tolerance rtol (the local error of a step h on
+/// sin(w t) is ~ (w h)^(p+1): w h ~ rtol^(1/(p+1)), 2 pi / (w h) steps per
+/// period); BDF's order is at most 5, so it needs more of them.
+double steps_per_period(double rtol, int order) { return 2.0 * M_PI * std::pow(rtol, -1.0 / (order + 1)); }
+
+struct Spectrum {
+  std::complex<double> dominant = 0.0;  ///< the eigenvalue of largest modulus
+  /// The fastest lightly damped oscillation other than the dominant
+  /// eigenvalue (|Im| > |Re|): the motion an accurate run has to resolve
+  /// whatever the method (a spin, a nutation, a whip near resonance); 0 if none or unknown.
+  double oscillation = 0.0;
+};
+
+/// The eigenvalue of largest modulus, and the fastest resolved oscillation.
+Spectrum spectrum_of(const MatX& J) {
+  Spectrum s;
+  if (J.rows() == 0) return s;  // no degree of freedom
   if (J.rows() <= kMaxDenseEigen) {
     const Eigen::EigenSolver<MatX> es(J, false);
     if (es.info() == Eigen::Success) {
       const auto& ev = es.eigenvalues();
       Eigen::Index k = 0;
       ev.cwiseAbs().maxCoeff(&k);
-      return ev(k);
+      s.dominant = ev(k);
+      for (Eigen::Index i = 0; i < ev.size(); ++i)
+        if (std::abs(ev(i)) < 0.999 * std::abs(s.dominant) && std::abs(ev(i).imag()) > std::abs(ev(i).real()))
+          s.oscillation = std::max(s.oscillation, std::abs(ev(i).imag()));
+      return s;
     }
   }
   // Power iteration on J^2 (a complex pair of equal modulus does not converge
@@ -66,7 +85,8 @@ std::complex<double> dominant_eigenvalue(const MatX& J) {
     if (!(r2 > 0)) break;
     v = w / r2;
   }
-  return {0.0, std::sqrt(r2)};
+  s.dominant = {0.0, std::sqrt(r2)};
+  return s;
 }
 
 }  // namespace
@@ -79,14 +99,22 @@ IntegratorChoice choose_integrator(Engine& engine, const State& initial, double 
   VecX x0(model.nq + model.nu);
   x0 << initial.q, initial.u;
   const double horizon = t_end - initial.t;
-  const std::complex<double> lambda = dominant_eigenvalue(jacobian_at(p, initial.t, x0));
+  const Spectrum sp = spectrum_of(jacobian_at(p, initial.t, x0));
+  const std::complex<double> lambda = sp.dominant;
   c.spectral_radius = std::abs(lambda);
   c.fastest_decay = std::max(0.0, -lambda.real());
   c.explicit_steps = c.spectral_radius * horizon / kExplicitStabilityRadius;
   const bool decays_within_a_cycle = lambda.real() < 0 && std::abs(lambda.imag()) <= 2.0 * -lambda.real();
   const std::string spectrum = fmt::format("dominant eigenvalue {:.3g}{:+.3g}i of the Jacobian at the start",
                                            lambda.real(), lambda.imag());
-  if (decays_within_a_cycle && c.fastest_decay * dt_out > 100 && c.explicit_steps > kStiffSteps) {
+  // Stiffness is stability against accuracy: BDF pays off only when the steps
+  // an explicit method needs for stability exceed, by the cost of an implicit
+  // step (about 3x), those BDF needs anyway to follow the oscillations that
+  // an accurate run resolves (a spinning spacecraft's nutation, a whip near
+  // resonance): then an explicit method is held back by accuracy, not stability.
+  c.resolved_steps_bdf = horizon * sp.oscillation / (2.0 * M_PI) * steps_per_period(rtol, 5);
+  const bool accuracy_bound = c.explicit_steps < 3.0 * c.resolved_steps_bdf;
+  if (decays_within_a_cycle && c.fastest_decay * dt_out > 100 && c.explicit_steps > kStiffSteps && !accuracy_bound) {
     c.kind = IntegratorKind::cvode_bdf;
     c.reason = fmt::format("stiff: {} (a mode that dies out within {:.2g} s, far inside the output interval {} s) "
                            "would hold an explicit method to {:.2g} steps over the horizon: cvode-bdf with the "
@@ -100,9 +128,14 @@ IntegratorChoice choose_integrator(Engine& engine, const State& initial, double 
                            spectrum, c.explicit_steps);
   } else {
     c.kind = rtol < kHighOrderBelowRtol ? IntegratorKind::rkf78 : IntegratorKind::dopri5;
-    c.reason = fmt::format("non-stiff: {} bounds an explicit method's steps by {:.2g} over the horizon: {} "
-                           "(explicit, {})",
-                           spectrum, c.explicit_steps, to_string(c.kind),
+    const std::string why =
+        decays_within_a_cycle && c.explicit_steps > kStiffSteps && accuracy_bound
+            ? fmt::format("accuracy-bound: {} would allow an explicit method {:.2g} steps, but the oscillation at "
+                          "{:.3g} rad/s needs ~{:.2g} steps of BDF (order <= 5) to follow at this rtol",
+                          spectrum, c.explicit_steps, sp.oscillation, c.resolved_steps_bdf)
+            : fmt::format("non-stiff: {} bounds an explicit method's steps by {:.2g} over the horizon", spectrum,
+                          c.explicit_steps);
+    c.reason = fmt::format("{}: {} (explicit, {})", why, to_string(c.kind),
                            c.kind == IntegratorKind::rkf78 ? "order 7(8), for rtol below 1e-5"
                                                            : "order 5(4), for loose tolerances");
   }

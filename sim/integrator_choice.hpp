@@ -15,6 +15,9 @@ struct IntegratorChoice {
   double spectral_radius = 0;    ///< max |lambda| of d x_dot / d x at the start [1/s]
   double fastest_decay = 0;      ///< -Re lambda of that eigenvalue [1/s] (0 if it does not decay)
   double explicit_steps = 0;     ///< steps an explicit method needs for stability alone over the horizon
+  /// steps BDF needs to follow the fastest lightly damped oscillation (other
+  /// than the dominant eigenvalue) at rtol over the horizon
+  double resolved_steps_bdf = 0;
 };
 
 /// Picks the method for a run of `engine` from `initial` to t_end with output
@@ -22,8 +25,10 @@ struct IntegratorChoice {
 /// x_dot = [q_dot; u_dot] at the initial state (the engine's exact Jacobian,
 /// else central differences):
 ///  - stiff (the dominant eigenvalue decays within about a cycle, faster than
-///    100 / dt_out, and an explicit method would need more than 1e5 steps for
-///    stability alone): cvode-bdf with the exact Jacobian;
+///    100 / dt_out, an explicit method would need more than 1e5 steps for
+///    stability alone, and more than 3x the steps BDF needs anyway to follow
+///    the scene's fastest lightly damped oscillation at rtol: otherwise the
+///    run is accuracy-bound and explicit): cvode-bdf with the exact Jacobian;
 ///  - a fast, lightly damped oscillation that would cost an explicit method
 ///    more than 1e7 steps: cvode-bdf2 (A-stable; it damps that oscillation
 ///    numerically, which the reason says);
