@@ -76,7 +76,9 @@ void write_file(const fs::path& p, const std::string& text) {
   if (!out) throw std::runtime_error(fmt::format("kanegen: cannot write {}", p.string()));
 }
 
-bool announce(const JitOptions& o) { return o.verbose || isatty(STDERR_FILENO); }
+/// Compiles and cache hits are said on stderr, one line each, terminal or not
+/// (a first run waits for the compiler: the user is told what and for how long).
+bool announce(const JitOptions& o) { return o.verbose || !o.quiet; }
 
 /// Runs argv with stdout and stderr to `log_path`; returns the exit status,
 /// or -1 with `error` set when it could not be started or was killed.
@@ -157,7 +159,7 @@ std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out
   const std::string include = "-I" + o.include_dir;
   const ManifestFunction* udot = manifest.find("udot");
   const long udot_ops = udot ? udot->ops : 0;
-  const bool jacobian_left_out = udot_ops > kMaxJacobianUdotOps;
+  const bool jacobian_left_out = udot_ops > kMaxJacobianUdotOps || !o.derivatives;
   std::vector<CompileStep> steps;
   std::vector<std::string> objects;
   auto add = [&](const std::string& part, long ops, const std::string& opt, const std::vector<std::string>& extra) {
@@ -287,10 +289,13 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
 
   const bool talk = announce(o);
   if (talk) {
-    fmt::print(stderr, "kanegen: compiling generated code for {} ...", label);
+    const ManifestFunction* ud = manifest.find("udot");
+    fmt::print(stderr, "kanegen: compiling generated code for {} ({} functions, u-dot {} operations; {} compile steps "
+                       "on {} cores) ...\n",
+               label, manifest.functions.size(), ud ? ud->ops : 0, steps.size(),
+               std::max(1u, std::thread::hardware_concurrency()));
     if (o.verbose)
-      for (const auto& st : steps) fmt::print(stderr, "\n  {}", join_quoted(st.argv));
-    if (o.verbose) fmt::print(stderr, "\n");
+      for (const auto& st : steps) fmt::print(stderr, "  {}\n", join_quoted(st.argv));
     std::fflush(stderr);
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -301,7 +306,7 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   if (status != 0 || !fs::exists(out_path)) {
-    if (talk) fmt::print(stderr, " failed\n");
+    if (talk) fmt::print(stderr, "kanegen: compiling {} failed after {:.1f} s\n", label, seconds);
     fs::remove(out_path, ec);  // never keep a half-written library
     // Keep sources and log for inspection, outside the library namespace of the cache.
     fs::path kept = dir / "failed" / so_path.stem();
@@ -337,7 +342,7 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
     throw std::runtime_error(fmt::format("kanegen: cannot move the compiled library to {}: {}", so_path.string(),
                                          ec.message()));
   jit_cache::write_record(so_path.string(), record);
-  if (talk) fmt::print(stderr, " done in {:.1f} s\n", seconds);
+  if (talk) fmt::print(stderr, "kanegen: compiled {} in {:.1f} s; cached as {}\n", label, seconds, fs::path(so_path).string());
 }
 
 /// dlopen + dlsym of a verified library; throws std::runtime_error.
@@ -363,9 +368,15 @@ template <class MakeSources>
 std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::string& so_path,
                                                const std::string& generator_hash, const JitOptions& o,
                                                MakeSources make_sources) {
-  if (const auto record = jit_cache::verified_record(so_path))
+  if (const auto record = jit_cache::verified_record(so_path)) {
+    if (announce(o)) fmt::print(stderr, "kanegen: generated code for {} from the cache ({})\n", model.name, so_path);
     return open_library(model, so_path, record->api_symbol, generator_hash);
+  }
+  const auto t_gen = std::chrono::steady_clock::now();
   const GeneratedSources sources = make_sources();
+  if (announce(o))
+    fmt::print(stderr, "kanegen: generated the equations of {} in {:.1f} s\n", model.name,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - t_gen).count());
   const Manifest manifest = parse_manifest(sources.manifest, "generated manifest of " + model.name);
   build_library(sources, manifest, so_path, o);
   const auto record = jit_cache::verified_record(so_path);
@@ -403,6 +414,7 @@ std::string jit_cache_key(const Model& model, const std::string& generator_hash,
     flags += "\nonly " + join_quoted(only);
   }
   if (o.native) flags += "\nnative";
+  if (!o.derivatives) flags += "\nno derivatives";
   return fnv1a64_hex(fmt::format("{}\n{}\n{}\n{}\n{}\nplan {}", model_hash(model), KANEGEN_VERSION,
                                  KANEGEN_GENERATED_API_VERSION, generator_hash, flags, kCompilePlanVersion));
 }
@@ -422,7 +434,12 @@ std::unique_ptr<GeneratedEngine> compile_and_load(const Model& model, const Gene
 
 std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerator& generator,
                                           const JitOptions& opts) {
-  const JitOptions o = resolved(opts);
+  JitOptions o = resolved(opts);
+  if (!o.derivatives) {  // a full library already cached serves as well
+    JitOptions full = o;
+    full.derivatives = true;
+    if (jit_cache::verified_record(jit_library_path(model, generator.hash, full))) o = full;
+  }
   const std::string so_path = jit_library_path(model, generator.hash, o);
   return load_or_build(model, so_path, generator.hash, o, [&] { return generator.generate(model); });
 }

@@ -34,7 +34,13 @@ struct JitOptions {
   std::string compiler;     ///< empty: $CXX, else "c++" (may hold several words, e.g. "ccache g++")
   std::string flags;        ///< empty: default_jit_flags()
   std::string include_dir;  ///< where engine/generated_api.h is; empty: resources.hpp's include_dir()
-  bool verbose = false;     ///< announce compiles on stderr (also done whenever stderr is a terminal)
+  bool verbose = false;     ///< also print the compile commands
+  /// Compile the dual-number derivatives (jacobian, input_jacobian,
+  /// output_jacobian): the larger part of a first build. Commands that need
+  /// none of them (eval, an explicit simulate) build without them when no
+  /// full library is cached yet (cached separately).
+  bool derivatives = true;
+  bool quiet = false;       ///< say nothing on stderr (by default a compile and a cache hit are one line each)
   /// Compile only these functions of the table besides the four every engine
   /// needs (qdot, mass_matrix, forcing, udot); empty: all of them. E.g. {} vs
   /// {"reactions"}: a build without the Jacobian and the invariants compiles faster.

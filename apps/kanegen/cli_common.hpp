@@ -38,7 +38,11 @@ Subcommand add_sweep(CLI::App& app);
 Model load_checked(const std::string& path);
 /// "generated" (JIT, with the generator of codegen/) or "generic"; a compile
 /// failure of the generated code is a refused input.
-std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name, bool native = false);
+/// `derivatives`: whether the command needs the generated dual-number
+/// Jacobians (linearize, implicit integrators); without them a first build is
+/// faster (a full library already cached is used all the same).
+std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name, bool native = false,
+                                    bool derivatives = true);
 /// The model's initial state, or STATE.json when a path is given.
 State state_for(const Model& model, const std::string& state_path);
 

@@ -18,7 +18,13 @@ int run(const Options& o) {
   const Model model = load_checked(o.model);
   const State state = state_for(model, o.state);
   const SimulationOptions opt = simulation_options(o.sim, state);
-  auto engine = make_engine(model, o.engine, o.native);
+  // explicit methods (and auto's choice, from central differences when no
+  // Jacobian is compiled) need no derivatives; the implicit ones use the exact Jacobian
+  const IntegratorKind k = opt.integrator.kind;
+  const bool explicit_method = k == IntegratorKind::automatic || k == IntegratorKind::rkf78 ||
+                               k == IntegratorKind::dopri5 || k == IntegratorKind::rk4 ||
+                               k == IntegratorKind::arkode_erk;
+  auto engine = make_engine(model, o.engine, o.native, /*derivatives=*/!explicit_method);
   try {
     const SimulationResult r = simulate_to_file(*engine, state, opt, o.sim.output);
     fmt::print(stderr, "{} [{} engine], {} rows to {}, max quaternion drift {:.2e}\n{}", r.stats.summary(),
