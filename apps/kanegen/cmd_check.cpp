@@ -14,7 +14,7 @@ int run(const std::string& path) {
   for (const Body& b : model.bodies) {
     std::string parent = b.parent < 0 ? "ground" : model.bodies[b.parent].name;
     if (b.joint.node >= 0) parent += fmt::format(" @node {}", model.bodies[b.parent].flex->nodes[b.joint.node].id);
-    fmt::print("  {:<16} {:<9} joint to {:<16} mass {:.6g} kg", b.name, to_string(b.joint.type), parent,
+    fmt::print("  {:<16} {:<11} joint to {:<16} mass {:.6g} kg", b.name, to_string(b.joint.type), parent,
                b.total_mass);
     if (b.flex) {
       fmt::print(", flexible: {} modes, {} nodes ({})", b.n_modes(), b.flex->nodes.size(), b.flex->source);

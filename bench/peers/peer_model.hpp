@@ -232,8 +232,8 @@ inline Model load_model(const std::string& path) {
       m.nu += b.nu;
     };
     switch (b.joint) {
-      case JointType::revolute: add({"angle"}, {"angle"}); break;
-      case JointType::prismatic: add({"disp"}, {"disp"}); break;
+      case JointType::revolute: add({"angle"}, {"angle_rate"}); break;
+      case JointType::prismatic: add({"disp"}, {"disp_rate"}); break;
       case JointType::fixed: add({}, {}); break;
       case JointType::free:
         add({"x", "y", "z", "qw", "qx", "qy", "qz"}, {"vx", "vy", "vz", "wx", "wy", "wz"});
@@ -244,7 +244,12 @@ inline Model load_model(const std::string& path) {
   }
   if (const YAML::Node init = root["initial"]) {
     if (init["q"]) for (const auto& kv : init["q"]) m.initial_q[kv.first.as<std::string>()] = kv.second.as<double>();
-    if (init["u"]) for (const auto& kv : init["u"]) m.initial_u[kv.first.as<std::string>()] = kv.second.as<double>();
+    if (init["u"])
+      for (const auto& kv : init["u"]) {
+        std::string k = kv.first.as<std::string>();  // an older speed name means the rate
+        if (std::find(m.u_names.begin(), m.u_names.end(), k) == m.u_names.end()) k += "_rate";
+        m.initial_u[k] = kv.second.as<double>();
+      }
   }
   return m;
 }
@@ -268,7 +273,11 @@ inline State load_state(const Model& m, const std::optional<std::string>& path) 
     auto check = [&](const char* key, const std::vector<std::string>& names) {
       if (!j.contains(key)) return std::map<std::string, double>{};
       std::map<std::string, double> given;
-      for (const auto& [k, v] : j.at(key).items()) {
+      for (const auto& [k0, v] : j.at(key).items()) {
+        std::string k = k0;  // a speed's older name (its coordinate's) means the rate
+        if (std::string(key) == "u" && std::find(names.begin(), names.end(), k) == names.end() &&
+            std::find(names.begin(), names.end(), k + "_rate") != names.end())
+          k += "_rate";
         if (std::find(names.begin(), names.end(), k) == names.end())
           throw Refused(*path + ": " + key + "." + k + ": unknown name");
         given[k] = v.get<double>();

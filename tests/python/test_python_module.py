@@ -90,6 +90,12 @@ for col in rows[0].keys():
         worst, worst_col = diff, col
 print(f"      Python PD vs C++ PD: largest difference {worst:.2e} (column {worst_col}, relative to its peak or 1e-6)")
 check(len(rows) == len(run["t"]) and worst <= 1e-7, "simulate: the Python controller reproduces the C++ simulator's run")
+# every name once; the groups hold the coordinate and its rate apart
+check(len(set(run["columns"])) == len(run["columns"]), "simulate: no column name repeats")
+check(set(run["q"]) == set(gen.q_names) and set(run["u"]) == set(gen.u_names)
+      and not np.array_equal(run["q"]["rw_z.angle"], run["u"]["rw_z.angle_rate"]),
+      "simulate: q and u grouped by name, a rate never under its coordinate's name")
+check(set(run["outputs"]) == set(gen.output_names), "simulate: outputs grouped by name")
 
 # ---- linearize: pendulum closed form
 pend = kanegen.Model(os.path.join(ROOT, "models", "pendulum.yaml"))
