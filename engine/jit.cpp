@@ -156,6 +156,7 @@ std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out
   for (auto& f : split_words(o.flags))
     if (f != "-shared" && !(default_flags && f.rfind("-O", 0) == 0)) flags.push_back(f);
   if (o.native) flags.push_back("-march=native");
+  if (o.quick) flags.push_back("-DKANEGEN_NO_DISPATCH");
   const std::string include = "-I" + o.include_dir;
   const ManifestFunction* udot = manifest.find("udot");
   const long udot_ops = udot ? udot->ops : 0;
@@ -166,7 +167,7 @@ std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out
     CompileStep st;
     st.argv = base;
     st.argv.insert(st.argv.end(), flags.begin(), flags.end());
-    if (default_flags) st.argv.push_back(opt);
+    if (default_flags) st.argv.push_back(o.quick ? "-O0" : opt);
     const std::string obj = (out.parent_path() / ("part_" + part + ".o")).string();
     st.argv.insert(st.argv.end(), {"-DKANEGEN_PART_" + part, include, "-c", entry.string(), "-o", obj});
     st.argv.insert(st.argv.end(), extra.begin(), extra.end());
@@ -415,6 +416,7 @@ std::string jit_cache_key(const Model& model, const std::string& generator_hash,
   }
   if (o.native) flags += "\nnative";
   if (!o.derivatives) flags += "\nno derivatives";
+  if (o.quick) flags += "\nquick";
   return fnv1a64_hex(fmt::format("{}\n{}\n{}\n{}\n{}\nplan {}", model_hash(model), KANEGEN_VERSION,
                                  KANEGEN_GENERATED_API_VERSION, generator_hash, flags, kCompilePlanVersion));
 }
@@ -435,11 +437,19 @@ std::unique_ptr<GeneratedEngine> compile_and_load(const Model& model, const Gene
 std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerator& generator,
                                           const JitOptions& opts) {
   JitOptions o = resolved(opts);
-  if (!o.derivatives) {  // a full library already cached serves as well
-    JitOptions full = o;
-    full.derivatives = true;
-    if (jit_cache::verified_record(jit_library_path(model, generator.hash, full))) o = full;
-  }
+  // a library already cached that does more serves as well: optimized, then with derivatives
+  for (const bool quick : {false, true})
+    for (const bool derivatives : {true, false}) {
+      if ((quick && !o.quick) || (!derivatives && o.derivatives)) continue;
+      JitOptions better = o;
+      better.quick = quick;
+      better.derivatives = derivatives;
+      if (jit_cache::verified_record(jit_library_path(model, generator.hash, better))) {
+        o = better;
+        goto chosen;
+      }
+    }
+chosen:
   const std::string so_path = jit_library_path(model, generator.hash, o);
   return load_or_build(model, so_path, generator.hash, o, [&] { return generator.generate(model); });
 }

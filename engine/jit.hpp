@@ -40,6 +40,10 @@ struct JitOptions {
   /// none of them (eval, an explicit simulate) build without them when no
   /// full library is cached yet (cached separately).
   bool derivatives = true;
+  /// For a command that evaluates a few times (eval): every part at -O0 and
+  /// for the baseline ISA only (no second copy for AVX2), the quickest build;
+  /// cached separately, and any optimized library already cached is used instead.
+  bool quick = false;
   bool quiet = false;       ///< say nothing on stderr (by default a compile and a cache hit are one line each)
   /// Compile only these functions of the table besides the four every engine
   /// needs (qdot, mass_matrix, forcing, udot); empty: all of them. E.g. {} vs

@@ -17,13 +17,15 @@ Model load_checked(const std::string& path) {
   return model;
 }
 
-std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name, bool native, bool derivatives) {
+std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name, bool native, bool derivatives,
+                                    bool quick) {
   if (name == "generic") return std::make_unique<GenericEngine>(model);
   if (name == "generated") {
     try {
       JitOptions jit;
       jit.native = native;
       jit.derivatives = derivatives;
+      jit.quick = quick;
       return jit_load(model, codegen::jit_code_generator(), jit);
     } catch (const JitError& e) {  // the generated code of this model does not compile
       throw InputError(Diagnostic{model.source_path, 0, "", e.what()});

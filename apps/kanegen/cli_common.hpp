@@ -41,8 +41,9 @@ Model load_checked(const std::string& path);
 /// `derivatives`: whether the command needs the generated dual-number
 /// Jacobians (linearize, implicit integrators); without them a first build is
 /// faster (a full library already cached is used all the same).
+/// `quick`: a build for a few evaluations (JitOptions::quick).
 std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name, bool native = false,
-                                    bool derivatives = true);
+                                    bool derivatives = true, bool quick = false);
 /// The model's initial state, or STATE.json when a path is given.
 State state_for(const Model& model, const std::string& state_path);
 

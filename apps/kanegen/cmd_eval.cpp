@@ -25,7 +25,7 @@ int run(const Options& o) {
     throw InputError(Diagnostic{o.state.empty() ? o.model : o.state, state.q_line > 0 ? state.q_line : 1, "q",
                                 gimbal_lock_message(model, lb, state.q.data(), measure) +
                                     "; M is singular there. Expected angles away from gimbal lock"});
-  auto engine = make_engine(model, o.engine, o.native, /*derivatives=*/false);
+  auto engine = make_engine(model, o.engine, o.native, /*derivatives=*/false, /*quick=*/!o.native);
   nlohmann::ordered_json j;
   try {
     j = eval_report(*engine, state);

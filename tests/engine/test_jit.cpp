@@ -594,3 +594,31 @@ TEST_CASE("jit_load of v_double3d matches the generic engine", "[jit][generator]
   CHECK(st1.st_ino == st0.st_ino);
   CHECK(st1.st_mtim.tv_nsec == st0.st_mtim.tv_nsec);
 }
+
+TEST_CASE("a quick build without derivatives is cached apart; a full library, once cached, serves it", "[jit]") {
+  const TempCache cache;
+  const Model m = make_handwritten_pendulum();
+  JitOptions lean = cache.options();
+  lean.quiet = true;
+  lean.derivatives = false;
+  lean.quick = true;
+  JitOptions full = cache.options();
+  full.quiet = true;
+  const auto gen = codegen::jit_code_generator();
+  CHECK(jit_library_path(m, gen.hash, lean) != jit_library_path(m, gen.hash, full));
+  const auto a = jit_load(m, gen, lean);
+  CHECK(a->library_path() == jit_library_path(m, gen.hash, lean));
+  CHECK(!a->has_jacobian());  // the dual-number functions were left out
+  GenericEngine generic(m);
+  VecX q(1), u(1), tau = VecX::Zero(1), ua, ug;
+  q << 0.4;
+  u << -0.3;
+  a->udot(q, u, tau, ua);
+  generic.udot(q, u, tau, ug);
+  CHECK(std::abs(ua(0) - ug(0)) <= 1e-14 * std::abs(ug(0)));
+  const auto b = jit_load(m, gen, full);
+  CHECK(b->has_jacobian());
+  const auto c = jit_load(m, gen, lean);  // now the optimized full library is used
+  CHECK(c->library_path() == jit_library_path(m, gen.hash, full));
+  CHECK(c->has_jacobian());
+}
