@@ -280,8 +280,10 @@ class Checker {
       return std::nullopt;
     }
     if (std::abs(nrm - 1.0) > 1e-6) {
+      std::string unit;  // the normalized vector, to paste
+      for (Eigen::Index i = 0; i < v->size(); ++i) unit += (i ? ", " : "") + fmt::format("{:.17g}", (*v)(i) / nrm);
       error(n, fallback, field,
-            fmt::format("norm {} is not 1 (to within 1e-6); expected {}", num(nrm), expected));
+            fmt::format("norm {} is not 1 (to within 1e-6); expected {} (normalized: [{}])", num(nrm), expected, unit));
       return std::nullopt;
     }
     return Eigen::VectorXd(*v / nrm);
