@@ -13,7 +13,7 @@ void compute_qdot(const Model& model, const VecQ& q, const VecU& u, VecQd& qdot)
   for (const Body& b : model.bodies) {
     if (!b.joint.prescribed()) {  // a prescribed joint has no q
       const JointTraits& t = joint_traits(b.joint.type);
-      S qj[7], uj[6], qdj[7];
+      S qj[kMaxJointCoordinates], uj[kMaxJointSpeeds], qdj[kMaxJointCoordinates];
       for (int k = 0; k < t.nq(); ++k) qj[k] = S(q(b.q_joint + k));
       for (int k = 0; k < t.nu(); ++k) uj[k] = S(u(b.u_joint + k));
       joints::joint_qdot<S>(b.primitives, qj, uj, qdj);

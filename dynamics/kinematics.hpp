@@ -102,7 +102,7 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, double t, const Ve
     // A prescribed joint moves with its motion's value and rate at t; its known
     // acceleration times its column joins the remainders below.
     const int nu_j = joint_traits(b.joint.type).nu();
-    S qj[7], uj[6];
+    S qj[kMaxJointCoordinates], uj[kMaxJointSpeeds];
     MotionValue mv{};
     if (b.joint.prescribed()) {
       mv = b.joint.motion->at(t);

@@ -18,6 +18,7 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <sstream>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -437,19 +438,20 @@ std::unique_ptr<GeneratedEngine> compile_and_load(const Model& model, const Gene
 std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerator& generator,
                                           const JitOptions& opts) {
   JitOptions o = resolved(opts);
-  // a library already cached that does more serves as well: optimized, then with derivatives
-  for (const bool quick : {false, true})
-    for (const bool derivatives : {true, false}) {
-      if ((quick && !o.quick) || (!derivatives && o.derivatives)) continue;
-      JitOptions better = o;
-      better.quick = quick;
-      better.derivatives = derivatives;
-      if (jit_cache::verified_record(jit_library_path(model, generator.hash, better))) {
-        o = better;
-        goto chosen;
-      }
-    }
-chosen:
+  // A library already cached that does at least as much serves as well:
+  // optimized before quick, with derivatives before without; else the one asked for.
+  auto cached = [&](bool quick, bool derivatives) {
+    JitOptions c = o;
+    c.quick = quick;
+    c.derivatives = derivatives;
+    return jit_cache::verified_record(jit_library_path(model, generator.hash, c)) ? std::optional<JitOptions>(c)
+                                                                                  : std::nullopt;
+  };
+  std::optional<JitOptions> serving;
+  for (const bool quick : {false, o.quick})
+    for (const bool derivatives : {true, o.derivatives})
+      if (!serving) serving = cached(quick, derivatives);
+  if (serving) o = *serving;
   const std::string so_path = jit_library_path(model, generator.hash, o);
   return load_or_build(model, so_path, generator.hash, o, [&] { return generator.generate(model); });
 }

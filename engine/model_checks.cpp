@@ -29,13 +29,12 @@ int first_singular_speed(const MatX& M) {
 }  // namespace
 
 int gimbal_locked_body(const Model& model, const double* q, double limit, double* measure) {
-  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+  for (const int i : model.lockable_joints) {
     const Body& b = model.bodies[i];
-    if (!joint_traits(b.joint.type).can_lock_up || b.joint.prescribed()) continue;
     const double m = joint_lock_measure(b.joint, q + b.q_joint);
     if (!(m > limit)) {
       if (measure) *measure = m;
-      return static_cast<int>(i);
+      return i;
     }
   }
   return -1;

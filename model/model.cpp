@@ -69,6 +69,7 @@ void finalize_model(Model& model) {
   model.u_names.clear();
   model.prescribed_names.clear();
   model.quaternions.clear();
+  model.lockable_joints.clear();
   int nq = 0, nu = 0;
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
     Body& b = model.bodies[i];
@@ -86,6 +87,7 @@ void finalize_model(Model& model) {
       for (const auto& c : jt.speeds) model.u_names.push_back(n + "." + c);
       if (jt.has_quaternion())
         model.quaternions.push_back({static_cast<int>(i), nq + jt.quaternion, nu + jt.angular_speeds});
+      if (jt.can_lock_up) model.lockable_joints.push_back(static_cast<int>(i));
     }
     nq += joint_nq(b.joint);
     nu += joint_nu(b.joint);

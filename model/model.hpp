@@ -134,6 +134,9 @@ struct Model {
     int u = 0;  ///< u index of the first of its three angular speeds (B components)
   };
   std::vector<QuaternionSlot> quaternions;
+  /// Bodies whose joints can reach gimbal lock (JointTraits::can_lock_up, not
+  /// prescribed), in body order.
+  std::vector<int> lockable_joints;
   VecX q0;                          ///< initial coordinates (quaternions unit)
   VecX u0;                          ///< initial speeds
   Outputs outputs;

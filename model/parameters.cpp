@@ -70,7 +70,7 @@ std::vector<RuntimeParameter> expand_parameter(const Model& model, const std::st
              stem0 == "stiffness" || stem0 == "damping" || stem0 == "rest") {
     // <body>.stiffness (every coordinate; the name itself on a one-coordinate
     // joint) or <body>.stiffness.<coordinate>; a ball joint: <body>.damping
-    const std::string stem = what.substr(0, what.find('.'));
+    const std::string& stem = stem0;
     const std::string coord = what.size() > stem.size() ? what.substr(stem.size() + 1) : "";
     const ParameterKind kind = stem == "stiffness" ? ParameterKind::stiffness : stem == "damping" ? ParameterKind::damping
                                                                                                    : ParameterKind::rest;

@@ -116,8 +116,7 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
   // (which throws SingularMassMatrix): the state and the accelerations checked,
   // the quaternion stabilization added.
   // A gimbal reaching gimbal lock (dynamics.md: |det Gamma| <= 1e-6) stops the run.
-  bool has_gimbal = false;
-  for (const Body& b : model.bodies) has_gimbal = has_gimbal || joint_traits(b.joint.type).can_lock_up;
+  const bool has_gimbal = !model.lockable_joints.empty();
   auto rhs_around = [&](auto derivative) {
     return [derivative, failure, nq, nu, stabilize, has_gimbal, &model](double t, const double* x, double* xdot) -> int {
       for (int i = 0; i < nq + nu; ++i)
@@ -333,10 +332,8 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
                                         to_string(options.integrator.kind), t, what),
                             t, x);
   };
-  std::vector<int> gimbals, gimbal_sign;  // bodies on joints that can lock up, and det Gamma's sign at the last row
-  for (std::size_t i = 0; i < model.bodies.size(); ++i)
-    if (joint_traits(model.bodies[i].joint.type).can_lock_up && !model.bodies[i].joint.prescribed())
-      gimbals.push_back(static_cast<int>(i)), gimbal_sign.push_back(0);
+  const std::vector<int>& gimbals = model.lockable_joints;
+  std::vector<int> gimbal_sign(gimbals.size(), 0);  // det Gamma's sign at the last row
   double last_row_t = initial.t;
   auto column_of = [&](std::size_t k) { return k < cols.size() ? cols[k] : fmt::format("column {}", k); };
 

@@ -38,7 +38,7 @@ template <class S>
 struct JointMotion {
   Mat<S> R_JB;
   Vec<S> e_J;
-  std::array<Vec<S>, 6> Sw, Sv;  ///< columns 0..nu-1, B components (at most 6 speeds)
+  std::array<Vec<S>, kMaxJointSpeeds> Sw, Sv;  ///< columns 0..nu-1, B components
   Vec<S> w_rel_B, e_dot_B;     ///< S u (zero when formed without velocities)
   Vec<S> bias_w_B, bias_v_B;   ///< S_dot u
 };

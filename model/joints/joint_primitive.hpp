@@ -11,6 +11,10 @@
 
 namespace kanegen {
 
+/// The most coordinates and speeds one joint has (the free joint's 7 and 6).
+inline constexpr int kMaxJointCoordinates = 7;
+inline constexpr int kMaxJointSpeeds = 6;
+
 struct JointPrimitive {
   enum class Kind {
     rotation,     ///< Rot(axis, q[q]) with rate u[u]
