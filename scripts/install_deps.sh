@@ -8,6 +8,7 @@ packages=(
   libsundials-dev libginac-dev catch2 libbenchmark-dev libspectra-dev libboost-dev zlib1g-dev
   python3 python3-numpy python3-scipy python3-matplotlib python3-dev pybind11-dev python3-pybind11
   libopenmpi-dev openmpi-bin
+  libmujoco-dev libsimbody-dev
 )
 missing=()
 for p in "${packages[@]}"; do

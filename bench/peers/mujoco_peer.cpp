@@ -27,6 +27,11 @@
 //     R_PJ·Rot(axis, θ) and at p_PJ + R_PJ·axis·s, exactly dynamics.md's table.
 //     Spring and damper: stiffness = k, springref = rest, damping = c, so MuJoCo's
 //     passive force is -k(q - rest) - c q̇ as ours.
+//   * universal, gimbal, cylindrical, planar -> the hinges and slides of our joint
+//     table in one body, in order (MuJoCo composes a body's joints as a body-fixed
+//     sequence, each axis in the frame the joints before it turned); ball -> ball
+//     (qpos = our quaternion R_JB, qvel = our ω_B: both MuJoCo's conventions too),
+//     its damper on the three dofs, no spring.
 //   * fixed -> a body without joint (welded to its parent).
 //   * free -> MuJoCo free joint (allowed only on children of the world body in 2.2).
 //     Its qpos/qvel are world-frame position, quaternion, world linear velocity of the
@@ -83,33 +88,37 @@ Principal principal_axes(const Matrix3d& I_B) {
   return {eig.eigenvalues(), Quaterniond(R_BI)};
 }
 
+/// The MJCF joint of one elementary motion: named after its first speed (a free
+/// joint after its body).
+std::string joint_name(const Model& m, const Body& b, const Motion& mo) {
+  return mo.kind == Motion::Kind::free ? b.name + ".free" : m.u_names[b.u_index + mo.u];
+}
+
 void write_body(const Model& m, int i, const std::vector<std::vector<int>>& children, std::string& xml,
                 int depth) {
   const Body& b = m.bodies[i];
   const std::string ind(2 * depth, ' ');
   xml += fmt::format("{}<body name=\"{}\" pos=\"{}\" quat=\"{}\">\n", ind, b.name, vec(b.p_PJ),
                      quat(Quaterniond(b.R_PJ)));
-  const std::string passive = fmt::format(
-      "stiffness=\"{}\" springref=\"{}\" damping=\"{}\" armature=\"0\" frictionloss=\"0\" limited=\"false\"",
-      num(b.stiffness), num(b.rest), num(b.damping));
-  switch (b.joint) {
-    case JointType::revolute:
-      xml += fmt::format("{}  <joint name=\"{}\" type=\"hinge\" pos=\"0 0 0\" axis=\"{}\" {}/>\n", ind,
-                         m.u_names[b.u_index], vec(b.axis_J), passive);
-      break;
-    case JointType::prismatic:
-      xml += fmt::format("{}  <joint name=\"{}\" type=\"slide\" pos=\"0 0 0\" axis=\"{}\" {}/>\n", ind,
-                         m.u_names[b.u_index], vec(b.axis_J), passive);
-      break;
-    case JointType::free:
+  for (const Motion& mo : b.motions) {
+    if (mo.kind == Motion::Kind::free) {
       if (b.parent != -1)
         throw Refused("body '" + b.name + "': MuJoCo 2.2 allows a free joint only on a child of the world body");
       xml += fmt::format(
-          "{}  <joint name=\"{}.free\" type=\"free\" stiffness=\"0\" damping=\"0\" armature=\"0\" "
+          "{}  <joint name=\"{}\" type=\"free\" stiffness=\"0\" damping=\"0\" armature=\"0\" "
           "frictionloss=\"0\"/>\n",
-          ind, b.name);
-      break;
-    case JointType::fixed: break;  // no joint: welded to the parent
+          ind, joint_name(m, b, mo));
+      continue;
+    }
+    // MuJoCo composes a body's joints in order, each axis in the frame the joints
+    // before it turned: the body-fixed sequence of our joint table.
+    const std::string type = mo.kind == Motion::Kind::hinge ? "hinge" : mo.kind == Motion::Kind::slide ? "slide" : "ball";
+    const std::string axis = mo.kind == Motion::Kind::ball ? "" : fmt::format(" axis=\"{}\"", vec(mo.axis));
+    // A ball joint has a damper only (stiffness 0).
+    xml += fmt::format(
+        "{}  <joint name=\"{}\" type=\"{}\" pos=\"0 0 0\"{} stiffness=\"{}\" springref=\"{}\" damping=\"{}\" "
+        "armature=\"0\" frictionloss=\"0\" limited=\"false\"/>\n",
+        ind, joint_name(m, b, mo), type, axis, num(b.stiffness[mo.u]), num(b.rest[mo.u]), num(b.damping[mo.u]));
   }
   if (b.mass > 0) {
     const Principal p = principal_axes(b.I_Bcm_B);
@@ -166,13 +175,13 @@ class MujocoPeer {
     m_ = compile(xml_);
     d_ = mj_makeData(m_);
     if (m_->nv != model.nu) throw Refused(fmt::format("MuJoCo has {} dofs, kanegen {}", m_->nv, model.nu));
-    for (const Body& b : model.bodies) {
-      if (b.nu == 0) continue;
-      const std::string jname = b.joint == JointType::free ? b.name + ".free" : model.u_names[b.u_index];
-      const int j = mj_name2id(m_, mjOBJ_JOINT, jname.c_str());
-      if (j < 0) throw Refused("MuJoCo lost joint " + jname);
-      adr_.push_back({&b, m_->jnt_qposadr[j], m_->jnt_dofadr[j]});
-    }
+    for (const Body& b : model.bodies)
+      for (const Motion& mo : b.motions) {
+        const std::string jname = joint_name(model, b, mo);
+        const int j = mj_name2id(m_, mjOBJ_JOINT, jname.c_str());
+        if (j < 0) throw Refused("MuJoCo lost joint " + jname);
+        adr_.push_back({&b, &mo, m_->jnt_qposadr[j], m_->jnt_dofadr[j]});
+      }
   }
   ~MujocoPeer() {
     mj_deleteData(d_);
@@ -183,7 +192,9 @@ class MujocoPeer {
 
   const std::string& xml() const { return xml_; }
 
-  /// Writes our (q, u) into d->qpos, d->qvel.
+  /// Writes our (q, u) into d->qpos, d->qvel. Hinge, slide: the coordinate and
+  /// its rate. Ball: the quaternion R_JB and ω_B (MuJoCo's ball qvel is in the
+  /// child frame, as ours).
   ///
   /// Free joint (parent = ground, joint frame J fixed in N; R_NB = R_NJ R(quat)):
   ///   qpos[0:3] = p_NJ + R_NJ [x y z]        body origin in N
@@ -193,9 +204,10 @@ class MujocoPeer {
   void set_state(const State& s) {
     for (const Adr& a : adr_) {
       const Body& b = *a.body;
-      if (b.joint != JointType::free) {
-        d_->qpos[a.qpos] = s.q(b.q_index);
-        d_->qvel[a.dof] = s.u(b.u_index);
+      if (a.motion->kind != Motion::Kind::free) {
+        const int nq = a.motion->kind == Motion::Kind::ball ? 4 : 1, nv = a.motion->kind == Motion::Kind::ball ? 3 : 1;
+        for (int k = 0; k < nq; ++k) d_->qpos[a.qpos + k] = s.q(b.q_index + a.motion->q + k);
+        for (int k = 0; k < nv; ++k) d_->qvel[a.dof + k] = s.u(b.u_index + a.motion->u + k);
         continue;
       }
       const Vector3d x = s.q.segment<3>(b.q_index);
@@ -231,9 +243,10 @@ class MujocoPeer {
     for (long i = 0; i < n; ++i) mj_step(m_, d_);
     VectorXd q(model_.nq), u(model_.nu);
     for (const Adr& a : adr_) {
-      if (a.body->joint == JointType::free) throw Refused("work-precision: free joints are not converted back");
-      q(a.body->q_index) = d_->qpos[a.qpos];
-      u(a.body->u_index) = d_->qvel[a.dof];
+      if (a.motion->kind == Motion::Kind::free) throw Refused("work-precision: free joints are not converted back");
+      const int nq = a.motion->kind == Motion::Kind::ball ? 4 : 1, nv = a.motion->kind == Motion::Kind::ball ? 3 : 1;
+      for (int k = 0; k < nq; ++k) q(a.body->q_index + a.motion->q + k) = d_->qpos[a.qpos + k];
+      for (int k = 0; k < nv; ++k) u(a.body->u_index + a.motion->u + k) = d_->qvel[a.dof + k];
     }
     return {q, u};
   }
@@ -247,8 +260,9 @@ class MujocoPeer {
     VectorXd ud(model_.nu);
     for (const Adr& a : adr_) {
       const Body& b = *a.body;
-      if (b.joint != JointType::free) {
-        ud(b.u_index) = d_->qacc[a.dof];
+      if (a.motion->kind != Motion::Kind::free) {
+        const int nv = a.motion->kind == Motion::Kind::ball ? 3 : 1;
+        for (int k = 0; k < nv; ++k) ud(b.u_index + a.motion->u + k) = d_->qacc[a.dof + k];
         continue;
       }
       const Quaterniond q_NB(d_->qpos[a.qpos + 3], d_->qpos[a.qpos + 4], d_->qpos[a.qpos + 5],
@@ -288,9 +302,9 @@ class MujocoPeer {
       }
     }
     for (const Adr& a : adr_)
-      if (a.body->joint != JointType::free) {
+      if (a.motion->kind == Motion::Kind::hinge || a.motion->kind == Motion::Kind::slide) {
         const int j = m_->dof_jntid[a.dof];
-        upd((Vector3d(m_->jnt_axis + 3 * j) - a.body->axis_J).cwiseAbs().maxCoeff(), 1);
+        upd((Vector3d(m_->jnt_axis + 3 * j) - a.motion->axis).cwiseAbs().maxCoeff(), 1);
       }
     return err;
   }
@@ -298,7 +312,8 @@ class MujocoPeer {
  private:
   struct Adr {
     const Body* body;
-    int qpos, dof;  ///< first qpos / qvel (dof) address of the body's joint
+    const Motion* motion;
+    int qpos, dof;  ///< first qpos / qvel (dof) address of the motion's MuJoCo joint
   };
   const Model& model_;
   std::string xml_;

@@ -42,21 +42,37 @@ struct Refused : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class JointType { revolute, prismatic, fixed, free };
+enum class JointType { revolute, prismatic, fixed, free, universal, gimbal, cylindrical, planar, ball };
+
+/// One elementary motion of a joint, as model-format.md's joint table composes
+/// them: a body-fixed (intrinsic) sequence from J to B, each axis in the frame
+/// turned by the motions before it. `q`, `u`: the coordinate/speed offset within
+/// the joint (a ball's quaternion takes q..q+3 and u..u+2).
+struct Motion {
+  enum class Kind { hinge, slide, ball, free } kind;
+  Vector3d axis;  ///< unit axis (hinge, slide)
+  int q = 0, u = 0;
+};
 
 struct Body {
   std::string name;
   int parent = -1;                         ///< index into Model::bodies; -1 = ground
   JointType joint = JointType::fixed;
-  Vector3d axis_J = Vector3d::Zero();      ///< revolute/prismatic unit axis, J components
+  std::vector<Motion> motions;             ///< the joint as elementary motions, J to B
   Vector3d p_PJ = Vector3d::Zero();        ///< joint frame origin in the parent frame
   Matrix3d R_PJ = Matrix3d::Identity();    ///< joint frame orientation in the parent frame
-  double stiffness = 0, damping = 0, rest = 0;  ///< spring/damper on the joint coordinate
+  /// Spring and damper per speed (model-format.md: a number or one per coordinate;
+  /// a ball joint: damping only, the same on its three speeds).
+  std::vector<double> stiffness, damping, rest;
   double mass = 0;                         ///< kg
   Vector3d com_B = Vector3d::Zero();       ///< centre of mass from the body origin, B
   Matrix3d I_Bcm_B = Matrix3d::Zero();     ///< inertia about the com, B axes (a matrix)
   int q_index = -1, u_index = -1;          ///< first coordinate/speed in kanegen ordering
   int nq = 0, nu = 0;
+  /// Where the joint's unit quaternion [w x y z] starts within q (-1: none).
+  int quaternion_offset() const {
+    return joint == JointType::free ? 3 : joint == JointType::ball ? 0 : -1;
+  }
 };
 
 struct Model {
@@ -172,6 +188,65 @@ inline Matrix3d inertia(const YAML::Node& n, const std::string& ctx) {
   return 0.5 * (I + I.transpose());
 }
 
+/// `sequence: zyx` -> the unit axes in order.
+inline std::vector<Vector3d> sequence_axes(const std::string& seq, const std::string& ctx) {
+  if (seq.size() != 3) throw Refused(ctx + ": expected three letters from x, y, z");
+  std::vector<Vector3d> axes;
+  for (char c : seq) {
+    if (c < 'x' || c > 'z') throw Refused(ctx + ": expected three letters from x, y, z");
+    axes.push_back(Vector3d::Unit(c - 'x'));
+  }
+  return axes;
+}
+
+inline std::vector<Vector3d> axes_list(const YAML::Node& n, std::size_t count, const std::string& ctx) {
+  if (!n.IsSequence() || n.size() != count) throw Refused(ctx + ": expected " + std::to_string(count) + " axes");
+  std::vector<Vector3d> axes;
+  for (std::size_t k = 0; k < count; ++k) axes.push_back(vec3(n[k], ctx).normalized());
+  return axes;
+}
+
+/// The joint table of model-format.md as elementary motions, J to B.
+inline std::vector<Motion> motions(JointType type, const YAML::Node& jn, const std::string& ctx) {
+  using K = Motion::Kind;
+  const Vector3d axis = jn["axis"] ? vec3(jn["axis"], ctx + ".joint.axis").normalized() : Vector3d(Vector3d::UnitZ());
+  auto turns = [](const std::vector<Vector3d>& axes) {
+    std::vector<Motion> out;
+    for (std::size_t k = 0; k < axes.size(); ++k) out.push_back({K::hinge, axes[k], int(k), int(k)});
+    return out;
+  };
+  switch (type) {
+    case JointType::revolute: return {{K::hinge, axis, 0, 0}};
+    case JointType::prismatic: return {{K::slide, axis, 0, 0}};
+    case JointType::fixed: return {};
+    case JointType::free: return {{K::free, Vector3d::Zero(), 0, 0}};
+    case JointType::universal:
+      return turns(jn["axes"] ? axes_list(jn["axes"], 2, ctx + ".joint.axes")
+                              : std::vector<Vector3d>{Vector3d::UnitX(), Vector3d::UnitY()});
+    case JointType::gimbal:
+      if (jn["axes"]) return turns(axes_list(jn["axes"], 3, ctx + ".joint.axes"));
+      return turns(sequence_axes(jn["sequence"] ? jn["sequence"].as<std::string>() : "xyz", ctx + ".joint.sequence"));
+    case JointType::cylindrical: return {{K::hinge, axis, 0, 0}, {K::slide, axis, 1, 1}};
+    case JointType::planar:
+      return {{K::slide, Vector3d::UnitX(), 0, 0}, {K::slide, Vector3d::UnitY(), 1, 1},
+              {K::hinge, Vector3d::UnitZ(), 2, 2}};
+    case JointType::ball: return {{K::ball, Vector3d::Zero(), 0, 0}};
+  }
+  throw Refused(ctx + ".joint.type: unhandled");
+}
+
+/// A spring/damper key: absent (zeros), a number (every speed), or one entry per
+/// coordinate. `ball`: one number for all three speeds.
+inline std::vector<double> per_speed(const YAML::Node& n, int nu, bool ball, const std::string& ctx) {
+  if (!n) return std::vector<double>(std::size_t(nu), 0.0);
+  if (n.IsScalar()) return std::vector<double>(std::size_t(nu), n.as<double>());
+  if (ball || !n.IsSequence() || n.size() != std::size_t(nu))
+    throw Refused(ctx + ": expected a number or " + std::to_string(nu) + " numbers");
+  std::vector<double> v;
+  for (const auto& x : n) v.push_back(x.as<double>());
+  return v;
+}
+
 }  // namespace detail
 
 /// Reads a rigid-body model file. Refuses what the peers do not translate:
@@ -205,17 +280,26 @@ inline Model load_model(const std::string& path) {
     const std::string type = jn["type"].as<std::string>();
     if (jn["motion"]) throw Refused(ctx + ".joint.motion: prescribed motion is not translated");
     if (jn["node"]) throw Refused(ctx + ".joint.node: joints at flexible nodes are not translated");
-    if (type == "revolute") b.joint = JointType::revolute;
-    else if (type == "prismatic") b.joint = JointType::prismatic;
-    else if (type == "fixed") b.joint = JointType::fixed;
-    else if (type == "free") b.joint = JointType::free;
-    else throw Refused(ctx + ".joint.type: unknown joint type '" + type + "'");
-    if (jn["axis"]) b.axis_J = detail::vec3(jn["axis"], ctx + ".joint.axis").normalized();
+    static const std::map<std::string, JointType> types = {
+        {"revolute", JointType::revolute},   {"prismatic", JointType::prismatic},
+        {"fixed", JointType::fixed},         {"free", JointType::free},
+        {"universal", JointType::universal}, {"gimbal", JointType::gimbal},
+        {"cylindrical", JointType::cylindrical}, {"planar", JointType::planar},
+        {"ball", JointType::ball}};
+    if (!types.count(type)) throw Refused(ctx + ".joint.type: unknown joint type '" + type + "'");
+    b.joint = types.at(type);
     if (jn["position"]) b.p_PJ = detail::vec3(jn["position"], ctx + ".joint.position");
     b.R_PJ = detail::rotation(jn["rotation"], ctx + ".joint.rotation");
-    if (jn["stiffness"]) b.stiffness = jn["stiffness"].as<double>();
-    if (jn["damping"]) b.damping = jn["damping"].as<double>();
-    if (jn["rest"]) b.rest = jn["rest"].as<double>();
+    b.motions = detail::motions(b.joint, jn, ctx);
+    b.nu = 0;
+    for (const Motion& mo : b.motions)
+      b.nu += mo.kind == Motion::Kind::free ? 6 : mo.kind == Motion::Kind::ball ? 3 : 1;
+    const bool ball = b.joint == JointType::ball;
+    if (ball && (jn["stiffness"] || jn["rest"]))
+      throw Refused(ctx + ".joint: a ball joint takes damping only");
+    b.stiffness = detail::per_speed(jn["stiffness"], b.nu, ball, ctx + ".joint.stiffness");
+    b.damping = detail::per_speed(jn["damping"], b.nu, ball, ctx + ".joint.damping");
+    b.rest = detail::per_speed(jn["rest"], b.nu, ball, ctx + ".joint.rest");
     if (bn["mass"]) b.mass = bn["mass"].as<double>();
     if (bn["com"]) b.com_B = detail::vec3(bn["com"], ctx + ".com");
     b.I_Bcm_B = detail::inertia(bn["inertia"], ctx + ".inertia");
@@ -231,14 +315,17 @@ inline Model load_model(const std::string& path) {
       m.nq += b.nq;
       m.nu += b.nu;
     };
-    switch (b.joint) {
-      case JointType::revolute: add({"angle"}, {"angle_rate"}); break;
-      case JointType::prismatic: add({"disp"}, {"disp_rate"}); break;
-      case JointType::fixed: add({}, {}); break;
-      case JointType::free:
-        add({"x", "y", "z", "qw", "qx", "qy", "qz"}, {"vx", "vy", "vz", "wx", "wy", "wz"});
-        break;
-    }
+    static const std::map<JointType, std::pair<std::vector<std::string>, std::vector<std::string>>> names = {
+        {JointType::revolute, {{"angle"}, {"angle_rate"}}},
+        {JointType::prismatic, {{"disp"}, {"disp_rate"}}},
+        {JointType::fixed, {{}, {}}},
+        {JointType::free, {{"x", "y", "z", "qw", "qx", "qy", "qz"}, {"vx", "vy", "vz", "wx", "wy", "wz"}}},
+        {JointType::universal, {{"angle1", "angle2"}, {"angle1_rate", "angle2_rate"}}},
+        {JointType::gimbal, {{"angle1", "angle2", "angle3"}, {"angle1_rate", "angle2_rate", "angle3_rate"}}},
+        {JointType::cylindrical, {{"angle", "disp"}, {"angle_rate", "disp_rate"}}},
+        {JointType::planar, {{"x", "y", "angle"}, {"x_rate", "y_rate", "angle_rate"}}},
+        {JointType::ball, {{"qw", "qx", "qy", "qz"}, {"wx", "wy", "wz"}}}};
+    add(names.at(b.joint).first, names.at(b.joint).second);
     index[b.name] = int(m.bodies.size());
     m.bodies.push_back(std::move(b));
   }
@@ -287,7 +374,7 @@ inline State load_state(const Model& m, const std::optional<std::string>& path) 
     const auto gq = check("q", m.q_names), gu = check("u", m.u_names);
     // A quaternion given (in full) in the state replaces the initial one as a whole.
     for (const Body& b : m.bodies) {
-      if (b.joint != JointType::free) continue;
+      if (b.quaternion_offset() < 0) continue;
       int n = 0;
       for (const char* c : {".qw", ".qx", ".qy", ".qz"}) n += int(gq.count(b.name + c));
       if (n != 0 && n != 4) throw Refused(*path + ": q: quaternion of '" + b.name + "' given in part");
@@ -303,8 +390,8 @@ inline State load_state(const Model& m, const std::optional<std::string>& path) 
   for (int i = 0; i < m.nq; ++i) if (q.count(m.q_names[i])) s.q(i) = q.at(m.q_names[i]);
   for (int i = 0; i < m.nu; ++i) if (u.count(m.u_names[i])) s.u(i) = u.at(m.u_names[i]);
   for (const Body& b : m.bodies) {
-    if (b.joint != JointType::free) continue;
-    auto quat = s.q.segment<4>(b.q_index + 3);
+    if (b.quaternion_offset() < 0) continue;
+    auto quat = s.q.segment<4>(b.q_index + b.quaternion_offset());
     int n = 0;
     for (const char* c : {".qw", ".qx", ".qy", ".qz"}) n += int(q.count(b.name + c));
     if (n == 0) quat << 1, 0, 0, 0;

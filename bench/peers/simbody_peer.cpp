@@ -19,6 +19,14 @@
 //     q = θ, u = θ̇: exactly dynamics.md's table.
 //   * prismatic -> Slider (along the common x axis), the same with R_A x = a:
 //     R_PB = R_PJ, origin p_PJ + R_PJ a s, q = s, u = ṡ.
+//   * cylindrical -> Cylinder (common z, R_A z = a); q = (angle, disp) as ours.
+//   * universal -> Universal (x, then the new y): R_A = [a1 a2 a1×a2] for
+//     orthogonal axes; gimbal -> Gimbal (body-fixed x, y, z): R_A = [a1 a2 a1×a2],
+//     a left-handed triple (a1×a2 = -a3) with its third angle negated. Non-orthogonal axes are refused
+//     (Simbody has no mobilizer with those coordinates).
+//   * planar -> Planar (F = J): Simbody's q = (angle, x, y), ours (x, y, angle).
+//   * ball -> Ball (F = J, M = B): Simbody's u is ω_FM in F, ours ω_B:
+//     u_F = R_FM ω_B; the quaternion is set by fitting R(quat).
 //   * fixed -> Weld with X_PF = (R_PJ, p_PJ), X_BM = identity.
 //   * free -> Free with X_PF = (R_PJ, p_PJ), X_BM = identity (so F = J, M = B):
 //     q = [quat_FM (w x y z), p_FM], u = [ω_FM, v_FM] both in F: converted below.
@@ -68,6 +76,97 @@ SimTK::MassProperties mass_properties(const peers::Body& b) {
   return SimTK::MassProperties(b.mass, to_simtk(c), SimTK::Inertia(M));
 }
 
+/// How our speeds k = 0..nu-1 of a joint sit among Simbody's mobilities of the
+/// same mobilizer: Simbody's u[index[k]] = sign[k] * our u[k] (also q; a ball's
+/// and a free joint's speeds are rotated instead, below).
+struct Map {
+  std::vector<int> index;
+  std::vector<double> sign;
+};
+
+/// Columns of a right-handed frame R_A for a sequence of mutually orthogonal
+/// rotation axes (a1, a2[, a3]) that Simbody's Universal (x, then the new y) or
+/// Gimbal (x, new y, new z) turns about: R_A x = a1, R_A y = a2, R_A z = a1×a2 =
+/// ±a3 (sign returned: Rot(a3, q3) = Rot(R_A z, sign q3)). Refused when the axes
+/// are not orthogonal: those have no Simbody mobilizer of the same coordinates.
+std::pair<Matrix3d, double> orthogonal_frame(const peers::Body& b) {
+  const Vector3d a1 = b.motions[0].axis, a2 = b.motions[1].axis;
+  constexpr double tol = 1e-12;
+  if (std::abs(a1.dot(a2)) > tol)
+    throw Refused("body '" + b.name + "': Simbody has no mobilizer for non-orthogonal joint axes");
+  Matrix3d R_A;
+  R_A.col(0) = a1;
+  R_A.col(1) = a2;
+  R_A.col(2) = a1.cross(a2);
+  double sign = 1;
+  if (b.motions.size() == 3) {
+    const double c = b.motions[2].axis.dot(R_A.col(2));
+    if (std::abs(std::abs(c) - 1) > tol)
+      throw Refused("body '" + b.name + "': Simbody's Gimbal turns about three orthogonal axes (x, y, z)");
+    sign = c > 0 ? 1 : -1;
+  }
+  return {R_A, sign};
+}
+
+Map mobility_map(const peers::Body& b) {
+  switch (b.joint) {
+    case JointType::planar: return {{1, 2, 0}, {1, 1, 1}};  // Simbody: (angle, x, y)
+    case JointType::gimbal: return {{0, 1, 2}, {1, 1, orthogonal_frame(b).second}};
+    default: {
+      Map m;
+      for (int k = 0; k < b.nu; ++k) {
+        m.index.push_back(k);
+        m.sign.push_back(1);
+      }
+      return m;
+    }
+  }
+}
+
+/// The Simbody mobilizer of one kanegen joint, with its frames F (in the parent,
+/// X_PF) and M (in the body, X_BM) chosen so that R_PB and the body origin follow
+/// dynamics.md's joint table for every q.
+SimTK::MobilizedBody mobilizer(const peers::Body& b, SimTK::MobilizedBody& parent, const SimTK::Body::Rigid& info) {
+  using namespace SimTK;
+  auto frames = [&](const Matrix3d& R_A) {
+    return std::pair{transform(b.R_PJ * R_A, b.p_PJ), transform(R_A, Vector3d::Zero())};
+  };
+  switch (b.joint) {
+    case JointType::revolute: {
+      const auto [X_PF, X_BM] = frames(frame_with_axis(b.motions[0].axis, 2));  // R_A z = a
+      return MobilizedBody::Pin(parent, X_PF, info, X_BM);
+    }
+    case JointType::prismatic: {
+      const auto [X_PF, X_BM] = frames(frame_with_axis(b.motions[0].axis, 0));  // R_A x = a
+      return MobilizedBody::Slider(parent, X_PF, info, X_BM);
+    }
+    case JointType::cylindrical: {
+      const auto [X_PF, X_BM] = frames(frame_with_axis(b.motions[0].axis, 2));  // R_A z = a
+      return MobilizedBody::Cylinder(parent, X_PF, info, X_BM);
+    }
+    case JointType::universal: {
+      const auto [X_PF, X_BM] = frames(orthogonal_frame(b).first);
+      return MobilizedBody::Universal(parent, X_PF, info, X_BM);
+    }
+    case JointType::gimbal: {
+      // R_A stays proper: a left-handed triple turns about R_A z = -a3 (sign: Map).
+      const auto [X_PF, X_BM] = frames(orthogonal_frame(b).first);
+      return MobilizedBody::Gimbal(parent, X_PF, info, X_BM);
+    }
+    case JointType::planar: {
+      const auto [X_PF, X_BM] = frames(Matrix3d::Identity());
+      return MobilizedBody::Planar(parent, X_PF, info, X_BM);
+    }
+    case JointType::ball: {
+      const auto [X_PF, X_BM] = frames(Matrix3d::Identity());
+      return MobilizedBody::Ball(parent, X_PF, info, X_BM);
+    }
+    case JointType::fixed: return MobilizedBody::Weld(parent, transform(b.R_PJ, b.p_PJ), info, Transform());
+    case JointType::free: return MobilizedBody::Free(parent, transform(b.R_PJ, b.p_PJ), info, Transform());
+  }
+  throw Refused("body '" + b.name + "': unhandled joint type");
+}
+
 class SimbodyPeer {
  public:
   explicit SimbodyPeer(const Model& model) : model_(model), matter_(system_), forces_(system_) {
@@ -76,29 +175,15 @@ class SimbodyPeer {
     for (const peers::Body& b : model.bodies) {
       MobilizedBody& parent = b.parent < 0 ? matter_.updGround() : mobod_[b.parent];
       const SimTK::Body::Rigid info(mass_properties(b));
-      switch (b.joint) {
-        case JointType::revolute: {
-          const Matrix3d R_A = frame_with_axis(b.axis_J, 2);  // R_A z = a
-          mobod_.push_back(MobilizedBody::Pin(parent, transform(b.R_PJ * R_A, b.p_PJ), info,
-                                              transform(R_A, Vector3d::Zero())));
-          break;
-        }
-        case JointType::prismatic: {
-          const Matrix3d R_A = frame_with_axis(b.axis_J, 0);  // R_A x = a
-          mobod_.push_back(MobilizedBody::Slider(parent, transform(b.R_PJ * R_A, b.p_PJ), info,
-                                                 transform(R_A, Vector3d::Zero())));
-          break;
-        }
-        case JointType::fixed:
-          mobod_.push_back(MobilizedBody::Weld(parent, transform(b.R_PJ, b.p_PJ), info, Transform()));
-          break;
-        case JointType::free:
-          mobod_.push_back(MobilizedBody::Free(parent, transform(b.R_PJ, b.p_PJ), info, Transform()));
-          break;
-      }
-      if (b.joint == JointType::revolute || b.joint == JointType::prismatic) {
-        if (b.stiffness != 0) Force::MobilityLinearSpring(forces_, mobod_.back(), 0, b.stiffness, b.rest);
-        if (b.damping != 0) Force::MobilityLinearDamper(forces_, mobod_.back(), 0, b.damping);
+      mobod_.push_back(mobilizer(b, parent, info));
+      // Springs and dampers on Simbody's mobilities (sign and order of ours: Map).
+      const Map map = mobility_map(b);
+      for (int k = 0; k < b.nu && b.joint != JointType::free; ++k) {
+        const int mob = map.index[k];
+        const double sign = map.sign[k];
+        if (b.stiffness[k] != 0)
+          Force::MobilityLinearSpring(forces_, mobod_.back(), mob, b.stiffness[k], sign * b.rest[k]);
+        if (b.damping[k] != 0) Force::MobilityLinearDamper(forces_, mobod_.back(), mob, b.damping[k]);
       }
     }
     system_.realizeTopology();
@@ -116,10 +201,18 @@ class SimbodyPeer {
     using namespace SimTK;
     for (std::size_t i = 0; i < model_.bodies.size(); ++i) {
       const peers::Body& b = model_.bodies[i];
-      if (b.joint == JointType::revolute || b.joint == JointType::prismatic) {
-        mobod_[i].setOneQ(state_, 0, s.q(b.q_index));
-        mobod_[i].setOneU(state_, 0, s.u(b.u_index));
-      } else if (b.joint == JointType::free) {
+      if (b.joint == JointType::ball) {
+        const auto q = s.q.segment<4>(b.q_index);  // normalized
+        mobod_[i].setQToFitRotation(state_, to_simtk_rotation(rotation_from_quaternion(q(0), q(1), q(2), q(3))));
+        const Vector3d w_F = rotation_from_quaternion(q(0), q(1), q(2), q(3)) * s.u.segment<3>(b.u_index);
+        for (int k = 0; k < 3; ++k) mobod_[i].setOneU(state_, k, w_F(k));
+      } else if (b.joint != JointType::free) {
+        const Map map = mobility_map(b);
+        for (int k = 0; k < b.nu; ++k) {
+          mobod_[i].setOneQ(state_, map.index[k], map.sign[k] * s.q(b.q_index + k));
+          mobod_[i].setOneU(state_, map.index[k], map.sign[k] * s.u(b.u_index + k));
+        }
+      } else {
         const auto& free = MobilizedBody::Free::downcast(mobod_[i]);
         const auto q = s.q.segment<7>(b.q_index);  // x y z qw qx qy qz, quaternion normalized
         free.setQ(state_, Vec7(q(3), q(4), q(5), q(6), q(0), q(1), q(2)));
@@ -149,9 +242,16 @@ class SimbodyPeer {
     VectorXd ud(model_.nu);
     for (std::size_t i = 0; i < model_.bodies.size(); ++i) {
       const peers::Body& b = model_.bodies[i];
-      if (b.joint == JointType::revolute || b.joint == JointType::prismatic) {
-        ud(b.u_index) = mobod_[i].getOneUDot(state_, 0);
-      } else if (b.joint == JointType::free) {
+      if (b.joint == JointType::ball) {
+        // u_F = R_FM ω_B, Ṙ_FM = R_FM [ω_B]×:  ω̇_B = R_FMᵀ u̇_F (ω_B × ω_B = 0).
+        const auto q = s.q.segment<4>(b.q_index);
+        const Vector3d wdot_F(mobod_[i].getOneUDot(state_, 0), mobod_[i].getOneUDot(state_, 1),
+                              mobod_[i].getOneUDot(state_, 2));
+        ud.segment<3>(b.u_index) = rotation_from_quaternion(q(0), q(1), q(2), q(3)).transpose() * wdot_F;
+      } else if (b.joint != JointType::free) {
+        const Map map = mobility_map(b);
+        for (int k = 0; k < b.nu; ++k) ud(b.u_index + k) = map.sign[k] * mobod_[i].getOneUDot(state_, map.index[k]);
+      } else {
         const auto& free = MobilizedBody::Free::downcast(mobod_[i]);
         const Vec6& a = free.getUDot(state_);
         const auto q = s.q.segment<7>(b.q_index);
