@@ -435,23 +435,35 @@ std::unique_ptr<GeneratedEngine> compile_and_load(const Model& model, const Gene
   return load_or_build(model, so_path, "", o, [&] { return sources; });
 }
 
-std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerator& generator,
-                                          const JitOptions& opts) {
-  JitOptions o = resolved(opts);
-  // A library already cached that does at least as much serves as well:
-  // optimized before quick, with derivatives before without; else the one asked for.
+namespace {
+
+/// The options of a library already cached that does at least as much as `o`
+/// asks: optimized before quick, with derivatives before without.
+std::optional<JitOptions> serving_options(const Model& model, const std::string& generator_hash, const JitOptions& o) {
   auto cached = [&](bool quick, bool derivatives) {
     JitOptions c = o;
     c.quick = quick;
     c.derivatives = derivatives;
-    return jit_cache::verified_record(jit_library_path(model, generator.hash, c)) ? std::optional<JitOptions>(c)
+    return jit_cache::verified_record(jit_library_path(model, generator_hash, c)) ? std::optional<JitOptions>(c)
                                                                                   : std::nullopt;
   };
   std::optional<JitOptions> serving;
   for (const bool quick : {false, o.quick})
     for (const bool derivatives : {true, o.derivatives})
       if (!serving) serving = cached(quick, derivatives);
-  if (serving) o = *serving;
+  return serving;
+}
+
+}  // namespace
+
+bool jit_cached(const Model& model, const CodeGenerator& generator, const JitOptions& opts) {
+  return serving_options(model, generator.hash, resolved(opts)).has_value();
+}
+
+std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerator& generator,
+                                          const JitOptions& opts) {
+  JitOptions o = resolved(opts);
+  if (const auto serving = serving_options(model, generator.hash, o)) o = *serving;
   const std::string so_path = jit_library_path(model, generator.hash, o);
   return load_or_build(model, so_path, generator.hash, o, [&] { return generator.generate(model); });
 }

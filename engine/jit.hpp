@@ -83,6 +83,10 @@ std::string jit_library_path(const Model& model, const std::string& generator_ha
 std::unique_ptr<GeneratedEngine> compile_and_load(const Model& model, const GeneratedSources& sources,
                                                   const std::string& so_path, const JitOptions& opts = {});
 
+/// Whether jit_load would find a library of the model in the cache (one that
+/// does at least as much as `opts` asks), i.e. load it without compiling.
+bool jit_cached(const Model& model, const CodeGenerator& generator, const JitOptions& opts = {});
+
 /// The generated engine of `model`: from the cache, else generated, compiled and cached.
 std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerator& generator,
                                           const JitOptions& opts = {});

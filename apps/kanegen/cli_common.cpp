@@ -1,15 +1,57 @@
 #include "apps/kanegen/cli_common.hpp"
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+
 #include <fmt/format.h>
 
 #include "codegen/jit_generator.hpp"
 #include "engine/generic_engine.hpp"
+#include "engine/handover_engine.hpp"
 #include "engine/jit.hpp"
 #include "engine/model_checks.hpp"
 #include "model/diagnostics.hpp"
 #include "model/model_loader.hpp"
 
 namespace kanegen::cli {
+
+namespace {
+const auto kProcessStart = std::chrono::steady_clock::now();  // static initialization: before main
+}  // namespace
+
+void run_background_compile(const std::string& model_path, bool native) {
+  std::error_code ec;
+  const std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();  // named so in ps
+  std::vector<std::string> argv = {ec ? std::string("/proc/self/exe") : self, "compile", model_path, "--background"};
+  if (native) argv.push_back("--native");
+  std::vector<char*> args;
+  for (auto& a : argv) args.push_back(a.data());
+  args.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  for (const int fd : {STDIN_FILENO, STDOUT_FILENO, STDERR_FILENO})
+    posix_spawn_file_actions_addopen(&fa, fd, "/dev/null", fd == STDIN_FILENO ? O_RDONLY : O_WRONLY, 0);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, args[0], &fa, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) throw std::runtime_error(fmt::format("cannot start kanegen compile: {}", std::strerror(rc)));
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) throw std::runtime_error(fmt::format("waiting for kanegen compile: {}", std::strerror(errno)));
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw std::runtime_error(fmt::format("kanegen compile {} failed (status {})", model_path, status));
+}
+
+double seconds_since_start() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - kProcessStart).count();
+}
 
 Model load_checked(const std::string& path) {
   Model model = load_model(path);
@@ -20,19 +62,37 @@ Model load_checked(const std::string& path) {
 std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name, bool native, bool derivatives,
                                     bool quick) {
   if (name == "generic") return std::make_unique<GenericEngine>(model);
-  if (name == "generated") {
+  JitOptions jit;
+  jit.native = native;
+  jit.derivatives = derivatives;
+  jit.quick = quick;
+  if (name == "auto" && !derivatives && !jit_cached(model, codegen::jit_code_generator(), jit)) {
+    fmt::print(stderr,
+               "kanegen: no compiled code of {} cached: integrating on the generic engine from {:.2f} s on; "
+               "its generated code is built in the background and takes over when ready\n",
+               model.name, seconds_since_start());
+    return std::make_unique<HandoverEngine>(model, [copy = model, jit, native]() -> std::unique_ptr<Engine> {
+      const double t0 = seconds_since_start();
+      run_background_compile(copy.source_path, native);
+      JitOptions load = jit;
+      load.quiet = true;
+      if (!jit_cached(copy, codegen::jit_code_generator(), load))
+        throw std::runtime_error("the background build left no library in the cache");
+      auto e = jit_load(copy, codegen::jit_code_generator(), load);
+      fmt::print(stderr, "kanegen: generated code of {} built in the background in {:.1f} s: it takes over the run\n",
+                 copy.name, seconds_since_start() - t0);
+      return e;
+    });
+  }
+  if (name == "generated" || name == "auto") {
     try {
-      JitOptions jit;
-      jit.native = native;
-      jit.derivatives = derivatives;
-      jit.quick = quick;
       return jit_load(model, codegen::jit_code_generator(), jit);
     } catch (const JitError& e) {  // the generated code of this model does not compile
       throw InputError(Diagnostic{model.source_path, 0, "", e.what()});
     }
   }
   throw InputError(
-      Diagnostic{"--engine", 0, "", fmt::format("unknown engine '{}'; expected generated or generic", name)});
+      Diagnostic{"--engine", 0, "", fmt::format("unknown engine '{}'; expected generated, generic or auto", name)});
 }
 
 State state_for(const Model& model, const std::string& state_path) {
@@ -43,11 +103,15 @@ void add_model_option(CLI::App* c, std::string& model) {
   c->add_option("MODEL", model, "model file (YAML, model-format.md)")->required()->check(CLI::ExistingFile);
 }
 
-void add_engine_option(CLI::App* c, std::string& engine, bool& native) {
-  c->add_option("--engine", engine,
-                "generated: the model's generated code (JIT-compiled, cached); generic: the numeric path")
-      ->check(CLI::IsMember({"generated", "generic"}))
-      ->capture_default_str();
+void add_engine_option(CLI::App* c, std::string& engine, bool& native, bool with_auto) {
+  std::string help = "generated: the model's generated code (JIT-compiled, cached); generic: the numeric path";
+  std::vector<std::string> names = {"generated", "generic"};
+  if (with_auto) {
+    help += "; auto: generated when cached (or an implicit method needs its Jacobian), else generic at once "
+            "while the generated code is built, handing over when it is ready";
+    names.push_back("auto");
+  }
+  c->add_option("--engine", engine, help)->check(CLI::IsMember(names))->capture_default_str();
   c->add_flag("--native", native,
               "compile the generated code for this machine's CPU (-march=native): faster, not portable");
 }

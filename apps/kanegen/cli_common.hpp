@@ -25,6 +25,7 @@ struct Subcommand {
 };
 
 Subcommand add_check(CLI::App& app);
+Subcommand add_compile(CLI::App& app);
 Subcommand add_generate(CLI::App& app);
 Subcommand add_modes(CLI::App& app);
 Subcommand add_crosscheck(CLI::App& app);
@@ -37,7 +38,10 @@ Subcommand add_sweep(CLI::App& app);
 /// load_model() plus the check that M is not singular at the initial state.
 Model load_checked(const std::string& path);
 /// "generated" (JIT, with the generator of codegen/) or "generic"; a compile
-/// failure of the generated code is a refused input.
+/// failure of the generated code is a refused input. "auto" (simulate): the
+/// generated engine when its library is cached or the command needs its
+/// derivatives, else a HandoverEngine: the generic engine at once, the
+/// generated code built in the background and used once ready.
 /// `derivatives`: whether the command needs the generated dual-number
 /// Jacobians (linearize, implicit integrators); without them a first build is
 /// faster (a full library already cached is used all the same).
@@ -49,8 +53,13 @@ State state_for(const Model& model, const std::string& state_path);
 
 /// The MODEL positional argument.
 void add_model_option(CLI::App* c, std::string& model);
-/// --engine generated|generic.
-/// --engine, and --native (the generated code compiled with -march=native).
-void add_engine_option(CLI::App* c, std::string& engine, bool& native);
+/// --engine generated|generic (|auto with `with_auto`), and --native (the
+/// generated code compiled with -march=native).
+void add_engine_option(CLI::App* c, std::string& engine, bool& native, bool with_auto = false);
+/// Runs `kanegen compile MODEL --background` (this executable, low priority,
+/// output to /dev/null) and waits for it; throws when it fails.
+void run_background_compile(const std::string& model_path, bool native);
+/// Seconds since the process started.
+double seconds_since_start();
 
 }  // namespace kanegen::cli

@@ -3,13 +3,14 @@
 
 #include "apps/common/simulation_cli.hpp"
 #include "apps/kanegen/cli_common.hpp"
+#include "engine/handover_engine.hpp"
 
 namespace kanegen::cli {
 
 namespace {
 
 struct Options {
-  std::string model, state, engine = "generated";
+  std::string model, state, engine = "auto";
   bool native = false;
   SimulationCli sim;
 };
@@ -25,15 +26,32 @@ int run(const Options& o) {
                                k == IntegratorKind::dopri5 || k == IntegratorKind::rk4 ||
                                k == IntegratorKind::arkode_erk;
   auto engine = make_engine(model, o.engine, o.native, /*derivatives=*/!explicit_method);
+  auto* handover = dynamic_cast<HandoverEngine*>(engine.get());
+  if (handover) handover->set_horizon(state.t, opt.t_end);
+  int status = 0;
   try {
     const SimulationResult r = simulate_to_file(*engine, state, opt, o.sim.output);
-    fmt::print(stderr, "{} [{} engine], {} rows to {}, max quaternion drift {:.2e}\n{}", r.stats.summary(),
-               engine->name(), r.rows, o.sim.output, r.max_quaternion_drift, describe_quality(r.quality));
+    const std::string engine_label = handover && handover->handed_over()
+                                         ? fmt::format("generic engine, then generated from t = {:.6g} s",
+                                                       handover->handover_time())
+                                         : engine->name() + " engine";
+    fmt::print(stderr, "{} [{}], {} rows to {}, max quaternion drift {:.2e}\n{}", r.stats.summary(), engine_label,
+               r.rows, o.sim.output, r.max_quaternion_drift, describe_quality(r.quality));
   } catch (const IntegrationError& e) {
     fmt::print(stderr, "kanegen simulate: {}\nno output written\n", describe_failure(model, e));
-    return kExitFailure;
+    status = kExitFailure;
   }
-  return 0;
+  if (handover) {
+    if (!handover->build_done())
+      fmt::print(stderr,
+                 "kanegen: run done at {:.2f} s; the generated code of {} goes on building in the background "
+                 "(kanegen compile, nice 10), cached for the next run\n",
+                 seconds_since_start(), model.name);
+    else if (!handover->error().empty())
+      fmt::print(stderr, "kanegen: warning: the generated code of {} did not build ({}); the generic engine ran\n",
+                 model.name, handover->error());
+  }
+  return status;
 }
 
 }  // namespace
@@ -46,7 +64,7 @@ Subcommand add_simulate(CLI::App& app) {
   c->get_option("-o")->required();
   c->add_option("--state", o->state, "initial STATE.json (default: the model's initial state)")
       ->check(CLI::ExistingFile);
-  add_engine_option(c, o->engine, o->native);
+  add_engine_option(c, o->engine, o->native, /*with_auto=*/true);
   return {c, [o] { return run(*o); }};
 }
 

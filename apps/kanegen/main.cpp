@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
                                                  cli::add_modes(app),      cli::add_crosscheck(app),
                                                  cli::add_eval(app),       cli::add_simulate(app),
                                                  cli::add_bench(app),      cli::add_linearize(app),
-                                                 cli::add_sweep(app)};
+                                                 cli::add_sweep(app),      cli::add_compile(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,6 +1,9 @@
 // The command line as users and outside checks drive it (interface.md):
 // exit statuses, messages naming file, line and field, outputs by name.
 #include <catch2/catch.hpp>
+
+#include <chrono>
+#include <thread>
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -227,4 +230,34 @@ TEST_CASE("cli: no CSV header of any model repeats a name; the older speed names
   const Run both = run("eval " + src("models/double_pendulum.yaml") + " --engine generic --state " + (d / "both.json").string());
   CHECK(both.status == 2);
   CHECK(both.out.find("name the same speed") != std::string::npos);
+}
+
+TEST_CASE("cli: a first simulate starts on the generic engine at once; the background build serves the next run",
+          "[cli][handover]") {
+  const fs::path cache = temp_dir() / "cold-cache";
+  fs::remove_all(cache);
+  const std::string env = "KANEGEN_CACHE_DIR=" + cache.string();
+  const std::string csv = (temp_dir() / "first.csv").string();
+  const std::string args = "simulate " + src("models/pendulum.yaml") + " --t-end 1 --no-progress -o " + csv;
+  const Run first = run(args, env);
+  REQUIRE(first.status == 0);
+  CHECK(first.out.find("integrating on the generic engine") != std::string::npos);
+  CHECK(first.out.find("[generic engine]") != std::string::npos);
+  // the background `kanegen compile` publishes the library (poll up to 5 minutes)
+  bool cached = false;
+  for (int i = 0; i < 600 && !cached; ++i) {
+    if (fs::exists(cache))
+      for (const auto& e : fs::directory_iterator(cache))
+        if (e.path().extension() == ".json") cached = true;  // the record: written after the library
+    if (!cached) std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
+  REQUIRE(cached);
+  const Run second = run(args, env);
+  REQUIRE(second.status == 0);
+  CHECK(second.out.find("integrating on the generic engine") == std::string::npos);
+  CHECK(second.out.find("[generated engine]") != std::string::npos);
+  // `kanegen compile` of a cached model is a cache hit
+  const Run compile = run("compile " + src("models/pendulum.yaml"), env);
+  CHECK(compile.status == 0);
+  fs::remove_all(cache);
 }
