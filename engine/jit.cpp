@@ -157,7 +157,7 @@ std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out
   for (auto& f : split_words(o.flags))
     if (f != "-shared" && !(default_flags && f.rfind("-O", 0) == 0)) flags.push_back(f);
   if (o.native) flags.push_back("-march=native");
-  if (o.quick) flags.push_back("-DKANEGEN_NO_DISPATCH");
+  if (o.quick || !o.dispatch) flags.push_back("-DKANEGEN_NO_DISPATCH");
   const std::string include = "-I" + o.include_dir;
   const ManifestFunction* udot = manifest.find("udot");
   const long udot_ops = udot ? udot->ops : 0;
@@ -418,6 +418,7 @@ std::string jit_cache_key(const Model& model, const std::string& generator_hash,
   if (o.native) flags += "\nnative";
   if (!o.derivatives) flags += "\nno derivatives";
   if (o.quick) flags += "\nquick";
+  if (!o.dispatch) flags += "\nno dispatch";
   return fnv1a64_hex(fmt::format("{}\n{}\n{}\n{}\n{}\nplan {}", model_hash(model), KANEGEN_VERSION,
                                  KANEGEN_GENERATED_API_VERSION, generator_hash, flags, kCompilePlanVersion));
 }

@@ -54,6 +54,10 @@ struct JitOptions {
   /// generated code runs 1.2-2x faster (FMA, wider registers), and only on
   /// CPUs with the same instruction sets. Opt-in; part of the cache key.
   bool native = false;
+  /// Compile the u-dot family also for AVX2 (x86-64-v3), picked at load time
+  /// on a CPU that has it (KANEGEN_DISPATCH, model.hpp.in). false: the
+  /// baseline x86-64 code only (what a flight build or a peer's harness gets).
+  bool dispatch = true;
 };
 
 /// $KANEGEN_CACHE_DIR, else $XDG_CACHE_HOME/kanegen, else ~/.cache/kanegen.

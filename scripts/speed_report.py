@@ -144,11 +144,11 @@ def simulate_ratios(bindir, quick):
                 return code, err, (float(w.group(1)) if w else None)
 
             t_end = 10.0
-            code, err, w = sim(t_end, [])
+            code, err, w = sim(t_end, ["--engine", "generated"])
             if code != 0 or w is None:
                 rows.append(dict(model=f[:-5], error=(err.strip().splitlines() or ["?"])[-1]))
                 continue
-            integ = err.split(":")[0].strip()
+            integ = next((l.split(":")[0].strip() for l in err.splitlines() if "rhs evals" in l), "?")
             if w < 0.2:
                 t_end = min(t_end * 0.2 / max(w, 1e-4), 1e4)
             walls = {"generated": [], "generic": []}
@@ -174,9 +174,10 @@ def error_estimates(bindir):
         t_end = 10.0
         with tempfile.TemporaryDirectory() as d:
             code, _, err = run([kanegen, "simulate", path, "--t-end", repr(t_end), "--dt-out", repr(t_end / 50),
-                                "--no-progress", "--estimate-error", "-o", os.path.join(d, "o.csv")])
+                                "--no-progress", "--estimate-error", "--engine", "generated",
+                                "-o", os.path.join(d, "o.csv")])
             est = re.search(r"estimated error ([0-9.e+-]+)", err)
-            integ = err.split(":")[0].strip()
+            integ = next((l.split(":")[0].strip() for l in err.splitlines() if "rhs evals" in l), "?")
             drift = re.search(r"accuracy: (.*)", err)
             code2, _, err2 = run([kanegen, "bench", path, "--engines", "generated", "--integrators", integ,
                                   "--tolerances", "1e-10", "--repeats", "1", "--no-plot", "--t-end", repr(t_end),
@@ -214,6 +215,109 @@ def per_step_overhead(bindir):
                 rows.append(dict(integrator=integ, wall=w, steps=steps, evals=evals, jacs=jacs,
                                  ns_per_eval=w / evals * 1e9))
                 print(f"  overhead {rows[-1]}", file=sys.stderr)
+    return rows
+
+
+COLD_START = [("flexible_spacecraft", 300.0), ("spacecraft_arrays", 300.0), ("gimbaled_spacecraft", 300.0),
+              ("explorer1", 60.0)]
+
+
+def cold_start(bindir):
+    """simulate from a cold cache: --engine auto (generic at once, handover) against --engine generated
+    (compile first), the warm generated run and the generic engine alone."""
+    kanegen = os.path.join(bindir, "kanegen")
+    rows = []
+    first_re = re.compile(r"integrating on the generic engine from ([0-9.]+) s on")
+    for name, t_end in COLD_START:
+        path = os.path.join(ROOT, "models", name + ".yaml")
+        row = dict(model=name, t_end=t_end)
+        with tempfile.TemporaryDirectory() as d:
+            csv = os.path.join(d, "o.csv")
+
+            def sim(cache, extra):
+                env = dict(os.environ, KANEGEN_CACHE_DIR=os.path.join(d, cache))
+                t0 = time.time()
+                code, _, err = run([kanegen, "simulate", path, "--t-end", repr(t_end), "--no-progress", "-o", csv]
+                                   + extra, env=env)
+                return code, time.time() - t0, err
+
+            code, wall, err = sim("auto", [])
+            m = first_re.search(err)
+            row["auto_first_step"] = float(m.group(1)) if m else None
+            row["auto_wall"] = wall if code == 0 else None
+            row["auto_handover"] = "then generated" in err
+            # let the background build finish before timing anything else
+            t0 = time.time()
+            while time.time() - t0 < 600 and not any(f.endswith(".json") for f in os.listdir(os.path.join(d, "auto"))
+                                                      if os.path.isdir(os.path.join(d, "auto"))):
+                time.sleep(0.2)
+            row["auto_build_done_after"] = wall + time.time() - t0
+            code, wall, err = sim("generated", ["--engine", "generated"])
+            row["generated_cold_wall"] = wall if code == 0 else None
+            m = re.search(r"compiled \S+ in ([0-9.]+) s", err)
+            row["compile"] = float(m.group(1)) if m else None
+            code, wall, _ = sim("generated", ["--engine", "generated"])
+            row["generated_warm_wall"] = wall if code == 0 else None
+            code, wall, _ = sim("generated", ["--engine", "generic"])
+            row["generic_wall"] = wall if code == 0 else None
+        print(f"  cold start {row}", file=sys.stderr)
+        rows.append(row)
+    return rows
+
+
+METHODS = ["rkf78", "dopri5", "cvode-bdf", "cvode-bdf2", "cvode-adams", "arkode-erk", "arkode-dirk"]
+
+
+def auto_suite(work):
+    """The models auto is judged on: models/, models/extreme/, and variants of the
+    physical Explorer I (stiffer and more damped whips; a higher spin)."""
+    suite = [os.path.join(ROOT, "models", f) for f in sorted(os.listdir(os.path.join(ROOT, "models")))
+             if f.endswith(".yaml")]
+    suite += [os.path.join(ROOT, "models", "extreme", f)
+              for f in sorted(os.listdir(os.path.join(ROOT, "models", "extreme"))) if f.endswith(".yaml")]
+    base = open(os.path.join(ROOT, "models", "extreme", "explorer1_damped_whips.yaml")).read()
+    variants = {
+        "whips_stiff_damped": [("EI: [0.7952156404, 0.7952156404]", "EI: [3.1808625616, 3.1808625616]"),
+                               ("damping_ratio: 0.05", "damping_ratio: 0.2")],
+        "whips_high_spin": [("bus.wz: 78.539816339744831", "bus.wz: 157.07963267948966")],
+    }
+    for name, subs in variants.items():
+        text = base.replace("name: explorer1_damped_whips", "name: " + name)
+        for a, b in subs:
+            assert a in text, a
+            text = text.replace(a, b)
+        path = os.path.join(work, name + ".yaml")
+        open(path, "w").write(text)
+        suite.append(path)
+    return suite
+
+
+def auto_against_methods(bindir, work, quick):
+    """Every model of auto_suite over 10 s at the defaults (generated engine, --estimate-error):
+    auto against every named adaptive method, wall time (integration) and estimated error."""
+    kanegen = os.path.join(bindir, "kanegen")
+    wall_re = re.compile(r"rhs evals, \d+ jac evals, ([0-9.e+-]+) s")
+    est_re = re.compile(r"estimated error ([0-9.e+-]+)")
+    rows = []
+    for path in auto_suite(work):
+        name = os.path.splitext(os.path.basename(path))[0]
+        row = dict(model=name, methods={})
+        with tempfile.TemporaryDirectory() as d:
+            for method in ["auto"] + METHODS:
+                walls, est, pick = [], None, None
+                for _ in range(1 if quick else 2):
+                    code, _, err = run([kanegen, "simulate", path, "--t-end", "10", "--dt-out", "0.1",
+                                        "--no-progress", "--engine", "generated", "--integrator", method,
+                                        "--estimate-error", "-o", os.path.join(d, "o.csv")], timeout=900)
+                    w, e = wall_re.search(err), est_re.search(err)
+                    if code != 0 or not w:
+                        break
+                    walls.append(float(w.group(1)))
+                    est = float(e.group(1)) if e else None
+                    pick = next((l.split(":")[0].strip() for l in err.splitlines() if "rhs evals" in l), None)
+                row["methods"][method] = dict(wall=min(walls) if walls else None, error=est, pick=pick)
+        print(f"  auto {name} {row['methods'].get('auto')}", file=sys.stderr)
+        rows.append(row)
     return rows
 
 
@@ -268,6 +372,10 @@ def main():
     ests = error_estimates(bindir)
     print("per-step overhead", file=sys.stderr)
     over = per_step_overhead(bindir)
+    print("cold start", file=sys.stderr)
+    cold = cold_start(bindir)
+    print("auto against every method", file=sys.stderr)
+    autos = auto_against_methods(bindir, work, a.quick)
     print("compile", file=sys.stderr)
     chains = [(32, os.path.join(SHARED, "chain_32.yaml")), (64, os.path.join(SHARED, "chain_64.yaml"))]
     if not a.quick:
@@ -289,26 +397,32 @@ def main():
           "Arbitrary geometry: the models of `../shared/bench-models/` (random revolute axes, rotated joint "
           "frames, full inertias, springs, gravity; `bus_4` a free bus with four hinged panels) and "
           "`chain_24_seed7`, another draw of `scripts/make_bench_chain.py`. Median ns per evaluation: kanegen's "
-          "generated u-dot (JIT at the default flags, and with `--native`, i.e. `-march=native`), kanegen's "
+          "generated u-dot compiled for baseline x86-64 alone (*baseline*: the instruction set of Debian's "
+          "MuJoCo build, and what a harness compiling the header at -O2 gets; the headline ratio), at the "
+          "JIT's default flags (*dispatched*: an AVX2 clone picked at load time on this CPU) and with `--native` "
+          "(`-march=native`), kanegen's "
           "generic engine and MuJoCo 2.2's `mj_forward` interleaved in one process; Simbody 3.7 (`realize` "
           "to Acceleration) in its own process right after. u-dot of MuJoCo and Simbody checked against "
           "kanegen's before timing: largest relative difference (last columns), accepted up to 1e-12, or, where "
           "M is ill-conditioned (two correct solvers then differ by up to cond(M)·1e-16), a normwise backward "
           "error of the peer's u-dot in kanegen's M u-dot = F below 1e-14 (given in brackets with cond(M)).", "",
-          "| model | nu | u-dot ops (form) | generated | native | generic | MuJoCo | MuJoCo / generated | "
-          "MuJoCo / native | Simbody | Simbody / generated | diff MuJoCo | diff Simbody |",
-          "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+          "| model | nu | u-dot ops (form) | baseline | dispatched | native | generic | MuJoCo | "
+          "**MuJoCo / baseline** | MuJoCo / dispatched | MuJoCo / native | Simbody | Simbody / baseline | "
+          "diff MuJoCo | diff Simbody |",
+          "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         if "mujoco_error" in r:
             L.append(f"| {r['model']} | | {r['ops']} ({r['form']}) | MuJoCo run failed: {r['mujoco_error']} "
                      "| | | | | | | | | |")
             continue
         sd = r.get("simbody_diff")
-        L.append(f"| {r['model']} | {r.get('nu', '')} | {r['ops']:,} ({r['form']}) | {fmt_ns(r.get('ns_generated'))} | "
+        L.append(f"| {r['model']} | {r.get('nu', '')} | {r['ops']:,} ({r['form']}) | "
+                 f"{fmt_ns(r.get('ns_generated_baseline'))} | {fmt_ns(r.get('ns_generated'))} | "
                  f"{fmt_ns(r.get('ns_generated_native'))} | {fmt_ns(r.get('ns_generic'))} | "
-                 f"{fmt_ns(r.get('ns_mujoco'))} | {ratio(r.get('ns_mujoco'), r.get('ns_generated'))} | "
+                 f"{fmt_ns(r.get('ns_mujoco'))} | **{ratio(r.get('ns_mujoco'), r.get('ns_generated_baseline'))}** | "
+                 f"{ratio(r.get('ns_mujoco'), r.get('ns_generated'))} | "
                  f"{ratio(r.get('ns_mujoco'), r.get('ns_generated_native'))} | {fmt_ns(r.get('ns_simbody'))} | "
-                 f"{ratio(r.get('ns_simbody'), r.get('ns_generated'))} | "
+                 f"{ratio(r.get('ns_simbody'), r.get('ns_generated_baseline'))} | "
                  f"{r.get('max_rel_diff_generated', float('nan')):.1e}{bw(r.get('backward_error_mujoco'), r)} | "
                  f"{'—' if sd is None else format(sd, '.1e')}{bw(r.get('simbody_backward'), r)} |")
     L.append("")
@@ -370,6 +484,61 @@ def main():
         L.append(f"| {o['integrator']} | {o['steps']:,} | {o['evals']:,} | {o['jacs']:,} | {o['wall']:.4f} | "
                  f"{o['ns_per_eval']:,.0f} | {fmt_ns(o['ns_per_eval'] - u8) if u8 else '—'} |")
     L.append("")
+    def sec(x):
+        return "—" if x is None else f"{x:.2f} s"
+
+    L += ["## A first run: cold start", "",
+          "`kanegen simulate` of each model from a cold cache, rkf78 at the defaults (the integrator auto picks "
+          "here), one run each. *auto*: the default `--engine auto`, which starts on the generic engine at once "
+          "while `kanegen compile --background` builds the generated code (first step: when integration began, "
+          "as the command reports it; wall: the command's; the build finishes later, \"built\"). *generated, "
+          "cold*: `--engine generated`, which compiles first (the behaviour before). *warm*: the next run, "
+          "cached. *generic*: `--engine generic`.", "",
+          "| model | horizon | auto: first step | auto: wall | auto handed over | built after | generated, cold | "
+          "(compile) | generated, warm | generic |",
+          "|---|---:|---:|---:|---|---:|---:|---:|---:|---:|"]
+    for r in cold:
+        L.append(f"| {r['model']} | {r['t_end']:g} s | {sec(r.get('auto_first_step'))} | {sec(r.get('auto_wall'))} | "
+                 f"{'yes' if r.get('auto_handover') else 'no'} | {sec(r.get('auto_build_done_after'))} | "
+                 f"{sec(r.get('generated_cold_wall'))} | {sec(r.get('compile'))} | "
+                 f"{sec(r.get('generated_warm_wall'))} | {sec(r.get('generic_wall'))} |")
+    L.append("")
+
+    L += ["## `--integrator auto` against every method", "",
+          "Every model of `models/` and `models/extreme/` and two variants of the physical Explorer I "
+          "(`whips_stiff_damped`: EI x4, 20 % damping; `whips_high_spin`: twice the spin), 10 s at the defaults "
+          "(rtol 1e-10, atol 1e-12), generated engine, `--estimate-error` (the run again at tolerances 100x "
+          "tighter). Each cell: integration wall time (best of the runs) / estimated error. *ratio*: auto's wall "
+          "time over the fastest method whose estimated error is at most 10x auto's; *err ratio*: auto's "
+          "estimated error over that method's.", "",
+          "| model | auto picks | auto | " + " | ".join(METHODS) + " | ratio | err ratio |",
+          "|---|---|---:|" + "---:|" * len(METHODS) + "---:|---:|"]
+    worst_ratio, worst_name = 0.0, ""
+    for r in autos:
+        ms = r["methods"]
+        a0 = ms.get("auto", {})
+
+        def cell(v):
+            if not v or v.get("wall") is None:
+                return "failed"
+            e = v.get("error")
+            return f"{v['wall']:.3g} s / {'—' if e is None else format(e, '.1e')}"
+
+        ratio_s, err_s = "—", "—"
+        if a0.get("wall") is not None and a0.get("error") is not None:
+            ok = [(v["wall"], m, v["error"]) for m, v in ms.items() if m != "auto" and v.get("wall") is not None
+                  and v.get("error") is not None and v["error"] <= 10 * max(a0["error"], 1e-300)]
+            if ok:
+                w, m, e = min(ok)
+                rr = a0["wall"] / w
+                ratio_s, err_s = f"{rr:.2f} ({m})", f"{a0['error'] / max(e, 1e-300):.2g}"
+                if rr > worst_ratio:
+                    worst_ratio, worst_name = rr, r["model"]
+        L.append(f"| {r['model']} | {a0.get('pick') or '—'} | {cell(a0)} | " +
+                 " | ".join(cell(ms.get(m)) for m in METHODS) + f" | {ratio_s} | {err_s} |")
+    L += ["", f"Worst ratio: {worst_ratio:.2f} ({worst_name}). Times below ~0.05 s are within the noise of "
+          "process start-up and a shared machine.", ""]
+
     L += ["## Generation and JIT compilation, cold cache", "",
           "`kanegen eval` of a bench chain with an empty JIT cache (generation, compilation of every part in "
           "parallel on the 2 cores, link, one evaluation). Memory: the largest compiler process, and the sum "

@@ -4,7 +4,8 @@
 //   mujoco_peer MODEL.yaml [--state S.json] [--check REF.json] [--time N] [--xml OUT.xml]
 //               [--kanegen] [--rounds R] [--work-precision REF_END.json --t-end T]
 //
-// With --kanegen, kanegen's generated (JIT) and generic engines are built from
+// With --kanegen, kanegen's generated (JIT: at the default flags, which add an
+// AVX2 clone picked at load time, and for baseline x86-64 alone) and generic engines are built from
 // the same file by kanegen's own loader, their u-dot checked against MuJoCo's
 // (--tol) and all three timed interleaved in this process (R rounds, each
 // engine one batch of ~1 ms per round; medians). With --work-precision, the
@@ -391,6 +392,11 @@ int main(int argc, char** argv) {
     const auto jit_t0 = Clock::now();
     auto generated = kanegen::jit_load(km, kanegen::codegen::jit_code_generator());
     j["kanegen_jit_seconds"] = std::chrono::duration<double>(Clock::now() - jit_t0).count();
+    // the baseline x86-64 code alone (no AVX2 clone): the instruction set of
+    // Debian's MuJoCo build, what an outside harness compiling the header gets
+    kanegen::JitOptions jb;
+    jb.dispatch = false;
+    auto generated_baseline = kanegen::jit_load(km, kanegen::codegen::jit_code_generator(), jb);
     std::unique_ptr<kanegen::GeneratedEngine> generated_native;
     if (native) {
       kanegen::JitOptions jn;
@@ -423,7 +429,14 @@ int main(int argc, char** argv) {
       std::vector<std::function<void()>> engines{[&] { peer.forward(); },
                                                  [&] { generated->udot(q, u, tau, ud_gen); },
                                                  [&] { generic.udot(q, u, tau, ud_gen2); }};
-      kanegen::VecX ud_nat;
+      kanegen::VecX ud_base, ud_nat;
+      generated_baseline->udot(q, u, tau, ud_base);
+      j["max_rel_diff_generated_baseline"] = max_rel(ud_base, ud);
+      if (!(max_rel(ud_base, ud) <= opt.tol || backward_error(M, F, ud_base) <= kBackwardTol)) {
+        std::cerr << "mujoco_peer: baseline u-dot differs from MuJoCo's: not timed\n";
+        status = 1;
+      }
+      engines.push_back([&] { generated_baseline->udot(q, u, tau, ud_base); });
       if (generated_native) {
         generated_native->udot(q, u, tau, ud_nat);
         j["max_rel_diff_generated_native"] = max_rel(ud_nat, ud);
@@ -438,7 +451,8 @@ int main(int argc, char** argv) {
       j["ns_mujoco"] = ns[0];
       j["ns_generated"] = ns[1];
       j["ns_generic"] = ns[2];
-      if (ns.size() > 3) j["ns_generated_native"] = ns[3];
+      j["ns_generated_baseline"] = ns[3];
+      if (ns.size() > 4) j["ns_generated_native"] = ns[4];
     }
     if (status == 0 && !wp_ref.empty()) {
       const kanegen::State ref = kanegen::load_state(km, wp_ref);
