@@ -60,7 +60,7 @@ def peer_udot(bindir, model, quick, rows):
         code, out, err = run([mj, model, "--kanegen", "--native", "--rounds", "11" if quick else "31"])
         if code == 0:
             j = json.loads(out)
-            row.update({k: j.get(k) for k in ("ns_mujoco", "ns_generated", "ns_generated_native", "ns_generic",
+            row.update({k: j.get(k) for k in ("ns_mujoco", "ns_generated", "ns_generated_native", "ns_generated_baseline", "ns_generic",
                                                "max_rel_diff_generated", "kanegen_jit_seconds",
                                                "backward_error_mujoco", "cond_M")})
             row["nu"] = len(j["u_names"])
