@@ -85,6 +85,7 @@ void Engine::set_parameters(const VecX& p) {
   apply_parameters(m, model_.parameters, p);  // throws for a value out of its domain
   do_set_parameters(m);
   p_ = p;
+  parameters_changed();
 }
 
 void Engine::outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) {

@@ -111,6 +111,8 @@ class Engine {
   virtual void do_outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) = 0;
   /// Called by set_parameters() with the new values (validated by applying them to a copy of the model).
   virtual void do_set_parameters(const Model& with_values) { (void)with_values; }
+  /// Called after parameters() took new values.
+  virtual void parameters_changed() {}
   virtual bool do_input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B) {
     (void)t, (void)q, (void)u, (void)tau, (void)B;
     return false;

@@ -19,8 +19,11 @@ class GeneratedEngine final : public Engine {
   /// `library` keeps the shared object holding `api` loaded (may be null when
   /// the code is linked in). Throws std::runtime_error on any mismatch
   /// between the table and the model (or `expected_generator_hash`, if not empty).
+  /// `implicit`: parameters the code takes after the model's own
+  /// (implicit_parameters(), model/parameters.hpp), fed with the model's
+  /// values: the code was generated from the model with them appended.
   GeneratedEngine(const Model& model, const KanegenGeneratedApi* api, std::shared_ptr<void> library = nullptr,
-                  const std::string& expected_generator_hash = {});
+                  const std::string& expected_generator_hash = {}, std::vector<RuntimeParameter> implicit = {});
   std::string name() const override { return "generated"; }
 
   bool has_jacobian() const override { return jacobian_ != nullptr; }
@@ -37,7 +40,7 @@ class GeneratedEngine final : public Engine {
   /// then throws the SingularMassMatrix that names it).
   int state_derivative(double t, const double* x, const double* tau, double* xdot) const {
     const int nq = model().nq;
-    const KanegenArgs a{t, x, x + nq, tau, nullptr, inputs().data(), parameters().data()};
+    const KanegenArgs a{t, x, x + nq, tau, nullptr, inputs().data(), code_parameters_.data()};
     qdot_(&a, xdot);
     return udot_(&a, xdot + nq);
   }
@@ -57,6 +60,7 @@ class GeneratedEngine final : public Engine {
   void do_outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) override;
   bool do_input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B) override;
   bool do_output_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& CD) override;
+  void parameters_changed() override;
 
  private:
   [[noreturn]] void missing_output(const char* what) const;
@@ -69,6 +73,8 @@ class GeneratedEngine final : public Engine {
                      outputs_ = nullptr, input_jacobian_ = nullptr, output_jacobian_ = nullptr;
   std::vector<double> wrenches_;
   MatX M_row_major_;
+  /// What the code's prm[] gets: the model's parameters, then the implicit ones.
+  VecX code_parameters_;
 };
 
 }  // namespace kanegen

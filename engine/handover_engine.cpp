@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <thread>
 
 #include <fmt/format.h>
@@ -10,23 +11,31 @@
 
 namespace kanegen {
 
-HandoverEngine::HandoverEngine(const Model& model, std::function<std::unique_ptr<Engine>()> build)
+namespace {
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+HandoverEngine::HandoverEngine(const Model& model, std::function<void()> build,
+                               std::function<std::unique_ptr<Engine>()> load)
     : Engine(model),
       generic_(std::make_unique<GenericEngine>(model)),
       build_(std::make_shared<Build>()),
+      load_(std::move(load)),
       handover_t_(std::nan("")) {
-  build_->make = std::move(build);
+  build_->run = std::move(build);
   std::thread([b = build_] {
-    std::unique_ptr<Engine> e;
     std::string error;
     try {
-      e = b->make();
+      b->run();
     } catch (const std::exception& ex) {
       error = ex.what();
+    } catch (...) {
+      error = "unknown failure";
     }
     {
       std::lock_guard<std::mutex> lock(b->mutex);
-      b->engine = std::move(e);
       b->error = std::move(error);
       b->ready.store(true, std::memory_order_release);
     }
@@ -34,52 +43,69 @@ HandoverEngine::HandoverEngine(const Model& model, std::function<std::unique_ptr
   }).detach();
 }
 
-void HandoverEngine::wait() const {
+bool HandoverEngine::wait(double seconds) const {
   std::unique_lock<std::mutex> lock(build_->mutex);
-  build_->done.wait(lock, [this] { return build_->ready.load(std::memory_order_acquire); });
+  return build_->done.wait_for(lock, std::chrono::duration<double>(seconds),
+                               [this] { return build_->ready.load(std::memory_order_acquire); });
 }
 
-std::string HandoverEngine::error() const { return build_done() ? build_->error : std::string(); }
+std::string HandoverEngine::error() const {
+  if (!build_done()) return "";
+  return !build_->error.empty() ? build_->error : load_error_;
+}
 
 std::string HandoverEngine::name() const {
   if (!compiled_) return "generic";
   return fmt::format("generic, then generated from t = {:.6g} s", handover_t_);
 }
 
-void HandoverEngine::set_horizon(double t0, double t_end, double wait_beyond) {
+void HandoverEngine::set_horizon(double t0, double t_end, double wait_beyond, double max_wait) {
   t0_ = t0;
   t_end_ = t_end;
   wait_beyond_ = wait_beyond;
+  max_wait_ = max_wait;
   horizon_ = t_end > t0;
 }
 
-namespace {
-double now_seconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-}  // namespace
-
 void HandoverEngine::maybe_wait(double t) {
-  if (!horizon_ || (calls_++ & 255) != 0) return;
+  if (!horizon_) return;
+  if (t < last_t_) {  // a run from an earlier time: project afresh
+    wall_start_ = -1;
+    calls_ = 0;
+  }
+  last_t_ = t;
+  if ((calls_++ & 255) != 0) return;
   const double now = now_seconds();
-  if (wall_start_ < 0) wall_start_ = now;
+  if (wall_start_ < 0) {
+    wall_start_ = now;
+    t0_ = t;
+  }
   const double w = now - wall_start_;
   if (w < 1.0 || !(t > t0_)) return;
   const double remaining = w * (t_end_ - t) / (t - t0_);
   if (remaining <= wait_beyond_) return;
-  fmt::print(stderr,
-             "kanegen: at t = {:.6g} s the generic engine would need about {:.0f} s more: waiting for the "
-             "generated code\n",
-             t, remaining);
   horizon_ = false;  // decided once
-  wait();
+  std::fprintf(stderr,
+               "kanegen: at t = %.6g s the generic engine would need about %.0f s more: waiting for the generated "
+               "code\n",
+               t, remaining);
+  wait(max_wait_);
 }
 
 Engine& HandoverEngine::current(double t) {
-  if (!compiled_ && !build_->ready.load(std::memory_order_acquire)) maybe_wait(t);
-  if (!compiled_ && build_->ready.load(std::memory_order_acquire) && build_->engine) {
-    compiled_ = build_->engine.get();
-    handover_t_ = t;
+  if (!load_tried_) {
+    if (!build_done()) maybe_wait(t);
+    if (build_done()) {
+      load_tried_ = true;
+      if (build_->error.empty()) {
+        try {
+          compiled_ = load_();
+          handover_t_ = t;
+        } catch (const std::exception& e) {
+          load_error_ = e.what();
+        }
+      }
+    }
   }
   return synced(compiled_ ? *compiled_ : *generic_);
 }

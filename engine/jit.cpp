@@ -26,6 +26,7 @@
 #include "engine/manifest.hpp"
 #include "engine/resources.hpp"
 #include "model/model_hash.hpp"
+#include "model/parameters.hpp"
 #include "model/signal_cleanup.hpp"
 
 #ifndef KANEGEN_VERSION
@@ -349,7 +350,8 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
 
 /// dlopen + dlsym of a verified library; throws std::runtime_error.
 std::unique_ptr<GeneratedEngine> open_library(const Model& model, const std::string& path,
-                                              const std::string& api_symbol, const std::string& generator_hash) {
+                                              const std::string& api_symbol, const std::string& generator_hash,
+                                              const std::vector<RuntimeParameter>& implicit) {
   void* h = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!h) {
     const char* e = dlerror();
@@ -359,7 +361,7 @@ std::unique_ptr<GeneratedEngine> open_library(const Model& model, const std::str
   dlerror();
   auto fn = reinterpret_cast<KanegenGeneratedApiFn>(dlsym(h, api_symbol.c_str()));
   if (!fn) throw std::runtime_error(fmt::format("kanegen: {}: no symbol {}", path, api_symbol));
-  auto e = std::make_unique<GeneratedEngine>(model, fn(), std::move(handle), generator_hash);
+  auto e = std::make_unique<GeneratedEngine>(model, fn(), std::move(handle), generator_hash, implicit);
   e->set_library_path(path);
   return e;
 }
@@ -369,10 +371,11 @@ std::unique_ptr<GeneratedEngine> open_library(const Model& model, const std::str
 template <class MakeSources>
 std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::string& so_path,
                                                const std::string& generator_hash, const JitOptions& o,
-                                               MakeSources make_sources) {
+                                               MakeSources make_sources,
+                                               const std::vector<RuntimeParameter>& implicit = {}) {
   if (const auto record = jit_cache::verified_record(so_path)) {
     if (announce(o)) fmt::print(stderr, "kanegen: generated code for {} from the cache ({})\n", model.name, so_path);
-    return open_library(model, so_path, record->api_symbol, generator_hash);
+    return open_library(model, so_path, record->api_symbol, generator_hash, implicit);
   }
   const auto t_gen = std::chrono::steady_clock::now();
   const GeneratedSources sources = make_sources();
@@ -383,7 +386,7 @@ std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::st
   build_library(sources, manifest, so_path, o);
   const auto record = jit_cache::verified_record(so_path);
   if (!record) throw std::runtime_error(fmt::format("kanegen: the library just built at {} does not verify", so_path));
-  return open_library(model, so_path, record->api_symbol, generator_hash);
+  return open_library(model, so_path, record->api_symbol, generator_hash, implicit);
 }
 
 }  // namespace
@@ -409,6 +412,13 @@ JitOptions resolved(const JitOptions& opts) {
 
 std::string jit_cache_key(const Model& model, const std::string& generator_hash, const JitOptions& opts) {
   const JitOptions o = resolved(opts);
+  if (o.implicit_parameters) {
+    if (const Model m = with_implicit_parameters(model); m.parameters.size() != model.parameters.size()) {
+      JitOptions plain = o;
+      plain.implicit_parameters = false;
+      return jit_cache_key(m, generator_hash, plain);
+    }
+  }
   std::string flags = join_quoted(split_words(o.compiler)) + "\n" + join_quoted(split_words(o.flags));
   if (o.only_set) {
     std::vector<std::string> only = o.only;
@@ -466,7 +476,13 @@ std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerato
   JitOptions o = resolved(opts);
   if (const auto serving = serving_options(model, generator.hash, o)) o = *serving;
   const std::string so_path = jit_library_path(model, generator.hash, o);
-  return load_or_build(model, so_path, generator.hash, o, [&] { return generator.generate(model); });
+  // the code is generated from the model with its implicit parameters appended
+  // (a value edited in the model file then reuses the cached library)
+  const std::vector<RuntimeParameter> implicit =
+      o.implicit_parameters ? implicit_parameters(model) : std::vector<RuntimeParameter>{};
+  return load_or_build(
+      model, so_path, generator.hash, o,
+      [&] { return generator.generate(implicit.empty() ? model : with_implicit_parameters(model)); }, implicit);
 }
 
 }  // namespace kanegen

@@ -58,6 +58,10 @@ struct JitOptions {
   /// on a CPU that has it (KANEGEN_DISPATCH, model.hpp.in). false: the
   /// baseline x86-64 code only (what a flight build or a peer's harness gets).
   bool dispatch = true;
+  /// Keep the model's non-zero joint springs, dampers and modal damping ratios
+  /// as inputs of the code (implicit_parameters(), model/parameters.hpp), so
+  /// that editing one in the model file reuses the cached library.
+  bool implicit_parameters = true;
 };
 
 /// $KANEGEN_CACHE_DIR, else $XDG_CACHE_HOME/kanegen, else ~/.cache/kanegen.

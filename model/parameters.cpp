@@ -222,3 +222,35 @@ void apply_parameters(Model& model, const std::vector<RuntimeParameter>& params,
 }
 
 }  // namespace kanegen
+
+namespace kanegen {
+
+std::vector<RuntimeParameter> implicit_parameters(const Model& model) {
+  std::vector<RuntimeParameter> out;
+  auto keep = [&](const std::vector<RuntimeParameter>& candidates) {
+    for (const RuntimeParameter& p : candidates)
+      if (parameter_value(model, p) != 0.0 && find_parameter(model.parameters, p.kind, p.body, p.index) < 0)
+        out.push_back(p);
+  };
+  for (const Body& b : model.bodies) {
+    const JointTraits& jt = joint_traits(b.joint.type);
+    const bool springs = !b.joint.prescribed() && jt.springs > 0;
+    const bool ball_damper = !b.joint.prescribed() && jt.damping_only;
+    if (springs)
+      for (const char* stem : {".stiffness", ".damping", ".rest"}) keep(expand_parameter(model, b.name + stem));
+    else if (ball_damper)
+      keep(expand_parameter(model, b.name + ".damping"));
+    if (b.flex && b.n_modes() > 0) keep(expand_parameter(model, b.name + ".damping_ratio"));
+  }
+  for (RuntimeParameter& p : out) p.nominal = parameter_value(model, p);
+  return out;
+}
+
+Model with_implicit_parameters(const Model& model) {
+  Model m = model;
+  const std::vector<RuntimeParameter> implicit = implicit_parameters(model);
+  m.parameters.insert(m.parameters.end(), implicit.begin(), implicit.end());
+  return m;
+}
+
+}  // namespace kanegen

@@ -38,6 +38,17 @@ double parameter_value(const Model& model, const RuntimeParameter& p);
 /// non-positive frequency, an inertia that is not positive semi-definite, ...).
 void apply_parameters(Model& model, const std::vector<RuntimeParameter>& params, const VecX& values);
 
+/// The values the JIT keeps as inputs of the generated code although the model
+/// does not declare them (so that editing one in the model file reuses the
+/// cached library): every non-zero joint stiffness, damping and rest and modal
+/// damping ratio not already a declared parameter. They enter the forcing
+/// linearly: keeping them symbolic costs a multiply each, where a folded zero
+/// would cost nothing (zeros stay folded: making one non-zero recompiles).
+/// Nominal values: the model's.
+std::vector<RuntimeParameter> implicit_parameters(const Model& model);
+/// The model with its implicit parameters appended to its runtime parameters.
+Model with_implicit_parameters(const Model& model);
+
 /// The model's runtime parameter of this kind, body and index, or -1.
 int find_parameter(const std::vector<RuntimeParameter>& params, ParameterKind kind, int body, int index);
 

@@ -206,7 +206,8 @@ def per_step_overhead(bindir):
             walls = []
             for _ in range(3):
                 code, _, err = run([kanegen, "simulate", model, "--t-end", "10", "--dt-out", "10", "--no-progress",
-                                    "--integrator", integ, "-o", os.path.join(d, "o.csv")] + extra)
+                                    "--engine", "generated", "--integrator", integ, "-o", os.path.join(d, "o.csv")]
+                                   + extra)
                 m = re.search(r"(\d+) steps, (\d+) rhs evals, (\d+) jac evals, ([0-9.]+) s", err)
                 if code == 0 and m:
                     walls.append((float(m.group(4)), int(m.group(1)), int(m.group(2)), int(m.group(3))))
@@ -247,11 +248,14 @@ def cold_start(bindir):
             row["auto_wall"] = wall if code == 0 else None
             row["auto_handover"] = "then generated" in err
             # let the background build finish before timing anything else
+            auto_dir = os.path.join(d, "auto")
+
+            def built():
+                return os.path.isdir(auto_dir) and any(f.endswith(".json") for f in os.listdir(auto_dir))
             t0 = time.time()
-            while time.time() - t0 < 600 and not any(f.endswith(".json") for f in os.listdir(os.path.join(d, "auto"))
-                                                      if os.path.isdir(os.path.join(d, "auto"))):
+            while time.time() - t0 < 600 and not built():
                 time.sleep(0.2)
-            row["auto_build_done_after"] = wall + time.time() - t0
+            row["auto_build_done_after"] = wall + time.time() - t0 if built() and code == 0 else None
             code, wall, err = sim("generated", ["--engine", "generated"])
             row["generated_cold_wall"] = wall if code == 0 else None
             m = re.search(r"compiled \S+ in ([0-9.]+) s", err)
@@ -413,7 +417,7 @@ def main():
     for r in rows:
         if "mujoco_error" in r:
             L.append(f"| {r['model']} | | {r['ops']} ({r['form']}) | MuJoCo run failed: {r['mujoco_error']} "
-                     "| | | | | | | | | |")
+                     "| | | | | | | | | | | |")
             continue
         sd = r.get("simbody_diff")
         L.append(f"| {r['model']} | {r.get('nu', '')} | {r['ops']:,} ({r['form']}) | "

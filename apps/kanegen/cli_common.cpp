@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include "engine/generic_engine.hpp"
 #include "engine/handover_engine.hpp"
 #include "engine/jit.hpp"
+#include "engine/jit_cache.hpp"
 #include "engine/model_checks.hpp"
 #include "model/diagnostics.hpp"
 #include "model/model_loader.hpp"
@@ -26,27 +28,36 @@ namespace {
 const auto kProcessStart = std::chrono::steady_clock::now();  // static initialization: before main
 }  // namespace
 
-void run_background_compile(const std::string& model_path, bool native) {
+void run_background_compile(const std::string& model_path, bool native, const std::string& log_path) {
   std::error_code ec;
-  const std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();  // named so in ps
-  std::vector<std::string> argv = {ec ? std::string("/proc/self/exe") : self, "compile", model_path, "--background"};
+  const std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();
+  // spawned through /proc/self/exe (this very binary, even if it was replaced
+  // on disk since), named as itself for ps
+  std::vector<std::string> argv = {ec ? std::string("kanegen") : self, "compile", model_path, "--background"};
   if (native) argv.push_back("--native");
   std::vector<char*> args;
   for (auto& a : argv) args.push_back(a.data());
   args.push_back(nullptr);
+  std::filesystem::create_directories(std::filesystem::path(log_path).parent_path(), ec);
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
-  for (const int fd : {STDIN_FILENO, STDOUT_FILENO, STDERR_FILENO})
-    posix_spawn_file_actions_addopen(&fa, fd, "/dev/null", fd == STDIN_FILENO ? O_RDONLY : O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
   pid_t pid = 0;
-  const int rc = posix_spawn(&pid, args[0], &fa, nullptr, args.data(), environ);
+  const int rc = posix_spawn(&pid, "/proc/self/exe", &fa, nullptr, args.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
   if (rc != 0) throw std::runtime_error(fmt::format("cannot start kanegen compile: {}", std::strerror(rc)));
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno == ECHILD) return;  // reaped elsewhere (SIGCHLD ignored): the cache says whether it built
     if (errno != EINTR) throw std::runtime_error(fmt::format("waiting for kanegen compile: {}", std::strerror(errno)));
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw std::runtime_error(fmt::format("kanegen compile {} failed (status {})", model_path, status));
+  }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
+  throw std::runtime_error(fmt::format("kanegen compile {} {} (its messages: {})", model_path,
+                                       WIFEXITED(status) ? fmt::format("exited with status {}", WEXITSTATUS(status))
+                                                         : fmt::format("was killed by signal {}", WTERMSIG(status)),
+                                       log_path));
 }
 
 double seconds_since_start() {
@@ -71,18 +82,22 @@ std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name,
                "kanegen: no compiled code of {} cached: integrating on the generic engine from {:.2f} s on; "
                "its generated code is built in the background and takes over when ready\n",
                model.name, seconds_since_start());
-    return std::make_unique<HandoverEngine>(model, [copy = model, jit, native]() -> std::unique_ptr<Engine> {
-      const double t0 = seconds_since_start();
-      run_background_compile(copy.source_path, native);
-      JitOptions load = jit;
-      load.quiet = true;
-      if (!jit_cached(copy, codegen::jit_code_generator(), load))
-        throw std::runtime_error("the background build left no library in the cache");
-      auto e = jit_load(copy, codegen::jit_code_generator(), load);
-      fmt::print(stderr, "kanegen: generated code of {} built in the background in {:.1f} s: it takes over the run\n",
-                 copy.name, seconds_since_start() - t0);
-      return e;
-    });
+    const double t0 = seconds_since_start();
+    const std::string log = (std::filesystem::path(resolved(jit).cache_dir) /
+                             (jit_cache::file_stem(model.name) + "-background-build.log"))
+                                .string();
+    return std::make_unique<HandoverEngine>(
+        model, [path = model.source_path, native, log] { run_background_compile(path, native, log); },
+        [&model, jit, t0]() -> std::unique_ptr<Engine> {
+          JitOptions load = jit;
+          load.quiet = true;
+          if (!jit_cached(model, codegen::jit_code_generator(), load))
+            throw std::runtime_error("the background build left no library in the cache");
+          auto e = jit_load(model, codegen::jit_code_generator(), load);
+          std::fprintf(stderr, "kanegen: generated code of %s built in the background in %.1f s: it takes over the run\n",
+                       model.name.c_str(), seconds_since_start() - t0);
+          return e;
+        });
   }
   if (name == "generated" || name == "auto") {
     try {

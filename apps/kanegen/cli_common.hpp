@@ -57,8 +57,8 @@ void add_model_option(CLI::App* c, std::string& model);
 /// generated code compiled with -march=native).
 void add_engine_option(CLI::App* c, std::string& engine, bool& native, bool with_auto = false);
 /// Runs `kanegen compile MODEL --background` (this executable, low priority,
-/// output to /dev/null) and waits for it; throws when it fails.
-void run_background_compile(const std::string& model_path, bool native);
+/// its messages to `log_path`) and waits for it; throws when it fails.
+void run_background_compile(const std::string& model_path, bool native, const std::string& log_path);
 /// Seconds since the process started.
 double seconds_since_start();
 

@@ -56,7 +56,9 @@ std::string run(Engine& e, const Model& m, double t_end) {
 
 TEST_CASE("handover engine: a failed build keeps the generic engine, bit for bit", "[handover]") {
   const Model model = load_model(test::source_path("models/double_pendulum.yaml"));
-  HandoverEngine h(model, []() -> std::unique_ptr<Engine> { throw std::runtime_error("no compiler here"); });
+  HandoverEngine h(
+      model, [] { throw std::runtime_error("no compiler here"); },
+      [&model] { return std::unique_ptr<Engine>(test::generated_engine(model)); });
   h.wait();
   CHECK(h.error() == "no compiler here");
   GenericEngine generic(model);
@@ -68,7 +70,8 @@ TEST_CASE("handover engine: a failed build keeps the generic engine, bit for bit
 TEST_CASE("handover engine: a build ready at the start runs the generated code, bit for bit", "[handover][generated]") {
   const Model model = load_model(test::source_path("models/double_pendulum.yaml"));
   auto generated = test::generated_engine(model);
-  HandoverEngine h(model, [&model] { return std::unique_ptr<Engine>(test::generated_engine(model)); });
+  HandoverEngine h(
+      model, [] {}, [&model] { return std::unique_ptr<Engine>(test::generated_engine(model)); });
   h.wait();
   REQUIRE(h.error().empty());
   // energy and momentum come from the generic engine: compare the state columns
@@ -85,10 +88,9 @@ TEST_CASE("handover engine: a build ready during the run takes over; the run agr
   auto generated = test::generated_engine(model);  // cached before the clock matters
   GenericEngine generic(model);
   // the build becomes ready 20 ms into the run; the generic engine alone takes longer for this horizon
-  HandoverEngine h(model, [&model] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    return std::unique_ptr<Engine>(test::generated_engine(model));
-  });
+  HandoverEngine h(
+      model, [] { std::this_thread::sleep_for(std::chrono::milliseconds(20)); },
+      [&model] { return std::unique_ptr<Engine>(test::generated_engine(model)); });
   const double t_end = 200.0;
   std::ostringstream csv;
   const SimulationResult r = simulate(h, initial_state(model), options(t_end), csv);
@@ -103,4 +105,15 @@ TEST_CASE("handover engine: a build ready during the run takes over; the run agr
   CHECK(max_rel_diff(a, last_row(run(generic, model, t_end))) < 1e-7);
   CHECK(max_rel_diff(a, last_row(run(*generated, model, t_end))) < 1e-7);
   CHECK(r.quality.H_drift < 1e-9);
+}
+
+TEST_CASE("handover engine: a failed load keeps the generic engine and says why", "[handover]") {
+  const Model model = load_model(test::source_path("models/double_pendulum.yaml"));
+  HandoverEngine h(
+      model, [] {}, []() -> std::unique_ptr<Engine> { throw std::runtime_error("no library in the cache"); });
+  REQUIRE(h.wait(60.0));
+  GenericEngine generic(model);
+  CHECK(run(h, model, 1.0) == run(generic, model, 1.0));
+  CHECK_FALSE(h.handed_over());
+  CHECK(h.error() == "no library in the cache");
 }

@@ -21,6 +21,8 @@
 #include "engine/jit.hpp"
 #include "model/model_hash.hpp"
 #include "model/model_loader.hpp"
+#include "model/parameters.hpp"
+#include "model/state_io.hpp"
 #include "tests/support/test_support.hpp"
 
 #include "codegen/jit_generator.hpp"
@@ -46,6 +48,9 @@ struct TempCache {
   JitOptions options() const {
     JitOptions o;
     o.cache_dir = dir.string();
+    // the hand-written sources of these tests take no parameters; the real
+    // generator's implicit parameters are tested on their own below
+    o.implicit_parameters = false;
     return o;
   }
 };
@@ -621,4 +626,52 @@ TEST_CASE("a quick build without derivatives is cached apart; a full library, on
   const auto c = jit_load(m, gen, lean);  // now the optimized full library is used
   CHECK(c->library_path() == jit_library_path(m, gen.hash, full));
   CHECK(c->has_jacobian());
+}
+
+TEST_CASE("jit_load: editing a joint spring, damper or modal damping ratio reuses the cached library", "[jit]") {
+  TempCache cache;
+  JitOptions opts = cache.options();
+  opts.implicit_parameters = true;
+  opts.quiet = true;
+  opts.derivatives = false;
+  auto model_text = [](double k, double c, double zeta) {
+    return fmt::format(
+        "name: sprung\ngravity: [0, 0, -9.81]\nbodies:\n"
+        "  - {{name: arm, parent: ground, joint: {{type: revolute, axis: [0, 1, 0], stiffness: {}, damping: {}, rest: 0.2}},\n"
+        "     mass: 2.0, com: [0.5, 0, 0], inertia: [0.01, 0.2, 0.2, 0, 0, 0]}}\n"
+        "  - name: beam\n    parent: arm\n    joint: {{type: fixed, position: [1.0, 0, 0]}}\n"
+        "    flexible:\n      beam: {{length: 1.0, direction: x, mass_per_length: 0.5, EI: [20.0, 30.0], elements: 4, modes: 2}}\n"
+        "      damping_ratio: {}\n"
+        "initial:\n  q: {{arm.angle: 0.3, beam.eta1: 0.01}}\n  u: {{arm.angle_rate: 0.5, beam.eta2_rate: 0.1}}\n",
+        k, c, zeta);
+  };
+  const Model m1 = load_model(test::write_temp("sprung1.yaml", model_text(2.0, 0.1, 0.01)));
+  const Model m2 = load_model(test::write_temp("sprung2.yaml", model_text(5.0, 0.3, 0.05)));
+  const Model m0 = load_model(test::write_temp("sprung0.yaml", model_text(0.0, 0.1, 0.01)));
+  const CodeGenerator gen = codegen::jit_code_generator();
+  CHECK(implicit_parameters(m1).size() == 5);  // stiffness, damping, rest, two damping ratios
+  CHECK(jit_cache_key(m1, gen.hash, opts) == jit_cache_key(m2, gen.hash, opts));
+  CHECK(jit_cache_key(m1, gen.hash, opts) != jit_cache_key(m0, gen.hash, opts));  // a zero stays folded
+  auto e1 = jit_load(m1, gen, opts);
+  CHECK(jit_cached(m2, gen, opts));
+  auto e2 = jit_load(m2, gen, opts);
+  CHECK(e1->library_path() == e2->library_path());
+  int libraries = 0;
+  for (const auto& f : fs::directory_iterator(cache.dir)) libraries += f.path().extension() == ".so";
+  CHECK(libraries == 1);
+  CHECK(e2->parameters().size() == 0);  // the model's own parameters: none declared
+  for (const Model* m : {&m1, &m2}) {
+    GeneratedEngine& e = m == &m1 ? *e1 : *e2;
+    GenericEngine g(*m);
+    const State s = initial_state(*m);
+    VecX a, b;
+    e.udot(s.q, s.u, s.tau, a);
+    g.udot(s.q, s.u, s.tau, b);
+    CHECK((a - b).cwiseAbs().maxCoeff() <= 1e-12 * b.cwiseAbs().maxCoeff());
+  }
+  VecX a, b;
+  const State s = initial_state(m1);
+  e1->udot(s.q, s.u, s.tau, a);
+  e2->udot(s.q, s.u, s.tau, b);
+  CHECK((a - b).cwiseAbs().maxCoeff() > 1e-3);  // the values reached the code
 }
