@@ -320,9 +320,26 @@ def auto_against_methods(bindir, work, quick):
                     est = float(e.group(1)) if e else None
                     pick = next((l.split(":")[0].strip() for l in err.splitlines() if "rhs evals" in l), None)
                 row["methods"][method] = dict(wall=min(walls) if walls else None, error=est, pick=pick)
-        print(f"  auto {name} {row['methods'].get('auto')}", file=sys.stderr)
+        print(f"  auto {row}", file=sys.stderr)
         rows.append(row)
     return rows
+
+
+def read_log(path):
+    """The rows an earlier run printed on stderr (the dicts after each section's label)."""
+    import ast
+    rows, sims, ests, over, cold = [], [], [], [], []
+    for line in open(path):
+        line = line.strip()
+        for prefix, dest in (("simulate ", sims), ("estimate ", ests), ("overhead ", over), ("cold start ", cold)):
+            if line.startswith(prefix + "{"):
+                dest.append(ast.literal_eval(line[len(prefix):]))
+                break
+        else:
+            m = re.match(r"[\w-]+: (\{'model'.*\})$", line)
+            if m and "ns_mujoco" in line or (m and "mujoco_error" in line):
+                rows.append(ast.literal_eval(m.group(1)))
+    return rows, sims, ests, over, cold
 
 
 def compile_costs(bindir, chains):
@@ -348,6 +365,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--quick", action="store_true", help="fewer rounds and repeats, no 128-body compile")
+    ap.add_argument("--from-log", help="write the page from the stderr log of an earlier (possibly interrupted) "
+                    "run instead of measuring; the sections it did not reach are left out")
+    ap.add_argument("--log-commit", help="with --from-log: the commit that run measured")
     a = ap.parse_args()
     bindir = os.path.join(a.build, "bin")
     started = time.time()
@@ -356,45 +376,54 @@ def main():
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
     cxx = run(["c++", "--version"])[1].splitlines()[0]
 
-    work = tempfile.mkdtemp(prefix="kanegen_speed_")
-    chain128 = os.path.join(work, "chain_128.yaml")
-    run([sys.executable, os.path.join(ROOT, "scripts", "make_bench_chain.py"), "128", "--seed", "1", "-o", chain128])
-    tree_draw = os.path.join(work, "chain_24_seed7.yaml")
-    run([sys.executable, os.path.join(ROOT, "scripts", "make_bench_chain.py"), "24", "--seed", "7", "-o", tree_draw])
+    if a.from_log:
+        rows, sims, ests, over, cold = read_log(a.from_log)
+        wp, wp_err, autos, comp, sr = None, "not in the log this page was written from", [], [], ""
+        started = os.path.getmtime(a.from_log)
+        commit = a.log_commit or "?"
+        dirty = ""
+    else:
+        work = tempfile.mkdtemp(prefix="kanegen_speed_")
+        chain128 = os.path.join(work, "chain_128.yaml")
+        run([sys.executable, os.path.join(ROOT, "scripts", "make_bench_chain.py"), "128", "--seed", "1", "-o", chain128])
+        tree_draw = os.path.join(work, "chain_24_seed7.yaml")
+        run([sys.executable, os.path.join(ROOT, "scripts", "make_bench_chain.py"), "24", "--seed", "7", "-o", tree_draw])
 
-    print("u-dot against the peers", file=sys.stderr)
-    rows = []
-    for m in ("chain_2", "chain_4", "chain_8", "chain_16", "chain_32", "chain_64", "tree_15", "bus_4"):
-        peer_udot(bindir, os.path.join(SHARED, m + ".yaml"), a.quick, rows)
-    peer_udot(bindir, tree_draw, a.quick, rows)
-    print("work-precision", file=sys.stderr)
-    img = os.path.join(ROOT, "docs", "img", "speed_work_precision.png")
-    wp, wp_err = work_precision(bindir, img)
-    print("simulate", file=sys.stderr)
-    sims = simulate_ratios(bindir, a.quick)
-    print("error estimates", file=sys.stderr)
-    ests = error_estimates(bindir)
-    print("per-step overhead", file=sys.stderr)
-    over = per_step_overhead(bindir)
-    print("cold start", file=sys.stderr)
-    cold = cold_start(bindir)
-    print("auto against every method", file=sys.stderr)
-    autos = auto_against_methods(bindir, work, a.quick)
-    print("compile", file=sys.stderr)
-    chains = [(32, os.path.join(SHARED, "chain_32.yaml")), (64, os.path.join(SHARED, "chain_64.yaml"))]
-    if not a.quick:
-        chains.append((128, chain128))
-    comp = compile_costs(bindir, chains)
-    print("speed_report (generated vs generic, pin chains)", file=sys.stderr)
-    _, sr, _ = run([os.path.join(bindir, "kanegen_speed_report"), "--chains", "2,7,15,30"] +
-                   (["--quick"] if a.quick else []))
-    shutil.rmtree(work, ignore_errors=True)
-
+        print("u-dot against the peers", file=sys.stderr)
+        rows = []
+        for m in ("chain_2", "chain_4", "chain_8", "chain_16", "chain_32", "chain_64", "tree_15", "bus_4"):
+            peer_udot(bindir, os.path.join(SHARED, m + ".yaml"), a.quick, rows)
+        peer_udot(bindir, tree_draw, a.quick, rows)
+        print("work-precision", file=sys.stderr)
+        img = os.path.join(ROOT, "docs", "img", "speed_work_precision.png")
+        wp, wp_err = work_precision(bindir, img)
+        print("simulate", file=sys.stderr)
+        sims = simulate_ratios(bindir, a.quick)
+        print("error estimates", file=sys.stderr)
+        ests = error_estimates(bindir)
+        print("per-step overhead", file=sys.stderr)
+        over = per_step_overhead(bindir)
+        print("cold start", file=sys.stderr)
+        cold = cold_start(bindir)
+        print("auto against every method", file=sys.stderr)
+        autos = auto_against_methods(bindir, work, a.quick)
+        print("compile", file=sys.stderr)
+        chains = [(32, os.path.join(SHARED, "chain_32.yaml")), (64, os.path.join(SHARED, "chain_64.yaml"))]
+        if not a.quick:
+            chains.append((128, chain128))
+        comp = compile_costs(bindir, chains)
+        print("speed_report (generated vs generic, pin chains)", file=sys.stderr)
+        _, sr, _ = run([os.path.join(bindir, "kanegen_speed_report"), "--chains", "2,7,15,30"] +
+                       (["--quick"] if a.quick else []))
+        shutil.rmtree(work, ignore_errors=True)
     L = ["# Speed", "",
          "<!-- GENERATED by scripts/speed_report.py: do not edit; rerun the script. -->", "",
-         f"**Every figure on this page comes from one run of `/usr/bin/python3 scripts/speed_report.py` on "
-         f"{datetime.datetime.now():%Y-%m-%d %H:%M} (commit {commit}{' + local changes' if dirty else ''}; "
-         f"{(time.time() - started) / 60:.0f} min{', quick mode' if a.quick else ''}), on {cpu} "
+         (f"**Every figure on this page comes from the log of one run of `/usr/bin/python3 scripts/speed_report.py` "
+          f"that ended {datetime.datetime.fromtimestamp(started):%Y-%m-%d %H:%M} (commit {commit}), interrupted: "
+          "the sections it did not reach are left out (written with `--from-log`), on " if a.from_log else
+          f"**Every figure on this page comes from one run of `/usr/bin/python3 scripts/speed_report.py` on "
+          f"{datetime.datetime.now():%Y-%m-%d %H:%M} (commit {commit}{' + local changes' if dirty else ''}; "
+          f"{(time.time() - started) / 60:.0f} min{', quick mode' if a.quick else ''}), on ") + f"{cpu} "
          f"({os.cpu_count()} cores, shared and noisy), {cxx}.** Ratios measured in one process are steadier "
          "than absolute times.", ""]
     L += ["## u-dot per evaluation against MuJoCo and Simbody", "",
@@ -508,6 +537,19 @@ def main():
                  f"{sec(r.get('generated_warm_wall'))} | {sec(r.get('generic_wall'))} |")
     L.append("")
 
+    if autos:
+        L += auto_section(autos)
+    if comp:
+        L += compile_section(comp)
+    if sr:
+        L += pins_section(sr)
+    with open(os.path.join(ROOT, "docs", "speed.md"), "w") as f:
+        f.write("\n".join(L))
+    print(f"wrote docs/speed.md in {(time.time() - started) / 60:.1f} min", file=sys.stderr)
+
+
+def auto_section(autos):
+    L = []
     L += ["## `--integrator auto` against every method", "",
           "Every model of `models/` and `models/extreme/` and two variants of the physical Explorer I "
           "(`whips_stiff_damped`: EI x4, 20 % damping; `whips_high_spin`: twice the spin), 10 s at the defaults "
@@ -543,6 +585,11 @@ def main():
     L += ["", f"Worst ratio: {worst_ratio:.2f} ({worst_name}). Times below ~0.05 s are within the noise of "
           "process start-up and a shared machine.", ""]
 
+    return L
+
+
+def compile_section(comp):
+    L = []
     L += ["## Generation and JIT compilation, cold cache", "",
           "`kanegen eval` of a bench chain with an empty JIT cache (generation, compilation of every part in "
           "parallel on the 2 cores, link, one evaluation). Memory: the largest compiler process, and the sum "
@@ -555,6 +602,11 @@ def main():
             continue
         L.append(f"| {c['n']} | {c['ops']:,} | {c['wall']:.1f} | {c['max_rss_mb']:.0f} | {c['two_largest_mb']:.0f} |")
     L.append("")
+    return L
+
+
+def pins_section(sr):
+    L = []
     L += ["## Generated against generic on every model, and pin chains", "",
           "From `build/bin/kanegen_speed_report --chains 2,7,15,30` (bench/speed_report.cpp): axis-aligned pin "
           "chains (axes cycling z, y, x) and the models of `models/` and `tests/reference/`.", "",
@@ -574,9 +626,7 @@ def main():
             if n in pins:
                 L.append(f"| {n} | {sd:,} | {pins[n][0]:,} | {pins[n][1]} | {pins[n][2]:,} |")
         L.append("")
-    with open(os.path.join(ROOT, "docs", "speed.md"), "w") as f:
-        f.write("\n".join(L))
-    print(f"wrote docs/speed.md in {(time.time() - started) / 60:.1f} min", file=sys.stderr)
+    return L
 
 
 if __name__ == "__main__":
