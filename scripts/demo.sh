@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, simulates explorer1_rigid (minor-axis spin
 # turning into major-axis spin through damping in the antenna hinges) and
-# writes its plots to out/explorer1_rigid/. The default engine runs the
-# model's generated code (generated, compiled and cached on first use).
+# writes its plots to out/explorer1_rigid/. The default engine (auto) runs
+# the model's generated code when it is cached; on a first run it starts on
+# the generic engine while the generated code is built in the background.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
