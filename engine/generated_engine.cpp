@@ -40,9 +40,7 @@ GeneratedEngine::GeneratedEngine(const Model& m, const KanegenGeneratedApi* api,
                                          "{} bodies; regenerate it",
                                          who, api_->nq, api_->nu, api_->nbodies, m.source_path, m.nq, m.nu,
                                          m.bodies.size()));
-  Model generated_from = implicit.empty() ? Model() : m;
-  generated_from.parameters.insert(generated_from.parameters.end(), implicit.begin(), implicit.end());
-  const std::string hash = model_hash(implicit.empty() ? m : generated_from);
+  const std::string hash = model_hash(implicit.empty() ? m : with_parameters(m, implicit));
   if (str_or(api_->model_hash) != hash)
     throw std::runtime_error(fmt::format("{} was generated from a different version of the model (hash {}, the model "
                                          "'{}' has {}); regenerate it",

@@ -482,7 +482,7 @@ std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerato
       o.implicit_parameters ? implicit_parameters(model) : std::vector<RuntimeParameter>{};
   return load_or_build(
       model, so_path, generator.hash, o,
-      [&] { return generator.generate(implicit.empty() ? model : with_implicit_parameters(model)); }, implicit);
+      [&] { return generator.generate(implicit.empty() ? model : with_parameters(model, implicit)); }, implicit);
 }
 
 }  // namespace kanegen

@@ -246,11 +246,12 @@ std::vector<RuntimeParameter> implicit_parameters(const Model& model) {
   return out;
 }
 
-Model with_implicit_parameters(const Model& model) {
+Model with_parameters(const Model& model, const std::vector<RuntimeParameter>& extra) {
   Model m = model;
-  const std::vector<RuntimeParameter> implicit = implicit_parameters(model);
-  m.parameters.insert(m.parameters.end(), implicit.begin(), implicit.end());
+  m.parameters.insert(m.parameters.end(), extra.begin(), extra.end());
   return m;
 }
+
+Model with_implicit_parameters(const Model& model) { return with_parameters(model, implicit_parameters(model)); }
 
 }  // namespace kanegen

@@ -46,7 +46,9 @@ void apply_parameters(Model& model, const std::vector<RuntimeParameter>& params,
 /// would cost nothing (zeros stay folded: making one non-zero recompiles).
 /// Nominal values: the model's.
 std::vector<RuntimeParameter> implicit_parameters(const Model& model);
-/// The model with its implicit parameters appended to its runtime parameters.
+/// The model with `extra` appended to its runtime parameters.
+Model with_parameters(const Model& model, const std::vector<RuntimeParameter>& extra);
+/// with_parameters(model, implicit_parameters(model)).
 Model with_implicit_parameters(const Model& model);
 
 /// The model's runtime parameter of this kind, body and index, or -1.

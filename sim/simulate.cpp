@@ -474,7 +474,8 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     // Generated code has only the energy and momentum the model's outputs ask
     // for; the invariants are then measured on the generic engine, at the same
     // states (a few evaluations per output row, after the run).
-    const bool lacks = dynamic_cast<GeneratedEngine*>(&engine) && !(model.outputs.energy && model.outputs.momentum);
+    const bool lacks = (inv.energy || inv.momentum) && dynamic_cast<GeneratedEngine*>(&engine) &&
+                       !(model.outputs.energy && model.outputs.momentum);
     std::unique_ptr<GenericEngine> measure;
     if (lacks) {
       measure = std::make_unique<GenericEngine>(model);

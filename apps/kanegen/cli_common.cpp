@@ -78,11 +78,11 @@ std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name,
   jit.derivatives = derivatives;
   jit.quick = quick;
   if (name == "auto" && !derivatives && !jit_cached(model, codegen::jit_code_generator(), jit)) {
+    const double t0 = seconds_since_start();
     fmt::print(stderr,
                "kanegen: no compiled code of {} cached: integrating on the generic engine from {:.2f} s on; "
                "its generated code is built in the background and takes over when ready\n",
-               model.name, seconds_since_start());
-    const double t0 = seconds_since_start();
+               model.name, t0);
     const std::string log = (std::filesystem::path(resolved(jit).cache_dir) /
                              (jit_cache::file_stem(model.name) + "-background-build.log"))
                                 .string();
