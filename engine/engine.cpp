@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "engine/locks.hpp"
 #include "model/parameters.hpp"
 
 namespace kanegen {
@@ -38,7 +39,30 @@ void Engine::forcing(double t, const VecX& q, const VecX& u, const VecX& tau, Ve
 void Engine::udot(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& ud) {
   check_sizes(q, {&u, &tau});
   ud.resize(model_.nu);
-  do_udot(t, q, u, tau, ud);
+  if (locked_u_.empty()) {
+    do_udot(t, q, u, tau, ud);
+    return;
+  }
+  // the reduced system, from M and F at u_l = 0 (dynamics.md, Locks)
+  u_lock_ = u;
+  for (int k : locked_u_) u_lock_(k) = 0.0;
+  M_lock_.resize(model_.nu, model_.nu);
+  F_lock_.resize(model_.nu);
+  do_mass_matrix(t, q, M_lock_);
+  do_forcing(t, q, u_lock_, tau, F_lock_);
+  reduced_udot(M_lock_, F_lock_, locked_u_, ud);
+}
+
+void Engine::set_locks(const LockSet& locks) {
+  if (!locks.empty() && locks.size() != model_.bodies.size())
+    throw std::invalid_argument(fmt::format("{} engine: a lock set of {} bodies for a model with {}", name(),
+                                            locks.size(), model_.bodies.size()));
+  for (std::size_t b = 0; b < locks.size(); ++b)
+    if (locks[b] && !joint_can_lock(model_.bodies[b].joint))
+      throw std::invalid_argument(fmt::format("{} engine: the joint of '{}' cannot be locked", name(),
+                                              model_.bodies[b].name));
+  locks_ = locks;
+  locked_u_ = locked_speeds(model_, locks);
 }
 
 EnergyValues Engine::energy(double t, const VecX& q, const VecX& u) {
@@ -61,6 +85,7 @@ bool Engine::jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, M
   check_sizes(q, {&u, &tau});
   const int n = model_.nq + model_.nu;
   J.resize(n, n);
+  if (!locked_u_.empty()) return false;
   return do_jacobian(t, q, u, tau, J);
 }
 

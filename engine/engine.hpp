@@ -54,6 +54,7 @@ class Engine {
   void mass_matrix(double t, const VecX& q, MatX& M);
   void forcing(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& F);
   /// Solves M u_dot = F; throws SingularMassMatrix.
+  /// With joints locked (set_locks), the reduced system's: M_ff u_dot_f = F_f, u_dot_l = 0.
   void udot(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& udot);
   EnergyValues energy(double t, const VecX& q, const VecX& u);
   MomentumValues momentum(double t, const VecX& q, const VecX& u);
@@ -62,6 +63,7 @@ class Engine {
   /// Exact Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u] ((nq+nu)^2),
   /// if this engine provides one; false otherwise (the implicit integrators
   /// then use finite differences). Throws SingularMassMatrix.
+  /// false while joints are locked (the exact Jacobian is the free system's).
   bool jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& J);
   /// Whether jacobian() gives exact Jacobians.
   virtual bool has_jacobian() const { return false; }
@@ -70,6 +72,16 @@ class Engine {
   /// reactions, the Jacobians and outputs use from now on; zero until set
   /// (as MuJoCo's mjData.ctrl). Throws std::invalid_argument on a wrong size.
   void set_inputs(const VecX& w);
+  /// The joints locked from now on (per body, model/events.hpp; dynamics.md
+  /// "Locks"): udot() and the outputs give the reduced system's accelerations,
+  /// the reactions at a locked joint include the locking wrench (pass the
+  /// reduced u_dot). Empty or all free: none locked. Throws
+  /// std::invalid_argument for a wrong size or a joint that cannot lock.
+  void set_locks(const LockSet& locks);
+  const LockSet& locks() const { return locks_; }
+  bool has_locks() const { return !locked_u_.empty(); }
+  /// The speeds the locks hold at zero (ascending).
+  const std::vector<int>& locked_u() const { return locked_u_; }
   const VecX& inputs() const { return w_; }
   /// Values of the model's runtime parameters (model().parameters, in order;
   /// docs/sweeps.md), used by every evaluation from now on; the nominal values
@@ -128,6 +140,10 @@ class Engine {
   const Model& model_;
   VecX w_;
   VecX p_;
+  LockSet locks_;
+  std::vector<int> locked_u_;
+  MatX M_lock_;  ///< workspace of the reduced u_dot
+  VecX F_lock_, u_lock_;
 };
 
 }  // namespace kanegen

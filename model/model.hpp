@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "model/events.hpp"
 #include "model/inputs_outputs.hpp"
 #include "model/runtime_parameter.hpp"
 #include "model/modal_integrals.hpp"
@@ -151,6 +152,8 @@ struct Model {
   /// Runtime parameters (model/parameters.hpp): kept symbolic by the
   /// generator; scalar entries, nominal values from the model.
   std::vector<RuntimeParameter> parameters;
+  /// Events that lock and release joints during a run (model/events.hpp), in file order.
+  std::vector<Event> events;
 
   int body_index(const std::string& name) const;  ///< -1 if absent
   int q_index(const std::string& name) const;     ///< -1 if absent

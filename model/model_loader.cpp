@@ -98,6 +98,8 @@ class Loader {
   };
   std::map<std::string, Given> init_q_, init_u_;
   std::vector<std::pair<std::string, int>> parameter_names_;  ///< `parameters:` entries and their lines
+  YAML::Node events_;  ///< `events:`, read when the model is built (it names bodies and coordinates)
+  bool has_events_ = false;
 
   // ------------------------------------------------------------------ root
   void read_root(const YAML::Node& root) {
@@ -107,7 +109,8 @@ class Loader {
       return;
     }
     if (!ck_.expect_map(root, 1, "(document)")) return;
-    ck_.check_keys(root, "", {"name", "description", "gravity", "bodies", "initial", "inputs", "outputs", "parameters"});
+    ck_.check_keys(root, "", {"name", "description", "gravity", "bodies", "initial", "inputs", "outputs", "parameters",
+                              "events"});
 
     const YAML::Node name = root["name"];
     if (!name.IsDefined()) {
@@ -163,6 +166,10 @@ class Loader {
           parameter_names_.push_back({*s, line_of(ps[i]) ? line_of(ps[i]) : line_of(ps)});
     }
     if (root["outputs"].IsDefined()) read_outputs(root["outputs"]);
+    if (root["events"].IsDefined()) {
+      events_.reset(root["events"]);
+      has_events_ = true;
+    }
   }
 
   // ------------------------------------------------- inputs and sensors
@@ -585,7 +592,7 @@ class Loader {
     if (!ck_.expect_map(j, bi.line, f)) return;
     const int l = kl ? kl : line_of(j);
     ck_.check_keys(j, f, {"type", "axis", "axes", "sequence", "position", "node", "rotation", "stiffness", "damping",
-                          "rest", "motion"});
+                          "rest", "motion", "locked"});
     std::vector<std::string> type_names;
     for (const JointTraits* t : all_joint_traits()) type_names.push_back(t->name);
 
@@ -735,6 +742,22 @@ class Loader {
                                   "expected either motion or {}",
                                   key));
         if (auto m = read_motion(motion, key_line(j, "motion"), f + ".motion")) joint.motion = *m;
+      }
+    }
+
+    // locked from the start (model/events.hpp)
+    if (const YAML::Node lk = j["locked"]; lk.IsDefined()) {
+      if (auto v = ck_.boolean(lk, l, f + ".locked")) {
+        if (*v && motion.IsDefined())
+          ck_.error(lk, l, f + ".locked", "not allowed with motion: (a prescribed joint cannot be locked); expected "
+                                          "either motion or locked");
+        else if (*v && jt.nu() == 0)
+          ck_.error(lk, l, f + ".locked",
+                    fmt::format("not allowed on a {} joint (no degree of freedom); expected locked only on joints "
+                                "with degrees of freedom",
+                                tname));
+        else
+          joint.locked = *v;
       }
     }
 
@@ -1352,7 +1375,24 @@ class Loader {
         bad.push_back(Diagnostic{path_, line, fmt::format("parameters[{}]", i), e.what()});
       }
     }
-    if (!bad.empty()) throw InputError(bad);
+    if (has_events_) read_events(events_, path_, model_, bad);
+    // a joint locked from the start holds its speeds at zero (dynamics.md, Locks)
+    for (const Body& b : model_.bodies) {
+      if (!b.joint.locked) continue;
+      for (int k = 0; k < joint_nu(b.joint); ++k) {
+        const std::string& un = model_.u_names[b.u_joint + k];
+        auto it = init_u_.find(un);
+        if (it != init_u_.end() && it->second.value != 0.0)
+          bad.push_back(Diagnostic{path_, it->second.line, "initial.u." + un,
+                                   fmt::format("{} for a speed of '{}', whose joint is locked: true; expected 0 or "
+                                               "none (a locked joint does not move)",
+                                               num(it->second.value), b.name)});
+      }
+    }
+    if (!bad.empty()) {
+      std::sort(bad.begin(), bad.end(), [](const Diagnostic& a, const Diagnostic& b) { return a.line < b.line; });
+      throw InputError(bad);
+    }
     return std::move(model_);
   }
 };

@@ -20,6 +20,7 @@ State initial_state(const Model& model) {
   s.w = VecX::Zero(model.nw);
   if (model.q0.size() != model.nq)
     for (const auto& slot : model.quaternions) s.q(slot.q) = 1.0;
+  s.locked = initial_locks(model);
   return s;
 }
 
@@ -94,15 +95,18 @@ State load_state(const Model& model, const std::string& path) {
   State s = initial_state(model);
   const auto top = unique_members(root, "");
   const JsonValue::Member* sections[4] = {nullptr, nullptr, nullptr, nullptr};
+  const JsonValue::Member* locked = nullptr;
   for (const auto* m : top) {
     if (m->key == "t") {
       number(*m, "t", s.t);
+    } else if (m->key == "locked") {
+      locked = m;
     } else if (m->key == "q" || m->key == "u" || m->key == "tau" || m->key == "inputs") {
       sections[m->key == "q" ? 0 : m->key == "u" ? 1 : m->key == "tau" ? 2 : 3] = m;
       if (m->key == "q") s.q_line = m->key_line;
     } else {
       err(m->key_line, m->key.empty() ? "''" : m->key,
-          fmt::format("unknown key '{}'; expected only t, q, u, tau, inputs", m->key));
+          fmt::format("unknown key '{}'; expected only t, q, u, tau, inputs, locked", m->key));
     }
   }
 
@@ -148,6 +152,47 @@ State load_state(const Model& model, const std::string& path) {
       (*targets[k])(idx) = x;
       if (k == 0) given_q[m->key] = m->key_line;
     }
+  }
+
+  // "locked": the bodies whose joints are locked at this state; their speeds 0 or absent
+  if (locked) {
+    std::fill(s.locked.begin(), s.locked.end(), 0);
+    if (locked->value.kind != JsonValue::Kind::array) {
+      err(locked->value.line, "locked", fmt::format("got {}; expected a list of body names", locked->value.kind_name()));
+    } else {
+      std::vector<std::string> bodies;
+      for (const Body& b : model.bodies) bodies.push_back(b.name);
+      for (std::size_t k = 0; k < locked->value.items.size(); ++k) {
+        const JsonValue& v = locked->value.items[k];
+        const std::string field = fmt::format("locked[{}]", k);
+        if (v.kind != JsonValue::Kind::string) {
+          err(v.line, field, fmt::format("got {}; expected a body name", v.kind_name()));
+          continue;
+        }
+        const int b = model.body_index(v.text);
+        if (b < 0) {
+          err(v.line, field, fmt::format("no body named '{}'; expected one of: {}", v.text, hint(v.text, bodies)));
+          continue;
+        }
+        if (!joint_can_lock(model.bodies[b].joint)) {
+          err(v.line, field,
+              fmt::format("the joint of '{}' {}; expected a body whose joint has degrees of freedom", v.text,
+                          model.bodies[b].joint.prescribed() ? "is prescribed (motion:)" : "has no degree of freedom"));
+          continue;
+        }
+        s.locked[b] = 1;
+      }
+    }
+  }
+  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
+    if (!s.locked[b]) continue;
+    const Body& body = model.bodies[b];
+    for (int k = 0; k < joint_nu(body.joint); ++k)
+      if (s.u(body.u_joint + k) != 0.0)
+        err(locked ? locked->key_line : 0, "u." + model.u_names[body.u_joint + k],
+            fmt::format("{} for a speed of '{}', whose joint is locked; expected 0 or none (a locked joint does not "
+                        "move)",
+                        s.u(body.u_joint + k), body.name));
   }
 
   // Quaternions: all four components or none; any non-zero norm is

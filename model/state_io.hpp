@@ -15,6 +15,9 @@ struct State {
   VecX tau;  ///< nu generalized inputs
   VecX w;    ///< nw named inputs (docs/gnc.md), by name under "inputs"
   int q_line = 0;  ///< line of "q" in the STATE.json it was read from (0: q from the model)
+  /// Per body: its joint locked (model/events.hpp); the model's `locked: true`
+  /// joints unless a STATE.json lists them under "locked".
+  LockSet locked;
 };
 
 /// The model's `initial:` state, zero inputs.

@@ -37,6 +37,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "bench-models")
 SDFAST_OPS = {7: 2070, 15: 6490, 30: 14000}  # SD/FAST's better form (docs/decisions.md)
+AUTO_RUN_CAP_S = 120  # a method slower than this (with its --estimate-error rerun) on a 10 s run has lost
 
 
 def run(cmd, env=None, timeout=3600):
@@ -309,17 +310,26 @@ def auto_against_methods(bindir, work, quick):
         with tempfile.TemporaryDirectory() as d:
             for method in ["auto"] + METHODS:
                 walls, est, pick = [], None, None
+                over_cap = False
                 for _ in range(1 if quick else 2):
-                    code, _, err = run([kanegen, "simulate", path, "--t-end", "10", "--dt-out", "0.1",
-                                        "--no-progress", "--engine", "generated", "--integrator", method,
-                                        "--estimate-error", "-o", os.path.join(d, "o.csv")], timeout=900)
+                    try:
+                        code, _, err = run([kanegen, "simulate", path, "--t-end", "10", "--dt-out", "0.1",
+                                            "--no-progress", "--engine", "generated", "--integrator", method,
+                                            "--estimate-error", "-o", os.path.join(d, "o.csv")],
+                                           timeout=AUTO_RUN_CAP_S)
+                    except subprocess.TimeoutExpired:
+                        over_cap = True
+                        break
                     w, e = wall_re.search(err), est_re.search(err)
                     if code != 0 or not w:
                         break
                     walls.append(float(w.group(1)))
                     est = float(e.group(1)) if e else None
                     pick = next((l.split(":")[0].strip() for l in err.splitlines() if "rhs evals" in l), None)
-                row["methods"][method] = dict(wall=min(walls) if walls else None, error=est, pick=pick)
+                    if walls[-1] > 5.0:  # a slow method: one run is precise enough
+                        break
+                row["methods"][method] = dict(wall=min(walls) if walls else None, error=est, pick=pick,
+                                              over_cap=over_cap)
         print(f"  auto {row}", file=sys.stderr)
         rows.append(row)
     return rows
@@ -328,10 +338,11 @@ def auto_against_methods(bindir, work, quick):
 def read_log(path):
     """The rows an earlier run printed on stderr (the dicts after each section's label)."""
     import ast
-    rows, sims, ests, over, cold = [], [], [], [], []
+    rows, sims, ests, over, cold, autos, comp = [], [], [], [], [], [], []
     for line in open(path):
         line = line.strip()
-        for prefix, dest in (("simulate ", sims), ("estimate ", ests), ("overhead ", over), ("cold start ", cold)):
+        for prefix, dest in (("simulate ", sims), ("estimate ", ests), ("overhead ", over), ("cold start ", cold),
+                             ("auto ", autos), ("compile ", comp)):
             if line.startswith(prefix + "{"):
                 dest.append(ast.literal_eval(line[len(prefix):]))
                 break
@@ -339,7 +350,7 @@ def read_log(path):
             m = re.match(r"[\w-]+: (\{'model'.*\})$", line)
             if m and "ns_mujoco" in line or (m and "mujoco_error" in line):
                 rows.append(ast.literal_eval(m.group(1)))
-    return rows, sims, ests, over, cold
+    return rows, sims, ests, over, cold, autos, comp
 
 
 def compile_costs(bindir, chains):
@@ -365,9 +376,12 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--quick", action="store_true", help="fewer rounds and repeats, no 128-body compile")
-    ap.add_argument("--from-log", help="write the page from the stderr log of an earlier (possibly interrupted) "
-                    "run instead of measuring; the sections it did not reach are left out")
-    ap.add_argument("--log-commit", help="with --from-log: the commit that run measured")
+    ap.add_argument("--from-log", action="append", help="write the page from the stderr log of an earlier "
+                    "(possibly interrupted) run instead of measuring; the sections it did not reach are left out. "
+                    "Repeat to merge the logs of runs of separate sections (e.g. one from --only auto)")
+    ap.add_argument("--log-commit", help="with --from-log: the commit(s) those runs measured")
+    ap.add_argument("--only", choices=["auto"], help="measure one section only and print its rows on stderr "
+                    "(for --from-log); the page is not written")
     a = ap.parse_args()
     bindir = os.path.join(a.build, "bin")
     started = time.time()
@@ -376,10 +390,22 @@ def main():
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
     cxx = run(["c++", "--version"])[1].splitlines()[0]
 
+    if a.only == "auto":
+        work = tempfile.mkdtemp(prefix="kanegen_speed_")
+        print("auto against every method", file=sys.stderr)
+        auto_against_methods(bindir, work, a.quick)
+        shutil.rmtree(work, ignore_errors=True)
+        print(f"auto section done in {(time.time() - started) / 60:.1f} min (commit {commit}"
+              f"{' + local changes' if dirty else ''}); write the page with --from-log", file=sys.stderr)
+        return
     if a.from_log:
-        rows, sims, ests, over, cold = read_log(a.from_log)
-        wp, wp_err, autos, comp, sr = None, "not in the log this page was written from", [], [], ""
-        started = os.path.getmtime(a.from_log)
+        rows, sims, ests, over, cold, autos, comp = [], [], [], [], [], [], []
+        for path in a.from_log:
+            parts = read_log(path)
+            for dest, got in zip((rows, sims, ests, over, cold, autos, comp), parts):
+                dest.extend(got)
+        wp, wp_err, sr = None, "not in the logs this page was written from", ""
+        started = max(os.path.getmtime(p) for p in a.from_log)
         commit = a.log_commit or "?"
         dirty = ""
     else:
@@ -418,9 +444,10 @@ def main():
         shutil.rmtree(work, ignore_errors=True)
     L = ["# Speed", "",
          "<!-- GENERATED by scripts/speed_report.py: do not edit; rerun the script. -->", "",
-         (f"**Every figure on this page comes from the log of one run of `/usr/bin/python3 scripts/speed_report.py` "
-          f"that ended {datetime.datetime.fromtimestamp(started):%Y-%m-%d %H:%M} (commit {commit}), interrupted: "
-          "the sections it did not reach are left out (written with `--from-log`), on " if a.from_log else
+         (f"**Every figure on this page comes from the logs of {len(a.from_log)} run(s) of `/usr/bin/python3 "
+          f"scripts/speed_report.py` (an interrupted full run, and `--only` runs of single sections), the last "
+          f"ended {datetime.datetime.fromtimestamp(started):%Y-%m-%d %H:%M} (commit(s) {commit}); the sections "
+          "no log reached are left out (written with `--from-log`), on " if a.from_log else
           f"**Every figure on this page comes from one run of `/usr/bin/python3 scripts/speed_report.py` on "
           f"{datetime.datetime.now():%Y-%m-%d %H:%M} (commit {commit}{' + local changes' if dirty else ''}; "
           f"{(time.time() - started) / 60:.0f} min{', quick mode' if a.quick else ''}), on ") + f"{cpu} "
@@ -565,6 +592,8 @@ def auto_section(autos):
         a0 = ms.get("auto", {})
 
         def cell(v):
+            if v and v.get("over_cap"):
+                return f"> {AUTO_RUN_CAP_S} s"
             if not v or v.get("wall") is None:
                 return "failed"
             e = v.get("error")

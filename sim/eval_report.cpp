@@ -44,6 +44,14 @@ nlohmann::ordered_json eval_report(Engine& engine, const State& state) {
   VecX qdot, F, udot;
   MatX M;
   engine.set_inputs(state.w);
+  // with joints locked (STATE.json "locked"), u-dot and the reactions are the reduced system's
+  const LockSet before = engine.locks();
+  struct Restore {
+    Engine& e;
+    const LockSet& l;
+    ~Restore() { e.set_locks(l); }
+  } restore{engine, before};
+  engine.set_locks(state.locked);
   engine.qdot(state.q, state.u, qdot);
   engine.mass_matrix(state.t, state.q, M);
   engine.forcing(state.t, state.q, state.u, state.tau, F);
@@ -66,6 +74,12 @@ nlohmann::ordered_json eval_report(Engine& engine, const State& state) {
   j["M"] = rows;
   j["F"] = vec(F);
   j["udot"] = vec(udot);
+  if (engine.has_locks()) {
+    auto names = nlohmann::ordered_json::array();
+    for (std::size_t b = 0; b < model.bodies.size(); ++b)
+      if (state.locked[b]) names.push_back(model.bodies[b].name);
+    j["locked"] = names;
+  }
   if (model.outputs.energy) {
     const EnergyValues E = engine.energy(state.t, state.q, state.u);
     require_finite(Eigen::Vector2d(E.T, E.V), "energy (T, V)", {"T", "V"}, model, state);

@@ -38,6 +38,7 @@
 // about an unrecoverable failure, and the exception is rethrown unchanged
 // once the SUNDIALS call returns.
 #include "sim/integrators.hpp"
+#include "sim/event_location.hpp"
 #include "sim/odeint_integrators.hpp"
 #include "sim/output_schedule.hpp"
 
@@ -376,7 +377,7 @@ constexpr int kMaxStagnantSteps = 50;
 
 IntegratorStats integrate_sundials(const OdeProblem& problem, const IntegratorOptions& opt, double t0,
                                    const Eigen::VectorXd& x0, double t_end, double dt_out, const OutputFn& output,
-                                   IntegratorStats stats) {
+                                   IntegratorStats stats, double grid_origin) {
   const std::string name = to_string(opt.kind);
   const bool user_jac = static_cast<bool>(problem.jacobian);
   const int n = problem.n;
@@ -451,12 +452,22 @@ IntegratorStats integrate_sundials(const OdeProblem& problem, const IntegratorOp
   // total step budget, the exact (t_n, y_n) on failure (ARKODE reports a stage
   // time there), and lets us detect stagnation (t + h == t), which SUNDIALS
   // only warns about.
-  OutputSchedule schedule(t0, t_end, dt_out);
+  OutputSchedule schedule(t0, t_end, dt_out, grid_origin);
+  EventLocator events(problem);
+  events.reset(t0, ymap.data());
+  auto dense = [&](double t, double tout_now) {
+    const int flag = stepper->dense_output(t, yout.get());
+    if (flag < 0) {
+      const std::string fname = stepper->flag_name(flag);
+      throw fail("dense output failed", fmt::format("{}, flag {}", fname, flag), tout_now);
+    }
+  };
   double tout = t0;
   long nsteps = 0;
   int stagnant = 0;
   while (schedule.next(tout)) {
     while (tn < tout) {
+      const double t_before = tn;
       if (opt.max_steps > 0 && nsteps >= opt.max_steps)
         throw fail(fmt::format("too much work: max_steps = {} steps taken without reaching t_end = {}",
                                opt.max_steps, t_end),
@@ -479,16 +490,33 @@ IntegratorStats integrate_sundials(const OdeProblem& problem, const IntegratorOp
         stagnant = 0;
       }
       tn = tret;
-    }
-    if (tout == tn) {
-      youtmap = ymap;
-    } else {
-      const int flag = stepper->dense_output(tout, yout.get());
-      if (flag < 0) {
-        const std::string fname = stepper->flag_name(flag);
-        throw fail("dense output failed", fmt::format("{}, flag {}", fname, flag), tout);
+      if (events.active() && tn > t_before) {
+        if (events.crossed(tn, ymap.data())) {
+          const EventLocator::Root root = events.locate(t_before, tn, [&](double t, double* x) {
+            dense(t, tout);
+            std::copy(youtmap.data(), youtmap.data() + n, x);
+          });
+          bool go_on = true;
+          for (bool more = true; more && go_on && schedule.before(tout, root.t); more = schedule.next(tout)) {
+            dense(tout, tout);
+            go_on = emit(tout, youtmap);
+          }
+          if (go_on) {
+            youtmap = root.x;
+            emit(root.t, youtmap);
+          }
+          stats.event = root.event;
+          stats.t_event = root.t;
+          stepper->fill_stats(stats);
+          return stats;
+        }
+        events.reset(tn, ymap.data());
       }
     }
+    if (tout == tn)
+      youtmap = ymap;
+    else
+      dense(tout, tout);
     if (!emit(tout, youtmap)) break;
   }
   stepper->fill_stats(stats);
@@ -499,7 +527,7 @@ IntegratorStats integrate_sundials(const OdeProblem& problem, const IntegratorOp
 
 IntegratorStats integrate_rk4(const OdeProblem& problem, const IntegratorOptions& opt, double t0,
                               const Eigen::VectorXd& x0, double t_end, double dt_out, const OutputFn& output,
-                              IntegratorStats stats) {
+                              IntegratorStats stats, double grid_origin) {
   if (!(opt.h > 0) || !std::isfinite(opt.h))
     throw std::invalid_argument(fmt::format("rk4: step h must be positive and finite, got {}", opt.h));
   const int n = problem.n;
@@ -525,7 +553,28 @@ IntegratorStats integrate_rk4(const OdeProblem& problem, const IntegratorOptions
 
   if (!emit()) return stats;
 
-  OutputSchedule schedule(t0, t_end, dt_out);
+  OutputSchedule schedule(t0, t_end, dt_out, grid_origin);
+  EventLocator events(problem);
+  events.reset(t0, x.data());
+  // one RK4 step of size ts - t from the last accepted state: the interpolant inside a step
+  Eigen::VectorXd xa(n), ya(n), yb(n), yc(n), yd(n), ye(n);
+  double ta = t0;
+  auto partial_step = [&](double ts, double* out) {
+    const double hs = ts - ta;
+    Eigen::Map<Eigen::VectorXd> o(out, n);
+    if (hs == 0) {
+      o = xa;
+      return;
+    }
+    eval(ta, xa, ya);
+    ye = xa + 0.5 * hs * ya;
+    eval(ta + 0.5 * hs, ye, yb);
+    ye = xa + 0.5 * hs * yb;
+    eval(ta + 0.5 * hs, ye, yc);
+    ye = xa + hs * yc;
+    eval(ts, ye, yd);
+    o = xa + (hs / 6.0) * (ya + 2.0 * yb + 2.0 * yc + yd);
+  };
   double tout = t0;
   while (schedule.next(tout)) {
     const double t_start = t;
@@ -537,6 +586,8 @@ IntegratorStats integrate_rk4(const OdeProblem& problem, const IntegratorOptions
       double t_next = t_start + static_cast<double>(j + 1) * h;
       if (t_next >= tout - 1e-8 * h) t_next = tout;  // shortened (or slightly stretched) last step
       const double hs = t_next - t;
+      xa = x;
+      ta = t;
       eval(t, x, k1);
       xs = x + 0.5 * hs * k1;
       eval(t + 0.5 * hs, xs, k2);
@@ -553,6 +604,27 @@ IntegratorStats integrate_rk4(const OdeProblem& problem, const IntegratorOptions
       t = t_next;
       ++j;
       ++stats.steps;
+      if (events.active()) {
+        if (events.crossed(t, x.data())) {
+          const EventLocator::Root root = events.locate(ta, t, partial_step);
+          bool go_on = true;
+          for (bool more = true; more && go_on && schedule.before(tout, root.t); more = schedule.next(tout)) {
+            partial_step(tout, xo.data());
+            if (problem.project) problem.project(xo.data());
+            go_on = output ? output(tout, xo) : true;
+          }
+          if (go_on) {
+            x = root.x;
+            t = root.t;
+            if (problem.project) problem.project(x.data());
+            emit();
+          }
+          stats.event = root.event;
+          stats.t_event = root.t;
+          return stats;
+        }
+        events.reset(t, x.data());
+      }
     }
     if (!emit()) break;
   }
@@ -596,7 +668,8 @@ std::string IntegratorStats::summary() const {
 }
 
 IntegratorStats integrate(const OdeProblem& problem, const IntegratorOptions& options, double t0,
-                          const Eigen::VectorXd& x0, double t_end, double dt_out, const OutputFn& output) {
+                          const Eigen::VectorXd& x0, double t_end, double dt_out, const OutputFn& output,
+                          double grid_origin) {
   if (problem.n < 0) throw std::invalid_argument(fmt::format("integrate: problem size n = {} is negative", problem.n));
   if (x0.size() != problem.n)
     throw std::invalid_argument(
@@ -615,7 +688,7 @@ IntegratorStats integrate(const OdeProblem& problem, const IntegratorOptions& op
   if (problem.n == 0) {
     // nothing to integrate (a model without degrees of freedom, e.g. only
     // prescribed motion): the (empty) state at every output time
-    OutputSchedule schedule(t0, t_end, dt_out);
+    OutputSchedule schedule(t0, t_end, dt_out, grid_origin);
     const Eigen::VectorXd empty;
     if (!output || output(t0, empty))
       for (double t; t_end > t0 && schedule.next(t);)
@@ -627,11 +700,11 @@ IntegratorStats integrate(const OdeProblem& problem, const IntegratorOptions& op
   } else if (options.kind == IntegratorKind::automatic) {
     throw std::invalid_argument("integrate: 'auto' is resolved by the caller (choose_integrator, simulate.hpp)");
   } else if (options.kind == IntegratorKind::rk4) {
-    stats = integrate_rk4(problem, options, t0, x0, t_end, dt_out, output, std::move(stats));
+    stats = integrate_rk4(problem, options, t0, x0, t_end, dt_out, output, std::move(stats), grid_origin);
   } else if (options.kind == IntegratorKind::dopri5 || options.kind == IntegratorKind::rkf78) {
-    stats = integrate_odeint(problem, options, t0, x0, t_end, dt_out, output, std::move(stats));
+    stats = integrate_odeint(problem, options, t0, x0, t_end, dt_out, output, std::move(stats), grid_origin);
   } else {
-    stats = integrate_sundials(problem, options, t0, x0, t_end, dt_out, output, std::move(stats));
+    stats = integrate_sundials(problem, options, t0, x0, t_end, dt_out, output, std::move(stats), grid_origin);
   }
   stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;

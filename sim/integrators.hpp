@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -41,6 +42,13 @@ struct OdeProblem {
   /// Optional projection applied to an accepted state (e.g. quaternion
   /// normalization); used after each RK4 step and on every output state.
   std::function<void(double* x)> project;
+  /// Optional event functions g_i(t, x), i < n_events (g has n_events
+  /// entries): integrate() stops at the first time one of them goes from its
+  /// sign at the start to the other sign or to zero, located to round-off in
+  /// t on the step's interpolant (sim/event_location.hpp), and gives that
+  /// time and state as its last output (IntegratorStats::event says which).
+  int n_events = 0;
+  std::function<void(double t, const double* x, double* g)> events;
 };
 
 struct IntegratorOptions {
@@ -60,6 +68,8 @@ struct IntegratorStats {
   long error_test_failures = 0;
   long nonlinear_failures = 0;
   double wall_seconds = 0.0;
+  int event = -1;          ///< the event function that stopped the run (OdeProblem::events), -1 if none
+  double t_event = 0.0;    ///< where it did
   /// "cvode-bdf: 1234 steps, 2345 rhs evals, 12 jac evals, 0.123 s"
   std::string summary() const;
 };
@@ -80,8 +90,12 @@ class IntegrationError : public std::runtime_error {
 /// Return false to stop early.
 using OutputFn = std::function<bool(double t, const Eigen::VectorXd& x)>;
 
-/// Integrates from (t0, x0) to t_end. Throws IntegrationError on failure.
+/// Integrates from (t0, x0) to t_end, or to the first event (OdeProblem::events).
+/// Outputs: t0, the times grid_origin + k dt_out after t0 (grid_origin: t0
+/// when not finite; a later segment of a run keeps its first segment's grid),
+/// and t_end or the event's time. Throws IntegrationError on failure.
 IntegratorStats integrate(const OdeProblem& problem, const IntegratorOptions& options, double t0,
-                          const Eigen::VectorXd& x0, double t_end, double dt_out, const OutputFn& output);
+                          const Eigen::VectorXd& x0, double t_end, double dt_out, const OutputFn& output,
+                          double grid_origin = std::numeric_limits<double>::quiet_NaN());
 
 }  // namespace kanegen

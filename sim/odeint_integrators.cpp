@@ -25,6 +25,7 @@
 #include <cmath>
 #include <vector>
 
+#include "sim/event_location.hpp"
 #include "sim/output_schedule.hpp"
 
 namespace kanegen {
@@ -106,6 +107,28 @@ class OdeintRun {
   }
 
   /// Calls output at t with x projected; throws StopRequested when it asks to stop.
+  /// An event crossed in the last step, (t_a, t_b] with the step's interpolant
+  /// `state_at`: the outputs before it, then the event's time and state as the
+  /// last output; the run stops (EventReached).
+  template <class StateAt>
+  void stop_at_event(EventLocator& events, double t_a, double t_b, StateAt state_at, OutputSchedule& schedule,
+                     double& tout, const OutputFn& output) {
+    const EventLocator::Root root = events.locate(t_a, t_b, [&](double t, double* x) {
+      StateVec s(n_);
+      state_at(t, s);
+      std::copy(s.begin(), s.end(), x);
+    });
+    stats_.event = root.event;
+    stats_.t_event = root.t;
+    StateVec xo(n_);
+    for (bool more = true; more && schedule.before(tout, root.t); more = schedule.next(tout)) {
+      state_at(tout, xo);
+      emit(tout, xo, output);
+    }
+    emit(root.t, StateVec(root.x.data(), root.x.data() + n_), output);
+    throw StopRequested{};
+  }
+
   void emit(double t, const StateVec& x, const OutputFn& output) {
     Eigen::VectorXd xo = Eigen::Map<const Eigen::VectorXd>(x.data(), n_);
     if (problem_.project) problem_.project(xo.data());
@@ -123,7 +146,7 @@ class OdeintRun {
 };
 
 void run_dopri5(OdeintRun& run, double t0, StateVec x, double t_end, double dt_out, const OutputFn& output,
-                const IntegratorOptions& opt) {
+                const IntegratorOptions& opt, const OdeProblem& problem, double grid_origin) {
   auto sys = [&run](const StateVec& xi, StateVec& dx, double t) { run.rhs(xi, dx, t); };
   auto stepper = odeint::make_dense_output(opt.atol, opt.rtol, odeint::runge_kutta_dopri5<StateVec>());
   run.start(t0, x);
@@ -133,7 +156,9 @@ void run_dopri5(OdeintRun& run, double t0, StateVec x, double t_end, double dt_o
     throw run.fail(f.what);
   }
   run.emit(t0, x, output);
-  OutputSchedule schedule(t0, t_end, dt_out);
+  OutputSchedule schedule(t0, t_end, dt_out, grid_origin);
+  EventLocator events(problem);
+  events.reset(t0, x.data());
   StateVec xo(x.size());
   double tout = t0;
   while (schedule.next(tout)) {
@@ -153,6 +178,12 @@ void run_dopri5(OdeintRun& run, double t0, StateVec x, double t_end, double dt_o
       if (!(stepper.current_time() > t_before))
         throw run.fail(fmt::format("step size underflow at t = {} (h = {})", t_before, stepper.current_time_step()));
       run.accepted(stepper.current_time(), stepper.current_state());
+      if (events.active()) {
+        if (events.crossed(stepper.current_time(), stepper.current_state().data()))
+          run.stop_at_event(events, t_before, stepper.current_time(),
+                            [&](double t, StateVec& s) { stepper.calc_state(t, s); }, schedule, tout, output);
+        events.reset(stepper.current_time(), stepper.current_state().data());
+      }
     }
     stepper.calc_state(tout, xo);
     run.emit(tout, xo, output);
@@ -160,7 +191,7 @@ void run_dopri5(OdeintRun& run, double t0, StateVec x, double t_end, double dt_o
 }
 
 void run_rkf78(OdeintRun& run, double t0, StateVec x, double t_end, double dt_out, const OutputFn& output,
-               const IntegratorOptions& opt) {
+               const IntegratorOptions& opt, const OdeProblem& problem, double grid_origin) {
   auto sys = [&run](const StateVec& xi, StateVec& dx, double t) { run.rhs(xi, dx, t); };
   auto stepper = odeint::make_controlled(opt.atol, opt.rtol, odeint::runge_kutta_fehlberg78<StateVec>());
   odeint::runge_kutta_fehlberg78<StateVec> plain;  // for the output times inside a step
@@ -169,7 +200,19 @@ void run_rkf78(OdeintRun& run, double t0, StateVec x, double t_end, double dt_ou
   double t_prev = t0;
   StateVec x_prev = x, xo;
   run.emit(t0, x, output);
-  OutputSchedule schedule(t0, t_end, dt_out);
+  OutputSchedule schedule(t0, t_end, dt_out, grid_origin);
+  EventLocator events(problem);
+  events.reset(t0, x.data());
+  // inside an accepted step: one step of the same method from its start
+  auto inside = [&](double ts, StateVec& s) {
+    s = x_prev;
+    if (ts == t_prev) return;
+    try {
+      plain.do_step(sys, s, t_prev, ts - t_prev);
+    } catch (const StepFailed& f) {
+      throw run.fail(f.what);
+    }
+  };
   double tout = t0;
   long rejected_in_a_row = 0;
   while (schedule.next(tout)) {
@@ -197,6 +240,10 @@ void run_rkf78(OdeintRun& run, double t0, StateVec x, double t_end, double dt_ou
         run.accepted(t, x);
         rejected_in_a_row = 0;
         if (!cut || h_try > h) h = h_try;  // a cut step keeps the step the controller had
+        if (events.active()) {
+          if (events.crossed(t, x.data())) run.stop_at_event(events, t_prev, t, inside, schedule, tout, output);
+          events.reset(t, x.data());
+        }
       } else {
         h = h_try;
         if (++rejected_in_a_row > 500 || !(t_before + h > t_before))
@@ -221,14 +268,14 @@ void run_rkf78(OdeintRun& run, double t0, StateVec x, double t_end, double dt_ou
 
 IntegratorStats integrate_odeint(const OdeProblem& problem, const IntegratorOptions& opt, double t0,
                                  const Eigen::VectorXd& x0, double t_end, double dt_out, const OutputFn& output,
-                                 IntegratorStats stats) {
+                                 IntegratorStats stats, double grid_origin) {
   OdeintRun run(problem, opt, stats);
   StateVec x(x0.data(), x0.data() + x0.size());
   try {
     if (opt.kind == IntegratorKind::dopri5)
-      run_dopri5(run, t0, std::move(x), t_end, dt_out, output, opt);
+      run_dopri5(run, t0, std::move(x), t_end, dt_out, output, opt, problem, grid_origin);
     else if (opt.kind == IntegratorKind::rkf78)
-      run_rkf78(run, t0, std::move(x), t_end, dt_out, output, opt);
+      run_rkf78(run, t0, std::move(x), t_end, dt_out, output, opt, problem, grid_origin);
     else
       throw std::logic_error("integrate_odeint called for " + to_string(opt.kind));
   } catch (const StopRequested&) {

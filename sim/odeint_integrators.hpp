@@ -8,6 +8,6 @@ namespace kanegen {
 
 IntegratorStats integrate_odeint(const OdeProblem& problem, const IntegratorOptions& options, double t0,
                                  const Eigen::VectorXd& x0, double t_end, double dt_out, const OutputFn& output,
-                                 IntegratorStats stats);
+                                 IntegratorStats stats, double grid_origin);
 
 }  // namespace kanegen

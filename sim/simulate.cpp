@@ -6,6 +6,7 @@
 
 #include "engine/generated_engine.hpp"
 #include "model/output_file.hpp"
+#include "sim/event_run.hpp"
 #include "sim/integrator_choice.hpp"
 #include "sim/work_precision.hpp"
 
@@ -162,13 +163,15 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
     // the generated code's own entry: x in, x_dot out, nothing copied; on a
     // failed pivot the engine's own call throws the exception that names it
     p.rhs = rhs_around([g, tau, through_engine](double t, const double* x, double* xdot) {
-      if (g->state_derivative(t, x, tau.data(), xdot) != 0) through_engine(t, x, xdot);
+      // (with joints locked, the engine's reduced u-dot instead)
+      if (g->has_locks() || g->state_derivative(t, x, tau.data(), xdot) != 0) through_engine(t, x, xdot);
     });
   } else {
     p.rhs = rhs_around(through_engine);
   }
   p.project = [&model](double* x) { normalize_quaternions(model, x); };
-  if (use_jacobian && engine.has_jacobian()) {
+  // the exact Jacobian is the free system's: with joints locked the implicit methods difference the rhs
+  if (use_jacobian && engine.has_jacobian() && !engine.has_locks()) {
     auto J = std::make_shared<MatX>(nq + nu, nq + nu);
     p.jacobian = [&engine, tau, scratch, J, failure, nq, nu, free_joints](double t, const double* x, const double*,
                                                                            double* out) -> int {
@@ -229,17 +232,129 @@ namespace {
 /// At most this many output states are kept for the drift and the error estimate.
 constexpr double kMaxKeptStates = 2000;
 
-/// The states at every `stride`-th output time, and the last one.
+/// The states at every `stride`-th output time, and those it must keep (the
+/// last one, the states just before and after an event); where each segment
+/// between events begins, and its locks.
 struct SampledRun {
   long stride = 1, k = 0;
   bench::Trajectory traj;
-  void add(double t, const VecX& x, bool last) {
-    if (k++ % stride == 0 || last) {
+  std::vector<std::size_t> segment_begin{0};
+  std::vector<LockSet> segment_locks;
+  void add(double t, const VecX& x, bool keep) {
+    if (k++ % stride == 0 || keep) {
       traj.t.push_back(t);
       traj.x.push_back(x);
     }
   }
+  void new_segment(const LockSet& locks) {
+    segment_begin.push_back(traj.t.size());
+    segment_locks.push_back(locks);
+  }
+  bench::Trajectory segment(std::size_t i) const {
+    bench::Trajectory s;
+    const std::size_t a = segment_begin[i], b = i + 1 < segment_begin.size() ? segment_begin[i + 1] : traj.t.size();
+    s.t.assign(traj.t.begin() + a, traj.t.begin() + b);
+    s.x.assign(traj.x.begin() + a, traj.x.begin() + b);
+    return s;
+  }
 };
+
+/// Integrates from `initial` to t_end segment by segment: a segment ends at
+/// the next event (model.events: a time event, or a crossing the integrator
+/// locates) and, with a digital controller (sample_period > 0), at the next
+/// sample. At an event the state just before and just after are both rows
+/// (`row(t, x, true)`); at a sample time the next segment starts with the
+/// inputs the law set there (`at_sample`), one row if on the output grid.
+/// `problem()` builds the ODE for the engine's current locks and inputs.
+struct SegmentHooks {
+  std::function<OdeProblem()> problem;
+  std::function<void(double t, const VecX& x)> at_sample;
+  std::function<void(double t, const VecX& x, bool keep)> row;
+  std::function<void(const LockSet& locks)> new_segment;
+};
+
+IntegratorStats run_segments(Engine& engine, const State& initial, double t_end, double dt_out, double sample_period,
+                             const IntegratorOptions& opt, EventRun& events, long& segments, const SegmentHooks& h) {
+  const double t0 = initial.t;
+  double t = t0;
+  VecX x(engine.model().nq + engine.model().nu);
+  x << initial.q, initial.u;
+  IntegratorStats total;
+  total.integrator = to_string(opt.kind);
+  const double T = sample_period;
+  const double tol = 1e-9 * std::min(dt_out, T > 0 ? T : dt_out) +
+                     16 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t0), std::abs(t_end));
+  auto on_grid = [&](double ts) {
+    const double k = (ts - t0) / dt_out;
+    return std::abs(k - std::round(k)) <= 1e-9 * std::max(1.0, std::abs(k));
+  };
+  long k_sample = 0;  // the last sample: t0 + k_sample T
+  bool start_row = true;
+  segments = 0;
+  if (events.time_event_due(t) && t < t_end) {  // events at the start: a row before, then the run from after
+    h.row(t, x, true);
+    events.fire(engine, t, x, -1);
+    h.new_segment(events.locks());
+  }
+  for (;;) {
+    double t_stop = events.next_stop(t, t_end);
+    bool sample_now = false;
+    if (T > 0) {
+      while (t0 + static_cast<double>(k_sample + 1) * T <= t + tol) ++k_sample;
+      sample_now = std::abs(t - (t0 + static_cast<double>(k_sample) * T)) <= tol;
+      const double next_sample = t0 + static_cast<double>(k_sample + 1) * T;
+      if (next_sample < t_stop - tol) t_stop = next_sample;
+    }
+    if (sample_now) h.at_sample(t, x);
+    OdeProblem p = h.problem();
+    events.arm(p);
+    bool first = true, pending = false;
+    double tp = t;
+    VecX xp = x;
+    const IntegratorStats s = integrate(
+        p, opt, t, x, t_stop, dt_out,
+        [&](double ts, const VecX& xs) {
+          if (first) {
+            first = false;
+            if (start_row) h.row(ts, xs, true);
+            return true;
+          }
+          if (pending) h.row(tp, xp, false);
+          tp = ts;
+          xp = xs;
+          pending = true;
+          return true;
+        },
+        t0);
+    ++segments;
+    total.steps += s.steps;
+    total.rhs_evals += s.rhs_evals;
+    total.jac_evals += s.jac_evals;
+    total.error_test_failures += s.error_test_failures;
+    total.nonlinear_failures += s.nonlinear_failures;
+    total.wall_seconds += s.wall_seconds;
+    t = pending ? tp : t_stop;
+    x = xp;
+    const bool at_end = !(t < t_end - tol);
+    if (s.event >= 0 || (!at_end && events.time_event_due(t))) {
+      h.row(t, x, true);  // just before
+      events.fire(engine, t, x, s.event);
+      h.new_segment(events.locks());
+      start_row = true;   // just after: the next segment's first row
+      if (at_end) {
+        h.row(t, x, true);
+        break;
+      }
+      continue;
+    }
+    if (at_end) {
+      h.row(t, x, true);
+      break;
+    }
+    start_row = on_grid(t);  // a sample time: one row, with the inputs the law sets there
+  }
+  return total;
+}
 
 long stride_for(const State& initial, const SimulationOptions& o) {
   const double rows = std::floor((o.t_end - initial.t) / o.dt_out) + 2;
@@ -278,8 +393,10 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   engine.set_inputs(initial.w);
   // A continuous controller's feedback is not in the engine's Jacobian: the
   // implicit methods then difference the right-hand side.
-  OdeProblem problem = make_ode_problem(engine, initial.tau, &failure, options.use_jacobian && !controller,
-                                        options.integrator.kind != IntegratorKind::rk4);
+  auto base_problem = [&] {
+    return make_ode_problem(engine, initial.tau, &failure, options.use_jacobian && !controller,
+                            options.integrator.kind != IntegratorKind::rk4);
+  };
   VecX y(model.ny), w_ctl(model.nw), q_ctl(nq), u_ctl(nu);
   // the law at (t, x): the outputs with the inputs held so far, then the new inputs
   auto apply_law = [&](double t, const double* x) {
@@ -291,18 +408,21 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     controller.law(t, q_ctl, u_ctl, y, w_ctl);
     engine.set_inputs(w_ctl);
   };
-  if (controller && !digital) {
-    auto base = problem.rhs;
-    problem.rhs = [&, base](double t, const double* x, double* xdot) -> int {
-      try {
-        apply_law(t, x);
-      } catch (const SingularMassMatrix& e) {
-        failure = fmt::format("{} at t = {:.17g} (while computing the controller's outputs)", e.what(), t);
-        return -1;
-      }
-      return base(t, x, xdot);
-    };
-  }
+  auto with_law = [&](OdeProblem problem) {
+    if (controller && !digital) {
+      auto base = problem.rhs;
+      problem.rhs = [&, base](double t, const double* x, double* xdot) -> int {
+        try {
+          apply_law(t, x);
+        } catch (const SingularMassMatrix& e) {
+          failure = fmt::format("{} at t = {:.17g} (while computing the controller's outputs)", e.what(), t);
+          return -1;
+        }
+        return base(t, x, xdot);
+      };
+    }
+    return problem;
+  };
   VecX x0(nq + nu);
   x0 << initial.q, initial.u;
 
@@ -339,7 +459,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   double last_row_t = initial.t;
   auto column_of = [&](std::size_t k) { return k < cols.size() ? cols[k] : fmt::format("column {}", k); };
 
-  auto write = [&](double t, const VecX& x) -> bool {
+  auto write = [&](double t, const VecX& x, bool keep) -> bool {
     // x arrives projected; the drift was measured on the raw state by project below.
     if (pending.body >= 0) {
       const Body& b = model.bodies[pending.body];
@@ -395,7 +515,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     for (std::size_t k = 0; k < row.size(); ++k)
       if (!std::isfinite(row[k]))
         throw fail_at(t, x, fmt::format("non-finite value {} in column '{}'", row[k], column_of(k + 1)));
-    sampled.add(t, x, !(t < options.t_end));
+    sampled.add(t, x, keep);
     line = fmt::format("{:.17g}", t);
     for (double v : row) line += fmt::format(",{:.17g}", v);
     csv << line << '\n';
@@ -403,63 +523,49 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     bar.update(t);
     return true;
   };
-  // Drift is measured on the unprojected state: wrap project (called on every
-  // output state, and after every rk4 step).
-  auto project = problem.project;
-  problem.project = [&](double* x) {
-    VecX raw = Eigen::Map<VecX>(x, nq + nu);
-    QuatDrift worst;
-    result.max_quaternion_drift = std::max(result.max_quaternion_drift, normalize_quaternions(model, raw.data(), &worst));
-    if (worst.body >= 0 && !(worst.drift <= drift_limit) && pending.body < 0) {
-      pending = worst;
-      pending_raw = Eigen::Map<VecX>(x, nq + nu);
-    }
-    project(x);
-  };
-  try {
-    if (!digital) {
-      result.stats = integrate(problem, options.integrator, initial.t, x0, options.t_end, options.dt_out, write);
-    } else {
-      // A digital controller: one integration per sample period, restarted at
-      // each sample with the inputs the law set there (zero-order hold).
-      const double T = controller.period, t0 = initial.t;
-      const double dt_seg = std::min(options.dt_out, T);
-      auto on_output_grid = [&](double t) {
-        const double k = (t - t0) / options.dt_out;
-        return std::abs(k - std::round(k)) <= 1e-9 * std::max(1.0, std::abs(k));
-      };
-      VecX x = x0, x_end = x0;
-      result.stats.integrator = to_string(options.integrator.kind);
-      for (long k = 0;; ++k) {
-        const double t_a = t0 + static_cast<double>(k) * T;
-        if (!(t_a < options.t_end)) break;
-        const double t_b = std::min(t0 + static_cast<double>(k + 1) * T, options.t_end);
-        const bool last = !(t_b < options.t_end) || t_b + 1e-12 * std::max(1.0, std::abs(t_b)) >= options.t_end;
-        try {
-          apply_law(t_a, x.data());
-        } catch (const SingularMassMatrix& e) {
-          throw IntegrationError(fmt::format("{} (while computing the controller's outputs)", e.what()), t_a, x);
-        }
-        const IntegratorStats s =
-            integrate(problem, options.integrator, t_a, x, last ? options.t_end : t_b, dt_seg,
-                      [&](double t, const VecX& xs) {
-                        const bool end = !(t < (last ? options.t_end : t_b));
-                        if (end) x_end = xs;
-                        if (end && last) return write(t, xs);
-                        // a segment's end is the next one's start, written there with its inputs
-                        if (end) return true;
-                        return on_output_grid(t) ? write(t, xs) : true;
-                      });
-        result.stats.steps += s.steps;
-        result.stats.rhs_evals += s.rhs_evals;
-        result.stats.jac_evals += s.jac_evals;
-        result.stats.error_test_failures += s.error_test_failures;
-        result.stats.nonlinear_failures += s.nonlinear_failures;
-        result.stats.wall_seconds += s.wall_seconds;
-        x = x_end;
-        if (last) break;
+  // The ODE of a segment (for the engine's locks and inputs then). Drift is
+  // measured on the unprojected state: project is wrapped (it is called on
+  // every output state, and after every rk4 step).
+  auto make_problem = [&] {
+    OdeProblem problem = with_law(base_problem());
+    auto project = problem.project;
+    problem.project = [&, project](double* x) {
+      VecX raw = Eigen::Map<VecX>(x, nq + nu);
+      QuatDrift worst;
+      result.max_quaternion_drift =
+          std::max(result.max_quaternion_drift, normalize_quaternions(model, raw.data(), &worst));
+      if (worst.body >= 0 && !(worst.drift <= drift_limit) && pending.body < 0) {
+        pending = worst;
+        pending_raw = Eigen::Map<VecX>(x, nq + nu);
       }
+      project(x);
+    };
+    return problem;
+  };
+  // the locks at the start, and back as they were after the run
+  const LockSet locks_before = engine.locks();
+  struct RestoreLocks {
+    Engine& e;
+    const LockSet& l;
+    ~RestoreLocks() { e.set_locks(l); }
+  } restore{engine, locks_before};
+  engine.set_locks(initial.locked);
+  sampled.segment_locks.push_back(engine.locks());
+  EventRun events(model, initial.t, initial.locked);
+  SegmentHooks hooks;
+  hooks.problem = [&] { return make_problem(); };
+  hooks.at_sample = [&](double t, const VecX& x) {
+    try {
+      apply_law(t, x.data());
+    } catch (const SingularMassMatrix& e) {
+      throw IntegrationError(fmt::format("{} (while computing the controller's outputs)", e.what()), t, x);
     }
+  };
+  hooks.row = [&](double t, const VecX& x, bool keep) { write(t, x, keep); };
+  hooks.new_segment = [&](const LockSet& l) { sampled.new_segment(l); };
+  try {
+    result.stats = run_segments(engine, initial, options.t_end, options.dt_out, digital ? controller.period : 0.0,
+                                options.integrator, events, result.segments, hooks);
   } catch (const IntegrationError& e) {
     bar.finish();
     if (output_failure || failure.empty()) throw;
@@ -481,9 +587,19 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
       measure = std::make_unique<GenericEngine>(model);
       measure->set_parameters(engine.parameters());
     }
-    const bench::Drifts d = bench::invariant_drifts(lacks ? *measure : engine, inv, sampled.traj);
-    quality.energy_drift = d.energy;
-    quality.H_drift = d.H;
+    // between events (a latch loses energy; a joint to ground locked holds the momentum)
+    auto worse = [](double a, double b) { return std::isnan(a) ? b : std::isnan(b) ? a : std::max(a, b); };
+    for (std::size_t i = 0; i < sampled.segment_begin.size(); ++i) {
+      const bench::Trajectory seg = sampled.segment(i);
+      if (seg.t.size() < 2) continue;
+      bench::InvariantSet inv_i = inv;
+      const LockSet& l = sampled.segment_locks[std::min(i, sampled.segment_locks.size() - 1)];
+      for (std::size_t b = 0; b < l.size(); ++b)
+        if (l[b] && model.bodies[b].parent < 0) inv_i.momentum = false;
+      const bench::Drifts d = bench::invariant_drifts(lacks ? *measure : engine, inv_i, seg);
+      quality.energy_drift = worse(quality.energy_drift, d.energy);
+      quality.H_drift = worse(quality.H_drift, d.H);
+    }
   }
   if (options.estimate_error && controller) {
     quality.error_worst = "no error estimate with a controller in the loop (its state would be run twice)";
@@ -497,13 +613,23 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     SampledRun ref;
     ref.stride = sampled.stride;
     std::string f2;
-    OdeProblem p2 = make_ode_problem(engine, initial.tau, &f2, options.use_jacobian,
-                                     options.integrator.kind != IntegratorKind::rk4);
+    SegmentHooks h2;
+    h2.problem = [&] {
+      return make_ode_problem(engine, initial.tau, &f2, options.use_jacobian,
+                              options.integrator.kind != IntegratorKind::rk4);
+    };
+    h2.at_sample = [](double, const VecX&) {};
+    h2.row = [&](double t, const VecX& x, bool keep) { ref.add(t, x, keep); };
+    h2.new_segment = [&](const LockSet& l) { ref.new_segment(l); };
     try {
-      integrate(p2, tight, initial.t, x0, options.t_end, options.dt_out, [&](double t, const VecX& x) {
-        ref.add(t, x, !(t < options.t_end));
-        return true;
-      });
+      engine.set_locks(initial.locked);
+      EventRun events2(model, initial.t, initial.locked);
+      long segments2 = 0;
+      run_segments(engine, initial, options.t_end, options.dt_out, 0.0, tight, events2, segments2, h2);
+      if (ref.traj.t.size() != sampled.traj.t.size())
+        throw IntegrationError(fmt::format("its events fired differently ({} states kept against {})",
+                                           ref.traj.t.size(), sampled.traj.t.size()),
+                               options.t_end, VecX());
       const bench::ErrorMeasure e = bench::trajectory_error(model, sampled.traj, ref.traj);
       quality.error_estimate = e.error;
       quality.error_worst = fmt::format("{} at t = {:.6g}", e.worst, e.worst_t);
@@ -512,6 +638,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     }
   }
   result.quality = quality;
+  result.events = events.fired();
   return result;
 }
 

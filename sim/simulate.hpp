@@ -10,6 +10,7 @@
 
 #include "engine/engine.hpp"
 #include "sim/controller.hpp"
+#include "sim/event_run.hpp"
 #include "sim/integrators.hpp"
 #include "model/state_io.hpp"
 
@@ -49,6 +50,9 @@ struct SimulationResult {
   double max_quaternion_drift = 0.0;  ///< max | |quat| - 1 | seen at output times, before normalization
   long rows = 0;
   RunQuality quality;
+  /// The events that fired (sim/event_run.hpp), in order, and the segments integrated between them.
+  std::vector<FiredEvent> events;
+  long segments = 0;
 };
 
 /// The ODE x = [q; u] of an engine, for the integrators. The right-hand side

@@ -4,13 +4,14 @@
 #include "apps/common/simulation_cli.hpp"
 #include "apps/kanegen/cli_common.hpp"
 #include "engine/handover_engine.hpp"
+#include "model/output_file.hpp"
 
 namespace kanegen::cli {
 
 namespace {
 
 struct Options {
-  std::string model, state, engine = "auto";
+  std::string model, state, engine = "auto", events;
   bool native = false;
   SimulationCli sim;
 };
@@ -37,6 +38,15 @@ int run(const Options& o) {
                                          : engine->name() + " engine";
     fmt::print(stderr, "{} [{}], {} rows to {}, max quaternion drift {:.2e}\n{}", r.stats.summary(), engine_label,
                r.rows, o.sim.output, r.max_quaternion_drift, describe_quality(r.quality));
+    if (!r.events.empty())
+      fmt::print(stderr, "events ({} fired, {} segments): {}\n", r.events.size(), r.segments, events_summary(r.events));
+    else if (!model.events.empty())
+      fmt::print(stderr, "events: none fired\n");
+    if (!o.events.empty()) {
+      OutputFile out(o.events);
+      write_events_csv(r.events, out.stream());
+      out.commit();
+    }
   } catch (const IntegrationError& e) {
     fmt::print(stderr, "kanegen simulate: {}\nno output written\n", describe_failure(model, e));
     status = kExitFailure;
@@ -64,6 +74,8 @@ Subcommand add_simulate(CLI::App& app) {
   c->get_option("-o")->required();
   c->add_option("--state", o->state, "initial STATE.json (default: the model's initial state)")
       ->check(CLI::ExistingFile);
+  c->add_option("--events", o->events,
+                "also write the events that fired as CSV (t, name, action, bodies, energy_lost; interface.md)");
   add_engine_option(c, o->engine, o->native, /*with_auto=*/true);
   return {c, [o] { return run(*o); }};
 }

@@ -42,6 +42,8 @@ struct Joint {
   /// function of time, not a degree of freedom (no q, no u, no input).
   std::optional<PrescribedMotion> motion;
   bool prescribed() const { return motion.has_value(); }
+  /// `locked: true`: the joint starts locked (model/events.hpp, dynamics.md "Locks").
+  bool locked = false;
   /// Whether coordinate i has a spring or damper.
   bool has_spring(int i) const { return stiffness[i] != 0.0 || damping[i] != 0.0; }
 };

@@ -1,0 +1,138 @@
+#include "sim/event_run.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ostream>
+
+#include "engine/locks.hpp"
+
+namespace kanegen {
+
+namespace {
+/// Time events within this of t are due at t (the segment ends exactly on them; this covers round-off).
+double time_tol(double t) { return 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t)); }
+}  // namespace
+
+EventRun::EventRun(const Model& model, double t0, const LockSet& initial_locks)
+    : model_(model), locks_(initial_locks), done_(model.events.size(), 0) {
+  if (locks_.size() != model.bodies.size()) locks_.assign(model.bodies.size(), 0);
+  for (std::size_t i = 0; i < model.events.size(); ++i) {
+    const Event& e = model.events[i];
+    if (e.trigger == Event::Trigger::time && e.at < t0 - time_tol(t0)) done_[i] = 1;  // in the past
+  }
+}
+
+double EventRun::next_stop(double t, double t_end) const {
+  double stop = t_end;
+  for (std::size_t i = 0; i < model_.events.size(); ++i) {
+    const Event& e = model_.events[i];
+    if (!done_[i] && e.trigger == Event::Trigger::time && e.at > t + time_tol(t) && e.at < stop) stop = e.at;
+  }
+  return stop;
+}
+
+bool EventRun::time_event_due(double t) const {
+  for (std::size_t i = 0; i < model_.events.size(); ++i) {
+    const Event& e = model_.events[i];
+    if (!done_[i] && e.trigger == Event::Trigger::time && std::abs(e.at - t) <= time_tol(t)) return true;
+  }
+  return false;
+}
+
+void EventRun::arm(OdeProblem& p) {
+  armed_.clear();
+  for (std::size_t i = 0; i < model_.events.size(); ++i) {
+    const Event& e = model_.events[i];
+    if (done_[i] || e.trigger != Event::Trigger::crossing) continue;
+    const int b = joint_body_of_coordinate(model_, e.coordinate);
+    if (b >= 0 && locks_[b]) continue;  // fires only while its joint is free
+    armed_.push_back(static_cast<int>(i));
+  }
+  p.n_events = static_cast<int>(armed_.size());
+  if (armed_.empty()) {
+    p.events = nullptr;
+    return;
+  }
+  std::vector<std::pair<int, double>> g;  // (q index, value)
+  for (int i : armed_) g.emplace_back(model_.events[i].coordinate, model_.events[i].reaches);
+  p.events = [g](double, const double* x, double* out) {
+    for (std::size_t k = 0; k < g.size(); ++k) out[k] = x[g[k].first] - g[k].second;
+  };
+}
+
+int EventRun::fire(Engine& engine, double t, VecX& x, int crossing) {
+  std::vector<int> due;
+  if (crossing >= 0 && crossing < static_cast<int>(armed_.size())) due.push_back(armed_[crossing]);
+  for (std::size_t i = 0; i < model_.events.size(); ++i) {
+    const Event& e = model_.events[i];
+    if (!done_[i] && e.trigger == Event::Trigger::time && std::abs(e.at - t) <= time_tol(t))
+      due.push_back(static_cast<int>(i));
+  }
+  std::sort(due.begin(), due.end());
+  due.erase(std::unique(due.begin(), due.end()), due.end());
+  const int nq = model_.nq, nu = model_.nu;
+  for (int i : due) {
+    const Event& e = model_.events[i];
+    done_[i] = 1;
+    FiredEvent f;
+    f.t = t;
+    f.name = e.name;
+    f.u_before = x.tail(nu);
+    std::vector<std::string> acted, notes;
+    bool locked_any = false, released_any = false;
+    for (int b : e.lock) {
+      if (locks_[b]) {
+        notes.push_back(fmt::format("{} already locked: ignored", model_.bodies[b].name));
+        continue;
+      }
+      locks_[b] = 1;
+      locked_any = true;
+      acted.push_back(model_.bodies[b].name);
+    }
+    for (int b : e.release) {
+      if (!locks_[b]) {
+        notes.push_back(fmt::format("{} already free: ignored", model_.bodies[b].name));
+        continue;
+      }
+      locks_[b] = 0;
+      released_any = true;
+      acted.push_back(model_.bodies[b].name);
+    }
+    if (locked_any) {  // the plastic latch (dynamics.md, Locks)
+      MatX M;
+      const VecX q = x.head(nq);
+      engine.mass_matrix(t, q, M);
+      const LatchImpact impact = latch_impact(M, x.tail(nu), locked_speeds(model_, locks_));
+      x.tail(nu) = impact.u_plus;
+      f.energy_lost = impact.energy_lost();
+    }
+    engine.set_locks(locks_);
+    f.u_after = x.tail(nu);
+    f.action = locked_any && released_any ? "lock+release" : locked_any ? "lock" : released_any ? "release" : "none";
+    for (const auto& a : acted) f.bodies += (f.bodies.empty() ? "" : " ") + a;
+    for (const auto& n : notes) f.note += (f.note.empty() ? "" : "; ") + n;
+    fired_.push_back(std::move(f));
+  }
+  return static_cast<int>(due.size());
+}
+
+std::string events_summary(const std::vector<FiredEvent>& fired) {
+  std::string s;
+  for (const FiredEvent& f : fired) {
+    s += s.empty() ? "" : "; ";
+    s += fmt::format("{} at t = {:.10g}: {} {}", f.name, f.t, f.action, f.bodies);
+    if (f.action.find("lock") == 0) s += fmt::format(" (energy lost {:.6g} J)", f.energy_lost);
+    if (!f.note.empty()) s += fmt::format(" [{}]", f.note);
+  }
+  return s;
+}
+
+void write_events_csv(const std::vector<FiredEvent>& fired, std::ostream& out) {
+  out << "t,name,action,bodies,energy_lost\n";
+  for (const FiredEvent& f : fired)
+    out << fmt::format("{:.17g},{},{},{},{:.17g}\n", f.t, f.name, f.action, f.bodies, f.energy_lost);
+}
+
+}  // namespace kanegen
