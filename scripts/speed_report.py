@@ -297,7 +297,7 @@ def auto_suite(work):
     return suite
 
 
-def auto_against_methods(bindir, work, quick):
+def auto_against_methods(bindir, work, quick, only_models=None):
     """Every model of auto_suite over 10 s at the defaults (generated engine, --estimate-error):
     auto against every named adaptive method, wall time (integration) and estimated error."""
     kanegen = os.path.join(bindir, "kanegen")
@@ -306,6 +306,10 @@ def auto_against_methods(bindir, work, quick):
     rows = []
     for path in auto_suite(work):
         name = os.path.splitext(os.path.basename(path))[0]
+        if only_models and name not in only_models:
+            continue
+        # the generated code (with the Jacobians of the implicit methods) built first, outside the time cap
+        run([kanegen, "compile", path, "--derivatives"], timeout=3600)
         row = dict(model=name, methods={})
         with tempfile.TemporaryDirectory() as d:
             for method in ["auto"] + METHODS:
@@ -380,6 +384,8 @@ def main():
                     "(possibly interrupted) run instead of measuring; the sections it did not reach are left out. "
                     "Repeat to merge the logs of runs of separate sections (e.g. one from --only auto)")
     ap.add_argument("--log-commit", help="with --from-log: the commit(s) those runs measured")
+    ap.add_argument("--models", help="with --only auto: these models of the suite only (comma-separated); a later "
+                    "log's rows replace an earlier one's in --from-log")
     ap.add_argument("--only", choices=["auto"], help="measure one section only and print its rows on stderr "
                     "(for --from-log); the page is not written")
     a = ap.parse_args()
@@ -393,7 +399,7 @@ def main():
     if a.only == "auto":
         work = tempfile.mkdtemp(prefix="kanegen_speed_")
         print("auto against every method", file=sys.stderr)
-        auto_against_methods(bindir, work, a.quick)
+        auto_against_methods(bindir, work, a.quick, a.models.split(",") if a.models else None)
         shutil.rmtree(work, ignore_errors=True)
         print(f"auto section done in {(time.time() - started) / 60:.1f} min (commit {commit}"
               f"{' + local changes' if dirty else ''}); write the page with --from-log", file=sys.stderr)
@@ -404,6 +410,9 @@ def main():
             parts = read_log(path)
             for dest, got in zip((rows, sims, ests, over, cold, autos, comp), parts):
                 dest.extend(got)
+        # a model measured again in a later log replaces its earlier row (keeping the suite's order)
+        latest = {r["model"]: r for r in autos}
+        autos = [latest[m] for m in dict.fromkeys(r["model"] for r in autos)]
         wp, wp_err, sr = None, "not in the logs this page was written from", ""
         started = max(os.path.getmtime(p) for p in a.from_log)
         commit = a.log_commit or "?"
