@@ -307,6 +307,19 @@ PYBIND11_MODULE(kanegen, m) {
               d["rhs_evals"] = r.stats.rhs_evals;
               d["steps"] = r.stats.steps;
               d["wall_seconds"] = r.stats.wall_seconds;
+              py::list events;  // the events that fired (model-format.md, Locks and events)
+              for (const FiredEvent& e : r.events) {
+                py::dict ev;
+                ev["t"] = e.t;
+                ev["name"] = e.name;
+                ev["action"] = e.action;
+                ev["bodies"] = e.bodies;
+                ev["energy_lost"] = e.energy_lost;
+                ev["u_before"] = e.u_before;
+                ev["u_after"] = e.u_after;
+                events.append(ev);
+              }
+              d["events"] = events;
               return d;
             });
           },
@@ -316,7 +329,8 @@ PYBIND11_MODULE(kanegen, m) {
           py::arg("atol") = 1e-12, py::arg("h") = 1e-3,
           "integrates from a state; inputs fixed, or set by controller(t, q, u, y) -> w (continuous when period "
           "is 0, else digital with zero-order hold); h is rk4's step; returns {column: array} as the CSV of "
-          "`kanegen simulate`");
+          "`kanegen simulate`, plus 'events': the events that fired (t, name, action, bodies, energy_lost, "
+          "u_before, u_after)");
 
   m.def(
       "generate",

@@ -1,5 +1,7 @@
 #include "sim/linearize.hpp"
 
+#include "engine/locks.hpp"
+
 #include <fmt/format.h>
 
 #include <Eigen/Eigenvalues>
@@ -122,6 +124,16 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
   const bool state_outputs = model.ny == 0 && options.outputs.empty();
   const std::vector<int> out_rows = state_outputs ? std::vector<int>{} : output_rows(model, options.outputs);
   engine.set_inputs(state.w);
+  // With joints locked (State::locked) the linear model is the reduced
+  // system's: the locked joints' coordinates and speeds are no states (the
+  // derivatives then come from central differences of the reduced u-dot).
+  const LockSet locks_before = engine.locks();
+  struct RestoreLocks {
+    Engine& e;
+    const LockSet& l;
+    ~RestoreLocks() { e.set_locks(l); }
+  } restore{engine, locks_before};
+  engine.set_locks(state.locked);
   const double t = state.t;
   const VecX &q0 = state.q, &u0 = state.u, &tau0 = state.tau;
 
@@ -134,7 +146,15 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
   {
     MatX M;
     engine.mass_matrix(t, q0, M);
-    Btau = M.llt().solve(MatX::Identity(nu, nu));
+    if (engine.has_locks()) {  // the reduced system's: M_ff^-1 on the free speeds
+      VecX col;
+      for (int k = 0; k < nu; ++k) {
+        reduced_udot(M, VecX::Unit(nu, k), engine.locked_u(), col);
+        Btau.col(k) = col;
+      }
+    } else {
+      Btau = M.llt().solve(MatX::Identity(nu, nu));
+    }
   }
   VecX y0 = VecX::Zero(model.ny);
   if (model.ny > 0) engine.outputs(t, q0, u0, tau0, y0);
@@ -170,6 +190,7 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
   const int nqt = nq - nfree, n = nqt + nu;
   MatX T_in = MatX::Zero(nx, n), T_out = MatX::Zero(n, nx);
   LinearModel lin;
+  std::vector<int> state_body;  // per tangent state: the body whose joint it belongs to (-1: a mode)
   {
     std::vector<bool> quat_row(nq, false);
     std::vector<std::string> qt_names;
@@ -184,11 +205,13 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
         T_in.block(i, r, 4, 3) = 0.5 * Xi;
         T_out.block(r, i, 3, 4) = 2.0 * Xi.transpose();
         for (const char* a : {".rx", ".ry", ".rz"}) lin.state_names.push_back("q." + free_body->name + a);
+        for (int k = 0; k < 3; ++k) state_body.push_back(joint_body_of_coordinate(model, i));
         i += 4, r += 3;
       } else {
         T_in(i, r) = 1.0;
         T_out(r, i) = 1.0;
         lin.state_names.push_back("q." + model.q_names[i]);
+        state_body.push_back(joint_body_of_coordinate(model, i));
         ++i, ++r;
       }
     }
@@ -196,6 +219,11 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
       T_in(nq + k, nqt + k) = 1.0;
       T_out(nqt + k, nq + k) = 1.0;
       lin.state_names.push_back("u." + model.u_names[k]);
+      int b = -1;
+      for (std::size_t j = 0; j < model.bodies.size(); ++j)
+        if (k >= model.bodies[j].u_joint && k < model.bodies[j].u_joint + joint_nu(model.bodies[j].joint))
+          b = static_cast<int>(j);
+      state_body.push_back(b);
     }
   }
   lin.A = T_out * J * T_in;
@@ -263,6 +291,35 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
   }
   lin.method = exact ? "exact: forward-mode dual numbers through the generated code"
                      : "central differences (step 1e-6 max(1, |x|)) of the " + engine.name() + " engine";
+  if (engine.has_locks()) {  // the reduced system: drop the locked joints' states
+    std::vector<int> keep;
+    for (int i = 0; i < n; ++i)
+      if (state_body[i] < 0 || !state.locked[state_body[i]]) keep.push_back(i);
+    const int nk = static_cast<int>(keep.size());
+    MatX A(nk, nk), B(nk, m), C(lin.C.rows(), nk);
+    VecX xd(nk);
+    std::vector<std::string> names;
+    for (int r = 0; r < nk; ++r) {
+      for (int c = 0; c < nk; ++c) A(r, c) = lin.A(keep[r], keep[c]);
+      B.row(r) = lin.B.row(keep[r]);
+      xd(r) = lin.x0_dot(keep[r]);
+      names.push_back(lin.state_names[keep[r]]);
+    }
+    for (int c = 0; c < nk; ++c) C.col(c) = lin.C.col(keep[c]);
+    if (state_outputs) {
+      lin.C = MatX::Identity(nk, nk);
+      lin.D = MatX::Zero(nk, m);
+      lin.output_names = names;
+      lin.y0 = VecX::Zero(nk);
+    } else {
+      lin.C = C;
+    }
+    lin.A = A;
+    lin.B = B;
+    lin.x0_dot = xd;
+    lin.state_names = names;
+    lin.method += fmt::format(", reduced: {} locked joint speeds", engine.locked_u().size());
+  }
   return lin;
 }
 

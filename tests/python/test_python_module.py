@@ -103,6 +103,15 @@ lin = pend.linearize(q=[math.pi / 2])
 check(lin["equilibrium"] and abs(lin["A"][1, 0] + 9.81) <= 1e-13 and lin["A"][0, 1] == 1.0,
       "linearize: pendulum A = [0 1; -g/L 0] hanging")
 
+# ---- events: the probe separation model's events and latch as the CLI reports them
+sep = kanegen.Model(os.path.join(ROOT, "models", "probe_separation.yaml"), engine="generic")
+srun = sep.simulate(8.0, dt_out=0.1, integrator="rkf78")
+names = [e["name"] for e in srun["events"]]
+latch = srun["events"][-1] if srun["events"] else {}
+check(names == ["eject", "separation"] and latch.get("energy_lost", 0) > 0
+      and abs(srun["q"]["plate.disp"][-1] - 0.2) < 1e-9 and srun["u"]["plate.disp_rate"][-1] == 0.0,
+      "simulate: events fire in Python as in the CLI (eject, then separation at the end of the stroke, latched)")
+
 # ---- the LQR example, reduced
 r = subprocess.run([sys.executable, os.path.join(ROOT, "examples", "python", "lqr_slew.py"), "--t-end", "200"],
                    check=True, capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=os.path.join(args.build, "python")))

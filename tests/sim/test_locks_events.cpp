@@ -17,6 +17,7 @@
 #include "model/model_loader.hpp"
 #include "model/rotation.hpp"
 #include "model/state_io.hpp"
+#include "sim/linearize.hpp"
 #include "sim/simulate.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/support/tolerances.hpp"
@@ -559,4 +560,35 @@ events:
                     Catch::Contains("u.a.angle_rate") && Catch::Contains("locked"));
   const State s = load_state(free_arm, test::write_temp("locked_state2.json", R"({"locked": ["a"]})"));
   CHECK(s.locked[0] == 1);
+}
+
+TEST_CASE("locks: linearize at a state with a joint locked gives the model with that joint fixed", "[locks][linearize]") {
+  const double th = 0.7;
+  const std::string locked_joint =
+      "{type: revolute, axis: [0, 0, 1], position: [0.6, 0.05, 0], stiffness: 2, rest: 0.3, locked: true}";
+  const std::string fixed_joint =
+      fmt::format("{{type: fixed, position: [0.6, 0.05, 0], rotation: {{axis_angle: [[0, 0, 1], {:.17g}]}}}}", th);
+  const Model locked = load_model(test::write_temp("lin_locked.yaml", chain_model(locked_joint)));
+  const Model fixed = load_model(test::write_temp("lin_fixed.yaml", chain_model(fixed_joint)));
+  State sl = initial_state(locked), sf = initial_state(fixed);
+  sl.q(locked.q_index("mid.angle")) = th;
+  for (const auto& n : {"link1.angle", "tip.angle"}) {
+    sl.q(locked.q_index(n)) = 0.4;
+    sf.q(fixed.q_index(n)) = 0.4;
+  }
+  GenericEngine el(locked), ef(fixed);
+  const LinearModel a = linearize(el, sl, {});
+  const LinearModel b = linearize(ef, sf, {});
+  REQUIRE(a.state_names == b.state_names);
+  CHECK(test::rel_err(a.A, b.A) < 1e-6);
+  // tau columns: M_ff^-1 against the fixed model's M^-1 (the locked speed's column is zero)
+  for (std::size_t k = 0; k < a.input_names.size(); ++k) {
+    const auto it = std::find(b.input_names.begin(), b.input_names.end(), a.input_names[k]);
+    if (it == b.input_names.end()) {
+      CHECK(a.B.col(k).isZero(0.0));
+      continue;
+    }
+    CHECK(test::rel_err(a.B.col(k), b.B.col(it - b.input_names.begin()), 1.0) < 1e-9);
+  }
+  CHECK(!el.has_locks());                 // the engine's locks are back as they were
 }
