@@ -261,3 +261,42 @@ TEST_CASE("cli: a first simulate starts on the generic engine at once; the backg
   CHECK(compile.status == 0);
   fs::remove_all(cache);
 }
+
+TEST_CASE("cli: events: simulate --events writes the events table and two rows at each event; eval takes locked",
+          "[cli][locks]") {
+  const fs::path d = temp_dir();
+  const std::string csv = (d / "sep.csv").string(), events = (d / "sep.events.csv").string();
+  const Run r = run("simulate " + src("models/probe_separation.yaml") +
+                    " --engine generic --t-end 6 --dt-out 0.5 --no-progress -o " + csv + " --events " + events);
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("events (2 fired, 3 segments): eject at t = 5: release plate; separation at t = 5.09") !=
+        std::string::npos);
+  std::ifstream ev(events);
+  std::string line;
+  std::getline(ev, line);
+  CHECK(line == "t,name,action,bodies,energy_lost");
+  std::getline(ev, line);
+  CHECK(line == "5,eject,release,plate,0");
+  std::getline(ev, line);
+  CHECK(line.find(",separation,lock+release,plate probe,") != std::string::npos);
+  std::ifstream in(csv);
+  int rows = 0;
+  for (std::string l; std::getline(in, l);) ++rows;
+  CHECK(rows == 1 + 13 + 1 + 2);  // header, the grid 0 ... 6, the second row at 5 s, two at the separation
+  // eval at a state with the plate locked: its speed's u-dot is zero, the others the reduced system's
+  const std::string state = (d / "locked.json").string();
+  std::ofstream(state) << R"({"locked": ["plate", "probe"]})";
+  const Run e = run("eval " + src("models/probe_separation.yaml") + " --engine generic --state " + state);
+  REQUIRE(e.status == 0);
+  const std::size_t at = e.out.find("\"locked\": [");
+  REQUIRE(at != std::string::npos);
+  CHECK(e.out.find("\"plate\"", at) < e.out.find("]", at));
+  CHECK(e.out.find("\"probe\"", at) < e.out.find("]", at));
+  // a bad event: exit 2 naming the file, line and field
+  const std::string bad = (d / "bad_event.yaml").string();
+  std::ofstream(bad) << "name: bad_event\nbodies:\n  - name: a\n    parent: ground\n    mass: 1\n"
+                        "    joint: {type: revolute, axis: [0, 0, 1]}\nevents:\n  - {name: e, at: 1, lock: [b]}\n";
+  const Run b = run("simulate " + bad + " --t-end 1 -o " + (d / "x.csv").string());
+  CHECK(b.status == 2);
+  CHECK(b.out.find("bad_event.yaml:8: events[0].lock[0]: no body named 'b'") != std::string::npos);
+}
