@@ -15,8 +15,8 @@ namespace {
 double time_tol(double t) { return 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t)); }
 }  // namespace
 
-EventRun::EventRun(const Model& model, double t0, const LockSet& initial_locks)
-    : model_(model), locks_(initial_locks), done_(model.events.size(), 0) {
+EventRun::EventRun(const Model& model, double t0, const LockSet& initial_locks, const std::vector<Event>* events)
+    : model_(model), events_(events ? *events : model.events), locks_(initial_locks), done_(events_.size(), 0) {
   if (locks_.size() != model.bodies.size()) locks_.assign(model.bodies.size(), 0);
   for (std::size_t i = 0; i < model.events.size(); ++i) {
     const Event& e = model.events[i];
@@ -26,16 +26,16 @@ EventRun::EventRun(const Model& model, double t0, const LockSet& initial_locks)
 
 double EventRun::next_stop(double t, double t_end) const {
   double stop = t_end;
-  for (std::size_t i = 0; i < model_.events.size(); ++i) {
-    const Event& e = model_.events[i];
+  for (std::size_t i = 0; i < events_.size(); ++i) {
+    const Event& e = events_[i];
     if (!done_[i] && e.trigger == Event::Trigger::time && e.at > t + time_tol(t) && e.at < stop) stop = e.at;
   }
   return stop;
 }
 
 bool EventRun::time_event_due(double t) const {
-  for (std::size_t i = 0; i < model_.events.size(); ++i) {
-    const Event& e = model_.events[i];
+  for (std::size_t i = 0; i < events_.size(); ++i) {
+    const Event& e = events_[i];
     if (!done_[i] && e.trigger == Event::Trigger::time && std::abs(e.at - t) <= time_tol(t)) return true;
   }
   return false;
@@ -43,8 +43,8 @@ bool EventRun::time_event_due(double t) const {
 
 void EventRun::arm(OdeProblem& p) {
   armed_.clear();
-  for (std::size_t i = 0; i < model_.events.size(); ++i) {
-    const Event& e = model_.events[i];
+  for (std::size_t i = 0; i < events_.size(); ++i) {
+    const Event& e = events_[i];
     if (done_[i] || e.trigger != Event::Trigger::crossing) continue;
     const int b = joint_body_of_coordinate(model_, e.coordinate);
     if (b >= 0 && locks_[b]) continue;  // fires only while its joint is free
@@ -56,7 +56,7 @@ void EventRun::arm(OdeProblem& p) {
     return;
   }
   std::vector<std::pair<int, double>> g;  // (q index, value)
-  for (int i : armed_) g.emplace_back(model_.events[i].coordinate, model_.events[i].reaches);
+  for (int i : armed_) g.emplace_back(events_[i].coordinate, events_[i].reaches);
   p.events = [g](double, const double* x, double* out) {
     for (std::size_t k = 0; k < g.size(); ++k) out[k] = x[g[k].first] - g[k].second;
   };
@@ -65,8 +65,8 @@ void EventRun::arm(OdeProblem& p) {
 int EventRun::fire(Engine& engine, double t, VecX& x, int crossing) {
   std::vector<int> due;
   if (crossing >= 0 && crossing < static_cast<int>(armed_.size())) due.push_back(armed_[crossing]);
-  for (std::size_t i = 0; i < model_.events.size(); ++i) {
-    const Event& e = model_.events[i];
+  for (std::size_t i = 0; i < events_.size(); ++i) {
+    const Event& e = events_[i];
     if (!done_[i] && e.trigger == Event::Trigger::time && std::abs(e.at - t) <= time_tol(t))
       due.push_back(static_cast<int>(i));
   }
@@ -74,7 +74,7 @@ int EventRun::fire(Engine& engine, double t, VecX& x, int crossing) {
   due.erase(std::unique(due.begin(), due.end()), due.end());
   const int nq = model_.nq, nu = model_.nu;
   for (int i : due) {
-    const Event& e = model_.events[i];
+    const Event& e = events_[i];
     done_[i] = 1;
     FiredEvent f;
     f.t = t;

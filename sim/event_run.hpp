@@ -27,8 +27,9 @@ struct FiredEvent {
 
 class EventRun {
  public:
-  /// `initial_locks`: the locks at t0 (State::locked). Events due before t0 do not fire.
-  EventRun(const Model& model, double t0, const LockSet& initial_locks);
+  /// `initial_locks`: the locks at t0 (State::locked). Events due before t0
+  /// do not fire. `events`: instead of the model's (e.g. a sweep's dispersed times and values).
+  EventRun(const Model& model, double t0, const LockSet& initial_locks, const std::vector<Event>* events = nullptr);
   const LockSet& locks() const { return locks_; }
   /// The first unfired time event after t (exclusive) before t_end, else t_end.
   double next_stop(double t, double t_end) const;
@@ -46,6 +47,7 @@ class EventRun {
 
  private:
   const Model& model_;
+  std::vector<Event> events_;
   LockSet locks_;
   std::vector<char> done_;          ///< per model event: fired (or in the past at the start)
   std::vector<int> armed_;          ///< event function i -> model event index

@@ -551,7 +551,8 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   } restore{engine, locks_before};
   engine.set_locks(initial.locked);
   sampled.segment_locks.push_back(engine.locks());
-  EventRun events(model, initial.t, initial.locked);
+  const std::vector<Event>* run_events = options.events ? &*options.events : nullptr;
+  EventRun events(model, initial.t, initial.locked, run_events);
   SegmentHooks hooks;
   hooks.problem = [&] { return make_problem(); };
   hooks.at_sample = [&](double t, const VecX& x) {
@@ -623,7 +624,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     h2.new_segment = [&](const LockSet& l) { ref.new_segment(l); };
     try {
       engine.set_locks(initial.locked);
-      EventRun events2(model, initial.t, initial.locked);
+      EventRun events2(model, initial.t, initial.locked, run_events);
       long segments2 = 0;
       run_segments(engine, initial, options.t_end, options.dt_out, 0.0, tight, events2, segments2, h2);
       if (ref.traj.t.size() != sampled.traj.t.size())

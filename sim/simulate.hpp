@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cmath>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -28,6 +29,8 @@ struct SimulationOptions {
   /// A control law setting the named inputs (sim/controller.hpp); without
   /// one the inputs stay at State::w for the whole run.
   Controller controller;
+  /// The events of the run instead of the model's (same entries; a sweep disperses their times and values).
+  std::optional<std::vector<Event>> events;
 };
 
 /// How far a run can be trusted, for its summary.

@@ -108,6 +108,25 @@ SweepPlan plan_sweep(const SweepSpec& spec) {
       t.kind = q ? SweepPlan::Target::Kind::q : SweepPlan::Target::Kind::u;
       t.index = k;
       t.nominal = q ? plan.model.q0(k) : plan.model.u0(k);
+    } else if (d.target.rfind("events.", 0) == 0) {
+      const auto dot = d.target.rfind('.');
+      const std::string name = d.target.substr(7, dot == std::string::npos || dot < 7 ? std::string::npos : dot - 7);
+      const std::string what = dot == std::string::npos || dot < 7 ? "" : d.target.substr(dot + 1);
+      int e = -1;
+      for (std::size_t k = 0; k < plan.model.events.size(); ++k)
+        if (plan.model.events[k].name == name) e = static_cast<int>(k);
+      const Event* ev = e >= 0 ? &plan.model.events[e] : nullptr;
+      const bool at = what == "at", reaches = what == "reaches";
+      if (!ev || !(at || reaches) || (at && ev->trigger != Event::Trigger::time) ||
+          (reaches && ev->trigger != Event::Trigger::crossing)) {
+        fault(d.line, f, fmt::format("'{}': expected events.<name>.at (a time event) or events.<name>.reaches (a "
+                                     "crossing event) of an event of the model{}",
+                                     d.target, ev ? "" : fmt::format(" (it has no event '{}')", name)));
+        continue;
+      }
+      t.kind = at ? SweepPlan::Target::Kind::event_at : SweepPlan::Target::Kind::event_reaches;
+      t.index = e;
+      t.nominal = at ? ev->at : ev->reaches;
     } else {
       std::vector<RuntimeParameter> ps;
       try {
@@ -136,6 +155,11 @@ SweepPlan plan_sweep(const SweepSpec& spec) {
   auto column = [&](const std::string& c, int line, const std::string& field) {
     // q.<name> / u.<name>: a coordinate or a speed (a revolute joint's are both called <body>.angle)
     const Model& m = plan.model;
+    if (c.rfind("event.", 0) == 0)
+      for (std::size_t e = 0; e < m.events.size(); ++e) {
+        if (c == "event." + m.events[e].name + ".t") return -static_cast<int>(2 * e + 2);
+        if (c == "event." + m.events[e].name + ".energy_lost") return -static_cast<int>(2 * e + 3);
+      }
     if (c.rfind("q.", 0) == 0 && m.q_index(c.substr(2)) >= 0) return 1 + m.q_index(c.substr(2));
     if (c.rfind("u.", 0) == 0 && m.speed_index(c.substr(2)) >= 0)
       return 1 + m.nq + static_cast<int>(m.prescribed_names.size()) + m.speed_index(c.substr(2));
@@ -149,7 +173,13 @@ SweepPlan plan_sweep(const SweepSpec& spec) {
   for (std::size_t i = 0; i < spec.metrics.size(); ++i)
     plan.metric_columns.push_back(column(spec.metrics[i].column, spec.metrics[i].line, fmt::format("metrics[{}].column", i)));
   for (std::size_t i = 0; i < spec.envelopes.size(); ++i)
+  {
     plan.envelope_columns.push_back(column(spec.envelopes[i], 1, fmt::format("envelopes[{}]", i)));
+    if (plan.envelope_columns.back() < -1)
+      fault(1, fmt::format("envelopes[{}]", i),
+            fmt::format("'{}' is an event's value, one per run; expected a column of the runs' output",
+                        spec.envelopes[i]));
+  }
   try {
     (void)integrator_from_string(spec.integrator);
   } catch (const std::invalid_argument& e) {
@@ -201,9 +231,16 @@ RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostrea
   r.metrics.assign(plan.spec.metrics.size(), kNaN);
   VecX p = Engine::nominal_parameters(model);
   State s = initial_state(model);
+  std::vector<Event> events = model.events;
   for (std::size_t i = 0; i < plan.targets.size(); ++i) {
     const auto& t = plan.targets[i];
-    (t.kind == SweepPlan::Target::Kind::parameter ? p(t.index) : t.kind == SweepPlan::Target::Kind::q ? s.q(t.index) : s.u(t.index)) = r.values[i];
+    switch (t.kind) {
+      case SweepPlan::Target::Kind::parameter: p(t.index) = r.values[i]; break;
+      case SweepPlan::Target::Kind::q: s.q(t.index) = r.values[i]; break;
+      case SweepPlan::Target::Kind::u: s.u(t.index) = r.values[i]; break;
+      case SweepPlan::Target::Kind::event_at: events[t.index].at = r.values[i]; break;
+      case SweepPlan::Target::Kind::event_reaches: events[t.index].reaches = r.values[i]; break;
+    }
   }
   for (const auto& slot : model.quaternions) s.q.segment<4>(slot.q).normalize();
   SimulationOptions o;
@@ -212,11 +249,14 @@ RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostrea
   o.integrator.kind = integrator_from_string(plan.spec.integrator);
   o.integrator.rtol = plan.spec.rtol;
   o.integrator.atol = plan.spec.atol;
+  if (!model.events.empty()) o.events = events;
   std::ostringstream out;
+  std::vector<FiredEvent> fired;
   try {
     engine.set_parameters(p);
     const SimulationResult sr = simulate(engine, s, o, out);
     r.integration_s = sr.stats.wall_seconds;
+    fired = sr.events;
   } catch (const std::exception& e) {
     std::string why = e.what();
     why = why.substr(0, why.find('\n'));
@@ -243,6 +283,7 @@ RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostrea
         c = end + 1;
       }
       for (std::size_t k = 0; k < ms.size(); ++k) {
+        if (plan.metric_columns[k] < 0) continue;  // an event's (below)
         const double v = row[plan.metric_columns[k]];
         double& m = r.metrics[k];
         switch (ms[k].stat) {
@@ -257,6 +298,13 @@ RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostrea
         seen[k] = true;
       }
       for (std::size_t k = 0; k < plan.envelope_columns.size(); ++k) r.envelopes[k].push_back(row[plan.envelope_columns[k]]);
+    }
+    for (std::size_t k = 0; k < ms.size(); ++k) {  // an event's time or energy lost, NaN if it did not fire
+      const int c = plan.metric_columns[k];
+      if (c >= 0) continue;
+      const std::size_t e = static_cast<std::size_t>(-c - 2) / 2;
+      for (const FiredEvent& f : fired)
+        if (f.name == model.events[e].name) r.metrics[k] = (-c - 2) % 2 == 0 ? f.t : f.energy_lost;
     }
   }
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -23,12 +23,15 @@ struct SweepPlan {
   SweepSpec spec;
   Model model;  ///< with the dispersed parameters among its runtime parameters
   struct Target {
-    enum class Kind { parameter, q, u } kind = Kind::parameter;
-    int index = 0;  ///< into model.parameters, q or u
+    /// event_at / event_reaches: "events.<name>.at" / ".reaches" (model-format.md, Locks and events)
+    enum class Kind { parameter, q, u, event_at, event_reaches } kind = Kind::parameter;
+    int index = 0;  ///< into model.parameters, q, u or model.events
     double nominal = 0.0;
   };
   std::vector<Target> targets;       ///< one per dispersion
   std::vector<std::string> columns;  ///< a run's CSV columns
+  /// Per metric its CSV column, or for "event.<name>.t" / "event.<name>.energy_lost" (an event's time, or
+  /// the energy its latch took; NaN when it did not fire) -(2 e + 2) / -(2 e + 3), e the event's index.
   std::vector<int> metric_columns, envelope_columns;
 };
 

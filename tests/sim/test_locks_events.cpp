@@ -19,6 +19,10 @@
 #include "model/state_io.hpp"
 #include "sim/linearize.hpp"
 #include "sim/simulate.hpp"
+#include "sim/sweep.hpp"
+#include "model/sweep_spec.hpp"
+
+#include <set>
 #include "tests/support/test_support.hpp"
 #include "tests/support/tolerances.hpp"
 
@@ -591,4 +595,77 @@ TEST_CASE("locks: linearize at a state with a joint locked gives the model with 
     CHECK(test::rel_err(a.B.col(k), b.B.col(it - b.input_names.begin()), 1.0) < 1e-9);
   }
   CHECK(!el.has_locks());                 // the engine's locks are back as they were
+}
+
+TEST_CASE("events: a sweep disperses an event's time and records another event's time and energy lost",
+          "[locks][events][sweep]") {
+  // the pendulum of the crossing test: released at a dispersed time, caught at the bottom a quarter period later
+  const double theta0 = 0.9, m = 1.5, L = 0.6, Izz = 0.02, g = 9.81;
+  const std::string model = test::write_temp("sweep_latch.yaml", fmt::format(R"(
+name: sweep_latch
+gravity: [0, -{}, 0]
+bodies:
+  - name: bob
+    parent: ground
+    mass: {}
+    com: [0, -{}, 0]
+    inertia: [[0.01, 0, 0], [0, 0.01, 0], [0, 0, {}]]
+    joint: {{type: revolute, axis: [0, 0, 1], locked: true}}
+initial:
+  q: {{bob.angle: {}}}
+events:
+  - {{name: drop, at: 0.5, release: [bob]}}
+  - {{name: catch, when: {{coordinate: bob.angle, reaches: 0}}, lock: [bob]}}
+)", g, m, L, Izz, theta0));
+  const std::string sweep = test::write_temp("sweep_latch.sweep.yaml", R"(
+model: sweep_latch.yaml
+runs: 4
+seed: 3
+t_end: 3.0
+dt_out: 0.1
+integrator: rkf78
+rtol: 1.0e-11
+atol: 1.0e-13
+engine: generic
+dispersions:
+  - {parameter: events.drop.at, distribution: uniform, low: -0.4, high: 0.4}
+metrics:
+  - {name: t_catch, column: event.catch.t}
+  - {name: lost, column: event.catch.energy_lost}
+)");
+  const SweepPlan plan = plan_sweep(load_sweep_spec(sweep));
+  const double I_O = Izz + m * L * L;
+  const double quarter = std::comp_ellint_1(std::sin(theta0 / 2)) * std::sqrt(I_O / (m * g * L));
+  // the catch takes the whole swing energy: the drop from theta0 to the bottom
+  const double swing = m * g * L * (1 - std::cos(theta0));
+  GenericEngine engine(plan.model);
+  std::set<double> drops;
+  for (long i = 0; i < 4; ++i) {
+    const RunResult r = run_one(engine, plan, i);
+    REQUIRE(r.ok());
+    drops.insert(r.values[0]);
+    CHECK(std::abs(r.metrics[0] - (r.values[0] + quarter)) < 1e-9);
+    CHECK(r.metrics[1] == Approx(swing).epsilon(1e-8));
+  }
+  CHECK(drops.size() == 4);  // the drop time was dispersed
+  // refused: an unknown event, .at of a crossing event
+  const std::string bad = test::write_temp("sweep_latch_bad.sweep.yaml", R"(
+model: sweep_latch.yaml
+runs: 2
+t_end: 1.0
+dispersions:
+  - {parameter: events.catch.at, distribution: uniform, low: -0.1, high: 0.1}
+  - {parameter: events.nothing.at, distribution: uniform, low: -0.1, high: 0.1}
+metrics:
+  - {name: t_catch, column: event.catch.t}
+)");
+  try {
+    plan_sweep(load_sweep_spec(bad));
+    FAIL("accepted");
+  } catch (const InputError& e) {
+    const std::string w = e.what();
+    INFO(w);
+    CHECK(w.find("dispersions[0].parameter: 'events.catch.at'") != std::string::npos);
+    CHECK(w.find("it has no event 'nothing'") != std::string::npos);
+  }
 }
