@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Eigenvalues>
+#include <chrono>
 #include <cmath>
 #include <complex>
 
@@ -18,6 +19,12 @@ constexpr double kExplicitStabilityRadius = 3.3;
 constexpr double kStiffSteps = 1e5;        ///< stability-limited explicit steps above which BDF pays off
 constexpr double kOscillationSteps = 1e7;  ///< ... above which even a resolved oscillation is left to BDF2
 constexpr int kMaxDenseEigen = 400;
+/// The probe of rkf78 against arkode-dirk (choose_integrator): the share of
+/// the horizon it runs, the speed-up DIRK must show, and how close to rkf78
+/// it must end (in units of rtol, relative to max(1, |x|)).
+constexpr double kProbeShare = 0.01;
+constexpr double kProbeSpeedup = 1.5;
+constexpr double kProbeAgreement = 1e4;
 /// rkf78 below this rtol, dopri5 above: on explorer1_rigid over 3000 s rkf78
 /// takes the same time as dopri5 at rtol 1e-6 with a 90x smaller error, and
 /// half the time at 1e-10 with a 200x smaller error (docs/speed.md).
@@ -49,6 +56,33 @@ MatX jacobian_at(const OdeProblem& p, double t0, const VecX& x0) {
 /// sin(w t) is ~ (w h)^(p+1): w h ~ rtol^(1/(p+1)), 2 pi / (w h) steps per
 /// period); BDF's order is at most 5, so it needs more of them.
 double steps_per_period(double rtol, int order) { return 2.0 * M_PI * std::pow(rtol, -1.0 / (order + 1)); }
+
+/// One candidate over [t0, t0 + span]: its cost in right-hand sides (an
+/// exact Jacobian counted as kJacobianEvals of them; a run's choice must not
+/// depend on the machine's load, so no wall time) and the end state (empty if it failed).
+constexpr double kJacobianEvals = 10.0;
+struct ProbeRun {
+  double cost = INFINITY;
+  VecX x_end;
+};
+ProbeRun probe_run(const OdeProblem& p, IntegratorKind kind, double rtol, double t0, const VecX& x0, double span) {
+  IntegratorOptions o;
+  o.kind = kind;
+  o.rtol = rtol;
+  o.atol = rtol / 100;
+  o.max_steps = 1'000'000;
+  ProbeRun r;
+  try {
+    const IntegratorStats s = integrate(p, o, t0, x0, t0 + span, span, [&](double, const VecX& x) {
+      r.x_end = x;
+      return true;
+    });
+    r.cost = static_cast<double>(s.rhs_evals) + (p.jacobian ? kJacobianEvals * static_cast<double>(s.jac_evals) : 0.0);
+  } catch (const std::exception&) {
+    r.x_end.resize(0);
+  }
+  return r;
+}
 
 struct Spectrum {
   std::complex<double> dominant = 0.0;  ///< the eigenvalue of largest modulus
@@ -120,6 +154,37 @@ IntegratorChoice choose_integrator(Engine& engine, const State& initial, double 
                            "would hold an explicit method to {:.2g} steps over the horizon: cvode-bdf with the "
                            "exact Jacobian",
                            spectrum, 1.0 / c.fastest_decay, dt_out, c.explicit_steps);
+  } else if (!decays_within_a_cycle && c.explicit_steps > kStiffSteps && c.explicit_steps <= kOscillationSteps && std::abs(lambda.imag()) > 0 &&
+             [&] {
+               // a probe: whether an L-stable DIRK, which damps the fast oscillation, runs the
+               // scene faster and ends where rkf78 does (the oscillation then hardly excited)
+               const double period = 2.0 * M_PI / std::abs(lambda.imag());
+               c.probe_interval = std::min(horizon, std::max(kProbeShare * horizon, 100.0 * period));
+               // each candidate over the interval and over twice it: the difference is its cost per
+               // interval once started (an implicit method's start-up is many small steps), which
+               // projects its cost over the horizon
+               auto projected = [&](IntegratorKind k, ProbeRun& twice) {
+                 const ProbeRun once = probe_run(p, k, rtol, initial.t, x0, c.probe_interval);
+                 twice = probe_run(p, k, rtol, initial.t, x0, 2 * c.probe_interval);
+                 return once.cost + std::max(0.0, twice.cost - once.cost) * (horizon / c.probe_interval - 1.0);
+               };
+               ProbeRun rk, dirk;
+               c.probe_rkf78_evals = projected(IntegratorKind::rkf78, rk);
+               c.probe_dirk_evals = projected(IntegratorKind::arkode_dirk, dirk);
+               if (rk.x_end.size() != x0.size() || dirk.x_end.size() != x0.size()) return false;
+               c.probe_difference = (dirk.x_end - rk.x_end).cwiseAbs().maxCoeff() /
+                                    std::max(1.0, rk.x_end.cwiseAbs().maxCoeff());
+               return c.probe_dirk_evals * kProbeSpeedup < c.probe_rkf78_evals &&
+                      c.probe_difference <= kProbeAgreement * rtol;
+             }()) {
+    c.kind = IntegratorKind::arkode_dirk;
+    c.reason = fmt::format("{} is a fast, lightly damped oscillation that would cost an explicit method {:.2g} "
+                           "steps; a probe over {:.3g} s projects arkode-dirk to {:.3g} right-hand sides over the "
+                           "horizon against rkf78's {:.3g}, the two ending "
+                           "{:.2g} apart (relative): arkode-dirk (L-stable, order 4; it damps that oscillation, "
+                           "which the probe found hardly excited)",
+                           spectrum, c.explicit_steps, c.probe_interval, c.probe_dirk_evals, c.probe_rkf78_evals,
+                           c.probe_difference);
   } else if (c.explicit_steps > kOscillationSteps) {
     c.kind = IntegratorKind::cvode_bdf2;
     c.reason = fmt::format("{} is a fast, lightly damped oscillation that would cost an explicit method {:.2g} "
@@ -128,6 +193,12 @@ IntegratorChoice choose_integrator(Engine& engine, const State& initial, double 
                            spectrum, c.explicit_steps);
   } else {
     c.kind = rtol < kHighOrderBelowRtol ? IntegratorKind::rkf78 : IntegratorKind::dopri5;
+    const std::string probed =
+        std::isnan(c.probe_interval)
+            ? ""
+            : fmt::format("; a probe over {:.3g} s found arkode-dirk no better (right-hand sides projected over "
+                          "the horizon: rkf78 {:.3g}, arkode-dirk {:.3g}; ending {:.2g} apart)",
+                          c.probe_interval, c.probe_rkf78_evals, c.probe_dirk_evals, c.probe_difference);
     const std::string why =
         decays_within_a_cycle && c.explicit_steps > kStiffSteps && accuracy_bound
             ? fmt::format("accuracy-bound: {} would allow an explicit method {:.2g} steps, but the oscillation at "
@@ -135,7 +206,7 @@ IntegratorChoice choose_integrator(Engine& engine, const State& initial, double 
                           spectrum, c.explicit_steps, sp.oscillation, c.resolved_steps_bdf)
             : fmt::format("non-stiff: {} bounds an explicit method's steps by {:.2g} over the horizon", spectrum,
                           c.explicit_steps);
-    c.reason = fmt::format("{}: {} (explicit, {})", why, to_string(c.kind),
+    c.reason = fmt::format("{}{}: {} (explicit, {})", why, probed, to_string(c.kind),
                            c.kind == IntegratorKind::rkf78 ? "order 7(8), for rtol below 1e-5"
                                                            : "order 5(4), for loose tolerances");
   }

@@ -1,6 +1,7 @@
 // `--integrator auto`: the method picked from the scene, and why.
 #pragma once
 
+#include <cmath>
 #include <string>
 
 #include "engine/engine.hpp"
@@ -18,6 +19,9 @@ struct IntegratorChoice {
   /// steps BDF needs to follow the fastest lightly damped oscillation (other
   /// than the dominant eigenvalue) at rtol over the horizon
   double resolved_steps_bdf = 0;
+  /// The probe (a fast lightly damped oscillation): each candidate's cost over it in right-hand sides
+  /// (deterministic), and how far apart they ended (relative to max(1, |x|)); NaN when no probe ran.
+  double probe_interval = NAN, probe_rkf78_evals = NAN, probe_dirk_evals = NAN, probe_difference = NAN;
 };
 
 /// Picks the method for a run of `engine` from `initial` to t_end with output
@@ -32,6 +36,13 @@ struct IntegratorChoice {
 ///  - a fast, lightly damped oscillation that would cost an explicit method
 ///    more than 1e7 steps: cvode-bdf2 (A-stable; it damps that oscillation
 ///    numerically, which the reason says);
+///  - a fast, lightly damped oscillation that would cost an explicit method
+///    1e5 to 1e7 steps: a probe of rkf78 and arkode-dirk over 1 % of the
+///    horizon (at least 100 of the oscillation's periods, at most the
+///    horizon) and over twice that, projecting each one's right-hand sides
+///    over the horizon; arkode-dirk when its projection is 1.5x below rkf78's
+///    and ended within 1e4 rtol of rkf78 (the oscillation it damps is then not
+///    excited enough to matter), else rkf78;
 ///  - otherwise non-stiff: rkf78, or dopri5 at rtol 1e-5 and looser.
 IntegratorChoice choose_integrator(Engine& engine, const State& initial, double t_end, double dt_out, double rtol);
 
