@@ -146,4 +146,20 @@ class Engine {
   VecX F_lock_, u_lock_;
 };
 
+/// Sets an engine's locks for a scope (a run, an evaluation at a state) and
+/// puts back the ones it had when the scope ends.
+class ScopedLocks {
+ public:
+  ScopedLocks(Engine& engine, const LockSet& locks) : engine_(engine), before_(engine.locks()) {
+    engine.set_locks(locks);
+  }
+  ~ScopedLocks() { engine_.set_locks(before_); }
+  ScopedLocks(const ScopedLocks&) = delete;
+  ScopedLocks& operator=(const ScopedLocks&) = delete;
+
+ private:
+  Engine& engine_;
+  LockSet before_;
+};
+
 }  // namespace kanegen

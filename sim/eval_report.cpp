@@ -45,13 +45,7 @@ nlohmann::ordered_json eval_report(Engine& engine, const State& state) {
   MatX M;
   engine.set_inputs(state.w);
   // with joints locked (STATE.json "locked"), u-dot and the reactions are the reduced system's
-  const LockSet before = engine.locks();
-  struct Restore {
-    Engine& e;
-    const LockSet& l;
-    ~Restore() { e.set_locks(l); }
-  } restore{engine, before};
-  engine.set_locks(state.locked);
+  const ScopedLocks locks(engine, state.locked);
   engine.qdot(state.q, state.u, qdot);
   engine.mass_matrix(state.t, state.q, M);
   engine.forcing(state.t, state.q, state.u, state.tau, F);

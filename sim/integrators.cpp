@@ -532,7 +532,7 @@ IntegratorStats integrate_rk4(const OdeProblem& problem, const IntegratorOptions
     throw std::invalid_argument(fmt::format("rk4: step h must be positive and finite, got {}", opt.h));
   const int n = problem.n;
   const double h = opt.h;
-  Eigen::VectorXd x = x0, xs(n), k1(n), k2(n), k3(n), k4(n), xo(n);
+  Eigen::VectorXd x = x0, xs(n), k1(n), k2(n), k3(n), k4(n), xo(n), x_next(n);
   double t = t0;  // time of the last accepted state x
 
   auto error = [&](const std::string& what) {
@@ -557,23 +557,24 @@ IntegratorStats integrate_rk4(const OdeProblem& problem, const IntegratorOptions
   EventLocator events(problem);
   events.reset(t0, x.data());
   // one RK4 step of size ts - t from the last accepted state: the interpolant inside a step
-  Eigen::VectorXd xa(n), ya(n), yb(n), yc(n), yd(n), ye(n);
+  // one classical RK4 step from (ta, xa) to ts: the method's step, and its interpolant inside a step
+  Eigen::VectorXd xa(n);
   double ta = t0;
-  auto partial_step = [&](double ts, double* out) {
+  auto step_to = [&](double ts, double* out) {
     const double hs = ts - ta;
     Eigen::Map<Eigen::VectorXd> o(out, n);
     if (hs == 0) {
       o = xa;
       return;
     }
-    eval(ta, xa, ya);
-    ye = xa + 0.5 * hs * ya;
-    eval(ta + 0.5 * hs, ye, yb);
-    ye = xa + 0.5 * hs * yb;
-    eval(ta + 0.5 * hs, ye, yc);
-    ye = xa + hs * yc;
-    eval(ts, ye, yd);
-    o = xa + (hs / 6.0) * (ya + 2.0 * yb + 2.0 * yc + yd);
+    eval(ta, xa, k1);
+    xs = xa + 0.5 * hs * k1;
+    eval(ta + 0.5 * hs, xs, k2);
+    xs = xa + 0.5 * hs * k2;
+    eval(ta + 0.5 * hs, xs, k3);
+    xs = xa + hs * k3;
+    eval(ts, xs, k4);
+    o = xa + (hs / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   };
   double tout = t0;
   while (schedule.next(tout)) {
@@ -585,17 +586,10 @@ IntegratorStats integrate_rk4(const OdeProblem& problem, const IntegratorOptions
                                 opt.max_steps, t_end));
       double t_next = t_start + static_cast<double>(j + 1) * h;
       if (t_next >= tout - 1e-8 * h) t_next = tout;  // shortened (or slightly stretched) last step
-      const double hs = t_next - t;
       xa = x;
       ta = t;
-      eval(t, x, k1);
-      xs = x + 0.5 * hs * k1;
-      eval(t + 0.5 * hs, xs, k2);
-      xs = x + 0.5 * hs * k2;
-      eval(t + 0.5 * hs, xs, k3);
-      xs = x + hs * k3;
-      eval(t_next, xs, k4);
-      xs = x + (hs / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+      step_to(t_next, x_next.data());
+      xs = x_next;
       if (problem.project) problem.project(xs.data());
       std::string bad = first_nonfinite(xs.data(), n);
       if (!bad.empty())
@@ -606,10 +600,10 @@ IntegratorStats integrate_rk4(const OdeProblem& problem, const IntegratorOptions
       ++stats.steps;
       if (events.active()) {
         if (events.crossed(t, x.data())) {
-          const EventLocator::Root root = events.locate(ta, t, partial_step);
+          const EventLocator::Root root = events.locate(ta, t, step_to);
           bool go_on = true;
           for (bool more = true; more && go_on && schedule.before(tout, root.t); more = schedule.next(tout)) {
-            partial_step(tout, xo.data());
+            step_to(tout, xo.data());
             if (problem.project) problem.project(xo.data());
             go_on = output ? output(tout, xo) : true;
           }

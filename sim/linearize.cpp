@@ -127,13 +127,7 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
   // With joints locked (State::locked) the linear model is the reduced
   // system's: the locked joints' coordinates and speeds are no states (the
   // derivatives then come from central differences of the reduced u-dot).
-  const LockSet locks_before = engine.locks();
-  struct RestoreLocks {
-    Engine& e;
-    const LockSet& l;
-    ~RestoreLocks() { e.set_locks(l); }
-  } restore{engine, locks_before};
-  engine.set_locks(state.locked);
+  const ScopedLocks locks(engine, state.locked);
   const double t = state.t;
   const VecX &q0 = state.q, &u0 = state.u, &tau0 = state.tau;
 

@@ -543,13 +543,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     return problem;
   };
   // the locks at the start, and back as they were after the run
-  const LockSet locks_before = engine.locks();
-  struct RestoreLocks {
-    Engine& e;
-    const LockSet& l;
-    ~RestoreLocks() { e.set_locks(l); }
-  } restore{engine, locks_before};
-  engine.set_locks(initial.locked);
+  const ScopedLocks locks(engine, initial.locked);
   sampled.segment_locks.push_back(engine.locks());
   const std::vector<Event>* run_events = options.events ? &*options.events : nullptr;
   EventRun events(model, initial.t, initial.locked, run_events);
