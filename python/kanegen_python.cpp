@@ -70,6 +70,22 @@ class PyModel {
     return s;
   }
 
+  /// `locked`: the bodies whose joints are locked at the state (None: the
+  /// model's `locked: true` joints), as STATE.json's "locked".
+  void apply_locked(State& s, const py::object& locked) const {
+    if (locked.is_none()) return;
+    std::fill(s.locked.begin(), s.locked.end(), 0);
+    for (const auto& item : locked.cast<std::vector<std::string>>()) {
+      const int b = model_->body_index(item);
+      if (b < 0) throw py::key_error("locked: no body named '" + item + "'");
+      if (!joint_can_lock(model_->bodies[b].joint))
+        throw py::value_error("locked: the joint of '" + item + "' has no degree of freedom to lock");
+      s.locked[b] = 1;
+    }
+    for (int k : locked_speeds(*model_, s.locked))
+      if (s.u(k) != 0.0) throw py::value_error("locked: '" + model_->u_names[k] + "' is not 0 but its joint is locked");
+  }
+
  private:
   /// `speeds`: the model when the names are speeds (the older names accepted, model-format.md).
   static void fill(const py::object& v, const std::vector<std::string>& names, VecX& out, const char* what,
@@ -218,8 +234,10 @@ PYBIND11_MODULE(kanegen, m) {
       .def(
           "eval",
           [](PyModel& p, const py::object& q, const py::object& u, const py::object& tau, const py::object& inputs,
-             double t) {
-            const State s = p.state(t, q, u, tau, inputs);
+             double t, const py::object& locked) {
+            State s = p.state(t, q, u, tau, inputs);
+            p.apply_locked(s, locked);
+            const ScopedLocks locks(p.engine(), s.locked);  // u_dot: the reduced system's while locked
             p.engine().set_inputs(s.w);
             VecX qd, F, ud, y;
             MatX M;
@@ -241,8 +259,9 @@ PYBIND11_MODULE(kanegen, m) {
             return d;
           },
           py::arg("q") = py::none(), py::arg("u") = py::none(), py::arg("tau") = py::none(),
-          py::arg("inputs") = py::none(), py::arg("t") = 0.0,
-          "q_dot, M, F, u_dot and the named outputs at a state (arrays or {name: value}; missing: the initial state)")
+          py::arg("inputs") = py::none(), py::arg("t") = 0.0, py::arg("locked") = py::none(),
+          "q_dot, M, F, u_dot and the named outputs at a state (arrays or {name: value}; missing: the initial state); "
+          "locked: bodies whose joints are locked there (default: the model's locked: true)")
       .def(
           "outputs",
           [](PyModel& p, const py::object& q, const py::object& u, const py::object& tau, const py::object& inputs,
@@ -276,9 +295,10 @@ PYBIND11_MODULE(kanegen, m) {
           "simulate",
           [](PyModel& p, double t_end, double dt_out, const py::object& q, const py::object& u, const py::object& tau,
              const py::object& inputs, const py::object& controller, double period, const std::string& integrator,
-             double rtol, double atol, double h) {
+             double rtol, double atol, double h, const py::object& locked) {
             return translating([&] {
-              const State s = p.state(0.0, q, u, tau, inputs);
+              State s = p.state(0.0, q, u, tau, inputs);
+              p.apply_locked(s, locked);
               SimulationOptions o;
               o.t_end = t_end;
               o.dt_out = dt_out;
@@ -326,8 +346,8 @@ PYBIND11_MODULE(kanegen, m) {
           py::arg("t_end"), py::arg("dt_out") = 0.01, py::arg("q") = py::none(), py::arg("u") = py::none(),
           py::arg("tau") = py::none(), py::arg("inputs") = py::none(), py::arg("controller") = py::none(),
           py::arg("period") = 0.0, py::arg("integrator") = "auto", py::arg("rtol") = 1e-10,
-          py::arg("atol") = 1e-12, py::arg("h") = 1e-3,
-          "integrates from a state; inputs fixed, or set by controller(t, q, u, y) -> w (continuous when period "
+          py::arg("atol") = 1e-12, py::arg("h") = 1e-3, py::arg("locked") = py::none(),
+          "integrates from a state (locked: the bodies whose joints start locked; default the model's); inputs fixed, or set by controller(t, q, u, y) -> w (continuous when period "
           "is 0, else digital with zero-order hold); h is rk4's step; returns {column: array} as the CSV of "
           "`kanegen simulate`, plus 'events': the events that fired (t, name, action, bodies, energy_lost, "
           "u_before, u_after)");
