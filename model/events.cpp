@@ -38,6 +38,14 @@ std::vector<int> locked_speeds(const Model& model, const LockSet& locks) {
   return out;
 }
 
+int joint_body_of_speed(const Model& model, int k) {
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const Body& b = model.bodies[i];
+    if (k >= b.u_joint && k < b.u_joint + joint_nu(b.joint)) return static_cast<int>(i);
+  }
+  return -1;
+}
+
 int joint_body_of_coordinate(const Model& model, int k) {
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
     const Body& b = model.bodies[i];
@@ -47,11 +55,6 @@ int joint_body_of_coordinate(const Model& model, int k) {
 }
 
 namespace {
-
-bool valid_event_name(const std::string& s) {
-  return !s.empty() && s.size() <= 64 && s[0] >= 'a' && s[0] <= 'z' &&
-         std::all_of(s.begin(), s.end(), [](char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_'; });
-}
 
 /// The bodies of `lock:` / `release:` (a list of body names), each one whose joint can lock.
 std::vector<int> read_bodies(const YAML::Node& n, int l, const std::string& f, const Model& model, Checker& ck) {
@@ -115,8 +118,9 @@ void read_events(const YAML::Node& events, const std::string& path, Model& model
     if (!name.IsDefined()) {
       ck.error(l, f + ".name", "missing; expected a name matching [a-z][a-z0-9_]*");
     } else if (auto s = ck.string(name, l, f + ".name")) {
-      if (!valid_event_name(*s))
-        ck.error(name, l, f + ".name", fmt::format("'{}'; expected a name matching [a-z][a-z0-9_]*", *s));
+      if (!valid_identifier(*s))
+        ck.error(name, l, f + ".name",
+                 fmt::format("'{}'; expected a name matching [a-z][a-z0-9_]* (at most 64 characters)", *s));
       else if (!seen.insert(*s).second)
         ck.error(name, l, f + ".name", fmt::format("'{}' is the name of an earlier event; expected a unique name", *s));
       else

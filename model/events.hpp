@@ -47,6 +47,8 @@ std::vector<int> locked_speeds(const Model& model, const LockSet& locks);
 
 /// The body whose joint coordinate q[k] is (-1 for a modal coordinate).
 int joint_body_of_coordinate(const Model& model, int k);
+/// The body whose joint speed u[k] is (-1 for a modal speed).
+int joint_body_of_speed(const Model& model, int k);
 
 /// Reads the `events:` list of a model file into model.events (the bodies are
 /// known by then), checking what can be known when the model is loaded

@@ -203,11 +203,7 @@ class Loader {
     }
     auto s = ck_.string(n, line_of(e), f + ".name");
     if (!s) return std::nullopt;
-    const bool ok = !s->empty() && s->size() <= 64 && (*s)[0] >= 'a' && (*s)[0] <= 'z' &&
-                    std::all_of(s->begin(), s->end(), [](char c) {
-                      return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
-                    });
-    if (!ok) {
+    if (!yamlcheck::valid_identifier(*s)) {
       ck_.error(n, line_of(e), f + ".name",
                 fmt::format("'{}' is not a valid name; expected [a-z][a-z0-9_]* (at most 64 characters)", *s));
       return std::nullopt;

@@ -184,16 +184,12 @@ State load_state(const Model& model, const std::string& path) {
       }
     }
   }
-  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
-    if (!s.locked[b]) continue;
-    const Body& body = model.bodies[b];
-    for (int k = 0; k < joint_nu(body.joint); ++k)
-      if (s.u(body.u_joint + k) != 0.0)
-        err(locked ? locked->key_line : 0, "u." + model.u_names[body.u_joint + k],
-            fmt::format("{} for a speed of '{}', whose joint is locked; expected 0 or none (a locked joint does not "
-                        "move)",
-                        s.u(body.u_joint + k), body.name));
-  }
+  for (int k : locked_speeds(model, s.locked))
+    if (s.u(k) != 0.0)
+      err(locked ? locked->key_line : 0, "u." + model.u_names[k],
+          fmt::format("{} for a speed of '{}', whose joint is locked; expected 0 or none (a locked joint does not "
+                      "move)",
+                      s.u(k), model.bodies[joint_body_of_speed(model, k)].name));
 
   // Quaternions: all four components or none; any non-zero norm is
   // normalized, robustly (scaled by the largest component first, so that

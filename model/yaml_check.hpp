@@ -80,6 +80,12 @@ inline std::string did_you_mean(const std::string& word, const std::vector<std::
   return hit.empty() ? std::string() : fmt::format("; did you mean '{}'?", hit);
 }
 
+/// A name of a port, sensor or event: [a-z][a-z0-9_]*, at most 64 characters.
+inline bool valid_identifier(const std::string& s) {
+  return !s.empty() && s.size() <= 64 && s[0] >= 'a' && s[0] <= 'z' &&
+         std::all_of(s.begin(), s.end(), [](char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_'; });
+}
+
 inline std::string join(const std::vector<std::string>& v, const char* sep = ", ") {
   std::string s;
   for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];

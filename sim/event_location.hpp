@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sim/integrators.hpp"
+#include "sim/output_schedule.hpp"
 
 namespace kanegen {
 
@@ -39,5 +40,17 @@ class EventLocator {
   std::vector<int> crossed_;
   Eigen::VectorXd x_work_;
 };
+
+/// The last outputs of a run an event stopped: the schedule's times before
+/// the event at t_event (`emit_at(t)`: the state there from the step's
+/// interpolant, emitted; false to stop), then the event's own state
+/// (`emit_event()`). `tout`: the schedule's current time.
+template <class EmitAt, class EmitEvent>
+void emit_up_to_event(double t_event, OutputSchedule& schedule, double& tout, EmitAt emit_at, EmitEvent emit_event) {
+  bool go_on = true;
+  for (bool more = true; more && go_on && schedule.before(tout, t_event); more = schedule.next(tout))
+    go_on = emit_at(tout);
+  if (go_on) emit_event();
+}
 
 }  // namespace kanegen

@@ -33,11 +33,14 @@ double EventRun::next_stop(double t, double t_end) const {
   return stop;
 }
 
+bool EventRun::due(std::size_t i, double t) const {
+  const Event& e = events_[i];
+  return !done_[i] && e.trigger == Event::Trigger::time && std::abs(e.at - t) <= time_tol(t);
+}
+
 bool EventRun::time_event_due(double t) const {
-  for (std::size_t i = 0; i < events_.size(); ++i) {
-    const Event& e = events_[i];
-    if (!done_[i] && e.trigger == Event::Trigger::time && std::abs(e.at - t) <= time_tol(t)) return true;
-  }
+  for (std::size_t i = 0; i < events_.size(); ++i)
+    if (due(i, t)) return true;
   return false;
 }
 
@@ -65,11 +68,8 @@ void EventRun::arm(OdeProblem& p) {
 int EventRun::fire(Engine& engine, double t, VecX& x, int crossing) {
   std::vector<int> due;
   if (crossing >= 0 && crossing < static_cast<int>(armed_.size())) due.push_back(armed_[crossing]);
-  for (std::size_t i = 0; i < events_.size(); ++i) {
-    const Event& e = events_[i];
-    if (!done_[i] && e.trigger == Event::Trigger::time && std::abs(e.at - t) <= time_tol(t))
-      due.push_back(static_cast<int>(i));
-  }
+  for (std::size_t i = 0; i < events_.size(); ++i)
+    if (this->due(i, t)) due.push_back(static_cast<int>(i));
   std::sort(due.begin(), due.end());
   due.erase(std::unique(due.begin(), due.end()), due.end());
   const int nq = model_.nq, nu = model_.nu;

@@ -52,6 +52,8 @@ class EventRun {
   std::vector<char> done_;          ///< per model event: fired (or in the past at the start)
   std::vector<int> armed_;          ///< event function i -> model event index
   std::vector<FiredEvent> fired_;
+  /// Whether model event i is an unfired time event due at t.
+  bool due(std::size_t i, double t) const;
 };
 
 /// "deploy at t = 10: release panel; latch at t = 12.3: lock panel (energy lost 0.53 J)"

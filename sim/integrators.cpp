@@ -496,15 +496,16 @@ IntegratorStats integrate_sundials(const OdeProblem& problem, const IntegratorOp
             dense(t, tout);
             std::copy(youtmap.data(), youtmap.data() + n, x);
           });
-          bool go_on = true;
-          for (bool more = true; more && go_on && schedule.before(tout, root.t); more = schedule.next(tout)) {
-            dense(tout, tout);
-            go_on = emit(tout, youtmap);
-          }
-          if (go_on) {
-            youtmap = root.x;
-            emit(root.t, youtmap);
-          }
+          emit_up_to_event(
+              root.t, schedule, tout,
+              [&](double t) {
+                dense(t, t);
+                return emit(t, youtmap);
+              },
+              [&] {
+                youtmap = root.x;
+                emit(root.t, youtmap);
+              });
           stats.event = root.event;
           stats.t_event = root.t;
           stepper->fill_stats(stats);
@@ -601,18 +602,19 @@ IntegratorStats integrate_rk4(const OdeProblem& problem, const IntegratorOptions
       if (events.active()) {
         if (events.crossed(t, x.data())) {
           const EventLocator::Root root = events.locate(ta, t, step_to);
-          bool go_on = true;
-          for (bool more = true; more && go_on && schedule.before(tout, root.t); more = schedule.next(tout)) {
-            step_to(tout, xo.data());
-            if (problem.project) problem.project(xo.data());
-            go_on = output ? output(tout, xo) : true;
-          }
-          if (go_on) {
-            x = root.x;
-            t = root.t;
-            if (problem.project) problem.project(x.data());
-            emit();
-          }
+          emit_up_to_event(
+              root.t, schedule, tout,
+              [&](double ts) {
+                step_to(ts, xo.data());
+                if (problem.project) problem.project(xo.data());
+                return output ? output(ts, xo) : true;
+              },
+              [&] {
+                x = root.x;
+                t = root.t;
+                if (problem.project) problem.project(x.data());
+                emit();
+              });
           stats.event = root.event;
           stats.t_event = root.t;
           return stats;

@@ -213,11 +213,7 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
       T_in(nq + k, nqt + k) = 1.0;
       T_out(nqt + k, nq + k) = 1.0;
       lin.state_names.push_back("u." + model.u_names[k]);
-      int b = -1;
-      for (std::size_t j = 0; j < model.bodies.size(); ++j)
-        if (k >= model.bodies[j].u_joint && k < model.bodies[j].u_joint + joint_nu(model.bodies[j].joint))
-          b = static_cast<int>(j);
-      state_body.push_back(b);
+      state_body.push_back(joint_body_of_speed(model, k));
     }
   }
   lin.A = T_out * J * T_in;

@@ -121,11 +121,14 @@ class OdeintRun {
     stats_.event = root.event;
     stats_.t_event = root.t;
     StateVec xo(n_);
-    for (bool more = true; more && schedule.before(tout, root.t); more = schedule.next(tout)) {
-      state_at(tout, xo);
-      emit(tout, xo, output);
-    }
-    emit(root.t, StateVec(root.x.data(), root.x.data() + n_), output);
+    emit_up_to_event(
+        root.t, schedule, tout,
+        [&](double t) {
+          state_at(t, xo);
+          emit(t, xo, output);  // throws StopRequested when the output asks to stop
+          return true;
+        },
+        [&] { emit(root.t, StateVec(root.x.data(), root.x.data() + n_), output); });
     throw StopRequested{};
   }
 

@@ -423,8 +423,6 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     }
     return problem;
   };
-  VecX x0(nq + nu);
-  x0 << initial.q, initial.u;
 
   SimulationResult result;
   const auto cols = csv_columns(model);
@@ -548,7 +546,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   const std::vector<Event>* run_events = options.events ? &*options.events : nullptr;
   EventRun events(model, initial.t, initial.locked, run_events);
   SegmentHooks hooks;
-  hooks.problem = [&] { return make_problem(); };
+  hooks.problem = make_problem;
   hooks.at_sample = [&](double t, const VecX& x) {
     try {
       apply_law(t, x.data());
@@ -588,7 +586,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
       const bench::Trajectory seg = sampled.segment(i);
       if (seg.t.size() < 2) continue;
       bench::InvariantSet inv_i = inv;
-      const LockSet& l = sampled.segment_locks[std::min(i, sampled.segment_locks.size() - 1)];
+      const LockSet& l = sampled.segment_locks[i];
       for (std::size_t b = 0; b < l.size(); ++b)
         if (l[b] && model.bodies[b].parent < 0) inv_i.momentum = false;
       const bench::Drifts d = bench::invariant_drifts(lacks ? *measure : engine, inv_i, seg);
