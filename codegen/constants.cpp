@@ -67,9 +67,26 @@ GiNaC::ex Constants::derived(const GiNaC::ex& e) {
   // next (its term order follows hash values): a derived constant is free of
   // a numeric factor, and a sum is taken with the sign that makes it
   // positive, so both forms give the same constant
-  if (GiNaC::is_a<GiNaC::mul>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(e.nops() - 1))) {
-    const GiNaC::ex n = e.op(e.nops() - 1);
-    return n * derived_unsigned(e / n);
+  // A product takes its sums (and their integer powers) with the sign that makes them positive:
+  // -(a - b) c and (b - a) c are one constant.
+  if (GiNaC::is_a<GiNaC::mul>(e)) {
+    GiNaC::ex sign = 1, rest = 1;
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      const GiNaC::ex f = e.op(i);
+      if (GiNaC::is_a<GiNaC::numeric>(f)) {
+        sign *= f;
+      } else if (GiNaC::is_a<GiNaC::add>(f) && evaluate(f) < 0.0) {
+        sign = -sign;
+        rest *= -f;
+      } else if (GiNaC::is_a<GiNaC::power>(f) && GiNaC::is_a<GiNaC::add>(f.op(0)) && f.op(1).info(GiNaC::info_flags::integer) &&
+                 evaluate(f.op(0)) < 0.0) {
+        if (f.op(1).info(GiNaC::info_flags::odd)) sign = -sign;
+        rest *= GiNaC::pow(-f.op(0), f.op(1));
+      } else {
+        rest *= f;
+      }
+    }
+    return sign * derived_unsigned(rest);
   }
   if (GiNaC::is_a<GiNaC::add>(e) && evaluate(e) < 0.0) return -derived_unsigned(-e);
   return derived_unsigned(e);
