@@ -112,6 +112,7 @@ State load_state(const Model& model, const std::string& path) {
 
   std::map<std::string, int> given_q;  // name -> line
   const char* keys[4] = {"q", "u", "tau", "inputs"};
+  std::map<int, int> u_line;  // speed index -> line of its "u" entry
   const std::vector<std::string>* names[4] = {&model.q_names, &model.u_names, &model.u_names, &model.input_names};
   VecX* targets[4] = {&s.q, &s.u, &s.tau, &s.w};
   for (int k = 0; k < 4; ++k) {
@@ -151,6 +152,7 @@ State load_state(const Model& model, const std::string& path) {
       if (!number(*m, field, x)) continue;
       (*targets[k])(idx) = x;
       if (k == 0) given_q[m->key] = m->key_line;
+      if (k == 1) u_line[idx] = m->key_line;
     }
   }
 
@@ -186,7 +188,7 @@ State load_state(const Model& model, const std::string& path) {
   }
   for (int k : locked_speeds(model, s.locked))
     if (s.u(k) != 0.0)
-      err(locked ? locked->key_line : 0, "u." + model.u_names[k],
+      err(u_line.count(k) ? u_line[k] : locked ? locked->key_line : 0, "u." + model.u_names[k],
           fmt::format("{} for a speed of '{}', whose joint is locked; expected 0 or none (a locked joint does not "
                       "move)",
                       s.u(k), model.bodies[joint_body_of_speed(model, k)].name));
