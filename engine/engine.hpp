@@ -67,6 +67,8 @@ class Engine {
   bool jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& J);
   /// Whether jacobian() gives exact Jacobians.
   virtual bool has_jacobian() const { return false; }
+  /// The implicit integrators use jacobian() (else they difference the right-hand side).
+  virtual bool jacobian_for_integration() const { return has_jacobian(); }
 
   /// The named inputs w (model().nw values, docs/gnc.md) that forcing, udot,
   /// reactions, the Jacobians and outputs use from now on; zero until set

@@ -27,6 +27,9 @@ class GeneratedEngine final : public Engine {
   std::string name() const override { return "generated"; }
 
   bool has_jacobian() const override { return jacobian_ != nullptr; }
+  bool jacobian_for_integration() const override { return has_jacobian() && jacobian_for_integration_; }
+  /// false: the compiled Jacobian is slower than differencing u-dot (a large model's, built at -O0 for linearize).
+  void set_jacobian_for_integration(bool on) { jacobian_for_integration_ = on; }
   const KanegenGeneratedApi& api() const { return *api_; }
   /// The function of the table called `name`, or null.
   KanegenFunctionPtr function(const std::string& name) const;
@@ -75,6 +78,7 @@ class GeneratedEngine final : public Engine {
   MatX M_row_major_;
   /// What the code's prm[] gets: the model's parameters, then the implicit ones.
   VecX code_parameters_;
+  bool jacobian_for_integration_ = true;
 };
 
 }  // namespace kanegen

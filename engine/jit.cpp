@@ -134,15 +134,16 @@ struct CompileStep {
   double cost = 0;  ///< estimated effort, to start the largest parts first
 };
 
-/// Functions whose u-dot takes more operations get no compiled Jacobian:
-/// the dual-number Jacobian costs about 3 u-dot per column; compiled below
-/// -O1 it is slower than SUNDIALS' finite differences of the -O2 u-dot
-/// (deep_chain: 5.3 s against 0.7 s), and at -O1 past ~6000 u-dot operations
-/// it takes minutes to compile.
+/// Past this many u-dot operations the dual-number functions are compiled at
+/// -O0 (at -O1 they take minutes to compile) and serve linearize only (exact
+/// derivatives): the dual-number Jacobian costs about 3 u-dot per column, and
+/// at -O0 it is slower than SUNDIALS' finite differences of the -O2 u-dot
+/// (deep_chain: 5.3 s against 0.7 s at -O1), so the implicit integrators
+/// difference the right-hand side instead (LibraryRecord::jacobian_for_integration).
 constexpr long kMaxJacobianUdotOps = 6000;
 
 /// Changes whenever plan_compile() chooses differently (part of the cache key).
-constexpr int kCompilePlanVersion = 2;
+constexpr int kCompilePlanVersion = 3;
 
 /// The generated functions are compiled one per translation unit, in
 /// parallel, and linked. With the default flags each part gets an
@@ -162,7 +163,7 @@ std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out
   const std::string include = "-I" + o.include_dir;
   const ManifestFunction* udot = manifest.find("udot");
   const long udot_ops = udot ? udot->ops : 0;
-  const bool jacobian_left_out = udot_ops > kMaxJacobianUdotOps || !o.derivatives;
+  const bool jacobian_left_out = !o.derivatives;
   std::vector<CompileStep> steps;
   std::vector<std::string> objects;
   auto add = [&](const std::string& part, long ops, const std::string& opt, const std::vector<std::string>& extra) {
@@ -195,7 +196,7 @@ std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out
     if (!wanted(f.name)) continue;
     if (is_dual(f.name)) {
       if (jacobian_left_out) continue;
-      add(f.name, f.ops, udot_ops <= 1500 ? "-O2" : "-O1", {});
+      add(f.name, f.ops, udot_ops <= 1500 ? "-O2" : udot_ops <= kMaxJacobianUdotOps ? "-O1" : "-O0", {});
     } else {
       // u-dot is the hot path: -O2 always (large ones come in parts of a few
       // thousand operations, which -O2 compiles in linear time); the others
@@ -339,7 +340,9 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
   // Publish: the library, then its record (a library without a matching
   // record is rebuilt, never loaded). A concurrent process publishing its own
   // copy at the same time is harmless.
-  const jit_cache::LibraryRecord record = jit_cache::make_record(out_path.string(), manifest.api_symbol);
+  jit_cache::LibraryRecord record = jit_cache::make_record(out_path.string(), manifest.api_symbol);
+  const ManifestFunction* udot_fn = manifest.find("udot");
+  record.jacobian_for_integration = !(udot_fn && udot_fn->ops > kMaxJacobianUdotOps);
   fs::rename(out_path, so_path, ec);
   if (ec)
     throw std::runtime_error(fmt::format("kanegen: cannot move the compiled library to {}: {}", so_path.string(),
@@ -351,7 +354,8 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
 /// dlopen + dlsym of a verified library; throws std::runtime_error.
 std::unique_ptr<GeneratedEngine> open_library(const Model& model, const std::string& path,
                                               const std::string& api_symbol, const std::string& generator_hash,
-                                              const std::vector<RuntimeParameter>& implicit) {
+                                              const std::vector<RuntimeParameter>& implicit,
+                                              bool jacobian_for_integration) {
   void* h = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!h) {
     const char* e = dlerror();
@@ -363,6 +367,7 @@ std::unique_ptr<GeneratedEngine> open_library(const Model& model, const std::str
   if (!fn) throw std::runtime_error(fmt::format("kanegen: {}: no symbol {}", path, api_symbol));
   auto e = std::make_unique<GeneratedEngine>(model, fn(), std::move(handle), generator_hash, implicit);
   e->set_library_path(path);
+  e->set_jacobian_for_integration(jacobian_for_integration);
   return e;
 }
 
@@ -375,7 +380,7 @@ std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::st
                                                const std::vector<RuntimeParameter>& implicit = {}) {
   if (const auto record = jit_cache::verified_record(so_path)) {
     if (announce(o)) fmt::print(stderr, "kanegen: generated code for {} from the cache ({})\n", model.name, so_path);
-    return open_library(model, so_path, record->api_symbol, generator_hash, implicit);
+    return open_library(model, so_path, record->api_symbol, generator_hash, implicit, record->jacobian_for_integration);
   }
   const auto t_gen = std::chrono::steady_clock::now();
   const GeneratedSources sources = make_sources();
@@ -386,7 +391,7 @@ std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::st
   build_library(sources, manifest, so_path, o);
   const auto record = jit_cache::verified_record(so_path);
   if (!record) throw std::runtime_error(fmt::format("kanegen: the library just built at {} does not verify", so_path));
-  return open_library(model, so_path, record->api_symbol, generator_hash, implicit);
+  return open_library(model, so_path, record->api_symbol, generator_hash, implicit, record->jacobian_for_integration);
 }
 
 }  // namespace

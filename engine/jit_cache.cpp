@@ -61,6 +61,7 @@ std::optional<LibraryRecord> verified_record(const std::string& so_path) {
     r.api_symbol = j.at("api_symbol").get<std::string>();
     r.size = j.at("size").get<long long>();
     r.checksum = j.at("fnv1a64").get<std::string>();
+    r.jacobian_for_integration = j.value("jacobian_for_integration", true);
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;
   }
@@ -82,6 +83,7 @@ void write_record(const std::string& so_path, const LibraryRecord& r) {
   j["api_symbol"] = r.api_symbol;
   j["size"] = r.size;
   j["fnv1a64"] = r.checksum;
+  j["jacobian_for_integration"] = r.jacobian_for_integration;
   {
     std::ofstream out(tmp, std::ios::binary);
     out << j.dump() << "\n";

@@ -18,6 +18,8 @@ struct LibraryRecord {
   std::string api_symbol;
   long long size = 0;
   std::string checksum;  ///< fnv1a64 hex of the library's bytes
+  /// The compiled Jacobian is fast enough for the implicit integrators (else it serves linearize only).
+  bool jacobian_for_integration = true;
 };
 
 /// <dir>/<stem>-<key>.json for a library path <dir>/<stem>-<key>.so.

@@ -117,6 +117,72 @@ Eigen::Matrix<double, 4, 3> quaternion_xi(const Eigen::Vector4d& q) {
   return X;
 }
 
+namespace {
+
+/// LinearModel::ignorable and the relative equilibrium, from A and x0_dot. `body_of`: per state its joint's body.
+void find_ignorable(LinearModel& lin, const std::vector<int>& body_of) {
+  const int n = static_cast<int>(lin.A.rows());
+  // exact derivatives: zero is zero to rounding; central differences carry ~1e-8 of noise
+  const bool exact = lin.method.rfind("exact", 0) == 0;
+  const double small = (exact ? 1e-12 : 1e-6) * std::max(1.0, n ? lin.A.cwiseAbs().maxCoeff() : 0.0);
+  auto is_q = [&](int i) { return lin.state_names[i].rfind("q.", 0) == 0; };
+  std::vector<bool> cand(n, false);
+  for (int i = 0; i < n; ++i) cand[i] = is_q(i) && body_of[i] >= 0;
+  for (bool changed = true; changed;) {  // a candidate only other same-joint candidates depend on
+    changed = false;
+    for (int i = 0; i < n; ++i) {
+      if (!cand[i]) continue;
+      for (int j = 0; j < n; ++j)
+        if (std::abs(lin.A(j, i)) > small && !(cand[j] && body_of[j] == body_of[i])) {
+          cand[i] = false, changed = true;
+          break;
+        }
+    }
+  }
+  lin.ignorable.clear();
+  double rest = 0, own = 0;
+  for (int i = 0; i < n; ++i) {
+    if (cand[i]) lin.ignorable.push_back(lin.state_names[i]);
+    (cand[i] ? own : rest) = std::max(cand[i] ? own : rest, std::abs(lin.x0_dot(i)));
+  }
+  lin.relative_residual = rest;
+  lin.relative_equilibrium = !lin.equilibrium && rest <= kEquilibriumTolerance && own > 0;
+}
+
+/// The model without the states named `drop` (none of the others depends on them).
+void drop_states(LinearModel& lin, const std::vector<std::string>& drop) {
+  std::vector<int> keep;
+  for (int i = 0; i < static_cast<int>(lin.state_names.size()); ++i)
+    if (std::find(drop.begin(), drop.end(), lin.state_names[i]) == drop.end()) keep.push_back(i);
+  const int nk = static_cast<int>(keep.size());
+  const bool state_outputs = lin.output_names == lin.state_names;
+  MatX A(nk, nk), B(nk, lin.B.cols()), C(lin.C.rows(), nk);
+  VecX xd(nk);
+  std::vector<std::string> names;
+  for (int r = 0; r < nk; ++r) {
+    for (int c = 0; c < nk; ++c) A(r, c) = lin.A(keep[r], keep[c]);
+    B.row(r) = lin.B.row(keep[r]);
+    xd(r) = lin.x0_dot(keep[r]);
+    names.push_back(lin.state_names[keep[r]]);
+  }
+  for (int c = 0; c < nk; ++c) C.col(c) = lin.C.col(keep[c]);
+  if (state_outputs) {
+    lin.C = MatX::Identity(nk, nk);
+    lin.D = MatX::Zero(nk, lin.B.cols());
+    lin.output_names = names;
+    lin.y0 = VecX::Zero(nk);
+  } else {
+    lin.C = C;
+  }
+  lin.A = A, lin.B = B, lin.x0_dot = xd, lin.state_names = names;
+  lin.ignorable_dropped = true;
+  // without the ignorable rows the point is an equilibrium of what is left when it was a relative one
+  lin.residual = xd.size() ? xd.cwiseAbs().maxCoeff() : 0.0;
+  lin.equilibrium = lin.residual <= kEquilibriumTolerance;
+}
+
+}  // namespace
+
 LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions& options) {
   const Model& model = engine.model();
   const int nq = model.nq, nu = model.nu, nx = nq + nu;
@@ -296,6 +362,9 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
       names.push_back(lin.state_names[keep[r]]);
     }
     for (int c = 0; c < nk; ++c) C.col(c) = lin.C.col(keep[c]);
+    std::vector<int> kept_body;
+    for (int k : keep) kept_body.push_back(state_body[k]);
+    state_body = kept_body;
     if (state_outputs) {
       lin.C = MatX::Identity(nk, nk);
       lin.D = MatX::Zero(nk, m);
@@ -310,6 +379,8 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
     lin.state_names = names;
     lin.method += fmt::format(", reduced: {} locked joint speeds", engine.locked_u().size());
   }
+  find_ignorable(lin, state_body);
+  if (options.drop_ignorable && !lin.ignorable.empty()) drop_states(lin, lin.ignorable);
   return lin;
 }
 
@@ -322,6 +393,7 @@ std::vector<LinearMode> linear_modes(const LinearModel& lin) {
   const auto& V = es.eigenvectors();
   int nqt = 0;
   for (const auto& s : lin.state_names) nqt += s.rfind("q.", 0) == 0 ? 1 : 0;
+  const double zero_tol = 1e-6 * std::sqrt(std::max(1.0, lin.A.cwiseAbs().maxCoeff()));
   for (int k = 0; k < n; ++k) {
     const std::complex<double> l = lam(k);
     if (l.imag() < 0) continue;
@@ -330,7 +402,13 @@ std::vector<LinearMode> linear_modes(const LinearModel& lin) {
     const double mag = std::abs(l);
     m.natural_frequency_hz = mag / kTwoPi;
     m.damped_frequency_hz = l.imag() / kTwoPi;
-    m.damping_ratio = mag > 0 ? -l.real() / mag : 1.0;
+    m.damping_ratio = mag > 0 ? -l.real() / mag : NAN;
+    if (mag <= zero_tol) {  // a rigid-body or ignorable mode: 0 within the eigenvalue noise
+      m.zero = true;
+      m.eigenvalue = 0.0;
+      m.natural_frequency_hz = m.damped_frequency_hz = 0.0;
+      m.damping_ratio = NAN;
+    }
     std::vector<std::pair<double, int>> part;
     for (int i = 0; i < n; ++i) {
       double p = std::abs(V(i, k));
@@ -366,8 +444,16 @@ nlohmann::ordered_json to_json(const LinearModel& lin, const std::vector<LinearM
       "(states q.<body>.rx, .ry, .rz); attitude outputs likewise (rows <sensor>.rx, .ry, .rz)";
   j["equilibrium"] = lin.equilibrium;
   j["residual"] = lin.residual;
+  j["relative_equilibrium"] = lin.relative_equilibrium;
+  j["ignorable"] = lin.ignorable;
+  j["ignorable_dropped"] = lin.ignorable_dropped;
   j["note"] = lin.equilibrium
                   ? "the point is an equilibrium (max |x_dot| <= 1e-9): x_dot = A dx + B dw"
+                  : lin.relative_equilibrium
+                  ? fmt::format("the point is a relative equilibrium: x_dot is zero (<= 1e-9) except for the ignorable "
+                                "coordinates ({}), which nothing else depends on: x_dot = x0_dot + A dx + B dw with "
+                                "x0_dot their steady rates (--drop-ignorable leaves them out)",
+                                fmt::join(lin.ignorable, ", "))
                   : fmt::format("the point is not an equilibrium (max |x_dot| = {:.3g}): a first-order Taylor model "
                                 "x_dot = x0_dot + A dx + B dw, y = y0 + C dx + D dw",
                                 lin.residual);
@@ -385,7 +471,8 @@ nlohmann::ordered_json to_json(const LinearModel& lin, const std::vector<LinearM
     jm.push_back({{"eigenvalue", {m.eigenvalue.real(), m.eigenvalue.imag()}},
                   {"natural_frequency_hz", m.natural_frequency_hz},
                   {"damped_frequency_hz", m.damped_frequency_hz},
-                  {"damping_ratio", m.damping_ratio},
+                  {"damping_ratio", std::isnan(m.damping_ratio) ? nlohmann::ordered_json() : nlohmann::ordered_json(m.damping_ratio)},
+                  {"zero", m.zero},
                   {"dominant_states", m.dominant_states}});
   j["modes"] = jm;
   return j;

@@ -31,6 +31,9 @@ struct LinearizeOptions {
   /// the model declares none.
   std::vector<std::string> outputs;
   bool finite_differences = false;  ///< central differences even where exact derivatives exist
+  /// Leave the ignorable coordinates out of the linear model (LinearModel::ignorable): exact for the
+  /// other states, which do not depend on them.
+  bool drop_ignorable = false;
 };
 
 struct LinearModel {
@@ -43,6 +46,15 @@ struct LinearModel {
   bool equilibrium = false;
   double residual = 0;  ///< max |f(x0)|
   std::string method;   ///< how the derivatives were obtained
+  /// Coordinates (tangent states "q.<...>") no other state depends on: A's column of each is zero
+  /// outside the rows of ignorable coordinates of the same joint (a balanced wheel's angle; a free
+  /// body's position without gravity, and its attitude without gravity or external forces).
+  std::vector<std::string> ignorable;
+  /// Not an equilibrium, but x_dot is zero outside the ignorable coordinates' rows (a wheel spinning
+  /// steadily, a body in steady spin): a relative equilibrium, a valid operating point.
+  bool relative_equilibrium = false;
+  double relative_residual = 0;  ///< max |f(x0)| over the rows of the other states
+  bool ignorable_dropped = false;
 };
 
 /// Throws InputError (naming `option`) for unknown input or output names;
@@ -54,7 +66,10 @@ struct LinearMode {
   std::complex<double> eigenvalue;
   double natural_frequency_hz = 0;  ///< |lambda| / 2 pi
   double damped_frequency_hz = 0;   ///< Im(lambda) / 2 pi
-  double damping_ratio = 0;         ///< -Re(lambda) / |lambda| (1 for lambda = 0 by convention: not oscillating)
+  double damping_ratio = 0;         ///< -Re(lambda) / |lambda| (NaN for a zero eigenvalue)
+  /// |lambda| below the eigenvalue noise of a zero eigenvalue (1e-6 sqrt(max(1, |A|_max))): a rigid-body
+  /// or ignorable mode (a free body's drift, a wheel's angle), reported as 0 with its states.
+  bool zero = false;
   std::vector<std::string> dominant_states;  ///< largest participation first (speeds weighted by 1/|lambda|)
 };
 std::vector<LinearMode> linear_modes(const LinearModel& lin);

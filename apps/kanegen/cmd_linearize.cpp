@@ -19,22 +19,34 @@ namespace {
 struct Options {
   std::string model, state, engine = "generated", format = "json", output;
   std::vector<std::string> inputs, outputs;
-  bool native = false, finite_differences = false, quiet = false;
+  bool native = false, finite_differences = false, quiet = false, drop_ignorable = false;
 };
 
 void print_modes(const LinearModel& lin, const std::vector<LinearMode>& modes) {
   fmt::print(stderr, "linear model: {} states, {} inputs, {} outputs ({})\n", lin.A.rows(), lin.B.cols(),
              lin.C.rows(), lin.method);
-  fmt::print(stderr, "{}\n",
-             lin.equilibrium ? "the point is an equilibrium"
-                             : fmt::format("the point is NOT an equilibrium (max |x_dot| = {:.3g}): the result is a "
-                                           "first-order Taylor model about it",
-                                           lin.residual));
+  if (lin.equilibrium)
+    fmt::print(stderr, "the point is an equilibrium{}\n",
+               lin.ignorable_dropped ? " of the states left without the ignorable coordinates" : "");
+  else if (lin.relative_equilibrium)
+    fmt::print(stderr, "the point is a relative equilibrium: steady except for the ignorable coordinates, which "
+                       "nothing else depends on ({}); --drop-ignorable leaves them out\n",
+               fmt::join(lin.ignorable, ", "));
+  else
+    fmt::print(stderr, "the point is NOT an equilibrium (max |x_dot| = {:.3g}): the result is a first-order Taylor "
+                       "model about it\n", lin.residual);
+  if (!lin.ignorable.empty() && (lin.equilibrium || !lin.relative_equilibrium))
+    fmt::print(stderr, "ignorable coordinates{}: {}\n", lin.ignorable_dropped ? " (left out)" : "",
+               fmt::join(lin.ignorable, ", "));
   fmt::print(stderr, "{:>24} {:>24} {:>12} {:>10}  {}\n", "eigenvalue (1/s)", "", "f_n (Hz)", "zeta",
              "dominant states");
   for (const LinearMode& m : modes)
-    fmt::print(stderr, "{:>24.10g} {:>+23.10g}i {:>12.6g} {:>10.4g}  {}\n", m.eigenvalue.real(), m.eigenvalue.imag(),
-               m.natural_frequency_hz, m.damping_ratio, fmt::join(m.dominant_states, ", "));
+    if (m.zero)
+      fmt::print(stderr, "{:>24} {:>24} {:>12} {:>10}  rigid-body / ignorable: {}\n", "0", "", "0", "-",
+                 fmt::join(m.dominant_states, ", "));
+    else
+      fmt::print(stderr, "{:>24.10g} {:>+23.10g}i {:>12.6g} {:>10.4g}  {}\n", m.eigenvalue.real(), m.eigenvalue.imag(),
+                 m.natural_frequency_hz, m.damping_ratio, fmt::join(m.dominant_states, ", "));
 }
 
 int run(const Options& o) {
@@ -49,6 +61,7 @@ int run(const Options& o) {
   lo.inputs = o.inputs;
   lo.outputs = o.outputs;
   lo.finite_differences = o.finite_differences;
+  lo.drop_ignorable = o.drop_ignorable;
   const LinearModel lin = linearize(*engine, state, lo);
   const auto modes = linear_modes(lin);
   if (!o.quiet) print_modes(lin, modes);
@@ -98,6 +111,9 @@ Subcommand add_linearize(CLI::App& app) {
   c->add_option("-o,--output", o->output, "output file (csv: the prefix of OUT_A.csv ...); JSON goes to stdout without it");
   c->add_flag("--finite-differences", o->finite_differences,
               "central differences instead of the exact derivatives (a cross-check)");
+  c->add_flag("--drop-ignorable", o->drop_ignorable,
+              "leave out the ignorable coordinates (nothing else depends on them: a balanced wheel's angle, a free "
+              "body's position without gravity); exact for the other states");
   c->add_flag("--quiet", o->quiet, "no eigenvalue table on stderr");
   add_engine_option(c, o->engine, o->native);
   return {c, [o] { return run(*o); }};

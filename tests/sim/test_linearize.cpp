@@ -167,3 +167,48 @@ TEST_CASE("linearize: exact derivatives agree with central differences", "[linea
   CHECK(test::rel_err(fd_gen.A, exact.A) <= test::kCentralDifference);
   CHECK((exact.x0_dot - fd.x0_dot).cwiseAbs().maxCoeff() <= 1e-11 * (1 + fd.x0_dot.cwiseAbs().maxCoeff()));
 }
+
+TEST_CASE("linearize: spinning wheels are a relative equilibrium; ignorable coordinates, zero modes, --drop-ignorable",
+          "[linearize][generated]") {
+  // The slew spacecraft at rest with its three wheels spinning (balanced wheels, no gravity): u_dot = 0,
+  // only the wheel angles move; nothing depends on them, nor on the bus position and attitude.
+  const Model model = load_model(test::source_path("models/gnc/slew_spacecraft.yaml"));
+  auto engine = test::generated_engine(model);
+  const State s = at(model, {}, {{"rw_x.angle_rate", 50.0}, {"rw_y.angle_rate", -30.0}, {"rw_z.angle_rate", 80.0}});
+  const LinearModel lin = linearize(*engine, s, {});
+  CHECK_FALSE(lin.equilibrium);
+  CHECK(lin.relative_equilibrium);
+  for (const char* q : {"q.rw_x.angle", "q.rw_y.angle", "q.rw_z.angle", "q.bus.x", "q.bus.y", "q.bus.z"})
+    CHECK(std::find(lin.ignorable.begin(), lin.ignorable.end(), q) != lin.ignorable.end());
+  for (const auto& n : lin.ignorable) CHECK(n.rfind("q.array", 0) != 0);  // the arrays' deflections are not
+  const auto modes = linear_modes(lin);
+  int zeros = 0;
+  for (const auto& m : modes) {
+    if (std::abs(m.eigenvalue) < 1e-6) {
+      CHECK(m.zero);
+      CHECK(std::isnan(m.damping_ratio));
+    }
+    zeros += m.zero;
+  }
+  CHECK(zeros >= 6);
+  // without the ignorable coordinates: an equilibrium, and the elastic modes unchanged (the others do not depend
+  // on what was dropped, so dropping it is exact)
+  LinearizeOptions o;
+  o.drop_ignorable = true;
+  const LinearModel dropped = linearize(*engine, s, o);
+  CHECK(dropped.equilibrium);
+  CHECK(dropped.A.rows() == lin.A.rows() - static_cast<Eigen::Index>(lin.ignorable.size()));
+  const auto dm = linear_modes(dropped);
+  int elastic = 0;
+  for (const auto& m : modes) {
+    if (m.zero || m.eigenvalue.imag() < 1.0) continue;
+    ++elastic;
+    const auto l = nearest(dm, m.eigenvalue);
+    INFO("elastic mode " << m.eigenvalue << " after dropping " << l);
+    CHECK(std::abs(l - m.eigenvalue) <= 1e-9 * std::abs(m.eigenvalue));
+    // the arrays' 0.5 % of their clamped modes, shared with the bus in a free spacecraft's mode: near it, positive
+    CHECK(m.damping_ratio > 0.002);
+    CHECK(m.damping_ratio < 0.02);
+  }
+  CHECK(elastic >= 6);
+}
