@@ -5,6 +5,7 @@
 #include "engine/model_checks.hpp"
 
 #include "engine/generated_engine.hpp"
+#include "model/invariants.hpp"
 #include "model/output_file.hpp"
 #include "sim/event_run.hpp"
 #include "sim/integrator_choice.hpp"
@@ -15,6 +16,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -171,7 +173,7 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
   }
   p.project = [&model](double* x) { normalize_quaternions(model, x); };
   // the exact Jacobian is the free system's: with joints locked the implicit methods difference the rhs
-  if (use_jacobian && engine.has_jacobian() && !engine.has_locks()) {
+  if (use_jacobian && engine.jacobian_for_integration() && !engine.has_locks()) {
     auto J = std::make_shared<MatX>(nq + nu, nq + nu);
     p.jacobian = [&engine, tau, scratch, J, failure, nq, nu, free_joints](double t, const double* x, const double*,
                                                                            double* out) -> int {
@@ -221,10 +223,12 @@ std::string RunQuality::summary() const {
   if (std::isfinite(H_drift)) parts.push_back(fmt::format("|H| drift {:.2e}", H_drift));
   if (std::isfinite(error_estimate))
     parts.push_back(fmt::format("estimated error {:.2e} ({})", error_estimate, error_worst));
-  if (parts.empty()) return "no invariant holds here: --estimate-error gives an error estimate";
   std::string out;
   for (const auto& p : parts) out += (out.empty() ? "" : ", ") + p;
-  return out;
+  if (parts.empty())
+    return invariants_note.empty() ? "no error measure: --estimate-error gives an error estimate"
+                                   : invariants_note + "; --estimate-error gives an error estimate";
+  return invariants_note.empty() ? out : out + " (" + invariants_note + ")";
 }
 
 namespace {
@@ -364,7 +368,7 @@ long stride_for(const State& initial, const SimulationOptions& o) {
 }  // namespace
 
 SimulationResult simulate(Engine& engine, const State& initial, const SimulationOptions& options_in,
-                          std::ostream& csv) {
+                          RowSink& sink) {
   const Model& model = engine.model();
   const int nq = model.nq, nu = model.nu;
   SimulationOptions options = options_in;
@@ -426,14 +430,12 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
 
   SimulationResult result;
   const auto cols = csv_columns(model);
-  for (std::size_t c = 0; c < cols.size(); ++c) csv << (c ? "," : "") << cols[c];
-  csv << '\n';
+  sink.begin(cols);
 
   ProgressBar bar(options.progress, initial.t, options.t_end);
   VecX q(nq), u(nu), udot(nu);
   std::vector<Reaction> reactions;
   std::vector<double> row;
-  std::string line;
 
   // Checks on every output row, before it is written (a row with a bad value
   // is never written; simulate_to_file then removes the whole file):
@@ -482,7 +484,8 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     last_row_t = t;
     q = x.head(nq);
     u = x.tail(nu);
-    row.assign(x.data(), x.data() + nq);
+    row.assign(1, t);
+    row.insert(row.end(), x.data(), x.data() + nq);
     for (const Body& b : model.bodies)  // the prescribed coordinates, after the q's
       if (b.joint.prescribed()) row.push_back(b.joint.motion->at(t).f);
     row.insert(row.end(), x.data() + nq, x.data() + nq + nu);
@@ -512,11 +515,9 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     }
     for (std::size_t k = 0; k < row.size(); ++k)
       if (!std::isfinite(row[k]))
-        throw fail_at(t, x, fmt::format("non-finite value {} in column '{}'", row[k], column_of(k + 1)));
+        throw fail_at(t, x, fmt::format("non-finite value {} in column '{}'", row[k], column_of(k)));
     sampled.add(t, x, keep);
-    line = fmt::format("{:.17g}", t);
-    for (double v : row) line += fmt::format(",{:.17g}", v);
-    csv << line << '\n';
+    sink.row(row.data(), row.size());
     ++result.rows;
     bar.update(t);
     return true;
@@ -524,8 +525,22 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   // The ODE of a segment (for the engine's locks and inputs then). Drift is
   // measured on the unprojected state: project is wrapped (it is called on
   // every output state, and after every rk4 step).
+  const auto run_start = std::chrono::steady_clock::now();
   auto make_problem = [&] {
     OdeProblem problem = with_law(base_problem());
+    if (options.wall_time_limit > 0) {  // a run that would hang: checked every 64 evaluations
+      auto base = problem.rhs;
+      auto calls = std::make_shared<long>(0);
+      const double limit = options.wall_time_limit;
+      problem.rhs = [&, base, calls, limit](double t, const double* x, double* xdot) -> int {
+        if (++*calls % 64 == 0 &&
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count() > limit) {
+          failure = fmt::format("the run exceeded its wall-time limit of {} s at t = {:.17g}", limit, t);
+          return -1;
+        }
+        return base(t, x, xdot);
+      };
+    }
     auto project = problem.project;
     problem.project = [&, project](double* x) {
       VecX raw = Eigen::Map<VecX>(x, nq + nu);
@@ -566,10 +581,11 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   }
   bar.finish();
 
-  // Applied inputs or a controller do work: no invariant holds then.
-  const bool driven = controller || (initial.w.size() && !initial.w.isZero(0.0));
-  if (!driven) {
-    const bench::InvariantSet inv = bench::invariants_of(model, initial.tau);
+  // The invariants the scene's physics keeps (model/invariants.hpp), and why not the others.
+  const Invariants physics = invariants_of(model, initial.tau, initial.w, static_cast<bool>(controller));
+  quality.invariants_note = physics.note();
+  if (physics.energy || physics.momentum) {
+    const bench::InvariantSet inv{physics.energy, physics.momentum};
     // Generated code has only the energy and momentum the model's outputs ask
     // for; the invariants are then measured on the generic engine, at the same
     // states (a few evaluations per output row, after the run).
@@ -633,6 +649,11 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   result.quality = quality;
   result.events = events.fired();
   return result;
+}
+
+SimulationResult simulate(Engine& engine, const State& initial, const SimulationOptions& options, std::ostream& csv) {
+  CsvRowWriter writer(csv);
+  return simulate(engine, initial, options, writer);
 }
 
 SimulationResult simulate_to_file(Engine& engine, const State& initial, const SimulationOptions& options,

@@ -13,6 +13,7 @@
 #include "sim/controller.hpp"
 #include "sim/event_run.hpp"
 #include "sim/integrators.hpp"
+#include "sim/row_sink.hpp"
 #include "model/state_io.hpp"
 
 namespace kanegen {
@@ -29,6 +30,8 @@ struct SimulationOptions {
   /// A control law setting the named inputs (sim/controller.hpp); without
   /// one the inputs stay at State::w for the whole run.
   Controller controller;
+  /// Seconds of wall time the integration may take (0: no limit); past it the run fails (IntegrationError).
+  double wall_time_limit = 0.0;
   /// The events of the run instead of the model's (same entries; a sweep disperses their times and values).
   std::optional<std::vector<Event>> events;
 };
@@ -44,6 +47,8 @@ struct RunQuality {
   /// component over the output times), and where it is largest.
   double error_estimate = NAN;
   std::string error_worst;
+  /// Why an invariant does not hold here (model/invariants.hpp): "energy not conserved: dampers on 4 joints".
+  std::string invariants_note;
   /// "energy drift 3.1e-10, |H| drift 2.2e-12, estimated error 4.5e-9 (u link3.angle at t = 9.5)"
   std::string summary() const;
 };
@@ -73,8 +78,12 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
 /// the named inputs and the named outputs.
 std::vector<std::string> csv_columns(const Model& model);
 
-/// Integrates from `initial` to options.t_end writing CSV rows to `csv`.
+/// Integrates from `initial` to options.t_end giving the rows (the columns of
+/// csv_columns) to `sink`: every row is checked before the sink sees it.
 /// Throws IntegrationError (with time and state) on failure.
+SimulationResult simulate(Engine& engine, const State& initial, const SimulationOptions& options, RowSink& sink);
+
+/// The same, the rows written as CSV (interface.md) to `csv`.
 SimulationResult simulate(Engine& engine, const State& initial, const SimulationOptions& options, std::ostream& csv);
 
 /// Simulates into `path` atomically: the file appears only if the whole run

@@ -2,6 +2,8 @@
 // error metric, invariants, timing) are in work_precision.hpp.
 #include "sim/work_precision.hpp"
 
+#include "model/invariants.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -338,18 +340,8 @@ ErrorMeasure trajectory_error(const Model& model, const Trajectory& run, const T
 }
 
 InvariantSet invariants_of(const Model& model, const VecX& tau) {
-  const bool no_input = tau.size() == 0 || tau.isZero(0.0);
-  bool dissipation = false, grounded = false;
-  for (const Body& b : model.bodies) {
-    for (const SpringSlot& sl : spring_slots(b.joint))
-      if (b.joint.damping[sl.value] != 0) dissipation = true;
-    if (b.flex && b.flex->D.size() > 0 && !b.flex->D.isZero(0.0)) dissipation = true;
-    if (b.parent < 0 && b.joint.type != JointType::free) grounded = true;
-  }
-  InvariantSet s;
-  s.energy = no_input && !dissipation;
-  s.momentum = no_input && !grounded && model.g_N.isZero(0.0);
-  return s;
+  const Invariants inv = kanegen::invariants_of(model, tau, VecX::Zero(model.nw), false);  // model/invariants.hpp
+  return InvariantSet{inv.energy, inv.momentum};
 }
 
 std::optional<double> time_to_reach(const std::vector<std::pair<double, double>>& ew, double target) {

@@ -7,6 +7,7 @@
 #include "engine/generic_engine.hpp"
 #include "model/model_loader.hpp"
 #include "model/state_io.hpp"
+#include "sim/row_sink.hpp"
 #include "sim/simulate.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -55,5 +56,85 @@ outputs: [reactions]
     CHECK(std::abs(v[0] - t) <= 1e-12);
     CHECK(std::abs(v[1] - 0.3 * std::sin(w * t)) <= 1e-12);
     CHECK(std::abs(v[7] - J * (-0.3 * w * w * std::sin(w * t))) <= 1e-9);  // hub.tz
+  }
+}
+
+TEST_CASE("simulate: the summary keeps the invariants physics keeps and names what rules the others out", "[simulate]") {
+  SECTION("wheel motors under a controller are internal torques: H kept (to round-off), energy not") {
+    const Model model = load_model(test::source_path("models/gnc/slew_spacecraft.yaml"));
+    GenericEngine engine(model);
+    State s = initial_state(model);
+    s.u(model.speed_index("bus.wz")) = 0.01;
+    SimulationOptions o;
+    o.t_end = 20.0;
+    o.dt_out = 1.0;
+    o.integrator.kind = IntegratorKind::rkf78;
+    const int gyro = model.output_index("gyro.x"), motor = model.input_index("motor_x");
+    o.controller.law = [=](double, const VecX&, const VecX&, const VecX& y, VecX& w) {
+      w.segment<3>(motor) = 30.0 * y.segment<3>(gyro);  // rate damping through the wheels
+    };
+    RowTable rows;
+    const SimulationResult r = simulate(engine, s, o, rows);
+    const auto wz = rows.column("gyro.z");
+    CHECK(std::abs(wz.back()) < 0.6 * std::abs(wz.front()));  // the law did act (time constant about 29 s)
+    INFO(r.quality.summary());
+    CHECK(r.quality.H_drift < 1e-10);
+    CHECK(std::isnan(r.quality.energy_drift));
+    CHECK(r.quality.invariants_note.find("energy not conserved") != std::string::npos);
+    CHECK(r.quality.invariants_note.find("modal damping of 2 flexible bodies") != std::string::npos);
+    CHECK(r.quality.invariants_note.find("a controller setting 3 inputs") != std::string::npos);
+    CHECK(r.quality.invariants_note.find("p, H") == std::string::npos);
+  }
+  SECTION("prescribed motion: energy not conserved, named; no 'energy drift 1'") {
+    const Model model = load_model(test::write_temp("driven_arm.yaml", R"(
+name: driven_arm
+gravity: [0, 0, 0]
+bodies:
+  - name: hub
+    parent: ground
+    joint: {type: revolute, axis: [0, 0, 1], motion: {sine: {amplitude: 0.3, frequency: 0.5}}}
+    mass: 2.0
+    inertia: [0.1, 0.1, 0.2, 0, 0, 0]
+  - name: arm
+    parent: hub
+    joint: {type: revolute, axis: [0, 0, 1], position: [0.5, 0, 0], stiffness: 2.0}
+    mass: 1.0
+    com: [0.25, 0, 0]
+    inertia: [0.001, 0.02, 0.02, 0, 0, 0]
+outputs: [energy]
+)"));
+    GenericEngine engine(model);
+    SimulationOptions o;
+    o.t_end = 4.0;
+    o.dt_out = 0.5;
+    RowTable rows;
+    const SimulationResult r = simulate(engine, initial_state(model), o, rows);
+    INFO(r.quality.summary());
+    CHECK(std::isnan(r.quality.energy_drift));
+    CHECK(r.quality.summary().find("energy drift") == std::string::npos);
+    CHECK(r.quality.invariants_note.find("prescribed motion of hub") != std::string::npos);
+    CHECK(r.quality.invariants_note.find("the root joint of hub is not free") != std::string::npos);
+  }
+  SECTION("a thruster is external: neither energy nor momenta") {
+    const Model model = load_model(test::write_temp("thrust.yaml", R"(
+name: thrust
+gravity: [0, 0, 0]
+bodies:
+  - {name: sat, parent: ground, joint: {type: free}, mass: 10, inertia: [1, 2, 3, 0, 0, 0]}
+inputs:
+  - {name: thr, type: thruster, body: sat, point: [0, 0.5, 0], direction: [1, 0, 0]}
+)"));
+    GenericEngine engine(model);
+    State s = initial_state(model);
+    s.w(0) = 0.1;
+    SimulationOptions o;
+    o.t_end = 2.0;
+    o.dt_out = 0.5;
+    RowTable rows;
+    const SimulationResult r = simulate(engine, s, o, rows);
+    INFO(r.quality.summary());
+    CHECK(std::isnan(r.quality.energy_drift));
+    CHECK(std::isnan(r.quality.H_drift));
+    CHECK(r.quality.invariants_note.find("p, H not conserved: external 1 input (thr)") != std::string::npos);
   }
 }
