@@ -10,6 +10,10 @@
 #            [--state S.json] [--model M.yaml] [--eval] -o OUT.csv
 # The model file's absolute path is embedded; it is read at start (names,
 # initial state) and must hash to the code compiled in.
+#   <target> sweep SWEEP.yaml [-o DIR] [--threads N] [--run K] [--shard i/N] [--merge DIR ...]
+# runs a Monte Carlo sweep of the model on the compiled-in code, closed loop
+# with the compiled-in controller (docs/sweeps.md; under mpirun when Open MPI
+# is found at configure time).
 # CONTROLLER adds a control law to the simulator (docs/gnc.md): the file
 # defines `kanegen::Controller kanegen_controller(const kanegen::Model&)`
 # (sim/controller.hpp), called once at start; its law sets the model's named
@@ -54,6 +58,13 @@ function(kanegen_add_model target model)
   endif()
   target_include_directories(${target} PRIVATE "${_out}")
   target_link_libraries(${target} PRIVATE kanegen::sim CLI11::CLI11)
+  if(NOT DEFINED MPI_CXX_FOUND)
+    find_package(MPI COMPONENTS CXX QUIET)
+  endif()
+  if(MPI_CXX_FOUND)  # <target> sweep under mpirun
+    target_link_libraries(${target} PRIVATE MPI::MPI_CXX)
+    target_compile_definitions(${target} PRIVATE KANEGEN_HAVE_MPI)
+  endif()
   if(NOT ARG_NO_MAIN)
     target_compile_definitions(${target} PRIVATE KANEGEN_AOT_MAIN "KANEGEN_MODEL_PATH=\"${_model}\""
                                                  "KANEGEN_TARGET=\"${target}\"")

@@ -42,7 +42,7 @@ SweepSpec load_sweep_spec(const std::string& path) {
   if (auto text = read_input_text(path, kMaxModelFileBytes, diags)) s.text = *text;
   if (!ck.expect_map(root, 1, "(document)")) throw InputError(diags);
   ck.check_keys(root, "", {"model", "runs", "seed", "t_end", "dt_out", "integrator", "rtol", "atol", "engine",
-                           "dispersions", "metrics", "envelopes"});
+                           "dispersions", "correlations", "run_time_limit", "metrics", "envelopes"});
   auto required = [&](const char* key) {
     if (!root[key].IsDefined()) ck.error(1, key, "missing");
     return root[key].IsDefined();
@@ -77,6 +77,9 @@ SweepSpec load_sweep_spec(const std::string& path) {
       if (*v != "generated" && *v != "generic") ck.error(root["engine"], 1, "engine", fmt::format("'{}'; expected generated or generic", *v));
       else s.engine = *v;
     }
+  if (root["run_time_limit"].IsDefined())
+    if (auto v = ck.positive(root["run_time_limit"], 1, "run_time_limit", "seconds of wall time per run > 0"))
+      s.run_time_limit = *v;
   if (s.t_end > 0 && s.dt_out > 0 && s.t_end / s.dt_out > 1e6)
     ck.error(root["dt_out"].IsDefined() ? line_of(root["dt_out"]) : 1, "dt_out",
              fmt::format("{} output rows per run; expected at most 1e6", s.t_end / s.dt_out));
@@ -88,11 +91,24 @@ SweepSpec load_sweep_spec(const std::string& path) {
       const YAML::Node e = ds[i];
       if (!ck.expect_map(e, line_of(ds), f)) continue;
       const int l = line_of(e);
-      ck.check_keys(e, f, {"parameter", "distribution", "mean", "sigma", "low", "high", "values", "relative"});
+      ck.check_keys(e, f, {"name", "parameter", "distribution", "mean", "sigma", "low", "high", "values", "relative"});
       Dispersion d;
       d.line = l;
-      if (!e["parameter"].IsDefined()) ck.error(l, f + ".parameter", "missing; expected a runtime parameter (bus.mass, ...) or q.<name> / u.<name>");
-      else if (auto p = ck.string(e["parameter"], l, f + ".parameter")) d.target = *p;
+      const YAML::Node par = e["parameter"];
+      if (!par.IsDefined()) {
+        ck.error(l, f + ".parameter", "missing; expected a runtime parameter (bus.mass, ...), q.<name> / u.<name>, "
+                                      "inputs.<name>, or a list of them (one draw for all)");
+      } else if (par.IsSequence()) {
+        for (std::size_t k = 0; k < par.size(); ++k)
+          if (auto p = ck.string(par[k], l, fmt::format("{}.parameter[{}]", f, k))) d.members.push_back(*p);
+        if (par.size() == 0) ck.error(par, l, f + ".parameter", "an empty list; expected at least one name");
+        d.target = fmt::format("{}", fmt::join(d.members, "+"));
+      } else if (auto p = ck.string(par, l, f + ".parameter")) {
+        d.target = *p;
+        d.members = {*p};
+      }
+      if (e["name"].IsDefined())
+        if (auto n = ck.string(e["name"], l, f + ".name")) d.target = *n;
       std::string kind = "normal";
       if (e["distribution"].IsDefined())
         if (auto k = ck.string(e["distribution"], l, f + ".distribution")) kind = *k;
@@ -131,7 +147,52 @@ SweepSpec load_sweep_spec(const std::string& path) {
       }
       if (e["relative"].IsDefined())
         if (auto b = ck.boolean(e["relative"], l, f + ".relative")) d.relative = *b;
+      for (const Dispersion& o : s.dispersions)
+        if (o.target == d.target && !d.target.empty())
+          ck.error(e, l, f, fmt::format("'{}' is dispersed twice (give one of them a name: or one list)", d.target));
       s.dispersions.push_back(d);
+    }
+
+  const YAML::Node cs = root["correlations"];
+  if (cs.IsDefined() && ck.expect_seq(cs, 1, "correlations"))
+    for (std::size_t i = 0; i < cs.size(); ++i) {
+      const std::string f = fmt::format("correlations[{}]", i);
+      const YAML::Node e = cs[i];
+      if (!ck.expect_map(e, line_of(cs), f)) continue;
+      const int l = line_of(e);
+      ck.check_keys(e, f, {"between", "rho"});
+      Correlation c;
+      c.line = l;
+      const YAML::Node bw = e["between"];
+      if (!bw.IsDefined() || !bw.IsSequence() || bw.size() != 2) {
+        ck.error(bw.IsDefined() ? bw : e, l, f + ".between", "expected the names of two normal dispersions: [a, b]");
+        continue;
+      }
+      auto a = ck.string(bw[0], l, f + ".between[0]");
+      auto b = ck.string(bw[1], l, f + ".between[1]");
+      if (!a || !b) continue;
+      c.a = *a, c.b = *b;
+      if (!e["rho"].IsDefined()) ck.error(l, f + ".rho", "missing; expected a correlation coefficient in (-1, 1)");
+      else if (auto r = ck.number(e["rho"], l, f + ".rho")) {
+        if (!(*r > -1 && *r < 1)) ck.error(e["rho"], l, f + ".rho", fmt::format("{}; expected a coefficient in (-1, 1)", *r));
+        c.rho = *r;
+      }
+      auto find = [&](const std::string& n) -> const Dispersion* {
+        for (const Dispersion& d : s.dispersions)
+          if (d.target == n) return &d;
+        return nullptr;
+      };
+      for (const std::string* n : {&c.a, &c.b}) {
+        const Dispersion* d = find(*n);
+        if (!d) ck.error(bw, l, f + ".between", fmt::format("'{}' is not the name of a dispersion of this file", *n));
+        else if (d->kind != Dispersion::Kind::normal)
+          ck.error(bw, l, f + ".between", fmt::format("'{}' is a {} dispersion; only normal ones can be correlated", *n, to_string(d->kind)));
+      }
+      if (c.a == c.b) ck.error(bw, l, f + ".between", fmt::format("'{}' with itself", c.a));
+      for (const Correlation& o : s.correlations)
+        if ((o.a == c.a && o.b == c.b) || (o.a == c.b && o.b == c.a))
+          ck.error(e, l, f, fmt::format("{} and {} correlated twice", c.a, c.b));
+      s.correlations.push_back(c);
     }
 
   const YAML::Node ms = root["metrics"];

@@ -12,7 +12,12 @@ namespace kanegen {
 
 struct Dispersion {
   enum class Kind { normal, truncated_normal, uniform, choice };
-  std::string target;          ///< a runtime parameter name (bus.mass, ant1.damping, ...) or q.<name> / u.<name>
+  /// The dispersion's name (its column in runs.csv): `name:`, else `parameter:` as written (a list joined by '+').
+  std::string target;
+  /// What one draw sets (`parameter:` a name or a list of names): runtime parameters (bus.mass;
+  /// array.damping_ratio stands for every mode's), q.<name> / u.<name>, inputs.<name>,
+  /// events.<name>.at / .reaches. Every member gets the same draw: x_i (1 + d) relative, x_i + d absolute.
+  std::vector<std::string> members;
   int line = 0;
   Kind kind = Kind::normal;
   double mean = 0.0;           ///< normal, truncated normal: the deviation's mean
@@ -32,6 +37,14 @@ struct Metric {
   bool above = true;
 };
 
+/// Correlated normal draws (`correlations:`): the standard normal deviates of two normal dispersions
+/// with correlation coefficient rho (all pairs together must form a positive definite matrix).
+struct Correlation {
+  std::string a, b;  ///< the dispersions' names
+  double rho = 0.0;
+  int line = 0;
+};
+
 struct SweepSpec {
   std::string path;            ///< the sweep file
   std::string model_path;      ///< resolved relative to the sweep file
@@ -42,6 +55,9 @@ struct SweepSpec {
   double rtol = 1e-8, atol = 1e-10;
   std::string engine = "generated";
   std::vector<Dispersion> dispersions;
+  std::vector<Correlation> correlations;
+  /// Seconds of wall time a run may take (`run_time_limit:`; 0: no limit): a run past it is recorded failed.
+  double run_time_limit = 0.0;
   std::vector<Metric> metrics;
   std::vector<std::string> envelopes;  ///< columns whose percentile envelopes are recorded
   std::string text;            ///< the file's bytes (its hash identifies a sweep's results)

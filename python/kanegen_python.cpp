@@ -1,9 +1,14 @@
 // `import kanegen`: the Python face of kanegen (pybind11). A Model loads a
 // model file and its engine (the generated code through the JIT, or the
-// generic engine); eval, outputs, linearize and simulate return numpy arrays
-// with their names (dicts); simulate takes fixed named inputs or a Python
-// control law (t, q, u, y) -> w, continuous or digital. docs/gnc.md shows
-// the workflow; examples/python/ the LQR example.
+// generic engine); eval, outputs and linearize return numpy arrays with their
+// names (dicts); simulate takes fixed named inputs or a Python control law
+// (t, q, u, y) -> w, continuous or digital, and returns a Run: t, and q, u,
+// inputs, outputs as Signals (a 2-D array with its names, indexable by name),
+// every column by name, the summary as a dict. Runtime parameters (the
+// model's parameters:, every non-zero spring, damper and modal damping ratio,
+// and those named when loading) change without a compile: set_parameters or
+// parameters= per call. kanegen.sweep runs a sweep file, closed loop with a
+// Python law. docs/gnc.md shows the workflow; examples/python/ the LQR example.
 #include <pybind11/eigen.h>
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
@@ -23,10 +28,14 @@
 #include "model/diagnostics.hpp"
 #include "model/model_loader.hpp"
 #include "model/output_file.hpp"
+#include "model/parameters.hpp"
+#include "model/sweep_spec.hpp"
 #include "model/state_io.hpp"
 #include "sim/eval_report.hpp"
 #include "sim/linearize.hpp"
+#include "sim/row_sink.hpp"
 #include "sim/simulate.hpp"
+#include "sim/sweep.hpp"
 
 namespace py = pybind11;
 using namespace kanegen;
@@ -36,8 +45,20 @@ namespace {
 /// A model and its engine; the Python object owns both.
 class PyModel {
  public:
-  PyModel(const std::string& path, const std::string& engine, bool native)
-      : model_(std::make_unique<Model>(load_model(path))) {
+  /// `extra`: model values to keep as runtime parameters besides the model's
+  /// own and the implicit ones (a name may stand for several: bus.inertia).
+  PyModel(const std::string& path, const std::string& engine, bool native, const std::vector<std::string>& extra)
+      : model_(std::make_unique<Model>(with_implicit_parameters(load_model(path)))) {
+    for (const std::string& name : extra) {
+      std::vector<RuntimeParameter> ps;
+      try {
+        ps = expand_parameter(*model_, name);
+      } catch (const std::invalid_argument& e) {
+        throw py::value_error("parameters: " + std::string(e.what()));
+      }
+      for (const RuntimeParameter& rp : ps)
+        if (find_parameter(model_->parameters, rp.kind, rp.body, rp.index) < 0) model_->parameters.push_back(rp);
+    }
     check_mass_matrix_at_initial_state(*model_);
     if (engine == "generated") {
       JitOptions o;
@@ -52,6 +73,45 @@ class PyModel {
 
   const Model& model() const { return *model_; }
   Engine& engine() { return *engine_; }
+
+  /// The engine's runtime parameter values with `values` ({name: value or
+  /// [values]}, a name standing for each parameter it expands to) written in.
+  VecX parameters_with(const py::dict& values) const {
+    VecX p = engine_->parameters();
+    for (auto item : values) {
+      const std::string name = py::str(item.first);
+      std::vector<RuntimeParameter> ps;
+      try {
+        ps = expand_parameter(*model_, name);
+      } catch (const std::invalid_argument& e) {
+        throw py::key_error(std::string(e.what()));
+      }
+      std::vector<double> v;
+      if (py::isinstance<py::float_>(item.second) || py::isinstance<py::int_>(item.second))
+        v.assign(ps.size(), item.second.cast<double>());
+      else
+        v = item.second.cast<std::vector<double>>();
+      if (v.size() != ps.size())
+        throw py::value_error(name + ": " + std::to_string(v.size()) + " values; it stands for " +
+                              std::to_string(ps.size()) + " (give one value for all, or " + std::to_string(ps.size()) + ")");
+      for (std::size_t k = 0; k < ps.size(); ++k) {
+        const int i = find_parameter(model_->parameters, ps[k].kind, ps[k].body, ps[k].index);
+        if (i < 0)
+          throw py::key_error(ps[k].name + " is not a runtime parameter of this model: name it when loading, "
+                              "kanegen.Model(path, parameters=['" + name + "']) (one compile), or under parameters: "
+                              "in the model file");
+        p(i) = v[k];
+      }
+    }
+    return p;
+  }
+  void set_parameters(const VecX& p) {
+    try {
+      engine_->set_parameters(p);
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(e.what());
+    }
+  }
 
   /// A state from optional arrays or {name: value} dicts (missing: the model's initial state).
   State state(double t, const py::object& q, const py::object& u, const py::object& tau,
@@ -115,6 +175,61 @@ class PyModel {
   std::unique_ptr<Engine> engine_;
 };
 
+/// Per-call parameter values (`parameters=`), the engine's own back afterwards.
+class ScopedParameters {
+ public:
+  ScopedParameters(PyModel& m, const py::object& values) : m_(m), saved_(m.engine().parameters()) {
+    if (values.is_none()) return;
+    m_.set_parameters(m_.parameters_with(values.cast<py::dict>()));
+    active_ = true;
+  }
+  ~ScopedParameters() {
+    if (active_) m_.engine().set_parameters(saved_);
+  }
+
+ private:
+  PyModel& m_;
+  VecX saved_;
+  bool active_ = false;
+};
+
+/// Named columns of a run: a 2-D array (rows x names) that reads like a dict
+/// of 1-D arrays (signals["bus.qw"], keys(), items(), in).
+struct Signals {
+  std::vector<std::string> names;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> values;
+  int index(const std::string& n) const {
+    const auto it = std::find(names.begin(), names.end(), n);
+    return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+  }
+  VecX column(const std::string& n) const {
+    const int k = index(n);
+    if (k < 0) throw py::key_error("no signal named '" + n + "'");
+    return values.col(k);
+  }
+};
+
+/// A run's results as data: taken from the rows simulate() gives (RowTable), never from text.
+struct Run {
+  VecX t;
+  Signals q, u, inputs, outputs, all;
+  py::dict summary;
+  py::list events;
+};
+
+Signals signals_of(const RowTable& table, const std::vector<std::string>& names) {
+  Signals s;
+  for (const auto& n : names)
+    if (table.column_index(n) >= 0) s.names.push_back(n);
+  s.values.resize(static_cast<Eigen::Index>(table.rows()), static_cast<Eigen::Index>(s.names.size()));
+  for (std::size_t c = 0; c < s.names.size(); ++c) {
+    const int k = table.column_index(s.names[c]);
+    for (std::size_t r = 0; r < table.rows(); ++r)
+      s.values(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = table.at(r, static_cast<std::size_t>(k));
+  }
+  return s;
+}
+
 py::dict named(const std::vector<std::string>& names, const VecX& v) {
   py::dict d;
   for (std::size_t i = 0; i < names.size(); ++i) d[py::str(names[i])] = v(static_cast<Eigen::Index>(i));
@@ -133,6 +248,8 @@ py::dict linear_dict(const LinearModel& lin) {
   d["input_names"] = lin.input_names;
   d["output_names"] = lin.output_names;
   d["equilibrium"] = lin.equilibrium;
+  d["relative_equilibrium"] = lin.relative_equilibrium;
+  d["ignorable"] = lin.ignorable;
   d["residual"] = lin.residual;
   d["method"] = lin.method;
   py::list modes;
@@ -142,6 +259,7 @@ py::dict linear_dict(const LinearModel& lin) {
     md["natural_frequency_hz"] = m.natural_frequency_hz;
     md["damped_frequency_hz"] = m.damped_frequency_hz;
     md["damping_ratio"] = m.damping_ratio;
+    md["zero"] = m.zero;
     md["dominant_states"] = m.dominant_states;
     modes.append(md);
   }
@@ -149,49 +267,64 @@ py::dict linear_dict(const LinearModel& lin) {
   return d;
 }
 
-/// The CSV of a run as {column: array}, plus "columns" (their order); a
-/// repeated column name is refused (it would hide the other column).
-py::dict columns_of(const std::string& csv) {
-  std::istringstream in(csv);
-  std::string header, line;
-  std::getline(in, header);
-  std::vector<std::string> cols;
-  for (std::size_t a = 0, b; a <= header.size(); a = b + 1) {
-    b = header.find(',', a);
-    if (b == std::string::npos) b = header.size();
-    cols.push_back(header.substr(a, b - a));
-  }
-  std::vector<std::vector<double>> data(cols.size());
-  while (std::getline(in, line)) {
-    const char* p = line.c_str();
-    for (std::size_t c = 0; c < cols.size(); ++c) {
-      char* end = nullptr;
-      data[c].push_back(std::strtod(p, &end));
-      p = *end == ',' ? end + 1 : end;
-    }
-  }
-  py::dict d;
-  for (std::size_t c = 0; c < cols.size(); ++c) {
-    if (d.contains(py::str(cols[c]))) throw std::runtime_error("simulate: column '" + cols[c] + "' named twice");
-    d[py::str(cols[c])] = py::array_t<double>(data[c].size(), data[c].data());
-  }
-  d["columns"] = cols;
-  return d;
+/// A Python control law (t, q, u, y) -> w as a Controller.
+Controller python_controller(const py::object& law, double period, int nw) {
+  Controller c;
+  if (law.is_none()) return c;
+  py::function f = law.cast<py::function>();
+  c.period = period;
+  c.law = [f, nw](double t, const VecX& qq, const VecX& uu, const VecX& y, VecX& w) {
+    py::object r = f(t, qq, uu, y);
+    const VecX v = r.cast<VecX>();
+    if (v.size() != nw)
+      throw py::value_error("controller returned " + std::to_string(v.size()) + " inputs; expected " + std::to_string(nw));
+    w = v;
+  };
+  return c;
 }
 
-/// The named groups of a run's columns: "q", "u", "inputs", "outputs" as
-/// {name: array} (each name once), beside the flat columns.
-void add_groups(py::dict& d, const Model& m) {
-  auto group = [&](const std::vector<std::string>& names) {
-    py::dict g;
-    for (const auto& n : names)
-      if (d.contains(py::str(n))) g[py::str(n)] = d[py::str(n)];
-    return g;
-  };
-  d["q"] = group(m.q_names);
-  d["u"] = group(m.u_names);
-  d["inputs"] = group(m.input_names);
-  d["outputs"] = group(m.output_names);
+Run make_run(const RowTable& table, const SimulationResult& r, const Model& m) {
+  Run run;
+  run.t = table.rows() ? VecX(Eigen::Map<const VecX>(table.column(0).data(), static_cast<Eigen::Index>(table.rows())))
+                       : VecX();
+  std::vector<std::string> names = table.columns();
+  for (std::size_t i = 0; i < names.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (names[i] == names[j]) throw std::runtime_error("simulate: column '" + names[i] + "' named twice");
+  run.all = signals_of(table, names);
+  run.q = signals_of(table, m.q_names);
+  run.u = signals_of(table, m.u_names);
+  run.inputs = signals_of(table, m.input_names);
+  run.outputs = signals_of(table, m.output_names);
+  py::dict& d = run.summary;
+  d["integrator"] = r.stats.integrator;
+  d["integrator_choice"] = r.quality.integrator_choice;
+  d["steps"] = r.stats.steps;
+  d["rhs_evals"] = r.stats.rhs_evals;
+  d["jac_evals"] = r.stats.jac_evals;
+  d["wall_seconds"] = r.stats.wall_seconds;
+  d["rows"] = r.rows;
+  d["segments"] = r.segments;
+  d["max_quaternion_drift"] = r.max_quaternion_drift;
+  d["energy_drift"] = r.quality.energy_drift;  // NaN: not an invariant of the scene
+  d["H_drift"] = r.quality.H_drift;
+  d["error_estimate"] = r.quality.error_estimate;
+  d["error_worst"] = r.quality.error_worst;
+  d["accuracy"] = r.quality.summary();
+  d["text"] = r.stats.summary();
+  for (const FiredEvent& e : r.events) {  // model-format.md, Locks and events
+    py::dict ev;
+    ev["t"] = e.t;
+    ev["name"] = e.name;
+    ev["action"] = e.action;
+    ev["bodies"] = e.bodies;
+    ev["energy_lost"] = e.energy_lost;
+    ev["u_before"] = e.u_before;
+    ev["u_after"] = e.u_after;
+    run.events.append(ev);
+  }
+  d["events"] = run.events;
+  return run;
 }
 
 template <class F>
@@ -213,12 +346,72 @@ PYBIND11_MODULE(kanegen, m) {
   m.doc() = "kanegen: Kane's-method equations of motion for multibody spacecraft (docs/gnc.md)";
   py::register_exception<SingularMassMatrix>(m, "SingularMassMatrix", PyExc_ArithmeticError);
 
+  py::class_<Signals>(m, "Signals", "named columns of a run: values (rows x names), names; s[name] is a column")
+      .def_readonly("names", &Signals::names)
+      .def_property_readonly("values", [](const Signals& s) { return s.values; })
+      .def("__getitem__", &Signals::column)
+      .def("__contains__", [](const Signals& s, const std::string& n) { return s.index(n) >= 0; })
+      .def("__len__", [](const Signals& s) { return s.names.size(); })
+      .def("__iter__", [](const Signals& s) { return py::iter(py::cast(s.names)); })
+      .def("keys", [](const Signals& s) { return s.names; })
+      .def("items", [](const Signals& s) {
+        py::list l;
+        for (const auto& n : s.names) l.append(py::make_tuple(n, s.column(n)));
+        return l;
+      })
+      .def("__repr__", [](const Signals& s) {
+        return "Signals(" + std::to_string(s.values.rows()) + " rows: " +
+               (s.names.size() > 6 ? std::to_string(s.names.size()) + " names" : [&] {
+                 std::string j;
+                 for (const auto& n : s.names) j += (j.empty() ? "" : ", ") + n;
+                 return j;
+               }()) + ")";
+      });
+  py::class_<Run>(m, "Run", "a simulation's results: t, q, u, inputs, outputs (Signals), columns, summary, events")
+      .def_readonly("t", &Run::t)
+      .def_readonly("q", &Run::q)
+      .def_readonly("u", &Run::u)
+      .def_readonly("inputs", &Run::inputs)
+      .def_readonly("outputs", &Run::outputs)
+      .def_readonly("summary", &Run::summary)
+      .def_readonly("events", &Run::events)
+      .def_property_readonly("columns", [](const Run& r) {
+        py::dict d;  // in the CSV's order: pandas.DataFrame(run.columns)
+        for (const auto& n : r.all.names) d[py::str(n)] = r.all.column(n);
+        return d;
+      }, "{column: array} of every column of `kanegen simulate`'s CSV, in its order (pandas.DataFrame(run.columns))")
+      .def("__getitem__", [](const Run& r, const std::string& n) { return r.all.column(n); }, "a column by name")
+      .def("__contains__", [](const Run& r, const std::string& n) { return r.all.index(n) >= 0; })
+      .def("__len__", [](const Run& r) { return r.t.size(); })
+      .def("__repr__", [](const Run& r) {
+        return "Run(" + std::to_string(r.t.size()) + " rows, " + std::to_string(r.all.names.size()) + " columns)";
+      });
+
   py::class_<PyModel>(m, "Model")
-      .def(py::init([](const std::string& path, const std::string& engine, bool native) {
-             return translating([&] { return std::make_unique<PyModel>(path, engine, native); });
+      .def(py::init([](const std::string& path, const std::string& engine, bool native,
+                       const std::vector<std::string>& parameters) {
+             return translating([&] { return std::make_unique<PyModel>(path, engine, native, parameters); });
            }),
            py::arg("path"), py::arg("engine") = "generated", py::arg("native") = false,
-           "Loads a model file; engine 'generated' (JIT-compiled, cached) or 'generic'.")
+           py::arg("parameters") = std::vector<std::string>{},
+           "Loads a model file; engine 'generated' (JIT-compiled, cached) or 'generic'; parameters: model values "
+           "to keep as runtime parameters besides the model's own and its springs, dampers and damping ratios "
+           "(bus.mass, bus.inertia, ...: model-format.md)")
+      .def_property_readonly("parameter_names", [](const PyModel& p) {
+        std::vector<std::string> n;
+        for (const RuntimeParameter& rp : p.model().parameters) n.push_back(rp.name);
+        return n;
+      }, "the runtime parameters: values set_parameters changes without a compile")
+      .def_property_readonly("parameters", [](PyModel& p) {
+        py::dict d;
+        for (std::size_t i = 0; i < p.model().parameters.size(); ++i)
+          d[py::str(p.model().parameters[i].name)] = p.engine().parameters()(static_cast<Eigen::Index>(i));
+        return d;
+      }, "{name: value} of the runtime parameters now")
+      .def("set_parameters", [](PyModel& p, const py::dict& values) { p.set_parameters(p.parameters_with(values)); },
+           py::arg("values"),
+           "sets runtime parameters, {name: value}; a name standing for several (array.damping_ratio: every "
+           "mode's, bus.inertia: six) takes one value for all or a list; no compile")
       .def_property_readonly("name", [](const PyModel& p) { return p.model().name; })
       .def_property_readonly("engine", [](PyModel& p) { return p.engine().name(); })
       .def_property_readonly("q_names", [](const PyModel& p) { return p.model().q_names; })
@@ -234,7 +427,8 @@ PYBIND11_MODULE(kanegen, m) {
       .def(
           "eval",
           [](PyModel& p, const py::object& q, const py::object& u, const py::object& tau, const py::object& inputs,
-             double t, const py::object& locked) {
+             double t, const py::object& locked, const py::object& parameters) {
+            const ScopedParameters with(p, parameters);
             State s = p.state(t, q, u, tau, inputs);
             p.apply_locked(s, locked);
             const ScopedLocks locks(p.engine(), s.locked);  // u_dot: the reduced system's while locked
@@ -260,6 +454,7 @@ PYBIND11_MODULE(kanegen, m) {
           },
           py::arg("q") = py::none(), py::arg("u") = py::none(), py::arg("tau") = py::none(),
           py::arg("inputs") = py::none(), py::arg("t") = 0.0, py::arg("locked") = py::none(),
+          py::arg("parameters") = py::none(),
           "q_dot, M, F, u_dot and the named outputs at a state (arrays or {name: value}; missing: the initial state); "
           "locked: bodies whose joints are locked there (default: the model's locked: true)")
       .def(
@@ -278,24 +473,28 @@ PYBIND11_MODULE(kanegen, m) {
           "linearize",
           [](PyModel& p, const py::object& q, const py::object& u, const py::object& tau, const py::object& inputs,
              double t, const std::vector<std::string>& input_names, const std::vector<std::string>& output_names,
-             bool finite_differences) {
+             bool finite_differences, const py::object& parameters, bool drop_ignorable) {
             return translating([&] {
+              const ScopedParameters with(p, parameters);
               LinearizeOptions o;
               o.inputs = input_names;
               o.outputs = output_names;
               o.finite_differences = finite_differences;
+              o.drop_ignorable = drop_ignorable;
               return linear_dict(linearize(p.engine(), p.state(t, q, u, tau, inputs), o));
             });
           },
           py::arg("q") = py::none(), py::arg("u") = py::none(), py::arg("tau") = py::none(),
           py::arg("inputs") = py::none(), py::arg("t") = 0.0, py::arg("input_names") = std::vector<std::string>{},
           py::arg("output_names") = std::vector<std::string>{}, py::arg("finite_differences") = false,
+          py::arg("parameters") = py::none(), py::arg("drop_ignorable") = false,
           "continuous-time A, B, C, D about a state (tangent-space attitude), with names and modes")
       .def(
           "simulate",
           [](PyModel& p, double t_end, double dt_out, const py::object& q, const py::object& u, const py::object& tau,
              const py::object& inputs, const py::object& controller, double period, const std::string& integrator,
-             double rtol, double atol, double h, const py::object& locked) {
+             double rtol, double atol, double h, const py::object& locked, const py::object& parameters,
+             bool estimate_error) {
             return translating([&] {
               State s = p.state(0.0, q, u, tau, inputs);
               p.apply_locked(s, locked);
@@ -306,51 +505,74 @@ PYBIND11_MODULE(kanegen, m) {
               o.integrator.rtol = rtol;
               o.integrator.atol = atol;
               o.integrator.h = h;
-              if (!controller.is_none()) {
-                py::function f = controller.cast<py::function>();
-                const int nw = p.model().nw;
-                o.controller.period = period;
-                o.controller.law = [f, nw](double t, const VecX& qq, const VecX& uu, const VecX& y, VecX& w) {
-                  py::object r = f(t, qq, uu, y);
-                  const VecX v = r.cast<VecX>();
-                  if (v.size() != nw)
-                    throw py::value_error("controller returned " + std::to_string(v.size()) +
-                                          " inputs; expected " + std::to_string(nw));
-                  w = v;
-                };
-              }
-              std::ostringstream csv;
-              const SimulationResult r = simulate(p.engine(), s, o, csv);
-              py::dict d = columns_of(csv.str());
-              add_groups(d, p.model());
-              d["summary"] = r.stats.summary();
-              d["rhs_evals"] = r.stats.rhs_evals;
-              d["steps"] = r.stats.steps;
-              d["wall_seconds"] = r.stats.wall_seconds;
-              py::list events;  // the events that fired (model-format.md, Locks and events)
-              for (const FiredEvent& e : r.events) {
-                py::dict ev;
-                ev["t"] = e.t;
-                ev["name"] = e.name;
-                ev["action"] = e.action;
-                ev["bodies"] = e.bodies;
-                ev["energy_lost"] = e.energy_lost;
-                ev["u_before"] = e.u_before;
-                ev["u_after"] = e.u_after;
-                events.append(ev);
-              }
-              d["events"] = events;
-              return d;
+              o.controller = python_controller(controller, period, p.model().nw);
+              o.estimate_error = estimate_error;
+              const ScopedParameters with(p, parameters);
+              RowTable table;
+              const SimulationResult r = simulate(p.engine(), s, o, table);
+              return make_run(table, r, p.model());
             });
           },
           py::arg("t_end"), py::arg("dt_out") = 0.01, py::arg("q") = py::none(), py::arg("u") = py::none(),
           py::arg("tau") = py::none(), py::arg("inputs") = py::none(), py::arg("controller") = py::none(),
           py::arg("period") = 0.0, py::arg("integrator") = "auto", py::arg("rtol") = 1e-10,
           py::arg("atol") = 1e-12, py::arg("h") = 1e-3, py::arg("locked") = py::none(),
-          "integrates from a state (locked: the bodies whose joints start locked; default the model's); inputs fixed, or set by controller(t, q, u, y) -> w (continuous when period "
-          "is 0, else digital with zero-order hold); h is rk4's step; returns {column: array} as the CSV of "
-          "`kanegen simulate`, plus 'events': the events that fired (t, name, action, bodies, energy_lost, "
-          "u_before, u_after)");
+          py::arg("parameters") = py::none(), py::arg("estimate_error") = false,
+          "integrates from a state (locked: the bodies whose joints start locked; default the model's); inputs "
+          "fixed, or set by controller(t, q, u, y) -> w (continuous when period is 0, else digital with "
+          "zero-order hold); h is rk4's step; parameters: {name: value} for this run only. Returns a Run: t, q, "
+          "u, inputs, outputs (Signals by name), columns (every column of `kanegen simulate`'s CSV), summary "
+          "(integrator and why, steps, drifts, events), events");
+
+  m.def(
+      "sweep",
+      [](const std::string& path, const py::object& controller, double period, const std::string& output,
+         const std::string& engine) {
+        return translating([&] {
+          const SweepPlan plan = plan_sweep(load_sweep_spec(path));
+          const std::string which = engine.empty() ? plan.spec.engine : engine;
+          std::unique_ptr<Engine> e;
+          if (which == "generated") e = jit_load(plan.model, codegen::jit_code_generator(), JitOptions{});
+          else if (which == "generic") e = std::make_unique<GenericEngine>(plan.model);
+          else throw py::value_error("engine must be 'generated' or 'generic', not '" + which + "'");
+          ControllerFactory law;
+          if (!controller.is_none())
+            law = [&](const Model& m, long) { return python_controller(controller, period, m.nw); };
+          std::vector<RunResult> results;
+          for (long k = 0; k < plan.spec.runs; ++k) results.push_back(run_one(*e, plan, k, nullptr, law));
+          if (!output.empty()) write_sweep_outputs(plan, results, output);
+          py::dict d;
+          VecX run(static_cast<Eigen::Index>(results.size()));
+          py::list status;
+          for (std::size_t k = 0; k < results.size(); ++k) run(static_cast<Eigen::Index>(k)) = results[k].index, status.append(results[k].status);
+          d["run"] = run;
+          d["status"] = status;
+          auto table = [&](const std::vector<std::string>& names, auto get) {
+            py::dict t;
+            for (std::size_t i = 0; i < names.size(); ++i) {
+              VecX v(static_cast<Eigen::Index>(results.size()));
+              for (std::size_t k = 0; k < results.size(); ++k) v(static_cast<Eigen::Index>(k)) = get(results[k], i);
+              t[py::str(names[i])] = v;
+            }
+            return t;
+          };
+          std::vector<std::string> dn, mn;
+          for (const auto& x : plan.spec.dispersions) dn.push_back(x.target);
+          for (const auto& x : plan.spec.metrics) mn.push_back(x.name);
+          d["values"] = table(dn, [](const RunResult& r, std::size_t i) { return r.values[i]; });
+          d["metrics"] = table(mn, [](const RunResult& r, std::size_t i) { return r.metrics.empty() ? NAN : r.metrics[i]; });
+          double wall = 0;
+          for (const auto& r : results) wall += r.wall_s;
+          d["wall_seconds"] = wall;
+          return d;
+        });
+      },
+      py::arg("sweep"), py::arg("controller") = py::none(), py::arg("period") = 0.0, py::arg("output") = "",
+      py::arg("engine") = "",
+      "runs a sweep file (docs/sweeps.md) in this process, closed loop when controller(t, q, u, y) -> w is given "
+      "(continuous when period is 0, else digital); output: a directory for runs.csv, summary.json, ... as "
+      "`kanegen sweep` writes them (byte-identical for the same runs); returns {run, status, values: {name: "
+      "array}, metrics: {name: array}, wall_seconds}");
 
   m.def(
       "generate",

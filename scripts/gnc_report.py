@@ -184,7 +184,7 @@ def best(f, n=5):
 kw = dict(dt_out=1.0, integrator="rk4", h=cpp["h"])
 open_s, r0 = best(lambda: model.simulate(cpp["t_end"], **kw))
 py_s, r1 = best(lambda: model.simulate(cpp["t_end"], controller=pd_py, **kw))
-py_per_call = (py_s - open_s) / r1["rhs_evals"] * 1e6
+py_per_call = (py_s - open_s) / r1.summary["rhs_evals"] * 1e6
 dig_s, r2 = best(lambda: model.simulate(cpp["t_end"], controller=pd_py, period=0.1, **kw))
 
 fmt = lambda x: f"{x:.6g}"  # noqa: E731

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -11,6 +13,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <iostream>
 #include <sstream>
 #include <thread>
 
@@ -20,6 +23,7 @@
 #include "model/output_file.hpp"
 #include "model/parameters.hpp"
 #include "model/state_io.hpp"
+#include "sim/row_sink.hpp"
 #include "sim/simulate.hpp"
 
 namespace kanegen {
@@ -84,6 +88,41 @@ double percentile(const std::vector<double>& sorted, double p) {
   return i + 1 < sorted.size() ? sorted[i] * (1 - f) + sorted[i + 1] * f : sorted[i];
 }
 
+/// A run's metrics and envelopes, updated row by row as the run gives them.
+class MetricSink final : public RowSink {
+ public:
+  MetricSink(const SweepPlan& plan, RunResult& r)
+      : plan_(plan), r_(r), seen_(plan.spec.metrics.size(), false) {
+    r_.envelopes.assign(plan.envelope_columns.size(), {});
+  }
+  void begin(const std::vector<std::string>&) override {}
+  void row(const double* row, std::size_t) override {
+    const auto& ms = plan_.spec.metrics;
+    for (std::size_t k = 0; k < ms.size(); ++k) {
+      if (plan_.metric_columns[k] < 0) continue;  // an event's (after the run)
+      const double v = row[plan_.metric_columns[k]];
+      double& m = r_.metrics[k];
+      switch (ms[k].stat) {
+        case Metric::Stat::final: m = v; break;
+        case Metric::Stat::min: m = seen_[k] ? std::min(m, v) : v; break;
+        case Metric::Stat::max: m = seen_[k] ? std::max(m, v) : v; break;
+        case Metric::Stat::absmax: m = seen_[k] ? std::max(m, std::abs(v)) : std::abs(v); break;
+        case Metric::Stat::first_time:
+          if (std::isnan(m) && (ms[k].above ? v > ms[k].threshold : v < ms[k].threshold)) m = row[0];
+          break;
+      }
+      seen_[k] = true;
+    }
+    for (std::size_t k = 0; k < plan_.envelope_columns.size(); ++k)
+      r_.envelopes[k].push_back(row[plan_.envelope_columns[k]]);
+  }
+
+ private:
+  const SweepPlan& plan_;
+  RunResult& r_;
+  std::vector<bool> seen_;
+};
+
 }  // namespace
 
 SweepPlan plan_sweep(const SweepSpec& spec) {
@@ -94,24 +133,26 @@ SweepPlan plan_sweep(const SweepSpec& spec) {
   auto fault = [&](int line, const std::string& field, const std::string& msg) {
     bad.push_back(Diagnostic{spec.path, line, field, msg});
   };
-  for (std::size_t i = 0; i < spec.dispersions.size(); ++i) {
-    const Dispersion& d = spec.dispersions[i];
-    const std::string f = fmt::format("dispersions[{}].parameter", i);
+  // what one name sets: one value, or (a parameter group) several
+  auto resolve = [&](const std::string& target, int line, const std::string& f) {
+    std::vector<SweepPlan::Target> out;
     SweepPlan::Target t;
-    if (d.target.rfind("q.", 0) == 0 || d.target.rfind("u.", 0) == 0) {
-      const bool q = d.target[0] == 'q';
-      const int k = q ? plan.model.q_index(d.target.substr(2)) : plan.model.speed_index(d.target.substr(2));
+    const bool q = target.rfind("q.", 0) == 0, u = target.rfind("u.", 0) == 0, w = target.rfind("inputs.", 0) == 0;
+    if (q || u || w) {
+      const std::string name = target.substr(w ? 7 : 2);
+      const int k = q ? plan.model.q_index(name) : u ? plan.model.speed_index(name) : plan.model.input_index(name);
       if (k < 0) {
-        fault(d.line, f, fmt::format("'{}': the model has no {} named '{}'", d.target, q ? "coordinate" : "speed", d.target.substr(2)));
-        continue;
+        fault(line, f, fmt::format("'{}': the model has no {} named '{}'", target, q ? "coordinate" : u ? "speed" : "input", name));
+        return out;
       }
-      t.kind = q ? SweepPlan::Target::Kind::q : SweepPlan::Target::Kind::u;
+      t.kind = q ? SweepPlan::Target::Kind::q : u ? SweepPlan::Target::Kind::u : SweepPlan::Target::Kind::input;
       t.index = k;
-      t.nominal = q ? plan.model.q0(k) : plan.model.u0(k);
-    } else if (d.target.rfind("events.", 0) == 0) {
-      const auto dot = d.target.rfind('.');
-      const std::string name = d.target.substr(7, dot == std::string::npos || dot < 7 ? std::string::npos : dot - 7);
-      const std::string what = dot == std::string::npos || dot < 7 ? "" : d.target.substr(dot + 1);
+      t.nominal = q ? plan.model.q0(k) : u ? plan.model.u0(k) : 0.0;
+      out.push_back(t);
+    } else if (target.rfind("events.", 0) == 0) {
+      const auto dot = target.rfind('.');
+      const std::string name = target.substr(7, dot == std::string::npos || dot < 7 ? std::string::npos : dot - 7);
+      const std::string what = dot == std::string::npos || dot < 7 ? "" : target.substr(dot + 1);
       int e = -1;
       for (std::size_t k = 0; k < plan.model.events.size(); ++k)
         if (plan.model.events[k].name == name) e = static_cast<int>(k);
@@ -119,38 +160,72 @@ SweepPlan plan_sweep(const SweepSpec& spec) {
       const bool at = what == "at", reaches = what == "reaches";
       if (!ev || !(at || reaches) || (at && ev->trigger != Event::Trigger::time) ||
           (reaches && ev->trigger != Event::Trigger::crossing)) {
-        fault(d.line, f, fmt::format("'{}': expected events.<name>.at (a time event) or events.<name>.reaches (a "
-                                     "crossing event) of an event of the model{}",
-                                     d.target, ev ? "" : fmt::format(" (it has no event '{}')", name)));
-        continue;
+        fault(line, f, fmt::format("'{}': expected events.<name>.at (a time event) or events.<name>.reaches (a "
+                                   "crossing event) of an event of the model{}",
+                                   target, ev ? "" : fmt::format(" (it has no event '{}')", name)));
+        return out;
       }
       t.kind = at ? SweepPlan::Target::Kind::event_at : SweepPlan::Target::Kind::event_reaches;
       t.index = e;
       t.nominal = at ? ev->at : ev->reaches;
+      out.push_back(t);
     } else {
       std::vector<RuntimeParameter> ps;
       try {
-        ps = expand_parameter(plan.model, d.target);
+        ps = expand_parameter(plan.model, target);
       } catch (const std::invalid_argument& e) {
-        fault(d.line, f, e.what());
-        continue;
+        fault(line, f, e.what());
+        return out;
       }
-      if (ps.size() != 1) {
-        fault(d.line, f, fmt::format("'{}' stands for {} values; expected one (e.g. {})", d.target, ps.size(), ps[0].name));
-        continue;
+      for (const RuntimeParameter& rp : ps) {  // a name for several values (array.damping_ratio): one draw for all
+        int k = find_parameter(plan.model.parameters, rp.kind, rp.body, rp.index);
+        if (k < 0) {
+          plan.model.parameters.push_back(rp);  // the sweep makes it a runtime parameter
+          k = static_cast<int>(plan.model.parameters.size()) - 1;
+        }
+        t.index = k;
+        t.nominal = rp.nominal;
+        out.push_back(t);
       }
-      int k = find_parameter(plan.model.parameters, ps[0].kind, ps[0].body, ps[0].index);
-      if (k < 0) {
-        plan.model.parameters.push_back(ps[0]);  // the sweep makes it a runtime parameter
-        k = static_cast<int>(plan.model.parameters.size()) - 1;
-      }
-      t.index = k;
-      t.nominal = ps[0].nominal;
     }
-    for (std::size_t j = 0; j < i; ++j)
-      if (spec.dispersions[j].target == d.target) fault(d.line, f, fmt::format("'{}' is dispersed twice", d.target));
-    plan.targets.push_back(t);
+    return out;
+  };
+  std::vector<std::string> set_by;  // per member: the dispersion that sets it ("kind index")
+  for (std::size_t i = 0; i < spec.dispersions.size(); ++i) {
+    const Dispersion& d = spec.dispersions[i];
+    std::vector<SweepPlan::Target> group;
+    for (std::size_t m = 0; m < d.members.size(); ++m) {
+      const std::string f = d.members.size() > 1 ? fmt::format("dispersions[{}].parameter[{}]", i, m)
+                                                 : fmt::format("dispersions[{}].parameter", i);
+      for (const SweepPlan::Target& t : resolve(d.members[m], d.line, f)) {
+        const std::string key = fmt::format("{} {}", static_cast<int>(t.kind), t.index);
+        if (std::find(set_by.begin(), set_by.end(), key) != set_by.end())
+          fault(d.line, f, fmt::format("'{}' is dispersed twice (by this and an earlier dispersion)", d.members[m]));
+        set_by.push_back(key);
+        group.push_back(t);
+      }
+    }
+    plan.targets.push_back(group);
+    if (d.kind == Dispersion::Kind::normal) plan.normal_dispersions.push_back(static_cast<int>(i));
   }
+  // correlated normal draws: z = L n, L the Cholesky factor of the correlation matrix
+  const Eigen::Index nn = static_cast<Eigen::Index>(plan.normal_dispersions.size());
+  MatX C = MatX::Identity(nn, nn);
+  auto normal_slot = [&](const std::string& name) {
+    for (Eigen::Index k = 0; k < nn; ++k)
+      if (spec.dispersions[plan.normal_dispersions[k]].target == name) return k;
+    return Eigen::Index(-1);
+  };
+  for (const Correlation& c : spec.correlations) {
+    const Eigen::Index a = normal_slot(c.a), b = normal_slot(c.b);
+    if (a >= 0 && b >= 0) C(a, b) = C(b, a) = c.rho;
+  }
+  Eigen::LLT<MatX> llt(C);
+  if (llt.info() != Eigen::Success || (nn > 0 && llt.matrixL().toDenseMatrix().diagonal().minCoeff() < 1e-12))
+    fault(spec.correlations.empty() ? 1 : spec.correlations[0].line, "correlations",
+          "the coefficients do not form a positive definite correlation matrix (no joint distribution has them)");
+  else
+    plan.correlation_factor = llt.matrixL();
   plan.columns = csv_columns(plan.model);
   auto column = [&](const std::string& c, int line, const std::string& field) {
     // q.<name> / u.<name>: a coordinate or a speed (a revolute joint's are both called <body>.angle)
@@ -193,68 +268,109 @@ std::string sweep_identity(const SweepPlan& plan) {
   return fnv1a64_hex(plan.spec.text + model_hash(plan.model)).substr(0, 8);
 }
 
-std::vector<double> draw(const SweepPlan& plan, long index) {
+namespace {
+
+/// Per dispersion its draw: the deviation d (x (1 + d) relative, x + d absolute) or a choice's value v
+/// (x v relative, v absolute).
+std::vector<double> deviations(const SweepPlan& plan, long index) {
   std::mt19937_64 rng(splitmix64(plan.spec.seed ^ splitmix64(static_cast<std::uint64_t>(index))));
-  std::vector<double> out;
-  for (std::size_t i = 0; i < plan.spec.dispersions.size(); ++i) {
-    const Dispersion& d = plan.spec.dispersions[i];
-    const double nominal = plan.targets[i].nominal;
-    double dev = 0.0;
+  const auto& ds = plan.spec.dispersions;
+  std::vector<double> dev(ds.size(), 0.0);
+  VecX n(static_cast<Eigen::Index>(plan.normal_dispersions.size()));
+  for (std::size_t i = 0, k = 0; i < ds.size(); ++i) {
+    const Dispersion& d = ds[i];
     switch (d.kind) {
-      case Dispersion::Kind::normal: dev = std::normal_distribution<double>(d.mean, d.sigma)(rng); break;
+      case Dispersion::Kind::normal: n(static_cast<Eigen::Index>(k++)) = std::normal_distribution<double>(0.0, 1.0)(rng); break;
       case Dispersion::Kind::truncated_normal: {
         std::normal_distribution<double> N(d.mean, d.sigma);
         int tries = 0;
-        do dev = N(rng);
-        while ((dev < d.low || dev > d.high) && ++tries < 10000);
-        dev = std::clamp(dev, d.low, d.high);
+        do dev[i] = N(rng);
+        while ((dev[i] < d.low || dev[i] > d.high) && ++tries < 10000);
+        dev[i] = std::clamp(dev[i], d.low, d.high);
         break;
       }
-      case Dispersion::Kind::uniform: dev = std::uniform_real_distribution<double>(d.low, d.high)(rng); break;
-      case Dispersion::Kind::choice: {
-        const double v = d.values[std::uniform_int_distribution<std::size_t>(0, d.values.size() - 1)(rng)];
-        out.push_back(d.relative ? nominal * v : v);
-        continue;
-      }
+      case Dispersion::Kind::uniform: dev[i] = std::uniform_real_distribution<double>(d.low, d.high)(rng); break;
+      case Dispersion::Kind::choice:
+        dev[i] = d.values[std::uniform_int_distribution<std::size_t>(0, d.values.size() - 1)(rng)];
+        break;
     }
-    out.push_back(d.relative ? nominal * (1.0 + dev) : nominal + dev);
   }
+  if (n.size() > 0) {
+    const VecX z = plan.correlation_factor.triangularView<Eigen::Lower>() * n;
+    for (Eigen::Index k = 0; k < z.size(); ++k) {
+      const Dispersion& d = ds[plan.normal_dispersions[k]];
+      dev[plan.normal_dispersions[k]] = d.mean + d.sigma * z(k);
+    }
+  }
+  return dev;
+}
+
+double member_value(const Dispersion& d, const SweepPlan::Target& t, double dev) {
+  if (d.kind == Dispersion::Kind::choice) return d.relative ? t.nominal * dev : dev;
+  return d.relative ? t.nominal * (1.0 + dev) : t.nominal + dev;
+}
+
+}  // namespace
+
+std::vector<double> draw(const SweepPlan& plan, long index) {
+  const std::vector<double> dev = deviations(plan, index);
+  std::vector<double> out;
+  for (std::size_t i = 0; i < dev.size(); ++i)
+    out.push_back(plan.targets[i].empty() ? dev[i] : member_value(plan.spec.dispersions[i], plan.targets[i][0], dev[i]));
   return out;
 }
 
-RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostream* csv) {
+RunSetup run_setup(const SweepPlan& plan, long index) {
+  const Model& model = plan.model;
+  RunSetup r;
+  r.parameters = Engine::nominal_parameters(model);
+  r.state = initial_state(model);
+  r.events = model.events;
+  const std::vector<double> dev = deviations(plan, index);
+  for (std::size_t i = 0; i < plan.targets.size(); ++i)
+    for (const SweepPlan::Target& t : plan.targets[i]) {
+      const double v = member_value(plan.spec.dispersions[i], t, dev[i]);
+      switch (t.kind) {
+        case SweepPlan::Target::Kind::parameter: r.parameters(t.index) = v; break;
+        case SweepPlan::Target::Kind::q: r.state.q(t.index) = v; break;
+        case SweepPlan::Target::Kind::u: r.state.u(t.index) = v; break;
+        case SweepPlan::Target::Kind::input: r.state.w(t.index) = v; break;
+        case SweepPlan::Target::Kind::event_at: r.events[t.index].at = v; break;
+        case SweepPlan::Target::Kind::event_reaches: r.events[t.index].reaches = v; break;
+      }
+    }
+  for (const auto& slot : model.quaternions) r.state.q.segment<4>(slot.q).normalize();
+  SimulationOptions& o = r.options;
+  o.t_end = plan.spec.t_end;
+  o.dt_out = plan.spec.dt_out;
+  o.integrator.kind = integrator_from_string(plan.spec.integrator);
+  o.integrator.rtol = plan.spec.rtol;
+  o.integrator.atol = plan.spec.atol;
+  o.wall_time_limit = plan.spec.run_time_limit;
+  if (!model.events.empty()) o.events = r.events;
+  return r;
+}
+
+RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostream* csv,
+                  const ControllerFactory& controller) {
   const auto t0 = std::chrono::steady_clock::now();
   const Model& model = plan.model;
   RunResult r;
   r.index = index;
   r.values = draw(plan, index);
   r.metrics.assign(plan.spec.metrics.size(), kNaN);
-  VecX p = Engine::nominal_parameters(model);
-  State s = initial_state(model);
-  std::vector<Event> events = model.events;
-  for (std::size_t i = 0; i < plan.targets.size(); ++i) {
-    const auto& t = plan.targets[i];
-    switch (t.kind) {
-      case SweepPlan::Target::Kind::parameter: p(t.index) = r.values[i]; break;
-      case SweepPlan::Target::Kind::q: s.q(t.index) = r.values[i]; break;
-      case SweepPlan::Target::Kind::u: s.u(t.index) = r.values[i]; break;
-      case SweepPlan::Target::Kind::event_at: events[t.index].at = r.values[i]; break;
-      case SweepPlan::Target::Kind::event_reaches: events[t.index].reaches = r.values[i]; break;
-    }
-  }
-  for (const auto& slot : model.quaternions) s.q.segment<4>(slot.q).normalize();
-  SimulationOptions o;
-  o.t_end = plan.spec.t_end;
-  o.dt_out = plan.spec.dt_out;
-  o.integrator.kind = integrator_from_string(plan.spec.integrator);
-  o.integrator.rtol = plan.spec.rtol;
-  o.integrator.atol = plan.spec.atol;
-  if (!model.events.empty()) o.events = events;
-  std::ostringstream out;
+  RunSetup setup = run_setup(plan, index);
+  const State& s = setup.state;
+  const VecX& p = setup.parameters;
+  SimulationOptions& o = setup.options;
+  MetricSink metrics(plan, r);
+  CsvRowWriter text(csv ? *csv : std::cout);
+  TeeRowSink both(metrics, text);
   std::vector<FiredEvent> fired;
   try {
     engine.set_parameters(p);
-    const SimulationResult sr = simulate(engine, s, o, out);
+    if (controller) o.controller = controller(model, index);
+    const SimulationResult sr = simulate(engine, s, o, csv ? static_cast<RowSink&>(both) : metrics);
     r.integration_s = sr.stats.wall_seconds;
     fired = sr.events;
   } catch (const std::exception& e) {
@@ -262,43 +378,11 @@ RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostrea
     why = why.substr(0, why.find('\n'));
     if (why.size() > 300) why = why.substr(0, 300) + "...";
     r.status = "failed: " + why;
+    r.envelopes.clear();
+    std::fill(r.metrics.begin(), r.metrics.end(), kNaN);
   }
   if (r.ok()) {
-    const std::string text = out.str();
-    if (csv) *csv << text;
-    std::istringstream in(text);
-    std::string line;
-    std::getline(in, line);  // header
     const auto& ms = plan.spec.metrics;
-    std::vector<double> row;
-    std::vector<bool> seen(ms.size(), false);
-    r.envelopes.assign(plan.envelope_columns.size(), {});
-    while (std::getline(in, line)) {
-      row.clear();
-      const char* c = line.c_str();
-      for (;;) {
-        char* end = nullptr;
-        row.push_back(std::strtod(c, &end));
-        if (*end != ',') break;
-        c = end + 1;
-      }
-      for (std::size_t k = 0; k < ms.size(); ++k) {
-        if (plan.metric_columns[k] < 0) continue;  // an event's (below)
-        const double v = row[plan.metric_columns[k]];
-        double& m = r.metrics[k];
-        switch (ms[k].stat) {
-          case Metric::Stat::final: m = v; break;
-          case Metric::Stat::min: m = seen[k] ? std::min(m, v) : v; break;
-          case Metric::Stat::max: m = seen[k] ? std::max(m, v) : v; break;
-          case Metric::Stat::absmax: m = seen[k] ? std::max(m, std::abs(v)) : std::abs(v); break;
-          case Metric::Stat::first_time:
-            if (std::isnan(m) && (ms[k].above ? v > ms[k].threshold : v < ms[k].threshold)) m = row[0];
-            break;
-        }
-        seen[k] = true;
-      }
-      for (std::size_t k = 0; k < plan.envelope_columns.size(); ++k) r.envelopes[k].push_back(row[plan.envelope_columns[k]]);
-    }
     for (std::size_t k = 0; k < ms.size(); ++k) {  // an event's time or energy lost, NaN if it did not fire
       const int c = plan.metric_columns[k];
       if (c >= 0) continue;
@@ -338,7 +422,7 @@ RunResult deserialize(const std::string& line) {
 
 void run_on_threads(const SweepPlan& plan, const std::vector<long>& indices, int threads,
                     const std::function<std::unique_ptr<Engine>(const Model&)>& make_engine,
-                    const std::function<void(RunResult&&)>& done) {
+                    const std::function<void(RunResult&&)>& done, const ControllerFactory& controller) {
   threads = std::max(1, std::min<int>(threads, static_cast<int>(indices.size())));
   // engines made here, one after the other (the JIT compiles and caches once)
   std::vector<std::unique_ptr<Engine>> engines;
@@ -349,7 +433,7 @@ void run_on_threads(const SweepPlan& plan, const std::vector<long>& indices, int
   auto work = [&](Engine* e) {
     try {
       for (std::size_t i; (i = next++) < indices.size();) {
-        RunResult r = run_one(*e, plan, indices[i]);
+        RunResult r = run_one(*e, plan, indices[i], nullptr, controller);
         std::lock_guard<std::mutex> lock(m);
         done(std::move(r));
       }

@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "engine/engine.hpp"
+#include "model/state_io.hpp"
+#include "sim/simulate.hpp"
 #include "model/sweep_spec.hpp"
 
 namespace kanegen {
@@ -23,12 +25,18 @@ struct SweepPlan {
   SweepSpec spec;
   Model model;  ///< with the dispersed parameters among its runtime parameters
   struct Target {
-    /// event_at / event_reaches: "events.<name>.at" / ".reaches" (model-format.md, Locks and events)
-    enum class Kind { parameter, q, u, event_at, event_reaches } kind = Kind::parameter;
-    int index = 0;  ///< into model.parameters, q, u or model.events
+    /// event_at / event_reaches: "events.<name>.at" / ".reaches" (model-format.md, Locks and events);
+    /// input: "inputs.<name>", the named input's value for the whole run
+    enum class Kind { parameter, q, u, input, event_at, event_reaches } kind = Kind::parameter;
+    int index = 0;  ///< into model.parameters, q, u, the inputs or model.events
     double nominal = 0.0;
   };
-  std::vector<Target> targets;       ///< one per dispersion
+  /// Per dispersion the values one draw sets (its members, each parameter a name stands for).
+  std::vector<std::vector<Target>> targets;
+  /// Lower Cholesky factor of the correlation matrix of the normal dispersions (identity without
+  /// `correlations:`), in the order of `normal_dispersions`.
+  MatX correlation_factor;
+  std::vector<int> normal_dispersions;
   std::vector<std::string> columns;  ///< a run's CSV columns
   /// Per metric its CSV column, or for "event.<name>.t" / "event.<name>.energy_lost" (an event's time, or
   /// the energy its latch took; NaN when it did not fire) -(2 e + 2) / -(2 e + 3), e the event's index.
@@ -49,12 +57,29 @@ struct RunResult {
   bool ok() const { return status == "ok"; }
 };
 
-/// The dispersed values of run `index` (pure: the base seed and the index).
+/// The dispersed values of run `index` (pure: the base seed and the index):
+/// per dispersion the value of its first member.
 std::vector<double> draw(const SweepPlan& plan, long index);
+
+/// The control law of a closed-loop sweep, made afresh for each run (a law
+/// may keep state of its own: integrators, filters, a mode) from the run's
+/// model (plan.model) and index; an empty function or an empty Controller:
+/// open loop.
+using ControllerFactory = std::function<Controller(const Model& model, long index)>;
+
+/// Run `index`'s initial state, parameter values and events, as run_one uses them.
+struct RunSetup {
+  State state;
+  VecX parameters;
+  std::vector<Event> events;
+  SimulationOptions options;  ///< t_end, dt_out, integrator, events and the time limit of the sweep
+};
+RunSetup run_setup(const SweepPlan& plan, long index);
 
 /// Runs one case on `engine` (made for plan.model); a failure is recorded in
 /// the result, never thrown. With `csv`, the run's full time history.
-RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostream* csv = nullptr);
+RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostream* csv = nullptr,
+                  const ControllerFactory& controller = {});
 
 /// One result as one line of text and back (exact: 17 digits), for resuming
 /// and for sending between processes.
@@ -66,7 +91,7 @@ RunResult deserialize(const std::string& line);
 /// each result.
 void run_on_threads(const SweepPlan& plan, const std::vector<long>& indices, int threads,
                     const std::function<std::unique_ptr<Engine>(const Model&)>& make_engine,
-                    const std::function<void(RunResult&&)>& done);
+                    const std::function<void(RunResult&&)>& done, const ControllerFactory& controller = {});
 
 /// Writes runs.csv (one row per run, by index: parameters, metrics, status),
 /// timing.csv (wall and integration time per run: these alone depend on the

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "apps/common/simulation_cli.hpp"
+#include "apps/common/sweep_cli.hpp"
 #include "engine/generated_api.h"
 #include "engine/generated_engine.hpp"
 #include "engine/model_checks.hpp"
@@ -49,9 +50,18 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
       ->check(CLI::ExistingFile);
   app.add_option("--model", model_file, "model file the code was generated from")->capture_default_str();
   app.add_flag("--eval", eval, "print the eval JSON at the state instead of simulating");
-#ifdef KANEGEN_HAS_CONTROLLER
   bool open_loop = false;
+#ifdef KANEGEN_HAS_CONTROLLER
   app.add_flag("--open-loop", open_loop, "run without the compiled-in controller (inputs from --state)");
+#endif
+  // <program> sweep SWEEP.yaml ...: a Monte Carlo sweep of this model on the compiled-in code (closed loop with
+  // the compiled-in controller), as `kanegen sweep` (docs/sweeps.md)
+  cli::SweepCli sweep;
+  CLI::App* sweep_cmd = app.add_subcommand(
+      "sweep", "Monte Carlo sweep of this model on the compiled-in code and controller (docs/sweeps.md)");
+  cli::add_sweep_options(sweep_cmd, sweep);
+#ifdef KANEGEN_HAS_CONTROLLER
+  sweep_cmd->add_flag("--open-loop", open_loop, "run the sweep without the compiled-in controller");
 #endif
   try {
     app.parse(argc, argv);
@@ -60,6 +70,35 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
     return code == 0 ? 0 : 2;
   }
 
+  if (sweep_cmd->parsed()) {
+    try {
+      auto make = [&](const Model& m) -> std::unique_ptr<Engine> {
+        try {
+          return std::make_unique<GeneratedEngine>(m, api);
+        } catch (const std::runtime_error& e) {  // e.g. a dispersed value the compiled code keeps constant
+          throw InputError(Diagnostic{sweep.sweep, 0, "",
+                                      fmt::format("{}: the code compiled into {} does not fit the sweep's model "
+                                                  "(every dispersed model value must be among the model's "
+                                                  "parameters: when the code is generated)",
+                                                  e.what(), program)});
+        }
+      };
+      ControllerFactory controller;
+#ifdef KANEGEN_HAS_CONTROLLER
+      if (!open_loop) controller = [](const Model& m, long) { return kanegen_controller(m); };
+#endif
+      return cli::run_sweep_cli(sweep, make, controller);
+    } catch (const InputError& e) {
+      for (const Diagnostic& d : e.diagnostics()) fmt::print(stderr, "{}\n", d.str());
+      return 2;
+    } catch (const OutputRefused& e) {
+      fmt::print(stderr, "{}: cannot write output {}\n", program, e.what());
+      return 2;
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "{}: {}\n", program, e.what());
+      return 1;
+    }
+  }
   try {
     const Model model = load_model(model_file);
     check_mass_matrix_at_initial_state(model);
@@ -80,6 +119,8 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
     SimulationOptions opt = cli::simulation_options(sim, state);
 #ifdef KANEGEN_HAS_CONTROLLER
     if (!open_loop) opt.controller = kanegen_controller(model);
+#else
+    (void)open_loop;
 #endif
     try {
       const SimulationResult r = simulate_to_file(engine, state, opt, sim.output);

@@ -111,8 +111,8 @@ def main():
         "final_error_deg": float(err[-1]),
         "peak_tip_deflection_m": float(tips.max()),
         "peak_motor_torque_Nm": float(max(np.abs(run[f"motor_{a}"]).max() for a in "xyz")),
-        "rhs_evals": run["rhs_evals"],
-        "wall_seconds": run["wall_seconds"],
+        "rhs_evals": run.summary["rhs_evals"],
+        "wall_seconds": run.summary["wall_seconds"],
     }
     if args.plot:
         import matplotlib

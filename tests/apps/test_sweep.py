@@ -6,7 +6,11 @@
   - the draws follow their distributions (means within 4 standard errors,
     truncation and choice sets respected) and depend only on seed and index;
   - a run replayed alone (--run K) gives the table's metrics for K;
-  - an interrupted sweep resumes and ends with the same tables;
+  - an interrupted sweep resumes and ends with the same tables: one cut by
+    hand, one killed with SIGKILL while it runs, and (under mpirun) one whose
+    worker rank was killed, which stops the job;
+  - a run that passes its wall-time limit (run_time_limit:) is recorded as
+    failed with its reason, and the sweep completes;
   - runs that fail (a dispersed mass below zero) are recorded, the sweep goes on.
 
     test_sweep.py --kanegen BUILD/bin/kanegen [--mpirun /usr/bin/mpirun]
@@ -17,9 +21,11 @@ import json
 import math
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--kanegen", required=True)
@@ -101,6 +107,81 @@ try:
     r = sweep(SWEEP, "-o", dr, "--threads", "2")
     check(r.returncode == 0 and "resuming: 300 runs already done, 700 to go" in r.stderr, "resumed with 700 runs to go")
     check(same(d1, dr), "resumed sweep: identical tables")
+
+    def done_lines(d):
+        p = os.path.join(d, "results.tsv")
+        return sum(1 for _ in open(p)) - 1 if os.path.exists(p) else 0
+
+    def kill_when(d, proc, n, victim):
+        """SIGKILL `victim()` once d/results.tsv holds n runs; False if the sweep ended first."""
+        deadline = time.time() + 300
+        while proc.poll() is None and time.time() < deadline:
+            if done_lines(d) >= n:
+                os.kill(victim(), signal.SIGKILL)
+                proc.wait()
+                return True
+            time.sleep(0.02)
+        proc.wait()
+        return False
+
+    # a sweep killed with SIGKILL mid-run, then started again: the same tables (runs 20 times
+    # longer than SWEEP's, so that the kill lands mid-sweep)
+    LONG = os.path.join(tmp, "long.yaml")
+    open(LONG, "w").write(open(SWEEP).read().replace("model: ../../../models/", "model: " + os.path.join(ROOT, "models") + "/")
+                          .replace("runs: 1000", "runs: 200").replace("t_end: 2.0", "t_end: 400.0"))
+    dl = os.path.join(tmp, "long")
+    check(sweep(LONG, "-o", dl, "--threads", "2").returncode == 0, "a longer sweep, uninterrupted")
+    dk = os.path.join(tmp, "killed")
+    p = subprocess.Popen([args.kanegen, "sweep", LONG, "-o", dk, "--threads", "2", "--no-progress"],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    killed = kill_when(dk, p, 60, lambda: p.pid)
+    kept = done_lines(dk)
+    check(killed and 60 <= kept < 200, f"SIGKILL after {kept} runs")
+    r = sweep(LONG, "-o", dk, "--threads", "2")
+    check(r.returncode == 0 and "resuming:" in r.stderr, "restarted: resumes (" + r.stderr.strip()[:80] + ")")
+    check(same(dl, dk), "SIGKILLed and resumed: identical tables")
+
+    if args.mpirun:
+        # a worker rank killed: Open MPI ends the job; what rank 0 recorded stays, the rerun resumes
+        dw = os.path.join(tmp, "worker_killed")
+        p = subprocess.Popen([args.mpirun, "--allow-run-as-root", "--oversubscribe", "-np", "3", args.kanegen, "sweep",
+                              LONG, "-o", dw, "--no-progress"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+        victim = {}
+
+        def worker():
+            for pid in os.listdir("/proc"):
+                try:
+                    env = open(f"/proc/{pid}/environ", "rb").read().split(b"\0")
+                    cmd = open(f"/proc/{pid}/cmdline", "rb").read()
+                except OSError:
+                    continue
+                if b"OMPI_COMM_WORLD_RANK=1" in env and b"sweep" in cmd and dw.encode() in cmd:
+                    victim["rank 1"] = int(pid)
+                    return int(pid)
+            victim["mpirun"] = p.pid
+            return p.pid  # not found: kill the whole job instead (the resume is still checked)
+
+        killed = kill_when(dw, p, 60, worker)
+        kept = done_lines(dw)
+        check(killed and p.returncode != 0 and 60 <= kept < 200 and "rank 1" in victim,
+              f"{', '.join(victim)} killed after {kept} runs: the job stopped")
+        r = sweep(LONG, "-o", dw, prefix=(args.mpirun, "--allow-run-as-root", "--oversubscribe", "-np", "3"))
+        check(r.returncode == 0 and "resuming:" in r.stderr and same(dl, dw),
+              "rerun under mpirun after a killed worker: resumes to identical tables")
+
+    # a run past its wall-time limit is a failed run with its reason; the sweep completes
+    hung = os.path.join(tmp, "hung.yaml")
+    text = open(SWEEP).read().replace("model: ../../../models/", "model: " + os.path.join(ROOT, "models") + "/")
+    text = text.replace("runs: 1000", "runs: 6\nrun_time_limit: 0.02").replace("t_end: 2.0", "t_end: 1.0e4")
+    open(hung, "w").write(text)
+    dh = os.path.join(tmp, "hung")
+    t0 = time.time()
+    r = sweep(hung, "-o", dh, "--threads", "2")
+    hrows = list(csv.DictReader(open(os.path.join(dh, "runs.csv")))) if r.returncode == 0 else []
+    check(r.returncode == 0 and len(hrows) == 6 and
+          all("wall-time limit of 0.02 s" in h["status"] for h in hrows) and time.time() - t0 < 60,
+          "runs past run_time_limit: recorded as failed with the reason, the sweep completes")
 
     # failures are recorded, the sweep goes on
     bad = os.path.join(tmp, "bad.yaml")

@@ -7,6 +7,13 @@ and against physics; run by ctest with Debian's python3 and numpy:
   - eval: the generated and generic engines agree; u_dot solves M u_dot = F;
   - the same PD slew controller written in Python gives the trajectory of
     the C++ simulator with it compiled in (examples/gnc_slew);
+  - results as data: a Run (t, q, u, inputs, outputs by name, columns, the
+    summary as a dict: the wheel motors keep H);
+  - runtime parameters changed from Python without a compile (the JIT cache
+    untouched), per call or for good, equal to the generic engine's;
+  - a closed-loop sweep in the C++ simulator (slew_sim sweep): the same
+    tables on 1 and 2 threads, merged shards and mpirun; from Python with
+    the law in Python: the same draws and metrics; run k alone = the table;
   - linearize: a pendulum's A is the closed form;
   - the LQR example (reduced horizon) settles and leaves the arrays quiet.
 """
@@ -24,6 +31,7 @@ import numpy as np
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
 ap.add_argument("--slew-sim", required=True)
+ap.add_argument("--mpirun", default="")
 args = ap.parse_args()
 sys.path.insert(0, os.path.join(args.build, "python"))
 import kanegen  # noqa: E402
@@ -91,11 +99,110 @@ for col in rows[0].keys():
 print(f"      Python PD vs C++ PD: largest difference {worst:.2e} (column {worst_col}, relative to its peak or 1e-6)")
 check(len(rows) == len(run["t"]) and worst <= 1e-7, "simulate: the Python controller reproduces the C++ simulator's run")
 # every name once; the groups hold the coordinate and its rate apart
-check(len(set(run["columns"])) == len(run["columns"]), "simulate: no column name repeats")
-check(set(run["q"]) == set(gen.q_names) and set(run["u"]) == set(gen.u_names)
-      and not np.array_equal(run["q"]["rw_z.angle"], run["u"]["rw_z.angle_rate"]),
+check(len(set(run.columns)) == len(run.columns), "simulate: no column name repeats")
+check(set(run.q) == set(gen.q_names) and set(run.u) == set(gen.u_names)
+      and not np.array_equal(run.q["rw_z.angle"], run.u["rw_z.angle_rate"]),
       "simulate: q and u grouped by name, a rate never under its coordinate's name")
-check(set(run["outputs"]) == set(gen.output_names), "simulate: outputs grouped by name")
+check(set(run.outputs) == set(gen.output_names), "simulate: outputs grouped by name")
+
+check(run.summary["integrator"] == "cvode-adams" or run.summary["integrator"] != "", "simulate: the summary names the integrator")
+check(run.summary["H_drift"] < 1e-9 and math.isnan(run.summary["energy_drift"])
+      and "energy not conserved" in run.summary["accuracy"],
+      f"simulate: internal motor torques keep H ({run.summary['H_drift']:.1e}); energy ruled out, said why")
+check(run.q.values.shape == (len(run.t), gen.nq) and run.q.names == gen.q_names
+      and np.array_equal(run.q.values[:, gen.q_names.index("bus.qz")], run.q["bus.qz"]),
+      "simulate: Signals as a 2-D array with names, and by name")
+
+# ---- runtime parameters from Python, no compile
+cache = os.environ.get("KANEGEN_CACHE_DIR", "")
+
+
+def cache_listing():
+    if not cache or not os.path.isdir(cache):
+        return None
+    return sorted((f, os.path.getmtime(os.path.join(cache, f))) for f in os.listdir(cache))
+
+
+before = cache_listing()
+check("array_a.damping_ratio1" in gen.parameter_names and "bus.inertia.zz" in gen.parameter_names,
+      "parameters: the model's own and its damping ratios are runtime parameters")
+nominal = gen.parameters
+base = gen.simulate(20.0, dt_out=0.5, controller=pd, period=0.1)
+stiff = gen.simulate(20.0, dt_out=0.5, controller=pd, period=0.1,
+                     parameters={"array_a.damping_ratio": 0.05, "bus.inertia.zz": 700.0})
+check(gen.parameters == nominal, "parameters=: for that call only")
+gen.set_parameters({"array_a.damping_ratio": 0.05, "bus.inertia.zz": 700.0})
+again = gen.simulate(20.0, dt_out=0.5, controller=pd, period=0.1)
+gnr.set_parameters({"array_a.damping_ratio": [0.05, 0.05, 0.05], "bus.inertia.zz": 700.0})
+ref = gnr.simulate(20.0, dt_out=0.5, controller=pd, period=0.1)
+d_tip = np.abs(base["tip_a.z"] - stiff["tip_a.z"]).max()
+d_same = np.abs(again["tip_a.z"] - stiff["tip_a.z"]).max()
+d_gen = np.abs(ref["star_tracker.qz"] - again["star_tracker.qz"]).max()
+check(d_tip > 1e-6 and d_same == 0.0 and d_gen < 1e-8,
+      f"set_parameters: the changed run differs ({d_tip:.1e}), per call = set ({d_same}), generated = generic ({d_gen:.1e})")
+check(before is None or cache_listing() == before, "parameters changed without a compile (the JIT cache untouched)")
+gen.set_parameters(nominal)
+try:
+    gen.set_parameters({"bus.mass": 700.0})
+    check(False, "set_parameters refuses a value the code keeps constant")
+except KeyError as e:
+    check("parameters=['bus.mass']" in str(e), "set_parameters: a value the code keeps constant is refused, saying how")
+heavy = kanegen.Model(SLEW, engine="generic", parameters=["bus.mass"])
+heavy.set_parameters({"bus.mass": 1200.0})
+check(abs(heavy.eval(inputs={"motor_x": 0.0})["M"][0, 0] - (1200.0 + 12.0 + 40.0)) < 1e-9,
+      "Model(parameters=[...]): more runtime parameters (bus.mass: M's translational entry)")
+
+# ---- a closed-loop sweep: C++ (the controller compiled into slew_sim) and Python
+SWEEP = os.path.join(ROOT, "tests", "data", "sweeps", "slew_closed_loop.yaml")
+TABLES = ["runs.csv", "summary.json", "summary.md", "envelope_star_tracker.qz.csv"]
+
+
+def slew_sweep(*extra, prefix=()):
+    r = subprocess.run([*prefix, args.slew_sim, "sweep", SWEEP, "--no-progress", *extra], capture_output=True, text=True)
+    if r.returncode != 0:
+        print(r.stdout, r.stderr)
+    return r.returncode == 0
+
+
+def same(a, b):
+    return all(open(os.path.join(a, f), "rb").read() == open(os.path.join(b, f), "rb").read() for f in TABLES)
+
+
+with tempfile.TemporaryDirectory() as d:
+    t1, t2, s0, s1, merged, mpi, pyd = (os.path.join(d, n) for n in ("t1", "t2", "s0", "s1", "m", "mpi", "py"))
+    check(slew_sweep("-o", t1, "--threads", "1") and slew_sweep("-o", t2, "--threads", "2") and same(t1, t2),
+          "closed-loop sweep (slew_sim sweep): identical tables on 1 and 2 threads")
+    check(slew_sweep("-o", s0, "--shard", "0/2") and slew_sweep("-o", s1, "--shard", "1/2")
+          and slew_sweep("--merge", s0, s1, "-o", merged) and same(t1, merged),
+          "closed-loop sweep: two shards merged give identical tables")
+    if args.mpirun:
+        check(slew_sweep("-o", mpi, prefix=(args.mpirun, "--allow-run-as-root", "--oversubscribe", "-np", "3"))
+              and same(t1, mpi), "closed-loop sweep under mpirun -np 3: identical tables")
+    rows = list(csv.DictReader(open(os.path.join(t1, "runs.csv"))))
+    check(len(rows) == 6 and all(r["status"] == "ok" for r in rows), "closed-loop sweep: 6 runs, all ok")
+    py = kanegen.sweep(SWEEP, controller=pd, period=0.1, output=pyd)
+    same_draws = all(float(rows[k][n]) == py["values"][n][k] for k in range(6)
+                     for n in ("bus.inertia.xx", "bus.inertia.zz", "array_damping"))
+    worst = max(abs(float(rows[k][n]) - py["metrics"][n][k]) / max(1e-6, abs(float(rows[k][n])))
+                for k in range(6) for n in ("final_qz", "peak_rate_z", "peak_tip_a"))
+    check(same_draws and worst < 1e-7,
+          f"kanegen.sweep with the law in Python: the same draws, metrics within {worst:.1e} of the C++ sweep")
+    check(max(abs(float(r["Hz_final"])) for r in rows) < 1e-9,
+          "closed-loop sweep: H_z stays 0 under the wheel motors in every run")
+    one = os.path.join(d, "run3.csv")
+    subprocess.run([args.slew_sim, "sweep", SWEEP, "--run", "3", "-o", one], check=True, capture_output=True)
+    last = list(csv.DictReader(open(one)))[-1]
+    check(float(last["star_tracker.qz"]) == float(rows[3]["final_qz"]),
+          "closed-loop sweep: run 3 replayed alone ends where the table says")
+    # run 3 by hand: a Python model with run 3's values, simulated once
+    r3 = gen.simulate(60.0, dt_out=0.5, controller=pd, period=0.1, integrator="rkf78", rtol=1e-10, atol=1e-12,
+                      parameters={"bus.inertia.xx": float(rows[3]["bus.inertia.xx"]),
+                                  "bus.inertia.yy": float(rows[3]["bus.inertia.yy"]),
+                                  "bus.inertia.zz": float(rows[3]["bus.inertia.zz"]),
+                                  "array_a.damping_ratio": float(rows[3]["array_damping"]),
+                                  "array_b.damping_ratio": float(rows[3]["array_damping"])})
+    check(abs(r3["star_tracker.qz"][-1] - float(rows[3]["final_qz"])) < 1e-8,
+          "closed-loop sweep: run 3 equals a single simulate of its draw")
 
 # ---- linearize: pendulum closed form
 pend = kanegen.Model(os.path.join(ROOT, "models", "pendulum.yaml"))
@@ -106,14 +213,14 @@ check(lin["equilibrium"] and abs(lin["A"][1, 0] + 9.81) <= 1e-13 and lin["A"][0,
 # ---- events: the probe separation model's events and latch as the CLI reports them
 sep = kanegen.Model(os.path.join(ROOT, "models", "probe_separation.yaml"), engine="generic")
 srun = sep.simulate(8.0, dt_out=0.1, integrator="rkf78")
-names = [e["name"] for e in srun["events"]]
-latch = srun["events"][-1] if srun["events"] else {}
+names = [e["name"] for e in srun.events]
+latch = srun.events[-1] if srun.events else {}
 check(names == ["eject", "separation"] and latch.get("energy_lost", 0) > 0
-      and abs(srun["q"]["plate.disp"][-1] - 0.2) < 1e-9 and srun["u"]["plate.disp_rate"][-1] == 0.0,
+      and abs(srun.q["plate.disp"][-1] - 0.2) < 1e-9 and srun.u["plate.disp_rate"][-1] == 0.0,
       "simulate: events fire in Python as in the CLI (eject, then separation at the end of the stroke, latched)")
 # a state with the plate free from the start: the eject event then finds it free (ignored), the spring drives at once
 free_run = sep.simulate(2.0, dt_out=0.1, integrator="rkf78", locked=["probe"])
-check([e["name"] for e in free_run["events"]] == ["separation"] and free_run["events"][0]["t"] < 1.0,
+check([e["name"] for e in free_run.events] == ["separation"] and free_run.events[0]["t"] < 1.0,
       "simulate: locked= sets the locks at the start (the plate free, the separation within the first second)")
 ev_l = sep.eval(locked=["plate", "probe"])
 ev_f = sep.eval(locked=[])
