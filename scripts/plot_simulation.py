@@ -11,7 +11,15 @@ Writes, when the columns are there:
   P_energy.png           T, V and T + V
   P_momentum.png         |H| and its relative drift
   P_reactions.png        joint reaction force and torque magnitudes per body
-  P_joints.png           revolute / prismatic / modal coordinates
+  P_joints_<type>.png    joint coordinates, one plot per joint type (revolute, universal,
+                         gimbal, prismatic, cylindrical, planar; without --model: angles,
+                         displacements); a coordinate that spins (more than a turn, its
+                         rate of one sign, e.g. a reaction wheel) is plotted as its rate
+                         in P_spinning.png instead, so it does not swamp the others
+  P_modes.png            modal coordinates, one panel per flexible body
+  P_sensor_<name>.png    each sensor of the model (outputs with a name), its components
+  P_inputs.png           the model's named inputs (motor torques, thrusts, ...)
+A coordinate's rate is the column of its name with _rate (model-format.md, Joints).
 P is the model name (from --model) or the CSV file stem, unless --prefix is given.
 Prints the files written. Exit status 2 on a missing file or column.
 Run with /usr/bin/python3 (needs numpy, matplotlib; PyYAML for --model).
@@ -91,7 +99,7 @@ def rotation_of(spec):
 
 # ---------------------------------------------------------------- inputs
 class History:
-    """The CSV: names may repeat (a revolute q and its speed share a name): first = q."""
+    """The CSV of `kanegen simulate`: a header of unique names, then rows."""
 
     def __init__(self, path):
         if not os.path.isfile(path):
@@ -265,25 +273,97 @@ def plot_reactions(h, bodies, out, written):
     finish(fig, (a1, a2), os.path.join(out, f"{h.prefix}_reactions.png"), written)
 
 
-def plot_joints(h, coords, out, written):
+def spins(h, name):
+    """A coordinate that turns more than a full turn with a rate of one sign (a wheel)."""
+    rate = f"{name}_rate"
+    if not name.rsplit(".", 1)[-1].startswith("angle") or not h.has(rate):
+        return False
+    q, r = h.col(name), h.col(rate)
+    return np.ptp(q) > 2 * math.pi and (np.all(r > 0) or np.all(r < 0))
+
+
+def plot_lines(h, names, title, ylabel, path, written):
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    for n in coords:
-        ax.plot(h.t, h.col(n, 0), lw=0.7, label=n)
+    for n in names:
+        ax.plot(h.t, h.col(n), lw=0.7, label=n)
     ax.set_xlabel("time [s]")
-    ax.set_ylabel("joint coordinate [rad, m or modal]")
-    ax.set_title("joint coordinates")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
     ax.legend(loc="best", fontsize="small", ncol=2)
-    finish(fig, (ax,), os.path.join(out, f"{h.prefix}_joints.png"), written)
+    finish(fig, (ax,), path, written)
+
+
+UNITS = {"revolute": "rad", "universal": "rad", "gimbal": "rad", "prismatic": "m", "cylindrical": "rad, m",
+         "planar": "m, rad", "angle": "rad", "displacement": "m"}
+
+
+def plot_joints(h, groups, out, written):
+    """groups: {joint type: [coordinate names]}; spinning coordinates go to one plot of rates."""
+    spinning = []
+    for kind, coords in groups.items():
+        still = [n for n in coords if not spins(h, n)]
+        spinning += [n for n in coords if n not in still]
+        if still:
+            plot_lines(h, still, f"{kind} joint coordinates", f"coordinate [{UNITS.get(kind, 'rad or m')}]",
+                       os.path.join(out, f"{h.prefix}_joints_{kind}.png"), written)
+    if spinning:
+        plot_lines(h, [f"{n}_rate" for n in spinning], "spinning joints: rates (their angles grow without bound)",
+                   "rate [rad/s]", os.path.join(out, f"{h.prefix}_spinning.png"), written)
+
+
+def plot_modes(h, modal, out, written):
+    """modal: {body: [eta names]}: one panel per flexible body."""
+    fig, axes = plt.subplots(len(modal), 1, figsize=(8, 2.6 * len(modal) + 1), sharex=True, squeeze=False)
+    for ax, (body, names) in zip(axes[:, 0], modal.items()):
+        for n in names:
+            ax.plot(h.t, h.col(n), lw=0.7, label=n.rsplit(".", 1)[-1])
+        ax.set_ylabel("modal coordinate")
+        ax.set_title(f"{body}: modal coordinates")
+        ax.legend(loc="best", fontsize="small", ncol=3)
+    axes[-1, 0].set_xlabel("time [s]")
+    finish(fig, list(axes[:, 0]), os.path.join(out, f"{h.prefix}_modes.png"), written)
+
+
+def columns_of(h, name):
+    """A port's columns: NAME itself (a scalar) or NAME.<component>, in CSV order."""
+    return [n for n in h.names if n == name or n.startswith(name + ".")]
+
+
+# what docs/gnc.md, "Named outputs", says each sensor type reports
+SENSOR_UNITS = {"attitude": "quaternion of R_NB", "angular_velocity": "rad/s, body axes", "position": "m, N",
+                "velocity": "m/s, N", "acceleration": "m/s², body axes", "specific_force": "m/s², body axes",
+                "reaction": "N, N m, body axes", "deflection": "m, body axes"}
+
+
+def plot_sensors(h, sensors, out, written):
+    for name, kind in sensors:
+        cols = columns_of(h, name)
+        h.require(cols or [name], f"sensor {name}")
+        plot_lines(h, cols, f"sensor {name} ({kind})", f"{name} [{SENSOR_UNITS.get(kind, 'SI units')}]",
+                   os.path.join(out, f"{h.prefix}_sensor_{name}.png"), written)
+
+
+def plot_inputs(h, inputs, out, written):
+    cols = [c for n in inputs for c in columns_of(h, n)]
+    h.require(cols or inputs, "the model's inputs")
+    plot_lines(h, cols, "inputs", "value [N, N m or as declared]", os.path.join(out, f"{h.prefix}_inputs.png"),
+               written)
 
 
 # ---------------------------------------------------------------- main
+def joint_coordinates(h, body):
+    """The body's joint coordinates in the CSV: its columns with a rate column (model-format.md)."""
+    return [n for n in h.names if n.startswith(body + ".") and not n.endswith("_rate") and h.has(n + "_rate")
+            and not n[len(body) + 1:].startswith("eta")]
+
+
 def run(args):
     h = History(args.csv)
     model = load_model(args.model) if args.model else None
     h.prefix = args.prefix or (model.get("name") if model and model.get("name") else
                                os.path.splitext(os.path.basename(args.csv))[0])
 
-    free, reaction_bodies, rot_J, coords = [], [], {}, []
+    free, reaction_bodies, rot_J, groups, modal, sensors, inputs = [], [], {}, {}, {}, [], []
     if model:
         outputs = model.get("outputs") or []
         for b in model["bodies"]:
@@ -294,14 +374,22 @@ def run(args):
                 free.append(name)
                 if b.get("parent") == "ground":
                     rot_J[name] = rotation_of(joint.get("rotation"))
-            elif jt == "revolute":
-                coords.append(f"{name}.angle")
-            elif jt == "prismatic":
-                coords.append(f"{name}.disp")
-            coords += [n for n in h.index if n.startswith(f"{name}.eta")]
+            elif jt not in ("fixed", "ball") and "motion" not in joint:
+                coords = joint_coordinates(h, name)
+                if not coords:
+                    raise InputError(f"{h.path}: no coordinate columns of {name}'s {jt} joint")
+                groups.setdefault(jt, []).extend(coords)
+            etas = [n for n in h.names if n.startswith(f"{name}.eta") and not n.endswith("_rate")]
+            if b.get("flexible"):
+                if not etas:
+                    raise InputError(f"{h.path}: no modal coordinate columns of flexible body {name}")
+                modal[name] = etas
             if "reactions" in outputs:
                 reaction_bodies.append(name)
-        h.require(coords, "joint coordinates of the model")
+        for o in outputs:
+            if isinstance(o, dict) and o.get("name"):
+                sensors.append((o["name"], o.get("type", "sensor")))
+        inputs = [i["name"] for i in (model.get("inputs") or []) if isinstance(i, dict) and i.get("name")]
         if "energy" in outputs:
             h.require(["T", "V"], "the model's outputs list energy")
         if "momentum" in outputs:
@@ -310,7 +398,7 @@ def run(args):
             h.require([f"{b}.{c}" for b in reaction_bodies for c in WRENCH],
                       "the model's outputs list reactions")
     else:
-        # no model: bodies are recognized by their columns
+        # no model: bodies are recognized by their columns, coordinates by their rate columns
         for n in h.names:
             b, _, c = n.rpartition(".")
             if c == "qw" and h.has(*[f"{b}.{x}" for x in QUAT + OMEGA]) and b not in free:
@@ -318,8 +406,13 @@ def run(args):
                 rot_J[b] = np.eye(3)     # assumed: parent ground, identity joint rotation
             if c == "fx" and h.has(*[f"{b}.{x}" for x in WRENCH]) and b not in reaction_bodies:
                 reaction_bodies.append(b)
-            if (c in ("angle", "disp") or c.startswith("eta")) and n not in coords:
-                coords.append(n)
+            if b and not c.endswith("_rate") and h.has(n + "_rate"):
+                if c.startswith("eta"):
+                    modal.setdefault(b, []).append(n)
+                elif c.startswith("angle"):
+                    groups.setdefault("angle", []).append(n)
+                elif c in ("disp", "x", "y"):
+                    groups.setdefault("displacement", []).append(n)
 
     os.makedirs(args.output, exist_ok=True)
     written = []
@@ -336,10 +429,17 @@ def run(args):
                 print(f"note: {b} is free but not attached to ground; no nutation plot", file=sys.stderr)
     if reaction_bodies:
         plot_reactions(h, reaction_bodies, args.output, written)
-    if coords:
-        plot_joints(h, coords, args.output, written)
+    if groups:
+        plot_joints(h, groups, args.output, written)
+    if modal:
+        plot_modes(h, modal, args.output, written)
+    if sensors:
+        plot_sensors(h, sensors, args.output, written)
+    if inputs:
+        plot_inputs(h, inputs, args.output, written)
     if not written:
-        raise InputError(f"{args.csv}: nothing to plot (no free-body, energy, momentum, reaction or joint columns)")
+        raise InputError(f"{args.csv}: nothing to plot (no free-body, energy, momentum, reaction, joint, "
+                         "sensor or input columns)")
     print("wrote:")
     for p in written:
         print("  " + p)
