@@ -212,3 +212,23 @@ TEST_CASE("linearize: spinning wheels are a relative equilibrium; ignorable coor
   }
   CHECK(elastic >= 6);
 }
+
+TEST_CASE("linearize: exact above 6000 u-dot operations (spacecraft_arrays), equal to central differences",
+          "[linearize][generated]") {
+  // 21 speeds, two hinged flexible wings and a flexible boom: its u-dot is compiled at -O0 and its Jacobian
+  // is not used by the implicit integrators (jacobian_for_integration false: above 6000 operations), but
+  // linearize still takes the exact derivatives, never finite differences unless asked
+  const Model model = load_model(test::source_path("models/spacecraft_arrays.yaml"));
+  auto generated = test::generated_engine(model);
+  CHECK_FALSE(generated->jacobian_for_integration());
+  REQUIRE(generated->has_jacobian());
+  const State s = initial_state(model);
+  const LinearModel exact = linearize(*generated, s, {});
+  CHECK(exact.method.rfind("exact", 0) == 0);
+  GenericEngine generic(model);
+  const LinearModel fd = linearize(generic, s, {});
+  CHECK(fd.method.find("central") != std::string::npos);
+  INFO("A: exact vs central differences " << test::rel_err(exact.A, fd.A) << ", B " << test::rel_err(exact.B, fd.B));
+  CHECK(test::rel_err(exact.A, fd.A) <= 1e-6);
+  CHECK(test::rel_err(exact.B, fd.B) <= 1e-6);
+}
