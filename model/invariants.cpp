@@ -77,6 +77,7 @@ Invariants invariants_of(const Model& model, const VecX& tau, const VecX& w, boo
   if (!external_inputs.empty())
     m.push_back(fmt::format("external {} ({})", count(external_inputs.size(), "input", "inputs"), names(external_inputs)));
   inv.energy = e.empty();
+  inv.energy_with_drivers = e.size() == 1 && !prescribed.empty();
   inv.momentum = m.empty();
   return inv;
 }

@@ -10,6 +10,8 @@
 //    wheel's motor, a hinge's damper, a prescribed internal joint) act on
 //    both, while a thruster, a force or torque on a body, or a torque on a
 //    root joint's speeds come from outside.
+// With prescribed motion the only thing doing work, the balance E - E(0) = W
+// (the drivers' work) still holds, and is what the summary reports.
 // Latches and locks act per segment (sim/simulate.cpp): a latch takes energy
 // (it is reported, ev.energy_lost), a root joint locked to ground holds p and H.
 #pragma once
@@ -24,6 +26,9 @@ namespace kanegen {
 struct Invariants {
   bool energy = true;    ///< T + V
   bool momentum = true;  ///< p and H about N's origin
+  /// Energy is broken by prescribed motion alone: T + V minus the drivers' work is kept
+  /// (sim/driver_work.hpp measures that balance).
+  bool energy_with_drivers = false;
   std::vector<std::string> energy_broken_by, momentum_broken_by;  ///< why not, one phrase each
   /// "" when both hold; else "energy not conserved: dampers on 4 joints; p, H not conserved: gravity"
   std::string note() const;

@@ -307,6 +307,7 @@ Run make_run(const RowTable& table, const SimulationResult& r, const Model& m) {
   d["segments"] = r.segments;
   d["max_quaternion_drift"] = r.max_quaternion_drift;
   d["energy_drift"] = r.quality.energy_drift;  // NaN: not an invariant of the scene
+  d["energy_balance"] = r.quality.energy_balance;  // E - E0 - drivers' work (prescribed motion), NaN otherwise
   d["H_drift"] = r.quality.H_drift;
   d["error_estimate"] = r.quality.error_estimate;
   d["error_worst"] = r.quality.error_worst;

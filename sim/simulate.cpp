@@ -7,6 +7,7 @@
 #include "engine/generated_engine.hpp"
 #include "model/invariants.hpp"
 #include "model/output_file.hpp"
+#include "sim/driver_work.hpp"
 #include "sim/event_run.hpp"
 #include "sim/integrator_choice.hpp"
 #include "sim/work_precision.hpp"
@@ -220,6 +221,10 @@ std::vector<std::string> csv_columns(const Model& model) {
 std::string RunQuality::summary() const {
   std::vector<std::string> parts;
   if (std::isfinite(energy_drift)) parts.push_back(fmt::format("energy drift {:.2e}", energy_drift));
+  if (std::isfinite(energy_balance))
+    parts.push_back(fmt::format("energy balance with the drivers' work {:.2e} (their work by quadrature on the "
+                                "output rows, good to about {:.1e}: a smaller --dt-out tightens it)",
+                                energy_balance, energy_balance_quadrature));
   if (std::isfinite(H_drift)) parts.push_back(fmt::format("|H| drift {:.2e}", H_drift));
   if (std::isfinite(error_estimate))
     parts.push_back(fmt::format("estimated error {:.2e} ({})", error_estimate, error_worst));
@@ -608,6 +613,19 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
       const bench::Drifts d = bench::invariant_drifts(lacks ? *measure : engine, inv_i, seg);
       quality.energy_drift = worse(quality.energy_drift, d.energy);
       quality.H_drift = worse(quality.H_drift, d.H);
+    }
+  }
+  if (physics.energy_with_drivers) {
+    // E - E0 = the drivers' work, per segment, on the generic engine (it has the reactions at any state)
+    GenericEngine measure(model);
+    measure.set_parameters(engine.parameters());
+    measure.set_inputs(initial.w);
+    for (std::size_t i = 0; i < sampled.segment_begin.size(); ++i) {
+      measure.set_locks(sampled.segment_locks[i]);
+      const EnergyBalance b = energy_balance(measure, sampled.segment(i), initial.tau);
+      auto worse = [](double a, double c) { return std::isnan(a) ? c : std::isnan(c) ? a : std::max(a, c); };
+      quality.energy_balance = worse(quality.energy_balance, b.residual);
+      quality.energy_balance_quadrature = worse(quality.energy_balance_quadrature, b.quadrature);
     }
   }
   if (options.estimate_error && controller) {

@@ -42,6 +42,10 @@ struct RunQuality {
   /// Relative drift of the invariants that hold for the scene (NaN otherwise):
   /// max |E - E0| / max(|T0|, |V0|, |E0|) and max |H - H0| / |H0| over the output times.
   double energy_drift = NAN, H_drift = NAN;
+  /// When prescribed motion alone does work (Invariants::energy_with_drivers): the balance
+  /// max |E - E0 - W_drivers| / max(T + |V|) over the output times (sim/driver_work.hpp); NaN otherwise.
+  double energy_balance = NAN;
+  double energy_balance_quadrature = NAN;  ///< the part of it the quadrature of W can explain
   /// With SimulationOptions::estimate_error: the error of the run against the
   /// tighter one, measured as `kanegen bench` measures it (relative, worst
   /// component over the output times), and where it is largest.
