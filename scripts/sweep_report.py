@@ -19,7 +19,6 @@ import subprocess
 import tempfile
 import time
 
-import math
 import sys
 
 import numpy as np
@@ -83,23 +82,9 @@ slew_rows = list(csv.DictReader(open(os.path.join(d, "runs.csv"))))
 slew_runs = len(slew_rows)
 sys.path.insert(0, os.path.join(os.path.abspath(args.build), "python"))
 import kanegen  # noqa: E402
-INERTIA = np.array([995.0, 380.0, 875.0])  # examples/gnc_slew/slew_controller.cpp, in Python
-BW, ZETA, TMAX = 0.05, 0.9, 0.3
-tw, tz = math.cos(math.radians(15.0)), math.sin(math.radians(15.0))
-probe = kanegen.Model(os.path.join(ROOT, "models/gnc/slew_spacecraft.yaml"))
-att, gyro = probe.output_names.index("star_tracker.qw"), probe.output_names.index("gyro.x")
-
-
-def pd(t, q, u, y):
-    w0, x0, y0, z0 = y[att:att + 4]
-    e = np.array([tw * w0 + tz * z0, tw * x0 + tz * y0, tw * y0 - tz * x0, tw * z0 - tz * w0])
-    if e[0] < 0:
-        e = -e
-    torque = -(INERTIA * BW * BW * 2.0 * e[1:] + INERTIA * 2.0 * ZETA * BW * y[gyro:gyro + 3])
-    peak = np.abs(torque).max()
-    if peak > TMAX:
-        torque *= TMAX / peak
-    return -torque
+sys.path.insert(0, os.path.join(ROOT, "examples", "gnc_slew"))
+from slew_pd import pd_law  # noqa: E402  (slew_controller.cpp's law, in Python)
+pd = pd_law(kanegen.Model(os.path.join(ROOT, "models/gnc/slew_spacecraft.yaml")).output_names)
 
 
 t0 = time.perf_counter()

@@ -149,11 +149,8 @@ void find_ignorable(LinearModel& lin, const std::vector<int>& body_of) {
   lin.relative_equilibrium = !lin.equilibrium && rest <= kEquilibriumTolerance && own > 0;
 }
 
-/// The model without the states named `drop` (none of the others depends on them).
-void drop_states(LinearModel& lin, const std::vector<std::string>& drop) {
-  std::vector<int> keep;
-  for (int i = 0; i < static_cast<int>(lin.state_names.size()); ++i)
-    if (std::find(drop.begin(), drop.end(), lin.state_names[i]) == drop.end()) keep.push_back(i);
+/// The model restricted to the states `keep` (indices, ascending); with state outputs, C = I on them.
+void keep_states(LinearModel& lin, const std::vector<int>& keep) {
   const int nk = static_cast<int>(keep.size());
   const bool state_outputs = lin.output_names == lin.state_names;
   MatX A(nk, nk), B(nk, lin.B.cols()), C(lin.C.rows(), nk);
@@ -175,9 +172,17 @@ void drop_states(LinearModel& lin, const std::vector<std::string>& drop) {
     lin.C = C;
   }
   lin.A = A, lin.B = B, lin.x0_dot = xd, lin.state_names = names;
+}
+
+/// The model without the states named `drop` (none of the others depends on them).
+void drop_states(LinearModel& lin, const std::vector<std::string>& drop) {
+  std::vector<int> keep;
+  for (int i = 0; i < static_cast<int>(lin.state_names.size()); ++i)
+    if (std::find(drop.begin(), drop.end(), lin.state_names[i]) == drop.end()) keep.push_back(i);
+  keep_states(lin, keep);
   lin.ignorable_dropped = true;
   // without the ignorable rows the point is an equilibrium of what is left when it was a relative one
-  lin.residual = xd.size() ? xd.cwiseAbs().maxCoeff() : 0.0;
+  lin.residual = lin.x0_dot.size() ? lin.x0_dot.cwiseAbs().maxCoeff() : 0.0;
   lin.equilibrium = lin.residual <= kEquilibriumTolerance;
 }
 
@@ -351,32 +356,10 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
     std::vector<int> keep;
     for (int i = 0; i < n; ++i)
       if (state_body[i] < 0 || !state.locked[state_body[i]]) keep.push_back(i);
-    const int nk = static_cast<int>(keep.size());
-    MatX A(nk, nk), B(nk, m), C(lin.C.rows(), nk);
-    VecX xd(nk);
-    std::vector<std::string> names;
-    for (int r = 0; r < nk; ++r) {
-      for (int c = 0; c < nk; ++c) A(r, c) = lin.A(keep[r], keep[c]);
-      B.row(r) = lin.B.row(keep[r]);
-      xd(r) = lin.x0_dot(keep[r]);
-      names.push_back(lin.state_names[keep[r]]);
-    }
-    for (int c = 0; c < nk; ++c) C.col(c) = lin.C.col(keep[c]);
     std::vector<int> kept_body;
     for (int k : keep) kept_body.push_back(state_body[k]);
     state_body = kept_body;
-    if (state_outputs) {
-      lin.C = MatX::Identity(nk, nk);
-      lin.D = MatX::Zero(nk, m);
-      lin.output_names = names;
-      lin.y0 = VecX::Zero(nk);
-    } else {
-      lin.C = C;
-    }
-    lin.A = A;
-    lin.B = B;
-    lin.x0_dot = xd;
-    lin.state_names = names;
+    keep_states(lin, keep);
     lin.method += fmt::format(", reduced: {} locked joint speeds", engine.locked_u().size());
   }
   find_ignorable(lin, state_body);

@@ -37,6 +37,23 @@ kanegen::Controller kanegen_controller(const kanegen::Model& model);
 namespace kanegen {
 
 /// Exit status as the kanegen CLI: 0 success, 2 refused input, 1 failure while running.
+/// f()'s exit status, or the contract's for what it throws: 2 for a refused input or output, 1 for a failure.
+template <class F>
+int exit_status_of(const std::string& program, F&& f) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    for (const Diagnostic& d : e.diagnostics()) fmt::print(stderr, "{}\n", d.str());
+    return 2;
+  } catch (const OutputRefused& e) {
+    fmt::print(stderr, "{}: cannot write output {}\n", program, e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "{}: {}\n", program, e.what());
+    return 1;
+  }
+}
+
 inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* api, const std::string& model_path,
                               const std::string& program) {
   std::string model_file = model_path, state_path;
@@ -71,7 +88,7 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
   }
 
   if (sweep_cmd->parsed()) {
-    try {
+    return exit_status_of(program, [&] {
       auto make = [&](const Model& m) -> std::unique_ptr<Engine> {
         try {
           return std::make_unique<GeneratedEngine>(m, api);
@@ -88,18 +105,9 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
       if (!open_loop) controller = [](const Model& m, long) { return kanegen_controller(m); };
 #endif
       return cli::run_sweep_cli(sweep, make, controller);
-    } catch (const InputError& e) {
-      for (const Diagnostic& d : e.diagnostics()) fmt::print(stderr, "{}\n", d.str());
-      return 2;
-    } catch (const OutputRefused& e) {
-      fmt::print(stderr, "{}: cannot write output {}\n", program, e.what());
-      return 2;
-    } catch (const std::exception& e) {
-      fmt::print(stderr, "{}: {}\n", program, e.what());
-      return 1;
-    }
+    });
   }
-  try {
+  return exit_status_of(program, [&] {
     const Model model = load_model(model_file);
     check_mass_matrix_at_initial_state(model);
     const State state = state_path.empty() ? initial_state(model) : load_state(model, state_path);
@@ -131,16 +139,7 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
       return 1;
     }
     return 0;
-  } catch (const InputError& e) {
-    for (const Diagnostic& d : e.diagnostics()) fmt::print(stderr, "{}\n", d.str());
-    return 2;
-  } catch (const OutputRefused& e) {
-    fmt::print(stderr, "{}: cannot write output {}\n", program, e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    fmt::print(stderr, "{}: {}\n", program, e.what());
-    return 1;
-  }
+  });
 }
 
 }  // namespace kanegen

@@ -59,25 +59,10 @@ ya, yb = np.array(list(a["outputs"].values())), np.array(list(b["outputs"].value
 check(np.abs(ya - yb).max() <= 1e-12 * np.abs(yb).max(), "eval: outputs agree between the engines")
 check(abs(np.linalg.norm(ya[:4]) - 1) <= 1e-14, "eval: the star tracker's quaternion is a unit quaternion")
 
-# ---- the PD slew of examples/gnc_slew/slew_controller.cpp, in Python
-INERTIA = np.array([995.0, 380.0, 875.0])
-BW, ZETA, TMAX = 0.05, 0.9, 0.3
-half = math.radians(30.0) / 2
-tw, tz = math.cos(half), math.sin(half)
-att, gyro = gen.output_names.index("star_tracker.qw"), gen.output_names.index("gyro.x")
-
-
-def pd(t, q, u, y):
-    w0, x0, y0, z0 = y[att:att + 4]
-    # conj(target) (x) q with target = [tw, 0, 0, tz]
-    e = np.array([tw * w0 + tz * z0, tw * x0 + tz * y0, tw * y0 - tz * x0, tw * z0 - tz * w0])
-    if e[0] < 0:
-        e = -e
-    torque = -(INERTIA * BW * BW * 2.0 * e[1:] + INERTIA * 2.0 * ZETA * BW * y[gyro:gyro + 3])
-    peak = np.abs(torque).max()
-    if peak > TMAX:
-        torque *= TMAX / peak
-    return -torque
+# ---- the PD slew of examples/gnc_slew/slew_controller.cpp, in Python (examples/gnc_slew/slew_pd.py)
+sys.path.insert(0, os.path.join(ROOT, "examples", "gnc_slew"))
+from slew_pd import pd_law  # noqa: E402
+pd = pd_law(gen.output_names)
 
 
 T_END = 60.0
