@@ -52,7 +52,10 @@ FlexibleBodyModes describe_modes(const Body& body) {
   const FlexibleData& f = *body.flex;
   FlexibleBodyModes out;
   out.long_axis = slender_axis(f);
-  for (const ModalNode& n : f.nodes) {
+  for (std::size_t k = 0; k < f.nodes.size(); ++k) {
+    // a node no kept mode moves (a clamped root node) is no part of what the modes can carry
+    if (f.Phi.middleRows(3 * k, 3).isZero(0.0) && f.Psi.middleRows(3 * k, 3).isZero(0.0)) continue;
+    const ModalNode& n = f.nodes[k];
     out.node_mass += n.mass;
     const Vec3& r = n.rho_B;
     out.node_inertia_O += n.mass * Vec3(r.y() * r.y() + r.z() * r.z(), r.x() * r.x() + r.z() * r.z(),

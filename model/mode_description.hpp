@@ -10,9 +10,9 @@
 //   participation  L_t = Sum m_k Phi_kj                             (3, kg)
 //                  L_r = Sum m_k rho_k x Phi_kj + J_k Psi_kj        (3, kg m, about O)
 //   effective mass  L_t[a]^2 / Y_jj along B's axis a; effective inertia L_r[a]^2 / Y_jj about it.
-// Over a complete set of modes the effective masses add up to the nodes' mass
-// (and the inertias to their inertia about O): the fraction shows what the
-// kept modes miss.
+// Over a complete set of modes the effective masses add up to the mass of the
+// nodes that move (a clamped node is left out; and the inertias to their
+// inertia about O): the fraction shows what the kept modes miss.
 #pragma once
 
 #include <string>
@@ -33,8 +33,8 @@ struct ModeDescription {
 };
 
 struct FlexibleBodyModes {
-  double node_mass = 0.0;                  ///< the nodes' mass (what the effective masses tend to)
-  Vec3 node_inertia_O = Vec3::Zero();      ///< the nodes' moments of inertia about O's axes (diagonal)
+  double node_mass = 0.0;                  ///< the moving nodes' mass (what the effective masses tend to)
+  Vec3 node_inertia_O = Vec3::Zero();      ///< their moments of inertia about O's axes (diagonal)
   int long_axis = -1;                      ///< 0, 1, 2: the B axis a slender body lies along; -1: not slender
   std::vector<ModeDescription> modes;
 };

@@ -250,6 +250,7 @@ py::dict linear_dict(const LinearModel& lin) {
   d["equilibrium"] = lin.equilibrium;
   d["relative_equilibrium"] = lin.relative_equilibrium;
   d["ignorable"] = lin.ignorable;
+  d["ignorable_kept_for_outputs"] = lin.ignorable_kept_for_outputs;
   d["residual"] = lin.residual;
   d["method"] = lin.method;
   py::list modes;

@@ -279,7 +279,7 @@ def spins(h, name):
     if not name.rsplit(".", 1)[-1].startswith("angle") or not h.has(rate):
         return False
     q, r = h.col(name), h.col(rate)
-    return np.ptp(q) > 2 * math.pi and (np.all(r > 0) or np.all(r < 0))
+    return np.ptp(q) > 2 * math.pi and (np.all(r >= 0) or np.all(r <= 0))  # a wheel spun up from rest too
 
 
 def plot_lines(h, names, title, ylabel, path, written):

@@ -49,24 +49,12 @@ double interval_integral(const std::vector<double>& t, const std::vector<double>
 
 }  // namespace
 
-EnergyBalance energy_balance(Engine& engine, const bench::Trajectory& seg, const VecX& tau) {
-  const Model& m = engine.model();
+EnergyBalance energy_balance(const std::vector<double>& t, const std::vector<double>& E,
+                             const std::vector<double>& P, double scale) {
   EnergyBalance out;
-  // distinct times only (an event's two rows share one; none inside a segment, but be safe)
-  std::vector<double> t, P, E;
-  double scale = 0.0;
-  for (std::size_t k = 0; k < seg.t.size(); ++k) {
-    if (!t.empty() && seg.t[k] <= t.back()) continue;
-    const VecX q = seg.x[k].head(m.nq), u = seg.x[k].tail(m.nu);
-    const EnergyValues e = engine.energy(seg.t[k], q, u);
-    t.push_back(seg.t[k]);
-    E.push_back(e.T + e.V);
-    P.push_back(driver_power(engine, seg.t[k], q, u, tau));
-    scale = std::max(scale, e.T + std::abs(e.V));
-  }
   if (t.size() < 2) return out;
   if (!(scale > 0)) scale = 1.0;
-  // W on every sample, and on every other one (to gauge the quadrature)
+  // W on every row, and on every other one (to gauge the quadrature)
   std::vector<double> t2, P2;
   for (std::size_t k = 0; k < t.size(); k += 2) {
     t2.push_back(t[k]);
@@ -76,13 +64,39 @@ EnergyBalance energy_balance(Engine& engine, const bench::Trajectory& seg, const
   for (std::size_t k = 1; k < t.size(); ++k) {
     W += interval_integral(t, P, k - 1);
     worst = std::max(worst, std::abs(E[k] - E[0] - W));
-    if (k % 2 == 0 && t2.size() >= 2) {
+    if (k % 2 == 0) {
       W2 += interval_integral(t2, P2, k / 2 - 1);
       quad = std::max(quad, std::abs(W - W2) / 15.0);
     }
   }
   out.residual = worst / scale;
-  out.quadrature = quad / scale;
+  if (t.size() >= 5) out.quadrature = quad / scale;  // both rules fourth order only from 4 points each
+  return out;
+}
+
+void DriverWorkMeter::new_segment(const LockSet& locks) {
+  engine_.set_locks(locks);
+  segments_.emplace_back();
+}
+
+void DriverWorkMeter::add(double t, const VecX& q, const VecX& u) {
+  Segment& s = segments_.back();
+  if (!s.t.empty() && t <= s.t.back()) return;  // an event's second row: it starts the next segment
+  const EnergyValues e = engine_.energy(t, q, u);
+  s.t.push_back(t);
+  s.E.push_back(e.T + e.V);
+  s.P.push_back(driver_power(engine_, t, q, u, tau_));
+  s.scale = std::max(s.scale, e.T + std::abs(e.V));
+}
+
+EnergyBalance DriverWorkMeter::balance() const {
+  EnergyBalance out;
+  auto worse = [](double a, double b) { return std::isnan(a) ? b : std::isnan(b) ? a : std::max(a, b); };
+  for (const Segment& s : segments_) {
+    const EnergyBalance b = energy_balance(s.t, s.E, s.P, s.scale);
+    out.residual = worse(out.residual, b.residual);
+    out.quadrature = worse(out.quadrature, b.quadrature);
+  }
   return out;
 }
 

@@ -363,8 +363,24 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
     lin.method += fmt::format(", reduced: {} locked joint speeds", engine.locked_u().size());
   }
   find_ignorable(lin, state_body);
-  if (options.drop_ignorable && !lin.ignorable.empty()) drop_states(lin, lin.ignorable);
+  if (options.drop_ignorable && !lin.ignorable.empty()) {
+    // an ignorable state a sensor reads (a position sensor on a free bus) stays: dropping it would change C
+    std::vector<std::string> drop;
+    const bool state_outputs = lin.output_names == lin.state_names;
+    for (const std::string& name : lin.ignorable) {
+      const auto i = std::find(lin.state_names.begin(), lin.state_names.end(), name) - lin.state_names.begin();
+      if (state_outputs || lin.C.rows() == 0 || lin.C.col(i).cwiseAbs().maxCoeff() == 0.0) drop.push_back(name);
+      else lin.ignorable_kept_for_outputs.push_back(name);
+    }
+    drop_states(lin, drop);
+  }
   return lin;
+}
+
+double zero_mode_tolerance(const LinearModel& lin) {
+  // a zero eigenvalue in a Jordan block (a free body's position and speed) comes out of the eigensolver
+  // as +-sqrt(eps |A|): the tolerance scales with sqrt(|A|)
+  return 1e-6 * std::sqrt(std::max(1.0, lin.A.size() ? lin.A.cwiseAbs().maxCoeff() : 0.0));
 }
 
 std::vector<LinearMode> linear_modes(const LinearModel& lin) {
@@ -376,7 +392,7 @@ std::vector<LinearMode> linear_modes(const LinearModel& lin) {
   const auto& V = es.eigenvectors();
   int nqt = 0;
   for (const auto& s : lin.state_names) nqt += s.rfind("q.", 0) == 0 ? 1 : 0;
-  const double zero_tol = 1e-6 * std::sqrt(std::max(1.0, lin.A.cwiseAbs().maxCoeff()));
+  const double zero_tol = zero_mode_tolerance(lin);
   for (int k = 0; k < n; ++k) {
     const std::complex<double> l = lam(k);
     if (l.imag() < 0) continue;
@@ -430,6 +446,7 @@ nlohmann::ordered_json to_json(const LinearModel& lin, const std::vector<LinearM
   j["relative_equilibrium"] = lin.relative_equilibrium;
   j["ignorable"] = lin.ignorable;
   j["ignorable_dropped"] = lin.ignorable_dropped;
+  j["ignorable_kept_for_outputs"] = lin.ignorable_kept_for_outputs;
   j["note"] = lin.equilibrium
                   ? "the point is an equilibrium (max |x_dot| <= 1e-9): x_dot = A dx + B dw"
                   : lin.relative_equilibrium

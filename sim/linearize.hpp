@@ -55,6 +55,8 @@ struct LinearModel {
   bool relative_equilibrium = false;
   double relative_residual = 0;  ///< max |f(x0)| over the rows of the other states
   bool ignorable_dropped = false;
+  /// With drop_ignorable: the ignorable states an output depends on (kept, so that C stays exact).
+  std::vector<std::string> ignorable_kept_for_outputs;
 };
 
 /// Throws InputError (naming `option`) for unknown input or output names;
@@ -72,6 +74,9 @@ struct LinearMode {
   bool zero = false;
   std::vector<std::string> dominant_states;  ///< largest participation first (speeds weighted by 1/|lambda|)
 };
+/// |eigenvalue| at or below which linear_modes() reports a mode as zero: 1e-6 sqrt(max(1, max|A|)).
+double zero_mode_tolerance(const LinearModel& lin);
+
 std::vector<LinearMode> linear_modes(const LinearModel& lin);
 
 nlohmann::ordered_json to_json(const LinearModel& lin, const std::vector<LinearMode>& modes);

@@ -464,6 +464,19 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   double last_row_t = initial.t;
   auto column_of = [&](std::size_t k) { return k < cols.size() ? cols[k] : fmt::format("column {}", k); };
 
+  // The invariants the scene's physics keeps (model/invariants.hpp), and why not the others; with prescribed
+  // motion alone doing work, E - E0 = the drivers' work, measured at every row on the generic engine (it has the
+  // reactions at any state)
+  const Invariants physics = invariants_of(model, initial.tau, initial.w, static_cast<bool>(controller));
+  std::unique_ptr<GenericEngine> driver_engine;
+  std::unique_ptr<DriverWorkMeter> drivers;
+  if (physics.energy_with_drivers) {
+    driver_engine = std::make_unique<GenericEngine>(model);
+    driver_engine->set_parameters(engine.parameters());
+    driver_engine->set_inputs(initial.w);
+    driver_engine->set_locks(initial.locked);
+    drivers = std::make_unique<DriverWorkMeter>(*driver_engine, initial.tau);
+  }
   auto write = [&](double t, const VecX& x, bool keep) -> bool {
     // x arrives projected; the drift was measured on the raw state by project below.
     if (pending.body >= 0) {
@@ -522,6 +535,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
       if (!std::isfinite(row[k]))
         throw fail_at(t, x, fmt::format("non-finite value {} in column '{}'", row[k], column_of(k)));
     sampled.add(t, x, keep);
+    if (drivers) drivers->add(t, q, u);
     sink.row(row.data(), row.size());
     ++result.rows;
     bar.update(t);
@@ -575,7 +589,10 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     }
   };
   hooks.row = [&](double t, const VecX& x, bool keep) { write(t, x, keep); };
-  hooks.new_segment = [&](const LockSet& l) { sampled.new_segment(l); };
+  hooks.new_segment = [&](const LockSet& l) {
+    sampled.new_segment(l);
+    if (drivers) drivers->new_segment(l);
+  };
   try {
     result.stats = run_segments(engine, initial, options.t_end, options.dt_out, digital ? controller.period : 0.0,
                                 options.integrator, events, result.segments, hooks);
@@ -586,8 +603,6 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   }
   bar.finish();
 
-  // The invariants the scene's physics keeps (model/invariants.hpp), and why not the others.
-  const Invariants physics = invariants_of(model, initial.tau, initial.w, static_cast<bool>(controller));
   quality.invariants_note = physics.note();
   if (physics.energy || physics.momentum) {
     const bench::InvariantSet inv{physics.energy, physics.momentum};
@@ -615,18 +630,10 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
       quality.H_drift = worse(quality.H_drift, d.H);
     }
   }
-  if (physics.energy_with_drivers) {
-    // E - E0 = the drivers' work, per segment, on the generic engine (it has the reactions at any state)
-    GenericEngine measure(model);
-    measure.set_parameters(engine.parameters());
-    measure.set_inputs(initial.w);
-    for (std::size_t i = 0; i < sampled.segment_begin.size(); ++i) {
-      measure.set_locks(sampled.segment_locks[i]);
-      const EnergyBalance b = energy_balance(measure, sampled.segment(i), initial.tau);
-      auto worse = [](double a, double c) { return std::isnan(a) ? c : std::isnan(c) ? a : std::max(a, c); };
-      quality.energy_balance = worse(quality.energy_balance, b.residual);
-      quality.energy_balance_quadrature = worse(quality.energy_balance_quadrature, b.quadrature);
-    }
+  if (drivers) {
+    const EnergyBalance b = drivers->balance();
+    quality.energy_balance = b.residual;
+    quality.energy_balance_quadrature = b.quadrature;
   }
   if (options.estimate_error && controller) {
     quality.error_worst = "no error estimate with a controller in the loop (its state would be run twice)";

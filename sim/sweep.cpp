@@ -202,6 +202,10 @@ SweepPlan plan_sweep(const SweepSpec& spec) {
         if (std::find(set_by.begin(), set_by.end(), key) != set_by.end())
           fault(d.line, f, fmt::format("'{}' is dispersed twice (by this and an earlier dispersion)", d.members[m]));
         set_by.push_back(key);
+        if (d.relative && t.nominal == 0.0)
+          fault(d.line, f, fmt::format("relative: true on '{}', whose nominal value is 0: every run would get 0; "
+                                       "expected relative: false (deviations added to the nominal value)",
+                                       d.members[m]));
         group.push_back(t);
       }
     }

@@ -257,7 +257,7 @@ inline int run_sweep_cli(const SweepCli& o, const std::function<std::unique_ptr<
 inline void add_sweep_options(CLI::App* c, SweepCli& o) {
   c->add_option("sweep", o.sweep, "SWEEP.yaml")->required()->check(CLI::ExistingFile);
   c->add_option("-o,--output", o.output, "output directory (default SWEEP.out/); with --run, the run's CSV");
-  c->add_option("--threads", o.threads, "threads (default: every core; 1 per rank under mpirun unless given)");
+  c->add_option("--threads", o.threads, "threads (default: every core); under mpirun each rank runs one run at a time");
   c->add_option("--run", o.run, "replay one run alone and write its full time history")->check(CLI::Range(0L, 100000000L));
   c->add_option("--shard", o.shard, "i/N: the runs k with k mod N = i (a batch scheduler's job array)");
   c->add_option("--merge", o.merge, "merge the results of shards (their output directories) into -o")->expected(1, -1);

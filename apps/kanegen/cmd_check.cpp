@@ -30,7 +30,7 @@ void print_modes(const Body& b) {
     mass_sum += m.effective_mass;
     inertia_sum += m.effective_inertia;
   }
-  fmt::print("\n    the {} modes carry {} of the nodes' {:.6g} kg along x, y, z and {} of their inertia about O",
+  fmt::print("\n    the {} modes carry {} of the moving nodes' {:.6g} kg along x, y, z and {} of their inertia about O",
              b.n_modes(), percent(mass_sum, Vec3::Constant(d.node_mass)), d.node_mass,
              percent(inertia_sum, d.node_inertia_O));
 }

@@ -38,6 +38,10 @@ void print_modes(const LinearModel& lin, const std::vector<LinearMode>& modes) {
   if (!lin.ignorable.empty() && (lin.equilibrium || !lin.relative_equilibrium))
     fmt::print(stderr, "ignorable coordinates{}: {}\n", lin.ignorable_dropped ? " (left out)" : "",
                fmt::join(lin.ignorable, ", "));
+  if (!lin.ignorable_kept_for_outputs.empty())
+    fmt::print(stderr, "kept, since outputs read them: {}\n", fmt::join(lin.ignorable_kept_for_outputs, ", "));
+  fmt::print(stderr, "zero modes: |eigenvalue| <= {:.2g} (rigid-body or ignorable, or slower than that)\n",
+             zero_mode_tolerance(lin));
   fmt::print(stderr, "{:>24} {:>24} {:>12} {:>10}  {}\n", "eigenvalue (1/s)", "", "f_n (Hz)", "zeta",
              "dominant states");
   for (const LinearMode& m : modes)

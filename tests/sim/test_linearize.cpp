@@ -197,7 +197,11 @@ TEST_CASE("linearize: spinning wheels are a relative equilibrium; ignorable coor
   o.drop_ignorable = true;
   const LinearModel dropped = linearize(*engine, s, o);
   CHECK(dropped.equilibrium);
-  CHECK(dropped.A.rows() == lin.A.rows() - static_cast<Eigen::Index>(lin.ignorable.size()));
+  // the star tracker reads the bus attitude: those ignorable states stay (C exact), the wheel angles go
+  CHECK(dropped.ignorable_kept_for_outputs == std::vector<std::string>{"q.bus.rx", "q.bus.ry", "q.bus.rz"});
+  CHECK(dropped.A.rows() == lin.A.rows() - static_cast<Eigen::Index>(lin.ignorable.size() - 3));
+  for (const char* q : {"q.rw_x.angle", "q.rw_y.angle", "q.rw_z.angle", "q.bus.x"})
+    CHECK(std::find(dropped.state_names.begin(), dropped.state_names.end(), q) == dropped.state_names.end());
   const auto dm = linear_modes(dropped);
   int elastic = 0;
   for (const auto& m : modes) {
