@@ -110,6 +110,12 @@ class History:
             raise InputError(f"{path}: empty file, expected a kanegen simulate CSV")
         self.path = path
         self.names = [h.strip() for h in header.split(",")]
+        # a CSV from before 2026-12-01 named a rate as its coordinate: its second column of a name is the rate
+        seen = set()
+        for i, n in enumerate(self.names):
+            if n in seen and f"{n}_rate" not in self.names:
+                self.names[i] = f"{n}_rate"
+            seen.add(n)
         try:
             self.data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
         except ValueError as e:

@@ -64,6 +64,14 @@ def main():
         pngs2 = sorted(os.listdir(out2)) if os.path.isdir(out2) else []
         check(r.returncode == 0 and "slew_joints_angle.png" in pngs2 and "slew_spinning.png" in pngs2
               and "slew_modes.png" in pngs2, f"without --model: joints, spinning, modes ({pngs2})")
+        # a CSV of the older names (a rate named as its coordinate): read the same way
+        old = os.path.join(tmp, "old.csv")
+        with open(csv) as f, open(old, "w") as g:
+            header, rest = f.readline(), f.read()
+            g.write(",".join(c[:-len("_rate")] if c.endswith("_rate") else c for c in header.strip().split(",")) + "\n")
+            g.write(rest)
+        ho = ps.History(old)
+        check(ho.names == h.names and ps.spins(ho, "rw_x.angle"), "an older CSV (rates named as coordinates): same columns")
         # a CSV without a sensor's columns: refused, nothing claimed
         cut = os.path.join(tmp, "cut.csv")
         with open(csv) as f, open(cut, "w") as g:
