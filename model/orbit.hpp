@@ -1,0 +1,45 @@
+// Two-body orbits about a central body at N's origin (model-format.md,
+// "Gravity"): classical elements to position and velocity and back, Kepler's
+// equation, and the orbit (LVLH) frame. The pieces `initial: orbit:` and the
+// orbit-frame sensors are built from; closed forms only, no integration.
+#pragma once
+
+#include <Eigen/Dense>
+
+namespace kanegen {
+
+/// Classical elements (m, radians): semi-major axis a > 0, eccentricity 0 <= e < 1, inclination i,
+/// right ascension of the ascending node raan, argument of periapsis argp, true anomaly nu.
+struct OrbitElements {
+  double a = 0, e = 0, i = 0, raan = 0, argp = 0, nu = 0;
+};
+
+struct OrbitState {
+  Eigen::Vector3d r_N = Eigen::Vector3d::Zero();  ///< position from the central body, N components
+  Eigen::Vector3d v_N = Eigen::Vector3d::Zero();  ///< velocity, N components
+};
+
+/// Position and velocity on the elliptic orbit (throws std::invalid_argument unless mu > 0, a > 0, 0 <= e < 1).
+OrbitState state_from_elements(double mu, const OrbitElements& el);
+
+/// The elements of a bound state (throws std::invalid_argument for e >= 1 or r, v not finite); for a circular or
+/// equatorial orbit the undefined angles are taken 0 and the anomaly measured from the node or the x axis.
+OrbitElements elements_from_state(double mu, const OrbitState& s);
+
+/// The eccentric anomaly E of mean anomaly M (E - e sin E = M), to round-off, for 0 <= e < 1.
+double eccentric_anomaly(double M, double e);
+
+/// The true anomaly after time t on the unperturbed orbit (Kepler's equation).
+double true_anomaly_at(double mu, const OrbitElements& el, double t);
+
+/// Orbital period 2 pi sqrt(a^3 / mu).
+double orbital_period(double mu, double a);
+
+/// The orbit frame at a state, its axes as the columns of R_N_O (x_N = R_N_O x_O): z to nadir (-r),
+/// y against the orbit normal (-h), x = y x z (along track; the velocity's direction on a circular orbit).
+Eigen::Matrix3d lvlh_frame(const OrbitState& s);
+
+/// The orbit frame's angular velocity, N components: h / |r|^2 (about the orbit normal).
+Eigen::Vector3d lvlh_rate_N(const OrbitState& s);
+
+}  // namespace kanegen
