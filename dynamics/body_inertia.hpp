@@ -115,6 +115,41 @@ V3<S> integrated_first_moment(const BodyMassIntegrals& I, const VecS& eta) {
   return S_B;
 }
 
+/// Node k's position s_k = rho_k + Phi_k eta (+ 1/2 gamma_k(eta) with second-order data) and its
+/// derivative Phi~_k = Phi_k + G_k(eta) (3 x m), B components. tmp: m scratch.
+template <class S, class VecS, class Mat3m>
+V3<S> node_position(const FlexibleData& flex, int k, const VecS& eta, Mat3m& Phi_t, VecS& tmp) {
+  V3<S> s_k = flex.nodes[k].rho_B.template cast<S>();
+  Phi_t = as_scalar<S>(flex.Phi.template middleRows<3>(3 * k));
+  if (flex.modes()) s_k.noalias() += Phi_t * eta;
+  if (flex.has_second_order(k))
+    for (int a = 0; a < 3; ++a) {
+      const MatX& G = flex.Gamma[k][a];
+      if (G.size() == 0) continue;
+      tmp.noalias() = as_scalar<S>(G) * eta;
+      s_k(a) += S(0.5) * eta.dot(tmp);
+      Phi_t.row(a) += tmp.transpose();
+    }
+  return s_k;
+}
+
+/// Node k's frame C(Psi_k eta): its rotary inertia J'_k = C J_k C^T (B axes), and H_k (3 x m,
+/// w_k = w + H_k eta_dot); g = Psi_k eta / 2 returned for the rate terms.
+template <class S, class VecS, class Mat3m>
+M3<S> node_rotary_inertia(const FlexibleData& flex, int k, const VecS& eta, Mat3m& H, V3<S>& g) {
+  const int m = flex.modes();
+  const auto Psi_k = as_scalar<S>(flex.Psi.template middleRows<3>(3 * k));
+  V3<S> theta = V3<S>::Zero();
+  if (m) theta.noalias() = Psi_k * eta;
+  g = theta / S(2);
+  const M3<S> C = rodrigues_R<S>(theta);
+  if (m) {
+    H.noalias() = (M3<S>::Identity() + skew<S>(g)) * Psi_k;
+    H /= S(1) + g.dot(g);
+  }
+  return C * flex.nodes[k].J_B.template cast<S>() * C.transpose();
+}
+
 /// Adds node k of `flex` (a rich node) to M_body, h_body, g_body and to the
 /// first moment S_B (header comment). Phi_t, H, JH: 3 x m scratch; tmp: m scratch.
 template <class S, class VecS, class MatS, class Mat3m>
@@ -126,17 +161,12 @@ void add_node_terms(const FlexibleData& flex, int k, const VecS& eta, const VecS
   const M3<S> I3 = M3<S>::Identity();
   if (node.mass != 0.0) {
     const S mk = S(node.mass);
-    V3<S> s_k = node.rho_B.cast<S>();
-    Phi_t = as_scalar<S>(flex.Phi.template middleRows<3>(3 * k));
-    if (m) s_k.noalias() += Phi_t * eta;
+    const V3<S> s_k = node_position<S>(flex, k, eta, Phi_t, tmp);
     V3<S> gamma_dd = V3<S>::Zero();  // [eta_dot^T Gamma^a eta_dot]_a
     if (flex.has_second_order(k))
       for (int a = 0; a < 3; ++a) {
         const MatX& G = flex.Gamma[k][a];
         if (G.size() == 0) continue;
-        tmp.noalias() = as_scalar<S>(G) * eta;
-        s_k(a) += S(0.5) * eta.dot(tmp);
-        Phi_t.row(a) += tmp.transpose();
         tmp.noalias() = as_scalar<S>(G) * eta_dot;
         gamma_dd(a) = eta_dot.dot(tmp);
       }
@@ -167,22 +197,16 @@ void add_node_terms(const FlexibleData& flex, int k, const VecS& eta, const VecS
     S_B += mk * s_k;
   }
   if (!node.J_B.isZero(0.0)) {
-    const auto Psi_k = as_scalar<S>(flex.Psi.template middleRows<3>(3 * k));
-    V3<S> theta = V3<S>::Zero(), g_dot = V3<S>::Zero();
+    V3<S> g, g_dot = V3<S>::Zero();
+    const M3<S> Jp = node_rotary_inertia<S>(flex, k, eta, H, g);
     if (m) {
-      theta.noalias() = Psi_k * eta;
-      g_dot.noalias() = Psi_k * eta_dot;
+      g_dot.noalias() = as_scalar<S>(flex.Psi.template middleRows<3>(3 * k)) * eta_dot;
       g_dot /= S(2);
     }
-    const V3<S> g = theta / S(2);
     const S denom = S(1) + g.dot(g);
-    const M3<S> C = rodrigues_R<S>(theta);
-    const M3<S> Jp = C * node.J_B.cast<S>() * C.transpose();
     V3<S> w_rel = V3<S>::Zero();
     M_body.template block<3, 3>(3, 3) += Jp;
     if (m) {
-      H.noalias() = (I3 + skew<S>(g)) * Psi_k;
-      H /= denom;
       JH.noalias() = Jp * H;
       M_body.block(3, 6, 3, m) += JH;
       M_body.block(6, 3, m, 3) += JH.transpose();
