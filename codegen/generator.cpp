@@ -12,6 +12,8 @@
 #include "kanegen_generator_hash.h"
 #include "model/model_hash.hpp"
 
+#include "model/diagnostics.hpp"
+
 namespace kanegen::codegen {
 
 namespace {
@@ -218,6 +220,9 @@ const EmittedFunction* EmittedModel::find(const std::string& name) const {
 }
 
 EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
+  if (model_in.central)  // issue 22: the generic engine has it; the generator does not form it yet
+    throw InputError(Diagnostic{model_in.source_path, 0, "gravity.central",
+                                "central gravity is not in the generated code yet; run it with --engine generic"});
   if (options.udot_form != "auto" && options.udot_form != "composite" && options.udot_form != "articulated")
     throw std::invalid_argument("udot form must be auto, composite or articulated");
   const Model merged = options.merge_fixed ? merge_fixed_bodies(model_in) : model_in;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "dynamics/body_inertia.hpp"
+#include "dynamics/central_gravity.hpp"
 #include "model/model.hpp"
 #include "dynamics/workspace.hpp"
 
@@ -20,6 +21,7 @@ void compute_body_terms(const Model& model, Workspace<S>& ws) {
       add_node_terms<S>(*b.flex, k, s.eta, s.eta_dot, s.w_B, g_B, s.M_body, s.h_body, s.g_body, s.S_B, s.node_Phi,
                         s.node_H, s.node_JH, s.node_m);
   }
+  if (model.central) add_central_gravity(model, ws);
 }
 
 }  // namespace kanegen

@@ -5,6 +5,8 @@
 // Requires compute_kinematics and compute_body_terms.
 #pragma once
 
+#include "dynamics/central_gravity.hpp"
+
 #include "model/model.hpp"
 #include "dynamics/workspace.hpp"
 
@@ -52,6 +54,7 @@ Energy<S> compute_energy(const Model& model, Workspace<S>& ws, const VecQ& q) {
       }
     for (int k = 0; k < b.n_modes(); ++k) E.V += S(0.5 * b.flex->K(k)) * s.eta(k) * s.eta(k);
   }
+  if (model.central) E.V += central_potential(model, ws);  // g_N is zero then
   return E;
 }
 

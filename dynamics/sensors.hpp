@@ -4,6 +4,8 @@
 // accelerations z_dot and reaction wrench_B in the workspace).
 #pragma once
 
+#include "dynamics/central_gravity.hpp"
+
 #include <Eigen/Geometry>
 
 #include "dynamics/workspace.hpp"
@@ -38,7 +40,9 @@ void compute_sensor_outputs(const Model& model, const Workspace<double>& ws, Vec
       case SensorType::acceleration:
       case SensorType::specific_force: {
         Vec3 a_B = a_O_B + alpha_B.cross(p) + w_B.cross(w_B.cross(p));
-        if (sn.type == SensorType::specific_force) a_B -= s.R_NB.transpose() * model.g_N;
+        if (sn.type == SensorType::specific_force)
+          a_B -= s.R_NB.transpose() *
+                 (model.central ? central_field_at<double>(*model.central, Vec3(s.r_NO_N + s.R_NB * p)) : model.g_N);
         y.template segment<3>(sn.offset) = R_XB * a_B;
         break;
       }

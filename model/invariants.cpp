@@ -29,7 +29,9 @@ std::string Invariants::note() const {
     return j;
   };
   if (!energy) s += "energy not conserved: " + join(energy_broken_by);
-  if (!momentum) s += (s.empty() ? "" : "; ") + std::string("p, H not conserved: ") + join(momentum_broken_by);
+  if (!momentum)
+    s += (s.empty() ? "" : "; ") + std::string(angular_momentum ? "p not conserved: " : "p, H not conserved: ") +
+         join(momentum_broken_by);
   return s;
 }
 
@@ -73,12 +75,16 @@ Invariants invariants_of(const Model& model, const VecX& tau, const VecX& w, boo
   auto& m = inv.momentum_broken_by;
   if (!grounded.empty()) m.push_back(fmt::format("the root joint of {} is not free (the ground reacts)", names(grounded)));
   if (!model.g_N.isZero(0.0)) m.push_back("uniform gravity");
+  if (model.central) m.push_back(model.central->J2 != 0.0 ? "central gravity with J2 (only H_z is kept)"
+                                                          : "central gravity (H about N's origin is kept)");
   if (!tau_external.empty()) m.push_back(fmt::format("tau on a root joint's speeds ({})", names(tau_external)));
   if (!external_inputs.empty())
     m.push_back(fmt::format("external {} ({})", count(external_inputs.size(), "input", "inputs"), names(external_inputs)));
   inv.energy = e.empty();
   inv.energy_with_drivers = e.size() == 1 && !prescribed.empty();
   inv.momentum = m.empty();
+  // central gravity without J2 is the only thing changing the momenta: H about N's origin holds
+  inv.angular_momentum = inv.momentum || (m.size() == 1 && model.central && model.central->J2 == 0.0);
   return inv;
 }
 

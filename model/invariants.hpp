@@ -26,6 +26,8 @@ namespace kanegen {
 struct Invariants {
   bool energy = true;    ///< T + V
   bool momentum = true;  ///< p and H about N's origin
+  /// H about N's origin alone (central gravity without J2 turns p, not H; dynamics.md, "Invariants").
+  bool angular_momentum = true;
   /// Energy is broken by prescribed motion alone: T + V minus the drivers' work is kept
   /// (sim/driver_work.hpp measures that balance).
   bool energy_with_drivers = false;

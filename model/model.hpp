@@ -107,6 +107,13 @@ struct Body {
   std::vector<int> chain_u;
 };
 
+/// A central gravity field (dynamics.md, "Forces"): mu (m^3/s^2) > 0; J2 and radius (m) optional, together.
+struct CentralGravity {
+  double mu = 0.0;
+  double J2 = 0.0;
+  double radius = 0.0;
+};
+
 struct Outputs {
   bool energy = false;
   bool momentum = false;
@@ -117,7 +124,9 @@ struct Model {
   std::string name;
   std::string description;
   std::string source_path;          ///< the YAML file it was read from
-  Vec3 g_N = Vec3::Zero();          ///< gravity, N components
+  Vec3 g_N = Vec3::Zero();          ///< uniform gravity, N components (zero with a central field)
+  /// `gravity: {central: ...}` (model-format.md, "Gravity"): the central body at N's origin, J2 about N's z.
+  std::optional<CentralGravity> central;
   std::vector<Body> bodies;         ///< parents before children
   int nq = 0;
   int nu = 0;

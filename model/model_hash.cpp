@@ -44,6 +44,10 @@ std::string model_fingerprint(const Model& model) {
   w.str(model.name);
   w.key("gravity");
   w.mat(model.g_N);
+  if (model.central) {  // only then: the fingerprints of uniform-gravity models stay as they were
+    w.key("central gravity");
+    w.mat(Vec3(model.central->mu, model.central->J2, model.central->radius));
+  }
   w.key("nq");
   w.integer(model.nq);
   w.key("nu");

@@ -98,6 +98,7 @@ class Loader {
   };
   std::map<std::string, Given> init_q_, init_u_;
   std::vector<std::pair<std::string, int>> parameter_names_;  ///< `parameters:` entries and their lines
+  int central_line_ = 0;  ///< line of `gravity: {central: ...}`
   YAML::Node events_;  ///< `events:`, read when the model is built (it names bodies and coordinates)
   bool has_events_ = false;
 
@@ -139,9 +140,7 @@ class Loader {
           model_.description = *s;
       }
     }
-    if (root["gravity"].IsDefined()) {
-      if (auto g = ck_.vec3(root["gravity"], 1, "gravity")) model_.g_N = *g;
-    }
+    if (root["gravity"].IsDefined()) read_gravity(root["gravity"]);
 
     const YAML::Node bodies = root["bodies"];
     if (!bodies.IsDefined()) {
@@ -157,6 +156,7 @@ class Loader {
       check_speed_count(bodies);
     }
 
+    check_central_roots();
     if (root["initial"].IsDefined()) read_initial(root["initial"]);
     if (root["inputs"].IsDefined()) read_inputs(root["inputs"]);
     if (root["parameters"].IsDefined() && ck_.expect_seq(root["parameters"], 1, "parameters")) {
@@ -1232,6 +1232,48 @@ class Loader {
     return false;
   }
 
+  /// `gravity:` a uniform field [gx, gy, gz] or {central: {mu, J2, radius}} (model-format.md, "Gravity").
+  void read_gravity(const YAML::Node& g) {
+    if (!g.IsMap()) {
+      if (auto v = ck_.vec3(g, 1, "gravity")) model_.g_N = *v;
+      return;
+    }
+    ck_.check_keys(g, "gravity", {"central"});
+    const YAML::Node c = g["central"];
+    if (!c.IsDefined()) {
+      ck_.error(g, 1, "gravity", "a mapping without 'central'; expected [gx, gy, gz] or {central: {mu: ...}}");
+      return;
+    }
+    if (!ck_.expect_map(c, line_of(g), "gravity.central")) return;
+    const int l = line_of(c) ? line_of(c) : line_of(g);
+    ck_.check_keys(c, "gravity.central", {"mu", "J2", "radius"});
+    CentralGravity cg;
+    bool ok = true;
+    if (!c["mu"].IsDefined()) {
+      ck_.error(c, l, "gravity.central.mu", "missing; expected the gravitational parameter mu > 0 (m^3/s^2)");
+      ok = false;
+    } else if (auto mu = ck_.positive(c["mu"], l, "gravity.central.mu", "mu")) {
+      cg.mu = *mu;
+    } else {
+      ok = false;
+    }
+    const bool j2 = c["J2"].IsDefined(), radius = c["radius"].IsDefined();
+    if (j2 != radius) {
+      ck_.error(c, l, j2 ? "gravity.central.radius" : "gravity.central.J2",
+                "missing; J2 and radius are given together (J2 is relative to the body's radius)");
+      ok = false;
+    } else if (j2) {
+      if (auto v = ck_.number(c["J2"], l, "gravity.central.J2")) cg.J2 = *v;
+      else ok = false;
+      if (auto v = ck_.positive(c["radius"], l, "gravity.central.radius", "the central body's radius")) cg.radius = *v;
+      else ok = false;
+    }
+    if (ok) {
+      model_.central = cg;
+      central_line_ = l;
+    }
+  }
+
   void read_initial(const YAML::Node& n) {
     if (!ck_.expect_map(n, 1, "initial")) return;
     ck_.check_keys(n, "initial", {"q", "u"});
@@ -1335,6 +1377,17 @@ class Loader {
                 fmt::format("{} generalized speeds (joint coordinates and modes); expected at most {} "
                             "(docs/limits.md)",
                             nu, kMaxSpeeds));
+  }
+
+  /// A central field acts on a free system: every root joint free (a body fixed to N would sit in the field).
+  void check_central_roots() {
+    if (!model_.central) return;
+    for (std::size_t i = 0; i < info_.size(); ++i)
+      if (const BodyInfo& bi = info_[i]; bi.parent == -1 && bi.type_known && bi.body.joint.type != JointType::free)
+        ck_.error(bi.line, fmt::format("bodies[{}].joint.type", i),
+                  fmt::format("'{}' joint to ground under a central gravity field (line {}); expected a free root "
+                              "joint (the spacecraft orbits the central body)",
+                              to_string(bi.body.joint.type), central_line_));
   }
 
   // ----------------------------------------------------------------- build

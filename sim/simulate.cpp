@@ -604,8 +604,8 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   bar.finish();
 
   quality.invariants_note = physics.note();
-  if (physics.energy || physics.momentum) {
-    const bench::InvariantSet inv{physics.energy, physics.momentum};
+  if (physics.energy || physics.angular_momentum) {
+    const bench::InvariantSet inv{physics.energy, physics.angular_momentum};  // simulate reports H, not p
     // Generated code has only the energy and momentum the model's outputs ask
     // for; the invariants are then measured on the generic engine, at the same
     // states (a few evaluations per output row, after the run).

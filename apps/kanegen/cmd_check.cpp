@@ -39,6 +39,13 @@ int run(const std::string& path) {
   const Model model = load_checked(path);
   fmt::print("model {}: {} bodies, nq = {}, nu = {}\n", model.name, model.bodies.size(), model.nq, model.nu);
   if (!model.description.empty()) fmt::print("  {}\n", model.description);
+  if (model.central)
+    fmt::print("  gravity: central body at N's origin, mu {:.10g} m^3/s^2{}\n", model.central->mu,
+               model.central->J2 != 0.0 ? fmt::format(", J2 {:.10g} at radius {:.10g} m", model.central->J2,
+                                                      model.central->radius)
+                                        : std::string());
+  else if (!model.g_N.isZero(0.0))
+    fmt::print("  gravity: uniform [{:.6g}, {:.6g}, {:.6g}] m/s^2 (N)\n", model.g_N.x(), model.g_N.y(), model.g_N.z());
   for (const Body& b : model.bodies) {
     std::string parent = b.parent < 0 ? "ground" : model.bodies[b.parent].name;
     if (b.joint.node >= 0) parent += fmt::format(" @node {}", model.bodies[b.parent].flex->nodes[b.joint.node].id);
