@@ -2,6 +2,7 @@
 // recorded as a Diagnostic (file, line, field, message); all are reported
 // together in one InputError.
 #include "model/model_loader.hpp"
+#include "model/initial_orbit.hpp"
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -99,6 +100,8 @@ class Loader {
   std::map<std::string, Given> init_q_, init_u_;
   std::vector<std::pair<std::string, int>> parameter_names_;  ///< `parameters:` entries and their lines
   int central_line_ = 0;  ///< line of `gravity: {central: ...}`
+  std::optional<InitialOrbit> orbit_;  ///< `initial: orbit:`
+  int orbit_line_ = 0;
   YAML::Node events_;  ///< `events:`, read when the model is built (it names bodies and coordinates)
   bool has_events_ = false;
 
@@ -1274,9 +1277,91 @@ class Loader {
     }
   }
 
+  /// `initial: orbit: {a, e, i, raan, argp, nu, attitude: lvlh}` (checked against the rest in build()).
+  void read_orbit(const YAML::Node& o, int fallback) {
+    if (!ck_.expect_map(o, fallback, "initial.orbit")) return;
+    const int l = line_of(o) ? line_of(o) : fallback;
+    ck_.check_keys(o, "initial.orbit", {"a", "e", "i", "raan", "argp", "nu", "attitude"});
+    InitialOrbit orb;
+    bool ok = true;
+    auto get = [&](const char* key, double& out, bool required) {
+      const std::string f = std::string("initial.orbit.") + key;
+      if (!o[key].IsDefined()) {
+        if (required) {
+          ck_.error(o, l, f, "missing; expected the orbit's semi-major axis a (m) and eccentricity e");
+          ok = false;
+        }
+        return;
+      }
+      if (auto v = ck_.number(o[key], l, f)) out = *v;
+      else ok = false;
+    };
+    get("a", orb.elements.a, true);
+    get("e", orb.elements.e, true);
+    get("i", orb.elements.i, false);
+    get("raan", orb.elements.raan, false);
+    get("argp", orb.elements.argp, false);
+    get("nu", orb.elements.nu, false);
+    if (ok && !(orb.elements.a > 0)) {
+      ck_.error(o["a"], l, "initial.orbit.a", fmt::format("{} is not positive; expected a > 0 (m)", orb.elements.a));
+      ok = false;
+    }
+    if (ok && !(orb.elements.e >= 0 && orb.elements.e < 1)) {
+      ck_.error(o["e"], l, "initial.orbit.e",
+                fmt::format("{}; expected 0 <= e < 1 (an elliptic orbit)", orb.elements.e));
+      ok = false;
+    }
+    if (o["attitude"].IsDefined()) {
+      auto a = ck_.string(o["attitude"], l, "initial.orbit.attitude");
+      if (a && *a != "lvlh") {
+        ck_.error(o["attitude"], l, "initial.orbit.attitude", fmt::format("'{}'; expected lvlh", *a));
+        ok = false;
+      }
+      orb.lvlh = a && *a == "lvlh";
+    }
+    if (ok) {
+      orbit_ = orb;
+      orbit_line_ = l;
+    }
+  }
+
+  /// The orbit's free root body, with what it asks of the model and of the rest of `initial:`; -1 with faults.
+  int orbit_root() {
+    if (!model_.central) {
+      ck_.error(orbit_line_, "initial.orbit", "an orbit needs a central field; expected gravity: {central: {mu: ...}}");
+      return -1;
+    }
+    int root = -1, roots = 0;
+    for (std::size_t i = 0; i < model_.bodies.size(); ++i)
+      if (model_.bodies[i].parent < 0) ++roots, root = static_cast<int>(i);
+    if (roots != 1 || model_.bodies[root].joint.type != JointType::free) {
+      ck_.error(orbit_line_, "initial.orbit",
+                fmt::format("an orbit places one free root body; the model has {} root bodies{}", roots,
+                            roots == 1 ? " and its joint is not free" : ""));
+      return -1;
+    }
+    const std::string& b = model_.bodies[root].name;
+    std::vector<std::string> q_set{b + ".x", b + ".y", b + ".z"}, u_set{b + ".vx", b + ".vy", b + ".vz"};
+    if (orbit_->lvlh) {
+      for (const char* c : {".qw", ".qx", ".qy", ".qz"}) q_set.push_back(b + c);
+      for (const char* c : {".wx", ".wy", ".wz"}) u_set.push_back(b + c);
+    }
+    bool ok = true;
+    for (auto [set, given] : {std::pair{&q_set, &init_q_}, std::pair{&u_set, &init_u_}})
+      for (const std::string& n : *set)
+        if (auto it = given->find(n); it != given->end()) {
+          ck_.error(it->second.line, (given == &init_q_ ? "initial.q." : "initial.u.") + n,
+                    fmt::format("'{}' is set by initial.orbit (line {}){}; expected one of them", n, orbit_line_,
+                                orbit_->lvlh ? " with attitude: lvlh" : ""));
+          ok = false;
+        }
+    return ok ? root : -1;
+  }
+
   void read_initial(const YAML::Node& n) {
     if (!ck_.expect_map(n, 1, "initial")) return;
-    ck_.check_keys(n, "initial", {"q", "u"});
+    ck_.check_keys(n, "initial", {"q", "u", "orbit"});
+    if (n["orbit"].IsDefined()) read_orbit(n["orbit"], line_of(n));
     for (const bool speeds : {false, true}) {
       const char* key = speeds ? "u" : "q";
       const YAML::Node m = n[key];
@@ -1411,7 +1496,9 @@ class Loader {
       const int k = model_.speed_index(name);
       if (k >= 0) model_.u0(k) = g.value;
     }
-    std::vector<Diagnostic> bad;
+    if (orbit_)
+      if (const int root = orbit_root(); root >= 0) place_on_orbit(model_, root, *orbit_);
+    std::vector<Diagnostic> bad(diags_.begin(), diags_.end());  // the orbit's faults
     for (std::size_t i = 0; i < parameter_names_.size(); ++i) {
       const auto& [name, line] = parameter_names_[i];
       try {

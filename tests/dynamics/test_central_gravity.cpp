@@ -165,3 +165,54 @@ bodies:
   - {name: arm, parent: ground, joint: {type: revolute, axis: [0, 0, 1]}, mass: 1.0, inertia: [1, 1, 1, 0, 0, 0]}
 )", "expected a free root joint");
 }
+
+TEST_CASE("initial: orbit: the system's centre of mass on the orbit; attitude: lvlh aligned and turning", "[central]") {
+  const OrbitElements el{7.1e6, 0.05, 0.9, 0.4, 1.2, 0.7};
+  const std::string text = R"(name: placed
+gravity: {central: {mu: 3.986004418e14}}
+bodies:
+  - {name: bus, parent: ground, joint: {type: free}, mass: 200.0, com: [0.1, -0.05, 0.2], inertia: [80, 90, 70, 1, 2, 3]}
+  - {name: arm, parent: bus, joint: {type: revolute, axis: [0, 1, 0], position: [1.0, 0, 0]}, mass: 20.0,
+     com: [1.5, 0, 0], inertia: [1, 5, 5, 0, 0, 0]}
+initial:
+  q: {arm.angle: 0.3}
+  u: {arm.angle_rate: 0.2}
+  orbit: {a: 7.1e6, e: 0.05, i: 0.9, raan: 0.4, argp: 1.2, nu: 0.7, attitude: lvlh}
+)";
+  const Model model = load_model(test::write_temp("placed.yaml", text));
+  const State s = initial_state(model);
+  const OrbitState target = state_from_elements(kMu, el);
+  GenericEngine engine(model);
+  // centre of mass and its velocity: from the engine's momentum and a first-moment sum of its energy-free parts
+  const MomentumValues P = engine.momentum(0.0, s.q, s.u);
+  CHECK((P.p_N / 220.0 - target.v_N).norm() <= 1e-12 * target.v_N.norm());
+  const Vec3 x_bus = s.q.head<3>();
+  const Eigen::Quaterniond Q(s.q(3), s.q(4), s.q(5), s.q(6));
+  const Mat3 R_NB = Q.toRotationMatrix();
+  CHECK((R_NB - lvlh_frame(target)).norm() <= 1e-12);
+  CHECK((R_NB * s.u.segment<3>(3) - lvlh_rate_N(target)).norm() <= 1e-12 * lvlh_rate_N(target).norm());
+  // the arm's com at angle 0.3 about y from [1, 0, 0] + R_y(0.3) [1.5, 0, 0]
+  const Vec3 arm_com_B = Vec3(1.0, 0, 0) + Eigen::AngleAxisd(0.3, Vec3::UnitY()) * Vec3(1.5, 0, 0);
+  const Vec3 com = x_bus + R_NB * ((200.0 * Vec3(0.1, -0.05, 0.2) + 20.0 * arm_com_B) / 220.0);
+  CHECK((com - target.r_N).norm() <= 1e-9 * target.r_N.norm());
+  // the joint's own speed is kept
+  CHECK(s.u(model.speed_index("arm.angle_rate")) == 0.2);
+}
+
+TEST_CASE("initial: orbit: refused without a central field, for e >= 1, a <= 0, or with the root's position", "[central]") {
+  auto refused = [](const std::string& text, const std::string& what) {
+    CHECK_THROWS_WITH(load_model(test::write_temp("bad_orbit.yaml", text)), Catch::Contains(what));
+  };
+  const std::string body = "\nbodies:\n  - {name: sat, parent: ground, joint: {type: free}, mass: 1.0, inertia: [1, 1, 1, 0, 0, 0]}\n";
+  refused("name: o" + body + "initial:\n  orbit: {a: 7.0e6, e: 0.1}\n", "an orbit needs a central field");
+  refused("name: o\ngravity: {central: {mu: 3.986e14}}" + body + "initial:\n  orbit: {a: 7.0e6, e: 1.0}\n",
+          "initial.orbit.e");
+  refused("name: o\ngravity: {central: {mu: 3.986e14}}" + body + "initial:\n  orbit: {a: -7.0e6, e: 0.1}\n",
+          "initial.orbit.a");
+  refused("name: o\ngravity: {central: {mu: 3.986e14}}" + body +
+              "initial:\n  q: {sat.x: 7.0e6}\n  orbit: {a: 7.0e6, e: 0.1}\n",
+          "'sat.x' is set by initial.orbit");
+  refused("name: o\ngravity: {central: {mu: 3.986e14}}" + body +
+              "initial:\n  u: {sat.wz: 0.1}\n  orbit: {a: 7.0e6, e: 0.1, attitude: lvlh}\n",
+          "initial.u.sat.wz");
+}
