@@ -254,4 +254,11 @@ Model with_parameters(const Model& model, const std::vector<RuntimeParameter>& e
 
 Model with_implicit_parameters(const Model& model) { return with_parameters(model, implicit_parameters(model)); }
 
+int ensure_parameter(Model& model, const RuntimeParameter& p) {
+  const int k = find_parameter(model.parameters, p.kind, p.body, p.index);
+  if (k >= 0) return k;
+  model.parameters.push_back(p);
+  return static_cast<int>(model.parameters.size()) - 1;
+}
+
 }  // namespace kanegen

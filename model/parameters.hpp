@@ -53,5 +53,7 @@ Model with_implicit_parameters(const Model& model);
 
 /// The model's runtime parameter of this kind, body and index, or -1.
 int find_parameter(const std::vector<RuntimeParameter>& params, ParameterKind kind, int body, int index);
+/// The index of `p` among the model's runtime parameters, appending it when the model does not have it yet.
+int ensure_parameter(Model& model, const RuntimeParameter& p);
 
 }  // namespace kanegen

@@ -56,8 +56,7 @@ class PyModel {
       } catch (const std::invalid_argument& e) {
         throw py::value_error("parameters: " + std::string(e.what()));
       }
-      for (const RuntimeParameter& rp : ps)
-        if (find_parameter(model_->parameters, rp.kind, rp.body, rp.index) < 0) model_->parameters.push_back(rp);
+      for (const RuntimeParameter& rp : ps) ensure_parameter(*model_, rp);
     }
     check_mass_matrix_at_initial_state(*model_);
     if (engine == "generated") {

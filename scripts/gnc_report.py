@@ -165,21 +165,9 @@ fig.savefig(os.path.join(ROOT, "docs/img/slew_pd.png"), dpi=110)
 cpp = json.loads(subprocess.run([os.path.join(B, "bin", "kanegen_controller_cost"), "--repeats", "5"], check=True,
                                 capture_output=True, text=True).stdout)
 model = kanegen.Model(os.path.join(ROOT, "models/gnc/slew_spacecraft.yaml"))
-att, gyro = model.output_names.index("star_tracker.qw"), model.output_names.index("gyro.x")
-I = np.array([995.0, 380.0, 875.0])
-tw, tz = math.cos(half), math.sin(half)
-
-
-def pd_py(t, q, u, y):
-    w0, x0, y0, z0 = y[att:att + 4]
-    e = np.array([tw * w0 + tz * z0, tw * x0 + tz * y0, tw * y0 - tz * x0, tw * z0 - tz * w0])
-    if e[0] < 0:
-        e = -e
-    torque = -(I * 0.05 * 0.05 * 2.0 * e[1:] + I * 2.0 * 0.9 * 0.05 * y[gyro:gyro + 3])
-    peak = np.abs(torque).max()
-    if peak > 0.3:
-        torque *= 0.3 / peak
-    return -torque
+sys.path.insert(0, os.path.join(ROOT, "examples", "gnc_slew"))
+from slew_pd import pd_law  # noqa: E402  (slew_controller.cpp's law, in Python)
+pd_py = pd_law(model.output_names)
 
 
 def best(f, n=5):

@@ -1,5 +1,7 @@
 #include "sim/driver_work.hpp"
 
+#include "sim/work_precision.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -91,11 +93,10 @@ void DriverWorkMeter::add(double t, const VecX& q, const VecX& u) {
 
 EnergyBalance DriverWorkMeter::balance() const {
   EnergyBalance out;
-  auto worse = [](double a, double b) { return std::isnan(a) ? b : std::isnan(b) ? a : std::max(a, b); };
   for (const Segment& s : segments_) {
     const EnergyBalance b = energy_balance(s.t, s.E, s.P, s.scale);
-    out.residual = worse(out.residual, b.residual);
-    out.quadrature = worse(out.quadrature, b.quadrature);
+    out.residual = bench::worse_measure(out.residual, b.residual);
+    out.quadrature = bench::worse_measure(out.quadrature, b.quadrature);
   }
   return out;
 }

@@ -617,7 +617,6 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
       measure->set_parameters(engine.parameters());
     }
     // between events (a latch loses energy; a joint to ground locked holds the momentum)
-    auto worse = [](double a, double b) { return std::isnan(a) ? b : std::isnan(b) ? a : std::max(a, b); };
     for (std::size_t i = 0; i < sampled.segment_begin.size(); ++i) {
       const bench::Trajectory seg = sampled.segment(i);
       if (seg.t.size() < 2) continue;
@@ -626,8 +625,8 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
       for (std::size_t b = 0; b < l.size(); ++b)
         if (l[b] && model.bodies[b].parent < 0) inv_i.momentum = false;
       const bench::Drifts d = bench::invariant_drifts(lacks ? *measure : engine, inv_i, seg);
-      quality.energy_drift = worse(quality.energy_drift, d.energy);
-      quality.H_drift = worse(quality.H_drift, d.H);
+      quality.energy_drift = bench::worse_measure(quality.energy_drift, d.energy);
+      quality.H_drift = bench::worse_measure(quality.H_drift, d.H);
     }
   }
   if (drivers) {

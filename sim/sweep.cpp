@@ -13,7 +13,6 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <random>
-#include <iostream>
 #include <sstream>
 #include <thread>
 
@@ -178,12 +177,7 @@ SweepPlan plan_sweep(const SweepSpec& spec) {
         return out;
       }
       for (const RuntimeParameter& rp : ps) {  // a name for several values (array.damping_ratio): one draw for all
-        int k = find_parameter(plan.model.parameters, rp.kind, rp.body, rp.index);
-        if (k < 0) {
-          plan.model.parameters.push_back(rp);  // the sweep makes it a runtime parameter
-          k = static_cast<int>(plan.model.parameters.size()) - 1;
-        }
-        t.index = k;
+        t.index = ensure_parameter(plan.model, rp);  // the sweep makes it a runtime parameter if it is not
         t.nominal = rp.nominal;
         out.push_back(t);
       }
@@ -232,7 +226,7 @@ SweepPlan plan_sweep(const SweepSpec& spec) {
     plan.correlation_factor = llt.matrixL();
   plan.columns = csv_columns(plan.model);
   auto column = [&](const std::string& c, int line, const std::string& field) {
-    // q.<name> / u.<name>: a coordinate or a speed (a revolute joint's are both called <body>.angle)
+    // q.<name> / u.<name>: a coordinate or a speed (also by a speed's older name)
     const Model& m = plan.model;
     if (c.rfind("event.", 0) == 0)
       for (std::size_t e = 0; e < m.events.size(); ++e) {
@@ -314,15 +308,17 @@ double member_value(const Dispersion& d, const SweepPlan::Target& t, double dev)
   return d.relative ? t.nominal * (1.0 + dev) : t.nominal + dev;
 }
 
-}  // namespace
-
-std::vector<double> draw(const SweepPlan& plan, long index) {
-  const std::vector<double> dev = deviations(plan, index);
+/// Per dispersion the value of its first member (the table's column).
+std::vector<double> first_member_values(const SweepPlan& plan, const std::vector<double>& dev) {
   std::vector<double> out;
   for (std::size_t i = 0; i < dev.size(); ++i)
     out.push_back(plan.targets[i].empty() ? dev[i] : member_value(plan.spec.dispersions[i], plan.targets[i][0], dev[i]));
   return out;
 }
+
+}  // namespace
+
+std::vector<double> draw(const SweepPlan& plan, long index) { return first_member_values(plan, deviations(plan, index)); }
 
 RunSetup run_setup(const SweepPlan& plan, long index) {
   const Model& model = plan.model;
@@ -331,6 +327,7 @@ RunSetup run_setup(const SweepPlan& plan, long index) {
   r.state = initial_state(model);
   r.events = model.events;
   const std::vector<double> dev = deviations(plan, index);
+  r.values = first_member_values(plan, dev);
   for (std::size_t i = 0; i < plan.targets.size(); ++i)
     for (const SweepPlan::Target& t : plan.targets[i]) {
       const double v = member_value(plan.spec.dispersions[i], t, dev[i]);
@@ -361,20 +358,24 @@ RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostrea
   const Model& model = plan.model;
   RunResult r;
   r.index = index;
-  r.values = draw(plan, index);
-  r.metrics.assign(plan.spec.metrics.size(), kNaN);
   RunSetup setup = run_setup(plan, index);
+  r.values = setup.values;
+  r.metrics.assign(plan.spec.metrics.size(), kNaN);
   const State& s = setup.state;
   const VecX& p = setup.parameters;
   SimulationOptions& o = setup.options;
   MetricSink metrics(plan, r);
-  CsvRowWriter text(csv ? *csv : std::cout);
-  TeeRowSink both(metrics, text);
+  std::unique_ptr<CsvRowWriter> text;  // with `csv`: the rows to it as well
+  std::unique_ptr<TeeRowSink> both;
+  if (csv) {
+    text = std::make_unique<CsvRowWriter>(*csv);
+    both = std::make_unique<TeeRowSink>(metrics, *text);
+  }
   std::vector<FiredEvent> fired;
   try {
     engine.set_parameters(p);
     if (controller) o.controller = controller(model, index);
-    const SimulationResult sr = simulate(engine, s, o, csv ? static_cast<RowSink&>(both) : metrics);
+    const SimulationResult sr = simulate(engine, s, o, both ? static_cast<RowSink&>(*both) : metrics);
     r.integration_s = sr.stats.wall_seconds;
     fired = sr.events;
   } catch (const std::exception& e) {

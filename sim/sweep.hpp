@@ -69,6 +69,7 @@ using ControllerFactory = std::function<Controller(const Model& model, long inde
 
 /// Run `index`'s initial state, parameter values and events, as run_one uses them.
 struct RunSetup {
+  std::vector<double> values;  ///< the table's dispersed values (draw(plan, index))
   State state;
   VecX parameters;
   std::vector<Event> events;

@@ -47,6 +47,9 @@
 // evaluated with the generic engine at the run's output states (outside timing).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+
 #include <Eigen/Dense>
 #include <optional>
 #include <string>
@@ -113,6 +116,9 @@ struct Drifts {
   double energy = NAN, H = NAN, p = NAN;
 };
 Drifts invariant_drifts(Engine& engine, const InvariantSet& inv, const Trajectory& tr);
+
+/// The worse of two measures of a run's segments, NaN meaning "not measured" (not "bad").
+inline double worse_measure(double a, double b) { return std::isnan(a) ? b : std::isnan(b) ? a : std::max(a, b); }
 
 /// One sweep point.
 struct RunRecord {
