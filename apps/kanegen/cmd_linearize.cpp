@@ -4,6 +4,8 @@
 // frequencies and damping ratios (a table on stderr, and in the JSON).
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include <iostream>
 
 #include "apps/kanegen/cli_common.hpp"
@@ -35,11 +37,21 @@ void print_modes(const LinearModel& lin, const std::vector<LinearMode>& modes) {
   else
     fmt::print(stderr, "the point is NOT an equilibrium (max |x_dot| = {:.3g}): the result is a first-order Taylor "
                        "model about it\n", lin.residual);
-  if (!lin.ignorable.empty() && (lin.equilibrium || !lin.relative_equilibrium))
-    fmt::print(stderr, "ignorable coordinates{}: {}\n", lin.ignorable_dropped ? " (left out)" : "",
-               fmt::join(lin.ignorable, ", "));
+  if (!lin.ignorable.empty() && (lin.equilibrium || !lin.relative_equilibrium)) {
+    if (lin.ignorable_dropped) {
+      std::vector<std::string> left_out;
+      for (const auto& n : lin.ignorable)
+        if (std::find(lin.ignorable_kept_for_outputs.begin(), lin.ignorable_kept_for_outputs.end(), n) ==
+            lin.ignorable_kept_for_outputs.end())
+          left_out.push_back(n);
+      fmt::print(stderr, "ignorable coordinates left out: {}\n", fmt::join(left_out, ", "));
+    } else {
+      fmt::print(stderr, "ignorable coordinates: {}\n", fmt::join(lin.ignorable, ", "));
+    }
+  }
   if (!lin.ignorable_kept_for_outputs.empty())
-    fmt::print(stderr, "kept, since outputs read them: {}\n", fmt::join(lin.ignorable_kept_for_outputs, ", "));
+    fmt::print(stderr, "ignorable but kept, since outputs read them: {}\n",
+               fmt::join(lin.ignorable_kept_for_outputs, ", "));
   fmt::print(stderr, "zero modes: |eigenvalue| <= {:.2g} (rigid-body or ignorable, or slower than that)\n",
              zero_mode_tolerance(lin));
   fmt::print(stderr, "{:>24} {:>24} {:>12} {:>10}  {}\n", "eigenvalue (1/s)", "", "f_n (Hz)", "zeta",
