@@ -1,6 +1,25 @@
 #!/usr/bin/env bash
-# Configures and builds kanegen (Release) into ./build.
+# Configures and builds kanegen (Release) into ./build, through ccache when it
+# is installed (cmake/BuildSpeed.cmake: a second clone on the same machine hits
+# its cache) and with precompiled headers.
+#   build.sh                     everything: the CLI, the Python module, the
+#                                examples, the benchmarks and peers, the tests
+#   build.sh --demo              the kanegen CLI only (what scripts/demo.sh runs);
+#                                configured without the tests, benchmarks, examples
+#                                and Python module, whose packages it does not need
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j"$(nproc)"
+args=(-DCMAKE_BUILD_TYPE=Release)
+targets=()
+if [[ "${1:-}" == --demo ]]; then
+  # options not given keep their cached value: a tree configured for the tests
+  # stays so, and a fresh one leaves out what needs packages the demo skips
+  if [[ ! -f build/CMakeCache.txt ]]; then
+    args+=(-DKANEGEN_BUILD_TESTS=OFF -DKANEGEN_BUILD_BENCH=OFF -DKANEGEN_BUILD_EXAMPLES=OFF -DKANEGEN_BUILD_PYTHON=OFF)
+  fi
+  targets=(--target kanegen)
+else
+  args+=(-DKANEGEN_BUILD_TESTS=ON -DKANEGEN_BUILD_BENCH=ON -DKANEGEN_BUILD_EXAMPLES=ON -DKANEGEN_BUILD_PYTHON=ON)
+fi
+cmake -S . -B build "${args[@]}" >/dev/null
+cmake --build build -j"$(nproc)" "${targets[@]}"

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "engine/generic_engine.hpp"
 #include "model/model_loader.hpp"
@@ -18,40 +19,17 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// Compiled at -O0 and without the Jacobian: this test checks the code, not its speed.
-std::unique_ptr<GeneratedEngine> engine_of_form(const Model& model, const std::string& form) {
-  codegen::GeneratorOptions g;
-  g.udot_form = form;
-  JitOptions o = test::jit_options();
-  o.flags = "-O0 -std=c++20 -fPIC -shared";
-  o.only_set = true;
-  o.only = {"energy", "momentum", "reactions", "outputs"};
-  return jit_load(model, codegen::jit_code_generator(g), o);
-}
-
-/// Every model of models/ and of the reference vectors.
-std::vector<std::string> all_models() {
-  std::vector<std::string> files = test::model_files();
-  for (const auto& d : fs::directory_iterator(test::source_path("tests/reference")))
-    if (d.is_directory()) files.push_back((d.path() / (d.path().filename().string() + ".yaml")).string());
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
 }  // namespace
 
-TEST_CASE("both u-dot forms agree with the generic engine on every model", "[generator][forms]") {
-  const auto files = all_models();
-  REQUIRE(files.size() >= 20);
-  int flexible = 0, node_children = 0;
-  for (const auto& f : files) {
+// Hidden ([.]): ctest runs it once per model ("u-dot forms: <model>",
+// tests/CMakeLists.txt); the test below checks that those cover every model.
+TEST_CASE("both u-dot forms agree with the generic engine on every model", "[.][generator][forms][per-model]") {
+  for (const auto& f : test::models_under_test(test::all_models())) {
     const Model model = load_model(f);
-    flexible += model.has_flexible();
-    for (const Body& b : model.bodies) node_children += b.joint.node >= 0;
     GenericEngine generic(model);
     for (const char* form : {"composite", "articulated"}) {
       INFO(fs::path(f).filename().string() << " " << form);
-      auto e = engine_of_form(model, form);
+      auto e = test::generated_engine(model, form);
       const CrosscheckResult r = crosscheck(*e, generic, 4, 11);
       for (const auto& [q, v] : r.worst) {
         INFO(q << " " << v);
@@ -59,9 +37,37 @@ TEST_CASE("both u-dot forms agree with the generic engine on every model", "[gen
       }
     }
   }
-  // The modal and node-attachment branches of both forms were exercised.
+}
+
+TEST_CASE("the per-model tests run on every model, flexible ones and node children among them", "[generator][forms]") {
+  const auto files = test::all_models();
+  REQUIRE(files.size() >= 20);
+  int flexible = 0, node_children = 0;
+  for (const auto& f : files) {
+    const Model model = load_model(f);
+    flexible += model.has_flexible();
+    for (const Body& b : model.bodies) node_children += b.joint.node >= 0;
+  }
+  // The modal and node-attachment branches of both forms are exercised.
   CHECK(flexible >= 5);
   CHECK(node_children >= 3);
+  // ctest holds one entry per model and per every-model test (the list CMake
+  // wrote when it made them): none left out, none stale
+  std::ifstream listed(KANEGEN_PER_MODEL_LIST);
+  REQUIRE(listed);
+  std::vector<std::string> names;
+  for (std::string line; std::getline(listed, line);)
+    if (!line.empty()) names.push_back(test::source_path(line));
+  std::sort(names.begin(), names.end());
+  CHECK(names == files);
+}
+
+TEST_CASE("jit: the suite's build of a model in every u-dot form", "[.][jit][per-model]") {
+  // ctest's fixture "jit: <model>": builds the code every test of the model loads
+  for (const auto& f : test::models_under_test(test::all_models())) {
+    const Model model = load_model(f);
+    for (const char* form : {"auto", "composite", "articulated"}) CHECK(test::generated_engine(model, form) != nullptr);
+  }
 }
 
 TEST_CASE("a singular mass matrix names the speed whose pivot failed, in both forms", "[generator][forms]") {
@@ -95,7 +101,7 @@ TEST_CASE("a singular mass matrix names the speed whose pivot failed, in both fo
   CHECK_THROWS_AS(generic.udot(s.q, s.u, s.tau, ud), SingularMassMatrix);
   for (const char* form : {"composite", "articulated"}) {
     INFO(form);
-    auto e = engine_of_form(m, form);
+    auto e = test::generated_engine(m, form);
     try {
       e->udot(s.q, s.u, s.tau, ud);
       FAIL("no SingularMassMatrix");
@@ -114,7 +120,7 @@ TEST_CASE("model names that are C++ keywords or start with a digit generate code
     INFO(name);
     const std::string path = test::write_temp(name + ".yaml", "name: " + name + "\n" + body);
     const Model model = load_model(path);
-    auto e = engine_of_form(model, "auto");
+    auto e = test::generated_engine(model, "auto");
     GenericEngine generic(model);
     const CrosscheckResult r = crosscheck(*e, generic, 2, 3);
     CHECK(r.passed());

@@ -7,7 +7,9 @@
 #include "sim/simulate.hpp"
 #include "model/state_io.hpp"
 
+#include <cstdlib>
 #include <filesystem>
+#include <stdexcept>
 #include <fstream>
 #include <unistd.h>
 
@@ -52,6 +54,23 @@ Drift run_invariants(const Model& model, double t_end, IntegratorKind kind, doub
     return true;
   });
   return d;
+}
+
+std::vector<std::string> all_models() {
+  std::vector<std::string> files = model_files();
+  for (const auto& d : std::filesystem::directory_iterator(source_path("tests/reference")))
+    if (d.is_directory()) files.push_back((d.path() / (d.path().filename().string() + ".yaml")).string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::vector<std::string> models_under_test(const std::vector<std::string>& files) {
+  const char* one = std::getenv("KANEGEN_TEST_MODEL");
+  if (!one || !*one) return files;
+  const std::string path = source_path(one);
+  for (const auto& f : files)
+    if (std::filesystem::path(f) == std::filesystem::path(path)) return {f};
+  throw std::runtime_error(std::string("KANEGEN_TEST_MODEL=") + one + " names none of this test's models");
 }
 
 std::vector<std::string> model_files() {

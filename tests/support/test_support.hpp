@@ -22,11 +22,15 @@ inline double rel_err(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double
 }
 
 /// JIT options of the test suite: a cache inside the build tree, shared by
-/// the test runs (KANEGEN_TEST_CACHE_DIR).
+/// the test runs (KANEGEN_TEST_CACHE_DIR), and the quickest build (-O0, the
+/// baseline ISA, every function): the suite checks what the code computes,
+/// not how fast, and ctest's fixture "jit: <model>" builds each model's code
+/// once for every test that asks for it (tests/CMakeLists.txt).
 inline JitOptions jit_options() {
   JitOptions o;
   o.cache_dir = KANEGEN_TEST_CACHE_DIR;
   o.quiet = true;  // the suite's output stays readable
+  o.quick = true;
   return o;
 }
 
@@ -51,6 +55,15 @@ Drift run_invariants(const Model& model, double t_end, IntegratorKind kind, doub
 /// Every model file under models/ (modal files and the generated benchmark
 /// models of models/spinup/ excluded), sorted.
 std::vector<std::string> model_files();
+
+/// Every model the every-model tests run on: model_files() and the reference
+/// models (tests/reference/<name>/<name>.yaml), sorted.
+std::vector<std::string> all_models();
+
+/// The models an every-model test runs on now: `files`, or, under ctest's
+/// per-model entries (tests/CMakeLists.txt), the one $KANEGEN_TEST_MODEL names
+/// (a path relative to the source tree; one that names none of `files` fails).
+std::vector<std::string> models_under_test(const std::vector<std::string>& files);
 
 /// Writes `text` to a fresh temporary file with the given name and returns its path.
 std::string write_temp(const std::string& name, const std::string& text);

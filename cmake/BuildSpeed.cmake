@@ -1,0 +1,27 @@
+# Build speed (issue 33): ccache when it is installed, and precompiled headers.
+#
+# ccache: base_dir is the source tree, so that a second clone on the same
+# machine (other absolute paths) hits the cache; the sloppiness ccache needs
+# with precompiled headers (a .gch is always newer than the compile started).
+option(KANEGEN_CCACHE "Compile through ccache when it is installed" ON)
+if(KANEGEN_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
+  find_program(KANEGEN_CCACHE_PROGRAM ccache)
+  if(KANEGEN_CCACHE_PROGRAM)
+    set(CMAKE_CXX_COMPILER_LAUNCHER
+        env "CCACHE_BASEDIR=${PROJECT_SOURCE_DIR}"
+        "CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime"
+        ${KANEGEN_CCACHE_PROGRAM})
+    message(STATUS "kanegen: compiling through ccache (${KANEGEN_CCACHE_PROGRAM})")
+  endif()
+endif()
+
+# Precompiled headers: most of a translation unit's time here is spent parsing
+# the standard library, Eigen and fmt; each target parses them once.
+option(KANEGEN_PRECOMPILED_HEADERS "Precompile the common headers of each target" ON)
+function(kanegen_precompile target)
+  if(KANEGEN_PRECOMPILED_HEADERS)
+    target_precompile_headers(${target} PRIVATE
+      <algorithm> <array> <cmath> <functional> <map> <memory> <optional> <stdexcept> <string> <vector>
+      <filesystem> <Eigen/Dense> <fmt/format.h> ${ARGN})
+  endif()
+endfunction()
