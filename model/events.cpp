@@ -63,6 +63,10 @@ std::vector<int> read_bodies(const YAML::Node& n, int l, const std::string& f, c
     ck.error(n, l, f, fmt::format("got {}; expected a list of body names", describe(n)));
     return out;
   }
+  if (n.size() == 0) {
+    ck.error(n, l, f, "an empty list; expected at least one body name (leave the key out for no such action)");
+    return out;
+  }
   std::vector<std::string> names;
   for (const Body& b : model.bodies) names.push_back(b.name);
   for (std::size_t k = 0; k < n.size(); ++k) {
@@ -141,6 +145,13 @@ void read_events(const YAML::Node& events, const std::string& path, Model& model
         ck.error(l, f + ".when.coordinate", "missing; expected the name of a coordinate (q)");
       } else if (auto s = ck.string(c, l, f + ".when.coordinate")) {
         ev.coordinate = model.q_index(*s);
+        for (const auto& slot : model.quaternions)
+          if (ev.coordinate >= slot.q && ev.coordinate < slot.q + 4)
+            ck.error(c, l, f + ".when.coordinate",
+                     fmt::format("'{}' is a component of a unit quaternion (a free or ball joint's attitude: its "
+                                 "value is no angle, and q and -q are the same attitude); expected a joint angle or "
+                                 "position, or a modal coordinate",
+                                 *s));
         if (ev.coordinate < 0) {
           const bool prescribed = std::find(model.prescribed_names.begin(), model.prescribed_names.end(), *s) !=
                                   model.prescribed_names.end();

@@ -99,6 +99,43 @@ void check_output_option(const std::string& option, const std::string& path) {
   }
 }
 
+namespace {
+
+/// The file a path names, for comparing two paths (symbolic links and ./.. resolved).
+fs::path identity_of(const std::string& path) {
+  std::error_code ec;
+  fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  return ec ? fs::absolute(path).lexically_normal() : p;
+}
+
+}  // namespace
+
+void check_output_options(const std::vector<OutputOption>& outputs, const std::vector<std::string>& inputs) {
+  std::vector<Diagnostic> faults;
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const OutputOption& out = outputs[i];
+    try {
+      check_output_option(out.option, out.path);
+    } catch (const InputError& e) {
+      faults.insert(faults.end(), e.diagnostics().begin(), e.diagnostics().end());
+      continue;
+    }
+    const fs::path id = identity_of(out.path);
+    for (std::size_t j = 0; j < i; ++j)
+      if (!outputs[j].path.empty() && identity_of(outputs[j].path) == id)
+        faults.push_back(Diagnostic{out.option, 0, "",
+                                    fmt::format("cannot write '{}': {} writes the same file; expected another file name",
+                                                out.path, outputs[j].option)});
+    for (const std::string& in : inputs)
+      if (!in.empty() && identity_of(in) == id)
+        faults.push_back(Diagnostic{out.option, 0, "",
+                                    fmt::format("cannot write '{}': it is an input of this command ({}); expected "
+                                                "another file name",
+                                                out.path, in)});
+  }
+  if (!faults.empty()) throw InputError(faults);
+}
+
 struct OutputFile::Impl {
   int fd = -1;
   std::string named_tmp;  ///< fallback only: the named temporary

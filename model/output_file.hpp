@@ -14,6 +14,7 @@
 #include <ostream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace kanegen {
 
@@ -62,5 +63,17 @@ void check_output_path(const std::string& path);
 /// check_output_path for the value of a command-line option: a refusal is an
 /// InputError "OPTION: cannot write 'PATH': why" (exit 2).
 void check_output_option(const std::string& option, const std::string& path);
+
+/// One output of a command: the option that names it and its path.
+struct OutputOption {
+  std::string option, path;
+};
+
+/// Every output of one command, checked before any work (issue 34): each as
+/// check_output_option (an empty path refused), two outputs on the same file
+/// refused, and an output on one of `inputs` (the model, its modal files, a
+/// state: what the command reads) refused. Throws InputError with one
+/// diagnostic per fault, each naming its option.
+void check_output_options(const std::vector<OutputOption>& outputs, const std::vector<std::string>& inputs);
 
 }  // namespace kanegen

@@ -18,40 +18,49 @@ double time_tol(double t) { return 4 * std::numeric_limits<double>::epsilon() * 
 EventRun::EventRun(const Model& model, double t0, const LockSet& initial_locks, const std::vector<Event>* events)
     : model_(model), events_(events ? *events : model.events), locks_(initial_locks), done_(events_.size(), 0) {
   if (locks_.size() != model.bodies.size()) locks_.assign(model.bodies.size(), 0);
-  for (std::size_t i = 0; i < model.events.size(); ++i) {
-    const Event& e = model.events[i];
-    if (e.trigger == Event::Trigger::time && e.at < t0 - time_tol(t0)) done_[i] = 1;  // in the past
+  for (std::size_t i = 0; i < events_.size(); ++i) {
+    const Event& e = events_[i];
+    if (e.trigger == Event::Trigger::time) {
+      by_time_.push_back(static_cast<int>(i));
+      if (e.at < t0 - time_tol(t0)) done_[i] = 1;  // in the past
+    } else {
+      crossings_.push_back(static_cast<int>(i));
+    }
   }
+  std::stable_sort(by_time_.begin(), by_time_.end(), [&](int a, int b) { return events_[a].at < events_[b].at; });
+  skip_done();
+}
+
+void EventRun::skip_done() {
+  while (next_time_ < by_time_.size() && done_[by_time_[next_time_]]) ++next_time_;
 }
 
 double EventRun::next_stop(double t, double t_end) const {
-  double stop = t_end;
-  for (std::size_t i = 0; i < events_.size(); ++i) {
-    const Event& e = events_[i];
-    if (!done_[i] && e.trigger == Event::Trigger::time && e.at > t + time_tol(t) && e.at < stop) stop = e.at;
+  // the time events from next_time_ on are unfired, in time order; those at t itself are due (fired at t)
+  for (std::size_t k = next_time_; k < by_time_.size(); ++k) {
+    const double at = events_[by_time_[k]].at;
+    if (at > t + time_tol(t)) return std::min(at, t_end);
   }
-  return stop;
-}
-
-bool EventRun::due(std::size_t i, double t) const {
-  const Event& e = events_[i];
-  return !done_[i] && e.trigger == Event::Trigger::time && std::abs(e.at - t) <= time_tol(t);
+  return t_end;
 }
 
 bool EventRun::time_event_due(double t) const {
-  for (std::size_t i = 0; i < events_.size(); ++i)
-    if (due(i, t)) return true;
+  for (std::size_t k = next_time_; k < by_time_.size(); ++k) {
+    const double at = events_[by_time_[k]].at;
+    if (at > t + time_tol(t)) return false;
+    if (!done_[by_time_[k]] && std::abs(at - t) <= time_tol(t)) return true;
+  }
   return false;
 }
 
 void EventRun::arm(OdeProblem& p) {
   armed_.clear();
-  for (std::size_t i = 0; i < events_.size(); ++i) {
+  for (const int i : crossings_) {
     const Event& e = events_[i];
-    if (done_[i] || e.trigger != Event::Trigger::crossing) continue;
+    if (done_[i]) continue;
     const int b = joint_body_of_coordinate(model_, e.coordinate);
     if (b >= 0 && locks_[b]) continue;  // fires only while its joint is free
-    armed_.push_back(static_cast<int>(i));
+    armed_.push_back(i);
   }
   p.n_events = static_cast<int>(armed_.size());
   if (armed_.empty()) {
@@ -68,8 +77,11 @@ void EventRun::arm(OdeProblem& p) {
 int EventRun::fire(Engine& engine, double t, VecX& x, int crossing) {
   std::vector<int> due;
   if (crossing >= 0 && crossing < static_cast<int>(armed_.size())) due.push_back(armed_[crossing]);
-  for (std::size_t i = 0; i < events_.size(); ++i)
-    if (this->due(i, t)) due.push_back(static_cast<int>(i));
+  for (std::size_t k = next_time_; k < by_time_.size(); ++k) {
+    const int i = by_time_[k];
+    if (events_[i].at > t + time_tol(t)) break;
+    if (!done_[i] && std::abs(events_[i].at - t) <= time_tol(t)) due.push_back(i);
+  }
   std::sort(due.begin(), due.end());
   due.erase(std::unique(due.begin(), due.end()), due.end());
   const int nq = model_.nq, nu = model_.nu;
@@ -115,6 +127,7 @@ int EventRun::fire(Engine& engine, double t, VecX& x, int crossing) {
     for (const auto& n : notes) f.note += (f.note.empty() ? "" : "; ") + n;
     fired_.push_back(std::move(f));
   }
+  skip_done();
   return static_cast<int>(due.size());
 }
 

@@ -52,8 +52,14 @@ class EventRun {
   std::vector<char> done_;          ///< per model event: fired (or in the past at the start)
   std::vector<int> armed_;          ///< event function i -> model event index
   std::vector<FiredEvent> fired_;
-  /// Whether model event i is an unfired time event due at t.
-  bool due(std::size_t i, double t) const;
+  /// The time events by time (file order among equal times) and the first
+  /// of them not yet fired or passed: next_stop, time_event_due and fire look
+  /// from there, so a run's cost is linear in its number of events.
+  std::vector<int> by_time_;
+  std::size_t next_time_ = 0;
+  std::vector<int> crossings_;      ///< the crossing events, in file order
+  /// Moves next_time_ past the time events fired or passed.
+  void skip_done();
 };
 
 /// "deploy at t = 10: release panel; latch at t = 12.3: lock panel (energy lost 0.53 J)"

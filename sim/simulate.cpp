@@ -121,8 +121,17 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
   // x_dot = f(t, x) around an engine's evaluation `derivative(t, x, xdot)`
   // (which throws SingularMassMatrix): the state and the accelerations checked,
   // the quaternion stabilization added.
-  // A gimbal reaching gimbal lock (dynamics.md: |det Gamma| <= 1e-6) stops the run.
+  // A gimbal reaching gimbal lock (dynamics.md: |det Gamma| <= 1e-6) stops the
+  // run where the lock monitor locates it (run_segments: an event function on
+  // every step). The right-hand side refuses states 100x closer to lock (M
+  // too ill-conditioned to trust) as a recoverable failure: such a state is a
+  // trial stage past the lock (an implicit method's iterate, or the locator's
+  // own evaluations at the 1e-6 edge), and the step is retried shorter until
+  // an accepted step ends at the crossing, where the monitor stops the run.
+  // A singular M within 1e-3 of a joint's lock is that lock's, and likewise.
   const bool has_gimbal = !model.lockable_joints.empty();
+  constexpr double kRhsLockGuard = kGimbalLockStop * 1e-2;
+  constexpr double kNearLock = 1e-3;
   auto rhs_around = [&](auto derivative) {
     return [derivative, failure, nq, nu, stabilize, has_gimbal, &model](double t, const double* x, double* xdot) -> int {
       for (int i = 0; i < nq + nu; ++i)
@@ -132,15 +141,15 @@ OdeProblem make_ode_problem(Engine& engine, const VecX& tau, std::string* failur
         }
       double measure = 0;
       if (has_gimbal)
-        if (const int lb = gimbal_locked_body(model, x, kGimbalLockStop, &measure); lb >= 0) {
+        if (const int lb = gimbal_locked_body(model, x, kRhsLockGuard, &measure); lb >= 0) {
           if (failure) *failure = fmt::format("{} at t = {:.17g}", gimbal_lock_message(model, lb, x, measure), t);
-          return -1;
+          return 1;
         }
       try {
         derivative(t, x, xdot);
       } catch (const SingularMassMatrix& e) {
         if (failure) *failure = fmt::format("{} at t = {:.17g}", e.what(), t);
-        return -1;
+        return has_gimbal && gimbal_locked_body(model, x, kNearLock, &measure) >= 0 ? 1 : -1;
       }
       stabilize(x, xdot);
       for (int i = nq; i < nq + nu; ++i)
@@ -282,6 +291,38 @@ struct SegmentHooks {
   std::function<void(const LockSet& locks)> new_segment;
 };
 
+/// A joint watched for gimbal lock over a segment: g = det Gamma - s 1e-6,
+/// s its sign at the segment's start, changes sign where |det Gamma| falls to
+/// kGimbalLockStop on the side it started, or where det Gamma passes through
+/// zero within a step (the step's interpolant locates it, as an event).
+struct LockMonitor {
+  int body = -1;
+  double sign = 1;
+};
+
+/// Appends one event function per free lockable joint to `p` (after the
+/// model's events) and returns them in that order.
+std::vector<LockMonitor> watch_gimbal_lock(const Model& model, const LockSet& locks, const VecX& x, OdeProblem& p) {
+  std::vector<LockMonitor> monitors;
+  for (const int b : model.lockable_joints) {
+    if (!locks.empty() && locks[b]) continue;  // a locked joint does not move
+    const double det = joint_lock_determinant(model.bodies[b].joint, x.data() + model.bodies[b].q_joint);
+    monitors.push_back({b, det < 0 ? -1.0 : 1.0});
+  }
+  if (monitors.empty()) return monitors;
+  const int n_before = p.n_events;
+  auto before = p.events;
+  p.n_events = n_before + static_cast<int>(monitors.size());
+  p.events = [before, n_before, monitors, &model](double t, const double* x, double* g) {
+    if (before) before(t, x, g);
+    for (std::size_t k = 0; k < monitors.size(); ++k) {
+      const Body& b = model.bodies[monitors[k].body];
+      g[n_before + static_cast<int>(k)] = joint_lock_determinant(b.joint, x + b.q_joint) - monitors[k].sign * kGimbalLockStop;
+    }
+  };
+  return monitors;
+}
+
 IntegratorStats run_segments(Engine& engine, const State& initial, double t_end, double dt_out, double sample_period,
                              const IntegratorOptions& opt, EventRun& events, long& segments, const SegmentHooks& h) {
   const double t0 = initial.t;
@@ -317,6 +358,8 @@ IntegratorStats run_segments(Engine& engine, const State& initial, double t_end,
     if (sample_now) h.at_sample(t, x);
     OdeProblem p = h.problem();
     events.arm(p);
+    const int n_model_events = p.n_events;
+    const std::vector<LockMonitor> monitors = watch_gimbal_lock(engine.model(), events.locks(), x, p);
     bool first = true, pending = false;
     double tp = t;
     VecX xp = x;
@@ -344,8 +387,17 @@ IntegratorStats run_segments(Engine& engine, const State& initial, double t_end,
     total.wall_seconds += s.wall_seconds;
     t = pending ? tp : t_stop;
     x = xp;
+    if (s.event >= n_model_events) {  // a joint reached gimbal lock: located on the step, the run fails there
+      const Body& b = engine.model().bodies[monitors[s.event - n_model_events].body];
+      throw IntegrationError(
+          fmt::format("{}: the {} joint of '{}' reached gimbal lock at t = {:.17g} (|det Gamma| = {:.3g} <= {:.0e}, "
+                      "located on the step; dynamics.md, Joints)",
+                      to_string(opt.kind), to_string(b.joint.type), b.name, t,
+                      std::abs(joint_lock_determinant(b.joint, x.data() + b.q_joint)), kGimbalLockStop),
+          t, x);
+    }
     const bool at_end = !(t < t_end - tol);
-    if (s.event >= 0 || (!at_end && events.time_event_due(t))) {
+    if (s.event >= 0 || events.time_event_due(t)) {  // an event at t_end fires too (two rows there)
       h.row(t, x, true);  // just before
       events.fire(engine, t, x, s.event);
       h.new_segment(events.locks());

@@ -14,12 +14,18 @@ struct Options {
   std::string model, state, engine = "auto", events;
   bool native = false;
   SimulationCli sim;
+  CLI::Option* events_option = nullptr;  ///< to tell --events "" from no --events
 };
 
 int run(const Options& o) {
   const Model model = load_checked(o.model);
   const State state = state_for(model, o.state);
   const SimulationOptions opt = simulation_options(o.sim, state);
+  std::vector<OutputOption> outputs{{"-o", o.sim.output}};
+  if (o.events_option->count() > 0) outputs.push_back({"--events", o.events});
+  std::vector<std::string> inputs = input_files(model);
+  if (!o.state.empty()) inputs.push_back(o.state);
+  check_output_options(outputs, inputs);  // before any work: nothing is written on a refusal
   // explicit methods (and auto's choice, from central differences when no
   // Jacobian is compiled) need no derivatives; the implicit ones use the exact Jacobian
   const IntegratorKind k = opt.integrator.kind;
@@ -74,7 +80,7 @@ Subcommand add_simulate(CLI::App& app) {
   c->get_option("-o")->required();
   c->add_option("--state", o->state, "initial STATE.json (default: the model's initial state)")
       ->check(CLI::ExistingFile);
-  c->add_option("--events", o->events,
+  o->events_option = c->add_option("--events", o->events,
                 "also write the events that fired as CSV (t, name, action, bodies, energy_lost; interface.md)");
   add_engine_option(c, o->engine, o->native, /*with_auto=*/true);
   return {c, [o] { return run(*o); }};

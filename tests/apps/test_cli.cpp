@@ -9,6 +9,9 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
+#include <cmath>
+#include <fmt/format.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -299,4 +302,96 @@ TEST_CASE("cli: events: simulate --events writes the events table and two rows a
   const Run b = run("simulate " + bad + " --t-end 1 -o " + (d / "x.csv").string());
   CHECK(b.status == 2);
   CHECK(b.out.find("bad_event.yaml:8: events[0].lock[0]: no body named 'b'") != std::string::npos);
+}
+
+TEST_CASE("cli: every output path is checked before the run, each fault naming its option; nothing written",
+          "[cli][outputs]") {
+  const fs::path d = temp_dir() / "outputs";
+  fs::create_directories(d);
+  // a copy of a model with a modal file, so that an overwrite could be seen
+  fs::copy_file(src("tests/data/good/flex_hub.yaml"), d / "flex_hub.yaml", fs::copy_options::overwrite_existing);
+  fs::copy_file(src("tests/data/good/hub.modal.yaml"), d / "hub.modal.yaml", fs::copy_options::overwrite_existing);
+  const std::string model = (d / "flex_hub.yaml").string(), modal = (d / "hub.modal.yaml").string();
+  auto slurp = [](const fs::path& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string model_text = slurp(model), modal_text = slurp(modal);
+  const std::string csv = (d / "out.csv").string();
+  const std::string sim = "simulate " + model + " --engine generic --t-end 2 --dt-out 0.5 --no-progress ";
+  struct Case {
+    std::string args, option, why;
+  };
+  const std::vector<Case> cases = {
+      {"-o " + csv + " --events " + (d / "no/such/dir/ev.csv").string(), "--events", "does not exist"},
+      {"-o " + csv + " --events " + csv, "--events", "-o writes the same file"},
+      {"-o " + csv + " --events " + (d / "." / "out.csv").string(), "--events", "-o writes the same file"},
+      {"-o " + csv + " --events ''", "--events", "empty output path"},
+      {"-o " + model, "-o", "it is an input of this command"},
+      {"-o " + csv + " --events " + model, "--events", "it is an input of this command"},
+      {"-o " + modal, "-o", "it is an input of this command"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.args);
+    const Run r = run(sim + c.args);
+    INFO(r.out);
+    CHECK(r.status == 2);
+    CHECK(r.out.find(c.option + ": cannot write") != std::string::npos);
+    CHECK(r.out.find(c.why) != std::string::npos);
+    CHECK_FALSE(fs::exists(csv));  // refused before the run: nothing written
+    CHECK(slurp(model) == model_text);
+    CHECK(slurp(modal) == modal_text);
+  }
+  // linearize -o on its model, and on its state
+  const Run lin = run("linearize " + model + " --engine generic -o " + model);
+  CHECK(lin.status == 2);
+  CHECK(lin.out.find("-o: cannot write") != std::string::npos);
+  CHECK(slurp(model) == model_text);
+  // the same command with good paths runs and writes both
+  const Run ok = run(sim + "-o " + csv + " --events " + (d / "ev.csv").string());
+  INFO(ok.out);
+  CHECK(ok.status == 0);
+  CHECK(fs::exists(csv));
+  CHECK(fs::exists(d / "ev.csv"));
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: a gimbal oscillating through lock stops at the located crossing, at every --dt-out, in every "
+          "integrator and both engines",
+          "[cli][joints][events]") {
+  // Only the middle angle moves (a principal axis, no coupling): theta(t) =
+  // rest + (theta0 - rest) cos(w t), w = sqrt(k / I_yy). det Gamma = cos(theta)
+  // reaches 1e-6 at theta* = acos(1e-6), long before the first output row
+  // after it (the run used to see lock only as a sign change between rows).
+  const double k = 0.5, I_yy = 0.02, rest = 1.67, theta0 = 1.45;
+  const std::string model = kanegen::test::write_temp("gimbal_oscillator.yaml", fmt::format(R"(name: gimbal_oscillator
+bodies:
+  - name: bob
+    parent: ground
+    joint: {{type: gimbal, sequence: xyz, stiffness: [0, {}, 0], rest: [0, {}, 0]}}
+    mass: 1.0
+    inertia: [0.01, {}, 0.03, 0, 0, 0]
+initial:
+  q: {{bob.angle2: {}}}
+)", k, rest, I_yy, theta0));
+  const double w = std::sqrt(k / I_yy);
+  const double t_lock = std::acos((std::acos(1e-6) - rest) / (theta0 - rest)) / w;
+  const fs::path csv = temp_dir() / "gimbal_oscillator.csv";
+  const std::regex at_re(R"(reached gimbal lock at t = ([0-9.eE+-]+))");
+  for (const std::string engine : {"generic", "generated"})
+    for (const std::string integrator :
+         {"rkf78", "dopri5", "rk4", "cvode-bdf", "cvode-bdf2", "cvode-adams", "arkode-erk", "arkode-dirk"})
+      for (const std::string dt_out : {"0.31", "0.01"}) {
+        const Run r = run("simulate " + model + " --engine " + engine + " --integrator " + integrator +
+                          " --rtol 1e-12 --atol 1e-14 --h 1e-4 --t-end 2 --no-progress --dt-out " + dt_out + " -o " +
+                          csv.string());
+        INFO(engine << " " << integrator << " --dt-out " << dt_out << "\n" << r.out);
+        CHECK(r.status == 1);
+        CHECK(r.out.find("gimbal joint of 'bob'") != std::string::npos);
+        CHECK(r.out.find("q bob.angle2 = ") != std::string::npos);  // the state there
+        std::smatch m;
+        REQUIRE(std::regex_search(r.out, m, at_re));
+        CHECK(std::abs(std::stod(m[1].str()) - t_lock) < 1e-9);
+        CHECK_FALSE(fs::exists(csv));  // nothing written
+      }
 }

@@ -250,6 +250,58 @@ events:
   }
 }
 
+TEST_CASE("events: a state event on a quaternion component is refused", "[locks][input]") {
+  const std::string path = test::write_temp("quat_event.yaml", R"(name: quat_event
+bodies:
+  - name: sat
+    parent: ground
+    mass: 1
+    inertia: [1, 2, 3, 0, 0, 0]
+    joint: {type: free}
+  - name: arm
+    parent: sat
+    mass: 1
+    joint: {type: revolute, axis: [0, 0, 1]}
+events:
+  - {name: a, when: {coordinate: sat.qz, reaches: 0.5}, lock: [arm]}
+)");
+  CHECK_THROWS_WITH(load_model(path), Catch::Contains("quat_event.yaml:13: events[0].when.coordinate:") &&
+                                          Catch::Contains("component of a unit quaternion"));
+}
+
+TEST_CASE("events: a time event exactly at the end time fires (two rows there)", "[locks][events]") {
+  const Model model = load_model(test::write_temp("end_event.yaml", R"(name: end_event
+gravity: [0, -9.81, 0]
+bodies:
+  - name: bob
+    parent: ground
+    mass: 1
+    com: [0, -1, 0]
+    inertia: [0.01, 0.01, 0.01, 0, 0, 0]
+    joint: {type: revolute, axis: [0, 0, 1]}
+initial:
+  q: {bob.angle: 0.5}
+events:
+  - {name: stop, at: 1.5, lock: [bob]}
+)"));
+  GenericEngine engine(model);
+  SimulationOptions o;
+  o.t_end = 1.5;
+  o.dt_out = 0.5;
+  o.integrator.kind = IntegratorKind::rkf78;
+  std::ostringstream out;
+  const SimulationResult r = simulate(engine, initial_state(model), o, out);
+  REQUIRE(r.events.size() == 1);
+  CHECK(r.events[0].t == 1.5);
+  CHECK(r.events[0].energy_lost > 0);  // the swinging bob latched
+  const Csv csv = parse_csv(out.str());
+  REQUIRE(csv.rows.size() == 5);  // 0, 0.5, 1, and 1.5 before and after
+  CHECK(csv.rows[3][0] == 1.5);
+  CHECK(csv.rows[4][0] == 1.5);
+  CHECK(csv.rows[3][csv.col("bob.angle_rate")] != 0.0);
+  CHECK(csv.rows[4][csv.col("bob.angle_rate")] == 0.0);
+}
+
 namespace {
 
 /// A chain on a free base, one joint of `type` in the middle, with gravity,
@@ -520,6 +572,8 @@ events:
        "already free"},
       {"  - {name: a, release: [arm]}\n", "events[0]", "no trigger"},
       {"  - {name: a, at: 1}\n", "events[0]", "no action"},
+      {"  - {name: a, at: 1, release: []}\n", "events[0].release", "an empty list"},
+      {"  - {name: a, at: 1, release: [arm], lock: []}\n", "events[0].lock", "an empty list"},
       {"  - {name: a, at: 1, release: [arm]}\n  - {name: a, at: 2, lock: [arm]}\n", "events[1].name", "unique"},
   };
   for (const Bad& b : bad) {
