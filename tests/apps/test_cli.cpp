@@ -38,7 +38,7 @@ Run shell(const std::string& cmd) {
 }
 
 Run run(const std::string& args, const std::string& env = "") {
-  return shell(env + " " + std::string(KANEGEN_BINARY) + " " + args);
+  return shell(env + " " + std::string(kanegen::test::kanegen_binary()) + " " + args);
 }
 
 std::string src(const std::string& rel) { return kanegen::test::source_path(rel); }
@@ -81,7 +81,7 @@ TEST_CASE("cli: missing model file, unknown state name, bad option exit 2", "[cl
 
 TEST_CASE("cli: eval prints the interface.md document, generated engine by default", "[cli][generated]") {
   const Run r = run("eval " + src("models/double_pendulum.yaml"),
-                    "KANEGEN_CACHE_DIR=" + std::string(KANEGEN_TEST_CACHE_DIR));
+                    "KANEGEN_CACHE_DIR=" + std::string(kanegen::test::jit_cache_dir()));
   REQUIRE(r.status == 0);
   const auto j = nlohmann::json::parse(r.out.substr(r.out.find('{')));
   CHECK(j["engine"] == "generated");

@@ -30,7 +30,7 @@ struct Run {
 };
 
 Run run(const std::string& args) {
-  const std::string cmd = std::string(KANEGEN_BINARY) + " " + args + " 2>&1";
+  const std::string cmd = std::string(kanegen::test::kanegen_binary()) + " " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;
   char buf[4096];
@@ -281,7 +281,7 @@ TEST_CASE("hostile: an interrupted or killed simulate leaves nothing behind", "[
     REQUIRE(pid >= 0);
     if (pid == 0) {
       const std::string m = model("models/explorer1_rigid.yaml");
-      execl(KANEGEN_BINARY, KANEGEN_BINARY, "simulate", m.c_str(), "--engine", "generic", "--t-end", "100000",
+      execl(kanegen::test::kanegen_binary(), kanegen::test::kanegen_binary(), "simulate", m.c_str(), "--engine", "generic", "--t-end", "100000",
             "--dt-out", "0.1", "--no-progress", "-o", out.c_str(), static_cast<char*>(nullptr));
       _exit(127);
     }

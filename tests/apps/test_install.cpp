@@ -38,7 +38,7 @@ TEST_CASE("install into a prefix, an outside project builds a simulator with fin
   fs::remove_all(tmp);
   fs::create_directories(tmp / "project");
   const fs::path prefix = tmp / "prefix";
-  REQUIRE(sh(fmt::format("cmake --install {} --prefix {}", KANEGEN_BUILD_DIR, prefix.string())) == 0);
+  REQUIRE(sh(fmt::format("cmake --install {} --prefix {}", kanegen::test::build_dir(), prefix.string())) == 0);
   CHECK(fs::exists(prefix / "bin" / "kanegen"));
   CHECK(fs::exists(prefix / "share" / "kanegen" / "templates" / "model.hpp.in"));
   CHECK(fs::exists(prefix / "include" / "kanegen" / "engine" / "generated_api.h"));

@@ -41,7 +41,7 @@ TEST_CASE("generated/ headers regenerate byte-identically", "[.][generated][gene
     const fs::path committed = kanegen::test::source_path("generated/" + name + ".hpp");
     REQUIRE(fs::exists(committed));
     const fs::path fresh = tmp / (name + ".hpp");
-    const std::string cmd = std::string(KANEGEN_BINARY) + " generate " + m.string() + " -o " + fresh.string() + " 2>/dev/null";
+    const std::string cmd = std::string(kanegen::test::kanegen_binary()) + " generate " + m.string() + " -o " + fresh.string() + " 2>/dev/null";
     REQUIRE(std::system(cmd.c_str()) == 0);
     CHECK(slurp(fresh) == slurp(committed));
   }

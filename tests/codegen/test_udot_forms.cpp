@@ -53,7 +53,7 @@ TEST_CASE("the per-model tests run on every model, flexible ones and node childr
   CHECK(node_children >= 3);
   // ctest holds one entry per model and per every-model test (the list CMake
   // wrote when it made them): none left out, none stale
-  std::ifstream listed(KANEGEN_PER_MODEL_LIST);
+  std::ifstream listed(kanegen::test::per_model_list());
   REQUIRE(listed);
   std::vector<std::string> names;
   for (std::string line; std::getline(listed, line);)

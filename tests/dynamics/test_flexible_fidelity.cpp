@@ -268,7 +268,7 @@ bodies:
 )";
   const std::string a = test::write_temp("beam_export.yaml", built_in);
   const std::string modal = test::write_temp("beam_export_boom.modal.yaml", "");
-  const std::string cmd = std::string(KANEGEN_BINARY) + " modes " + a + " --body boom -o " + modal + " > /dev/null";
+  const std::string cmd = std::string(kanegen::test::kanegen_binary()) + " modes " + a + " --body boom -o " + modal + " > /dev/null";
   REQUIRE(std::system(cmd.c_str()) == 0);
   std::string exported = built_in;
   const auto p0 = exported.find("      beam:"), p1 = exported.find("      damping_ratio");

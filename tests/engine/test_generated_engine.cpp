@@ -111,15 +111,15 @@ TEST_CASE("CVODE BDF with the generated Jacobian: same answer, fewer RHS evaluat
   for (std::size_t i = 0; i < ra.size(); ++i) CHECK(ra[i] == Approx(rb[i]).margin(1e-6));
 }
 
-#ifdef KANEGEN_AOT_SIM
+#ifdef KANEGEN_HAVE_AOT_SIM
 TEST_CASE("AOT simulator built by kanegen_add_model reproduces the generic engine", "[aot][generated]") {
   const fs::path tmp = fs::temp_directory_path() / ("kanegen_aot_" + std::to_string(getpid()));
   fs::create_directories(tmp);
   const std::string aot = (tmp / "aot.csv").string(), gen = (tmp / "generic.csv").string();
   const std::string model = test::source_path("models/double_pendulum.yaml");
   const std::string args = " --t-end 2 --dt-out 0.5 --integrator cvode-bdf --rtol 1e-11 --atol 1e-12";
-  REQUIRE(std::system((std::string(KANEGEN_AOT_SIM) + args + " -o " + aot + " 2>/dev/null").c_str()) == 0);
-  REQUIRE(std::system((std::string(KANEGEN_BINARY) + " simulate " + model + " --engine generic --no-progress" + args +
+  REQUIRE(std::system((std::string(kanegen::test::aot_simulator()) + args + " -o " + aot + " 2>/dev/null").c_str()) == 0);
+  REQUIRE(std::system((std::string(kanegen::test::kanegen_binary()) + " simulate " + model + " --engine generic --no-progress" + args +
                        " -o " + gen + " 2>/dev/null")
                           .c_str()) == 0);
   auto rows = [](const std::string& path) {

@@ -1,6 +1,8 @@
 // FEA modal data files (model-format.md, "Modal data file") and the built-in beam.
 #include <catch2/catch.hpp>
 
+#include "tests/support/test_support.hpp"
+
 #include <cmath>
 #include <filesystem>
 
@@ -12,8 +14,8 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-std::string data_path(const std::string& rel) { return std::string(KANEGEN_SOURCE_DIR) + "/tests/data/" + rel; }
-const std::string kHub = std::string(KANEGEN_SOURCE_DIR) + "/tests/reference/v_flex/v_flex_hub.modal.yaml";
+std::string data_path(const std::string& rel) { return std::string(kanegen::test::source_dir()) + "/tests/data/" + rel; }
+const std::string kHub = std::string(kanegen::test::source_dir()) + "/tests/reference/v_flex/v_flex_hub.modal.yaml";
 
 std::string dump(const std::vector<Diagnostic>& ds) {
   std::string s;

@@ -1,6 +1,8 @@
 // Model loading and validation (model-format.md): every refused model names
 // file, line and field; good models load with the documented layout.
 #include <catch2/catch.hpp>
+
+#include "tests/support/test_support.hpp"
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -16,7 +18,7 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-std::string data_path(const std::string& rel) { return std::string(KANEGEN_SOURCE_DIR) + "/tests/data/" + rel; }
+std::string data_path(const std::string& rel) { return std::string(kanegen::test::source_dir()) + "/tests/data/" + rel; }
 
 std::vector<Diagnostic> refusal(const std::string& path) {
   try {
@@ -221,7 +223,7 @@ nlohmann::json read_json(const std::string& path) {
 // takes a massless node's missing shape as zero (docs/decisions.md), so the
 // reference models load as they are. Shared with test_state_io.cpp.
 Model load_reference_model(const std::string& name) {
-  const auto dir = std::filesystem::path(KANEGEN_SOURCE_DIR) / "tests" / "reference" / name;
+  const auto dir = std::filesystem::path(kanegen::test::source_dir()) / "tests" / "reference" / name;
   return load_model((dir / (name + ".yaml")).string());
 }
 
@@ -239,7 +241,7 @@ namespace {
 
 std::vector<std::string> reference_models() {
   std::vector<std::string> out;
-  for (const auto& dir : std::filesystem::directory_iterator(std::string(KANEGEN_SOURCE_DIR) + "/tests/reference"))
+  for (const auto& dir : std::filesystem::directory_iterator(std::string(kanegen::test::source_dir()) + "/tests/reference"))
     if (dir.is_directory()) out.push_back(dir.path().filename().string());
   std::sort(out.begin(), out.end());
   return out;
@@ -251,7 +253,7 @@ TEST_CASE("loader: reference models load with the documented q/u layout", "[load
   const auto names = reference_models();
   REQUIRE(names.size() == 9);
   for (const auto& n : names) {
-    const std::string dir = std::string(KANEGEN_SOURCE_DIR) + "/tests/reference/" + n + "/";
+    const std::string dir = std::string(kanegen::test::source_dir()) + "/tests/reference/" + n + "/";
     INFO(n);
     const Model m = load_reference_model(n);
     const auto expected = read_json(dir + "state1.expected.json");
@@ -313,7 +315,7 @@ TEST_CASE("loader: reference v_flex details (modal subset, normalization, K, D, 
 }
 
 TEST_CASE("loader: rotation forms and inertia forms of the reference models", "[loader]") {
-  const std::string ref = std::string(KANEGEN_SOURCE_DIR) + "/tests/reference/";
+  const std::string ref = std::string(kanegen::test::source_dir()) + "/tests/reference/";
   {
     const Model m = load_model(ref + "v_prismatic_chain/v_prismatic_chain.yaml");
     Mat3 R;

@@ -19,8 +19,8 @@ Model load_reference_model(const std::string& name);
 
 namespace {
 
-const std::string kRef = std::string(KANEGEN_SOURCE_DIR) + "/tests/reference/";
-std::string data_path(const std::string& rel) { return std::string(KANEGEN_SOURCE_DIR) + "/tests/data/" + rel; }
+const std::string kRef = std::string(kanegen::test::source_dir()) + "/tests/reference/";
+std::string data_path(const std::string& rel) { return std::string(kanegen::test::source_dir()) + "/tests/data/" + rel; }
 
 /// Writes `text` to a temporary STATE.json (in this test process's own
 /// directory: ctest runs the test cases of this file in parallel) and returns its path.

@@ -56,6 +56,17 @@ Drift run_invariants(const Model& model, double t_end, IntegratorKind kind, doub
   return d;
 }
 
+const char* source_dir() { return KANEGEN_SOURCE_DIR; }
+const char* build_dir() { return KANEGEN_BUILD_DIR; }
+const char* kanegen_binary() { return KANEGEN_BINARY; }
+const char* jit_cache_dir() { return KANEGEN_TEST_CACHE_DIR; }
+const char* per_model_list() { return KANEGEN_PER_MODEL_LIST; }
+#ifdef KANEGEN_AOT_SIM
+const char* aot_simulator() { return KANEGEN_AOT_SIM; }
+#else
+const char* aot_simulator() { return ""; }
+#endif
+
 std::vector<std::string> all_models() {
   std::vector<std::string> files = model_files();
   for (const auto& d : std::filesystem::directory_iterator(source_path("tests/reference")))

@@ -13,7 +13,17 @@
 
 namespace kanegen::test {
 
-inline std::string source_path(const std::string& rel) { return std::string(KANEGEN_SOURCE_DIR) + "/" + rel; }
+/// The paths of this build: compiled into test_support.cpp alone (the other
+/// translation units are the same in every clone, so a second clone's build
+/// takes them from ccache).
+const char* source_dir();
+const char* build_dir();
+const char* kanegen_binary();   ///< the kanegen CLI
+const char* jit_cache_dir();    ///< the suite's JIT cache
+const char* per_model_list();   ///< the models CMake made per-model tests for
+const char* aot_simulator();    ///< double_pendulum_sim ("" when not built)
+
+inline std::string source_path(const std::string& rel) { return std::string(kanegen::test::source_dir()) + "/" + rel; }
 
 /// max |a - b| / max(max|b|, floor): the error relative to the largest entry.
 inline double rel_err(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double floor = 1e-300) {
@@ -28,7 +38,7 @@ inline double rel_err(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double
 /// once for every test that asks for it (tests/CMakeLists.txt).
 inline JitOptions jit_options() {
   JitOptions o;
-  o.cache_dir = KANEGEN_TEST_CACHE_DIR;
+  o.cache_dir = kanegen::test::jit_cache_dir();
   o.quiet = true;  // the suite's output stays readable
   o.quick = true;
   return o;
