@@ -44,14 +44,17 @@ double EventRun::next_stop(double t, double t_end) const {
   return t_end;
 }
 
-bool EventRun::time_event_due(double t) const {
+std::vector<int> EventRun::time_events_due(double t) const {
+  std::vector<int> due;
   for (std::size_t k = next_time_; k < by_time_.size(); ++k) {
-    const double at = events_[by_time_[k]].at;
-    if (at > t + time_tol(t)) return false;
-    if (!done_[by_time_[k]] && std::abs(at - t) <= time_tol(t)) return true;
+    const int i = by_time_[k];
+    if (events_[i].at > t + time_tol(t)) break;
+    if (!done_[i] && std::abs(events_[i].at - t) <= time_tol(t)) due.push_back(i);
   }
-  return false;
+  return due;
 }
+
+bool EventRun::time_event_due(double t) const { return !time_events_due(t).empty(); }
 
 void EventRun::arm(OdeProblem& p) {
   armed_.clear();
@@ -75,13 +78,8 @@ void EventRun::arm(OdeProblem& p) {
 }
 
 int EventRun::fire(Engine& engine, double t, VecX& x, int crossing) {
-  std::vector<int> due;
+  std::vector<int> due = time_events_due(t);
   if (crossing >= 0 && crossing < static_cast<int>(armed_.size())) due.push_back(armed_[crossing]);
-  for (std::size_t k = next_time_; k < by_time_.size(); ++k) {
-    const int i = by_time_[k];
-    if (events_[i].at > t + time_tol(t)) break;
-    if (!done_[i] && std::abs(events_[i].at - t) <= time_tol(t)) due.push_back(i);
-  }
   std::sort(due.begin(), due.end());
   due.erase(std::unique(due.begin(), due.end()), due.end());
   const int nq = model_.nq, nu = model_.nu;

@@ -60,6 +60,8 @@ class EventRun {
   std::vector<int> crossings_;      ///< the crossing events, in file order
   /// Moves next_time_ past the time events fired or passed.
   void skip_done();
+  /// The unfired time events due at t (model event indices).
+  std::vector<int> time_events_due(double t) const;
 };
 
 /// "deploy at t = 10: release panel; latch at t = 12.3: lock panel (energy lost 0.53 J)"

@@ -71,11 +71,7 @@ int run(const Options& o) {
   if (o.format != "json" && o.output.empty())
     throw InputError(Diagnostic{"(command line)", 0, "--format",
                                 fmt::format("--format {} writes a file; expected -o OUT as well", o.format)});
-  if (!o.output.empty()) {
-    std::vector<std::string> inputs = input_files(model);
-    if (!o.state.empty()) inputs.push_back(o.state);
-    check_output_options({{"-o", o.output}}, inputs);
-  }
+  if (!o.output.empty()) check_output_options({{"-o", o.output}}, input_files(model, o.state));
   auto engine = make_engine(model, o.engine, o.native);
   LinearizeOptions lo;
   lo.inputs = o.inputs;

@@ -23,9 +23,7 @@ int run(const Options& o) {
   const SimulationOptions opt = simulation_options(o.sim, state);
   std::vector<OutputOption> outputs{{"-o", o.sim.output}};
   if (o.events_option->count() > 0) outputs.push_back({"--events", o.events});
-  std::vector<std::string> inputs = input_files(model);
-  if (!o.state.empty()) inputs.push_back(o.state);
-  check_output_options(outputs, inputs);  // before any work: nothing is written on a refusal
+  check_output_options(outputs, input_files(model, o.state));  // before any work: nothing is written on a refusal
   // explicit methods (and auto's choice, from central differences when no
   // Jacobian is compiled) need no derivatives; the implicit ones use the exact Jacobian
   const IntegratorKind k = opt.integrator.kind;
