@@ -99,6 +99,26 @@ void check_output_option(const std::string& option, const std::string& path) {
   }
 }
 
+void check_output_directory_option(const std::string& option, const std::string& dir) {
+  auto refuse = [&](const std::string& why) {
+    throw InputError(Diagnostic{option, 0, "", fmt::format("cannot write '{}': {}", dir, why)});
+  };
+  if (dir.empty()) refuse("empty output directory");
+  std::error_code ec;
+  fs::path p = fs::absolute(dir, ec).lexically_normal();
+  if (ec) refuse(ec.message());
+  if (fs::exists(p, ec)) {
+    if (!fs::is_directory(p, ec)) refuse("is not a directory; expected an output directory");
+    if (access(p.c_str(), W_OK | X_OK) != 0) refuse("directory is not writable");
+    return;
+  }
+  // created with its missing parents: the nearest existing ancestor must be a writable directory
+  fs::path a = p;
+  while (a.has_parent_path() && a != a.parent_path() && !fs::exists(a, ec)) a = a.parent_path();
+  if (!fs::is_directory(a, ec)) refuse(a.string() + " is not a directory");
+  if (access(a.c_str(), W_OK | X_OK) != 0) refuse("directory " + a.string() + " is not writable");
+}
+
 namespace {
 
 /// The file a path names, for comparing two paths (symbolic links and ./.. resolved).

@@ -64,6 +64,12 @@ void check_output_path(const std::string& path);
 /// InputError "OPTION: cannot write 'PATH': why" (exit 2).
 void check_output_option(const std::string& option, const std::string& path);
 
+/// An output directory (a sweep's -o): refused with an InputError naming
+/// `option` when it is empty, exists and is not a directory (a file, e.g.
+/// one of the command's inputs), is an unwritable directory, or would be
+/// created under an ancestor that is not a writable directory.
+void check_output_directory_option(const std::string& option, const std::string& dir);
+
 /// One output of a command: the option that names it and its path.
 struct OutputOption {
   std::string option, path;

@@ -531,6 +531,7 @@ PYBIND11_MODULE(kanegen, m) {
          const std::string& engine) {
         return translating([&] {
           const SweepPlan plan = plan_sweep(load_sweep_spec(path));
+          if (!output.empty()) check_sweep_output_directory("output", output);  // before any run
           const std::string which = engine.empty() ? plan.spec.engine : engine;
           std::unique_ptr<Engine> e;
           if (which == "generated") e = jit_load(plan.model, codegen::jit_code_generator(), JitOptions{});

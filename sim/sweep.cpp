@@ -18,6 +18,7 @@
 
 #include "model/diagnostics.hpp"
 #include "model/model_hash.hpp"
+#include "model/model_files.hpp"
 #include "model/model_loader.hpp"
 #include "model/output_file.hpp"
 #include "model/parameters.hpp"
@@ -453,6 +454,26 @@ void run_on_threads(const SweepPlan& plan, const std::vector<long>& indices, int
   work(engines[0].get());
   for (auto& t : pool) t.join();
   if (error) std::rethrow_exception(error);
+}
+
+std::vector<std::string> sweep_input_files(const SweepPlan& plan) {
+  std::vector<std::string> files{plan.spec.path};
+  for (const std::string& f : model_files(plan.model)) files.push_back(f);
+  return files;
+}
+
+void check_sweep_output_directory(const std::string& option, const std::string& dir,
+                                  const std::vector<std::string>& merged) {
+  check_output_directory_option(option, dir);
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(fs::absolute(dir), ec);
+  for (const std::string& m : merged)
+    if (fs::weakly_canonical(fs::absolute(m), ec) == out)
+      throw InputError(Diagnostic{option, 0, "",
+                                  fmt::format("cannot write '{}': it is a shard directory merged by this command; "
+                                              "expected another directory",
+                                              dir)});
 }
 
 void write_sweep_outputs(const SweepPlan& plan, const std::vector<RunResult>& results, const std::string& dir) {

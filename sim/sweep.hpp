@@ -100,6 +100,17 @@ void run_on_threads(const SweepPlan& plan, const std::vector<long>& indices, int
 /// `results` must be sorted by index.
 void write_sweep_outputs(const SweepPlan& plan, const std::vector<RunResult>& results, const std::string& dir);
 
+/// The files a sweep reads: the sweep file, the model file and its modal
+/// files (what none of its outputs may overwrite).
+std::vector<std::string> sweep_input_files(const SweepPlan& plan);
+
+/// Before any run (issue 34): the output directory `dir` of the sweep's
+/// tables (check_output_directory_option, never one of the sweep's input
+/// files nor one of the shard directories `merged`), named by `option` in a
+/// refusal (an InputError, exit 2).
+void check_sweep_output_directory(const std::string& option, const std::string& dir,
+                                  const std::vector<std::string>& merged = {});
+
 /// An 8-hex-digit identity of the sweep file's text: results of another
 /// sweep are never resumed or merged with these.
 std::string sweep_identity(const SweepPlan& plan);

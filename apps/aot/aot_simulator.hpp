@@ -15,12 +15,14 @@
 #include <memory>
 #include <string>
 
+#include "apps/common/command_line_arguments.hpp"
 #include "apps/common/simulation_cli.hpp"
 #include "apps/common/sweep_cli.hpp"
 #include "engine/generated_api.h"
 #include "engine/generated_engine.hpp"
 #include "engine/model_checks.hpp"
 #include "model/diagnostics.hpp"
+#include "model/model_files.hpp"
 #include "model/model_loader.hpp"
 #include "model/output_file.hpp"
 #include "model/state_io.hpp"
@@ -81,7 +83,8 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
   sweep_cmd->add_flag("--open-loop", open_loop, "run the sweep without the compiled-in controller");
 #endif
   try {
-    app.parse(argc, argv);
+    cli::CommandLineArguments args(argc, argv);
+    app.parse(args.argc(), args.argv());
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
@@ -111,6 +114,7 @@ inline int aot_simulator_main(int argc, char** argv, const KanegenGeneratedApi* 
     const Model model = load_model(model_file);
     check_mass_matrix_at_initial_state(model);
     const State state = state_path.empty() ? initial_state(model) : load_state(model, state_path);
+    if (!eval) check_output_options({{"-o", sim.output}}, input_files(model, state_path));  // before any work
     std::unique_ptr<GeneratedEngine> engine_ptr;
     try {
       engine_ptr = std::make_unique<GeneratedEngine>(model, api);

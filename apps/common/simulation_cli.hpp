@@ -90,7 +90,7 @@ inline SimulationOptions simulation_options(const SimulationCli& o, const State&
       fault("--h", fmt::format("rk4 would take {:.3g} steps of {} s (more than {:.0e}); expected a larger step",
                                steps, o.h, kMaxFixedSteps));
   }
-  if (o.output.empty()) fault("-o", "an output CSV file is required");
+  if (o.output.empty()) fault("-o", "cannot write '': empty output path; expected an output CSV file");
   if (!faults.empty()) throw InputError(faults);
   check_output_option("-o", o.output);
   opt.t_end = o.t_end;

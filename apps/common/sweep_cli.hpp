@@ -44,6 +44,8 @@ struct SweepCli {
   std::string shard;
   std::vector<std::string> merge;
   bool no_progress = false;
+  CLI::Option* output_option = nullptr;  ///< to tell -o "" (refused) from no -o (the default place)
+  bool output_given() const { return output_option && output_option->count() > 0; }
 };
 
 /// Progress on stderr: runs done, runs/s, ETA (a terminal, or --progress under mpirun).
@@ -121,7 +123,8 @@ inline int run_sweep_cli(const SweepCli& o, const std::function<std::unique_ptr<
 
   if (o.run >= 0) {  // one run, replayed alone with its full time history
     if (o.run >= spec.runs) throw InputError(Diagnostic{"--run", 0, "", fmt::format("{}; the sweep has runs 0 to {}", o.run, spec.runs - 1)});
-    const std::string path = o.output.empty() ? fmt::format("run_{}.csv", o.run) : o.output;
+    const std::string path = o.output_given() ? o.output : fmt::format("run_{}.csv", o.run);
+    check_output_options({{"-o", path}}, sweep_input_files(plan));  // before the run: nothing written on a refusal
     OutputFile out(path);
     auto engine = make(plan.model);
     const RunResult r = run_one(*engine, plan, o.run, &out.stream(), controller);
@@ -136,7 +139,8 @@ inline int run_sweep_cli(const SweepCli& o, const std::function<std::unique_ptr<
     return 0;
   }
 
-  const std::string dir = o.output.empty() ? fs::path(o.sweep).replace_extension(".out").string() : o.output;
+  const std::string dir = o.output_given() ? o.output : fs::path(o.sweep).replace_extension(".out").string();
+  check_sweep_output_directory("-o", dir, o.merge);  // before any run
   if (!o.merge.empty()) {  // shards' results into one table
     std::map<long, RunResult> all;
     for (const std::string& d : o.merge) {
@@ -256,7 +260,7 @@ inline int run_sweep_cli(const SweepCli& o, const std::function<std::unique_ptr<
 /// The sweep's options: SWEEP.yaml, -o, --threads, --run, --shard, --merge, --no-progress.
 inline void add_sweep_options(CLI::App* c, SweepCli& o) {
   c->add_option("sweep", o.sweep, "SWEEP.yaml")->required()->check(CLI::ExistingFile);
-  c->add_option("-o,--output", o.output, "output directory (default SWEEP.out/); with --run, the run's CSV");
+  o.output_option = c->add_option("-o,--output", o.output, "output directory (default SWEEP.out/); with --run, the run's CSV");
   c->add_option("--threads", o.threads, "threads (default: every core); under mpirun each rank runs one run at a time");
   c->add_option("--run", o.run, "replay one run alone and write its full time history")->check(CLI::Range(0L, 100000000L));
   c->add_option("--shard", o.shard, "i/N: the runs k with k mod N = i (a batch scheduler's job array)");

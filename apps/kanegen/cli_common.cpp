@@ -110,14 +110,6 @@ std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name,
       Diagnostic{"--engine", 0, "", fmt::format("unknown engine '{}'; expected generated, generic or auto", name)});
 }
 
-std::vector<std::string> input_files(const Model& model, const std::string& state_path) {
-  std::vector<std::string> files{model.source_path};
-  for (const Body& b : model.bodies)
-    if (b.flex && b.flex->source != "beam" && !b.flex->source.empty()) files.push_back(b.flex->source);
-  if (!state_path.empty()) files.push_back(state_path);
-  return files;
-}
-
 State state_for(const Model& model, const std::string& state_path) {
   return state_path.empty() ? initial_state(model) : load_state(model, state_path);
 }

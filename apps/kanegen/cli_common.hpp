@@ -48,9 +48,6 @@ Model load_checked(const std::string& path);
 /// `quick`: a build for a few evaluations (JitOptions::quick).
 std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name, bool native = false,
                                     bool derivatives = true, bool quick = false);
-/// The files a command on `model` reads: the model file, its modal files and
-/// the state file when one is given (what no output may overwrite, check_output_options).
-std::vector<std::string> input_files(const Model& model, const std::string& state_path);
 /// The model's initial state, or STATE.json when a path is given.
 State state_for(const Model& model, const std::string& state_path);
 

@@ -9,6 +9,7 @@
 #include "codegen/assembler.hpp"
 #include "codegen/generator.hpp"
 #include "engine/resources.hpp"
+#include "model/model_files.hpp"
 #include "model/output_file.hpp"
 
 namespace kanegen::cli {
@@ -20,13 +21,16 @@ struct Options {
 };
 
 int run(const Options& o) {
-  // Every output's place is checked before any work, so that a bad path is
-  // refused up front and nothing is half-written.
-  const std::pair<const char*, const std::string*> outputs[] = {
-      {"-o", &o.output}, {"--entry", &o.entry}, {"--manifest", &o.manifest}, {"--depfile", &o.depfile}};
-  for (const auto& [option, path] : outputs)
-    if (!path->empty()) check_output_option(option, *path);
+  // Every output is checked before any work (and against the files the
+  // model is read from), so that a bad path is refused up front and nothing
+  // is half-written.
   const Model model = load_checked(o.model);
+  std::vector<OutputOption> outputs{{"-o", o.output}};
+  const std::pair<const char*, const std::string*> optional[] = {
+      {"--entry", &o.entry}, {"--manifest", &o.manifest}, {"--depfile", &o.depfile}};
+  for (const auto& [option, path] : optional)
+    if (!path->empty()) outputs.push_back({option, *path});
+  check_output_options(outputs, model_files(model));
   codegen::GeneratorOptions opt;
   opt.udot_form = o.form;
   const codegen::EmittedModel emitted = codegen::generate(model, opt);
@@ -43,9 +47,7 @@ int run(const Options& o) {
       for (char c : std::filesystem::absolute(f).string()) e += (c == ' ' ? std::string("\\ ") : std::string(1, c));
       deps += " " + e;
     };
-    add(model.source_path);
-    for (const Body& b : model.bodies)
-      if (b.flex && b.flex->source != "beam") add(b.flex->source);
+    for (const std::string& f : model_files(model)) add(f);
     write_file_atomically(o.depfile, deps + "\n");
   }
   const auto* udot = emitted.find("udot");

@@ -10,6 +10,7 @@
 
 #include "apps/kanegen/cli_common.hpp"
 #include "model/diagnostics.hpp"
+#include "model/model_files.hpp"
 #include "model/output_file.hpp"
 #include "sim/linearize.hpp"
 #include "sim/matrix_files.hpp"
@@ -22,6 +23,7 @@ struct Options {
   std::string model, state, engine = "generated", format = "json", output;
   std::vector<std::string> inputs, outputs;
   bool native = false, finite_differences = false, quiet = false, drop_ignorable = false;
+  CLI::Option* output_option = nullptr;  ///< to tell -o "" (refused) from no -o (JSON on stdout)
 };
 
 void print_modes(const LinearModel& lin, const std::vector<LinearMode>& modes) {
@@ -68,10 +70,11 @@ void print_modes(const LinearModel& lin, const std::vector<LinearMode>& modes) {
 int run(const Options& o) {
   const Model model = load_checked(o.model);
   const State state = state_for(model, o.state);
-  if (o.format != "json" && o.output.empty())
+  const bool to_file = o.output_option->count() > 0;
+  if (o.format != "json" && !to_file)
     throw InputError(Diagnostic{"(command line)", 0, "--format",
                                 fmt::format("--format {} writes a file; expected -o OUT as well", o.format)});
-  if (!o.output.empty()) check_output_options({{"-o", o.output}}, input_files(model, o.state));
+  if (to_file) check_output_options({{"-o", o.output}}, input_files(model, o.state));
   auto engine = make_engine(model, o.engine, o.native);
   LinearizeOptions lo;
   lo.inputs = o.inputs;
@@ -124,7 +127,7 @@ Subcommand add_linearize(CLI::App& app) {
       ->delimiter(',');
   c->add_option("--format", o->format, "json (default), npz (numpy), mat (MATLAB) or csv (one file per matrix)")
       ->check(CLI::IsMember({"json", "npz", "mat", "csv"}));
-  c->add_option("-o,--output", o->output, "output file (csv: the prefix of OUT_A.csv ...); JSON goes to stdout without it");
+  o->output_option = c->add_option("-o,--output", o->output, "output file (csv: the prefix of OUT_A.csv ...); JSON goes to stdout without it");
   c->add_flag("--finite-differences", o->finite_differences,
               "central differences instead of the exact derivatives (a cross-check)");
   c->add_flag("--drop-ignorable", o->drop_ignorable,

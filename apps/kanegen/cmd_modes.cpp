@@ -10,6 +10,7 @@
 #include "model/modal_data.hpp"
 #include "model/second_order.hpp"
 #include "model/model_loader.hpp"
+#include "model/model_files.hpp"
 #include "model/output_file.hpp"
 
 namespace kanegen::cli {
@@ -22,8 +23,8 @@ struct Options {
 };
 
 int run(const Options& o) {
-  check_output_option("-o", o.output);
   const Model model = load_model(o.model);
+  check_output_options({{"-o", o.output}}, model_files(model));
   const int i = model.body_index(o.body);
   if (i < 0 || !model.bodies[i].flex)
     throw InputError(Diagnostic{o.model, 0, "--body",

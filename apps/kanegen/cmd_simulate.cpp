@@ -4,6 +4,7 @@
 #include "apps/common/simulation_cli.hpp"
 #include "apps/kanegen/cli_common.hpp"
 #include "engine/handover_engine.hpp"
+#include "model/model_files.hpp"
 #include "model/output_file.hpp"
 
 namespace kanegen::cli {

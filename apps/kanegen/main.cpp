@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "apps/common/command_line_arguments.hpp"
 #include "apps/kanegen/cli_common.hpp"
 #include "engine/jit.hpp"
 #include "model/diagnostics.hpp"
@@ -20,7 +21,8 @@ int main(int argc, char** argv) {
                                                  cli::add_bench(app),      cli::add_linearize(app),
                                                  cli::add_sweep(app),      cli::add_compile(app)};
   try {
-    app.parse(argc, argv);
+    cli::CommandLineArguments args(argc, argv);
+    app.parse(args.argc(), args.argv());
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : cli::kExitRefused;

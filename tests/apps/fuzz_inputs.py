@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Fuzz kanegen's input handling with mutated model, modal and STATE.json files.
+"""Fuzz kanegen's input handling: mutated model, modal and STATE.json files,
+simulate's output paths, and a run through gimbal lock.
 
     fuzz_inputs.py --kanegen BIN --seed S --budget-seconds T
                    [--report report.json] [--keep-failures DIR] [--timeout 10]
@@ -16,6 +17,46 @@ same relative paths) into a temporary directory, mutates one file, and runs
 there, with a timeout per run:
     model or modal mutated:  BIN check MODEL;  BIN eval MODEL --engine generic
     STATE.json mutated:      BIN eval MODEL --engine generic --state STATE.json
+Two more case kinds run simulate, unmutated files, in the same way:
+    cli (simulate's output paths, issue 34; any seed; --events only for a seed
+    whose model has an events: list, else -o alone):
+        BIN simulate MODEL --engine generic --t-end 0.05 --dt-out 0.01
+            --no-progress -o PATH [--events PATH] [--state STATE.json]
+        (--t-end 0.05 after the state's t with --state; each option spelled
+        -o X, --output X, --output=X, --events X or --events=X). One path is
+        at fault, the other (if any) is a good distinct path:
+          c_same_file    -o and --events on one file (as given, ./x, sub/../x,
+                         the absolute path)
+          c_input_file   an output on an input: the model, a modal file it
+                         names, the --state file (as given, ./x, sub/../x, the
+                         absolute path, a symbolic link to it)
+          c_empty_path   '' (or --output=, --events=)
+          c_missing_dir  a path in a directory that does not exist, or under a
+                         file (MODEL/out.csv)
+          c_directory    a path that is a directory (., .., sub, sub/, ./sub/..,
+                         the case directory, a modal file's directory)
+        all "invalid": exit 2, every message line names an option
+        (^(--[a-z][a-z0-9-]*|-o): ; CLI11's own "Run with --help for more
+        information." line is let pass), one of them the option at fault (-o
+        or --output, or --events; either for c_same_file), and NOTHING written:
+        every file in the case directory byte-identical, no file, directory or
+        link added or removed. A hard link to an input is "either": refused
+        (nothing written) or exit 0 with the link replaced and the input as it
+        was. The control, c_control, gives distinct valid paths ("valid": exit
+        0, each output written and non-empty, nothing else changed).
+    gimbal (a model generated here, GIMBAL_MODEL, as the test "a gimbal
+    oscillating through lock" in tests/apps/test_cli.cpp: a gimbal xyz joint
+    with a spring on its middle angle, rest 1.67, from angle2 = 1.45 (or 1.3,
+    1.5, 1.55), so it passes pi/2):
+        BIN simulate gimbal_oscillator.yaml --engine generic --integrator I
+            --t-end 2 --dt-out DT --no-progress -o out.csv [--events ev.csv]
+        I from rk4, dopri5, rkf78, cvode-bdf; DT from 0.31, 0.01, 0.07, 1, 2.5
+        or random in [0.003, 3]. Expected ("lock"): exit 1, a message with
+        "gimbal lock", and nothing written (no out.csv, no ev.csv).
+The case kinds with a handful of pairs (s_events and c_same_file: two seeds;
+gimbal: one) are
+scheduled EVENTS_WEIGHT and GIMBAL_WEIGHT times a round so that a 30 s budget,
+a third of a round, sees them.
 
 Every mutation declares what the tool must do with it:
     valid    exit 0 (eval: and strict JSON on stdout: no null, NaN, Infinity)
@@ -43,9 +84,20 @@ given twice; types swapped; nesting 33..100000 deep in flow and block style;
 names (keywords, digits, 300 characters, bad characters); parents; joint types;
 axes; rotations; inertia; masses; list lengths; outputs; prescribed motion;
 initial quaternions; node ids; flexible blocks; modal normalization;
-second_order symmetry; huge gravity). The j_* operators do the same for
+second_order symmetry; huge gravity; events). The j_* operators do the same for
 STATE.json (duplicate keys, deep nesting, unknown names, wrong types, number
 range, huge values, quaternions tiny/huge/zero/partial/5e-324, valid edits).
+
+s_events (models with a top-level events: list only: models/array_deployment.yaml,
+models/probe_separation.yaml; model-format.md, Locks and events):
+    lock: [] or release: [] on an event (an empty action list)    invalid
+    when: {coordinate: B.qw|qx|qy|qz} (a free or ball joint's
+      quaternion component)                                        invalid
+    when: {coordinate: another position, angle or modal coordinate} valid
+    at: another finite time >= 0 (0, 1e-9, 3.5, 86400.0, ...)      valid
+    at: .nan, .inf, -.inf, 1e400; a string; null                  invalid
+    at: negative (-1.0, -1e-9, -1e300)                             either
+      (the spec only says "at: T (s) fires at time T"; kanegen refuses it)
 
 Choices this harness makes where the spec is silent (change them here):
   * a leading-zero integer in YAML ("010") is decimal ten, as YAML 1.2 core;
@@ -59,11 +111,17 @@ Choices this harness makes where the spec is silent (change them here):
   * null where a number is expected is "invalid"; 1e-400 (underflows to 0)
     is "either"; subnormals such as 5e-324 are ordinary numbers;
   * dropping a body's com or inertia, or a beam's elements or modes, is
-    "either": model-format.md gives no default, kanegen has one.
+    "either": model-format.md gives no default, kanegen has one;
+  * an event's negative at: is "either" (above);
+  * an output path that is a hard link to an input is "either" (above); a
+    symbolic link to one is "invalid", as kanegen refuses to write through any
+    symbolic link.
 
 Outcome of each run (one class per run; the first that applies):
     crash          killed by a signal, or an exit status not in {0, 1, 2}
     timeout        still running after --timeout seconds (killed)
+    written-on-refusal  (cli, gimbal) a run that exits non-zero changed the
+                   case directory (a file written, created or removed)
     wrongly-refused  exit 2 for a "valid" mutation
     silent-accept  exit 0 for an "invalid" mutation
     exit1-on-input exit 1 where 0 or 2 was due (any expectation), except eval
@@ -73,12 +131,20 @@ Outcome of each run (one class per run; the first that applies):
                    not located, or stderr is empty
     null-in-json   eval exit 0 but stdout is not strict JSON (null, NaN,
                    Infinity, or not parseable)
+    wrong-files    (cli) exit 0, but an output is missing or empty, or a file
+                   other than the outputs changed (an input, say)
+    missed-lock    (gimbal) not exit 1 with a message naming gimbal lock
     ok-valid       exit 0 as allowed (and strict JSON for eval)
-    ok-refused     exit 2 as allowed, every line located
+    ok-refused     exit 2 as allowed, every line located (cli: every line
+                   names an option, one of them the option at fault)
     ok-nonfinite   eval exit 1 naming a non-finite quantity (or a singular
                    mass matrix) for an "either" mutation
-The run fails (exit 1) when any class other than ok-valid, ok-refused and
-ok-nonfinite has a count.
+    ok-stopped     (gimbal) exit 1 naming gimbal lock, nothing written
+For cli and gimbal runs "unlocated" means a refusal whose messages do not all
+name an option or name none of the options at fault, and "silent-accept" exit
+0 for a path that must be refused.
+The run fails (exit 1) when any class other than ok-valid, ok-refused,
+ok-nonfinite and ok-stopped has a count.
 
 A message line is located when it matches LOCATED_RE
     ^(?P<file>[^:\\n]+):(?P<line>[1-9][0-9]*): (?P<field>[^:\\n]+): \\S
@@ -91,7 +157,7 @@ while "f.yaml:3: a second YAML document; ..." (no field) and "f.json: q.x: ..."
 (no line) do not, nor does a field that prints a user's key with a colon in
 it unquoted ("f.yaml:8: descri:]ption: unknown key ...").
 
-Deterministic for a seed: case N is the same mutation whatever the budget (the
+Deterministic for a seed: case N is the same mutation (or run) whatever the budget (the
 values of the synthesized STATE.json seeds come from BIN's eval output, so
 they may differ between binaries). --case N runs only case N (to reproduce).
 """
@@ -103,6 +169,7 @@ import math
 import os
 import random
 import re
+import shlex
 import shutil
 import signal
 import subprocess
@@ -123,8 +190,9 @@ LOCATED_RE = re.compile(r"^(?P<file>[^:\n]+):(?P<line>[1-9][0-9]*): (?P<field>[^
 OPTION_RE = re.compile(r"^(--[a-z][a-z0-9-]*|-o): \S")
 NONFINITE_RE = re.compile(r"(?i)(non-?finite|not finite|\bnan\b|\binf\b|\binfinity\b|overflow|singular)")
 
-OK_CLASSES = ["ok-valid", "ok-refused", "ok-nonfinite"]
-FAIL_CLASSES = ["crash", "timeout", "wrongly-refused", "silent-accept", "exit1-on-input", "unlocated", "null-in-json"]
+OK_CLASSES = ["ok-valid", "ok-refused", "ok-nonfinite", "ok-stopped"]
+FAIL_CLASSES = ["crash", "timeout", "written-on-refusal", "wrongly-refused", "silent-accept", "exit1-on-input",
+                "unlocated", "null-in-json", "wrong-files", "missed-lock"]
 ALL_CLASSES = OK_CLASSES + FAIL_CLASSES
 
 NUM_RE = re.compile(r"^[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)([eE][-+]?[0-9]+)?$")
@@ -503,9 +571,8 @@ def unlocated_lines(stderr, case_files):
     return bad
 
 
-def classify(expect, cmd, res, case_files):
-    """One outcome class for one run, and a short reason."""
-    rc, err = res["rc"], res["stderr"]
+def crash_or_timeout(res):
+    rc = res["rc"]
     if res["timed_out"]:
         return "timeout", f"killed after {res['seconds']:.1f} s"
     if rc is None or rc < 0 or rc not in (0, 1, 2):
@@ -516,6 +583,15 @@ def classify(expect, cmd, res, case_files):
             except ValueError:
                 pass
         return "crash", f"exit status {rc}{sig}"
+    return None
+
+
+def classify(expect, cmd, res, case_files):
+    """One outcome class for one run, and a short reason."""
+    rc, err = res["rc"], res["stderr"]
+    r = crash_or_timeout(res)
+    if r:
+        return r
     if rc == 2:
         if expect == "valid":
             return "wrongly-refused", "exit 2 for a valid input"
@@ -1815,6 +1891,88 @@ def s_gravity_huge(rng, seed, sf):
     return None
 
 
+
+def events_nodes(doc):
+    """(index, event mapping node) for the top-level events: list."""
+    if doc is None or not isinstance(doc.root, yaml.MappingNode):
+        return []
+    _, ev = get(doc.root, "events")
+    if not isinstance(ev, yaml.SequenceNode):
+        return []
+    return [(i, e) for i, e in enumerate(ev.value) if isinstance(e, yaml.MappingNode)]
+
+
+def s_events(rng, seed, sf):
+    """The events: list (model-format.md, Locks and events): an empty lock:/release: list, a state event on a
+    quaternion component or on another coordinate, the time of a time event."""
+    doc = sf.doc
+    if doc is None or sf.rel != seed.model_rel:
+        return None
+    evs = events_nodes(doc)
+    if not evs:
+        return None
+    kind = rng.choice(["empty_action", "quat_coordinate", "other_coordinate", "at_valid", "at_bad"])
+    if kind == "empty_action":
+        i, e = rng.choice(evs)
+        action = rng.choice(["lock", "release"])
+        k, v = get(e, action)
+        if v is not None:
+            out = replace_value(doc, v, k, "[]")
+        else:
+            edit = pair_insert_edit(doc.text, e, f"{action}: []")
+            if edit is None:
+                return None
+            out = apply_edits(doc.text, [edit])
+        return out, "invalid", f"events[{i}].{action}: [] (an empty action list)"
+    if kind in ("quat_coordinate", "other_coordinate"):
+        cands = []
+        for i, e in evs:
+            _, w = get(e, "when")
+            k, c = get(w, "coordinate")
+            if isinstance(c, yaml.ScalarNode):
+                cands.append((i, k, c))
+        quat = [n for n in seed.q_names if re.search(r"\.q[wxyz]$", n)]
+        if kind == "quat_coordinate":
+            names, expect, what = quat, "invalid", "a component of a free or ball joint's quaternion"
+        else:
+            prescribed = set(seed.prescribed)
+            names, expect, what = [n for n in seed.q_names if n not in quat and n not in prescribed], "valid", \
+                "another coordinate (a position, an angle or a modal coordinate)"
+        if not cands or not names:
+            return None
+        i, k, c = rng.choice(cands)
+        name = rng.choice(names)
+        if name == c.value:
+            return None
+        out = replace_value(doc, c, k, name)
+        return out, expect, f"events[{i}].when.coordinate: {c.value} -> {name} ({what})"
+    times = []
+    for i, e in evs:
+        k, v = get(e, "at")
+        if isinstance(v, yaml.ScalarNode):
+            times.append((i, k, v))
+    if not times:
+        return None
+    i, k, v = rng.choice(times)
+    if kind == "at_valid":
+        name, expect, pool = "another finite time", "valid", ["0", "0.0", "1e-9", "0.25", "3.5", "7", "12.75", "2.5e2",
+                                                                "1e3", "86400.0"]
+    else:
+        # model-format.md says no more than "at: T (s) fires at time T": a negative time is "either" (kanegen
+        # refuses it); a time that is no finite number is refused as any number is
+        name, expect, pool = rng.choice([
+            ("negative", "either", ["-1.0", "-0.5", "-1e-9", "-10", "-1e300"]),
+            ("nonfinite", "invalid", [".nan", ".NaN", ".inf", "-.inf", "1e400"]),
+            ("string", "invalid", ["ten", "abc", "'later'", "10 s", "now", "1.0.0"]),
+            ("null", "invalid", ["null", "~"]),
+        ])
+    repl = rng.choice(pool)
+    if repl == v.value:
+        return None
+    out = replace_value(doc, v, k, repl)
+    return out, expect, f"events[{i}].at: {v.value} -> {repl} ({name})"
+
+
 MODEL_OPS = [
     ("t_delete_line", t_delete_line), ("t_duplicate_line", t_duplicate_line), ("t_swap_lines", t_swap_lines),
     ("t_truncate", t_truncate), ("t_insert_bytes", t_insert_bytes), ("t_reindent", t_reindent),
@@ -1828,7 +1986,7 @@ MODEL_OPS = [
     ("s_inertia", s_inertia), ("s_mass", s_mass), ("s_list_length", s_list_length), ("s_outputs", s_outputs),
     ("s_motion", s_motion), ("s_initial_quaternion", s_initial_quaternion), ("s_node_refs", s_node_refs),
     ("s_flexible", s_flexible), ("s_modal_normalization", s_modal_normalization),
-    ("s_second_order", s_second_order), ("s_gravity_huge", s_gravity_huge),
+    ("s_second_order", s_second_order), ("s_gravity_huge", s_gravity_huge), ("s_events", s_events),
 ]
 # structure operators that also apply to modal files, and those that apply to modal files only
 MODAL_TOO = {"s_num_replace", "s_num_valid_forms", "s_drop_key", "s_add_key", "s_dup_key", "s_swap_type",
@@ -1836,6 +1994,10 @@ MODAL_TOO = {"s_num_replace", "s_num_valid_forms", "s_drop_key", "s_add_key", "s
 MODAL_ONLY = {"s_modal_normalization", "s_second_order"}
 # operators that are formatting-only and "valid": self-checked with PyYAML (same data), else downgraded
 FORMAT_ONLY = {"t_doc_markers", "t_line_endings", "t_comments", "t_whitespace", "s_num_valid_forms"}
+# operators (model and cli) for models with a top-level events: list only (two seeds), each pair
+# scheduled this many times a round, so that a 30 s budget (about a third of a round) sees them
+EVENTS_ONLY = {"s_events", "c_same_file"}
+EVENTS_WEIGHT = 12
 
 # ---- STATE.json
 
@@ -2136,19 +2298,296 @@ STATE_OPS = [
     ("j_huge_value", j_huge_speed), ("j_quaternion", j_quaternion), ("j_valid_edits", j_valid_edits),
 ]
 
+# ---- simulate's output paths (target "cli") and the gimbal-lock run (target "gimbal")
+#
+# A run operator is f(rng, seed) -> dict or None:
+#   argv        the command (after BIN); "@CASE@" is replaced by the case directory's absolute path
+#   expect      "invalid" (exit 2, one message naming an option of opts, nothing written), "valid" (exit 0,
+#               the outputs written, nothing else changed), "either" (exit 0 or 2; on exit 0 only outputs
+#               and may_change may change) or "lock" (exit 1 naming gimbal lock, nothing written)
+#   detail, opts (the options a refusal may name), outputs, may_change (paths relative to the case directory),
+#   setup       ("dir", path) | ("symlink", path, target) | ("hardlink", path, existing file), made before the run
+#   files       extra files written into the case directory (a STATE.json)
+
+SIM_ARGS = ["--engine", "generic", "--t-end", "0.05", "--dt-out", "0.01", "--no-progress"]
+CLI11_HINT = "Run with --help for more information."  # the line CLI11 adds after its own messages (--output=)
+OPT_NAMES = {"-o": ["-o", "--output"], "--events": ["--events"]}
+
+
+def has_events(seed):
+    return isinstance(seed.data, dict) and isinstance(seed.data.get("events"), list) and bool(seed.data["events"])
+
+
+def opt_args(rng, opt, path):
+    """The option with its value, in one of the spellings the CLI takes."""
+    form = rng.choice(["-o", "--output", "--output="] if opt == "-o" else ["--events", "--events="])
+    return [form + path] if form.endswith("=") else [form, path]
+
+
+def sim_args(seed, state_text=None):
+    """simulate MODEL and SIM_ARGS; with a STATE.json, --t-end 0.05 after its t (so that --t-end is no fault)."""
+    args = ["simulate", seed.model_rel] + SIM_ARGS
+    if state_text is not None:
+        t0 = 0.0
+        obj = state_obj(state_text)
+        if isinstance(obj, dict) and isinstance(obj.get("t"), (int, float)):
+            t0 = float(obj["t"])
+        args[args.index("--t-end") + 1] = repr(t0 + 0.05)
+    return args
+
+
+def sim_run(rng, seed, bad_opt, bad_path, expect, detail, setup=(), files=None, state=None, state_text=None,
+            may_change=()):
+    """A simulate run with bad_path given to bad_opt; the other output (if any) gets a good distinct path, which
+    may be written when the run exits 0 ("either")."""
+    argv = sim_args(seed, state_text)
+    if state:
+        argv += ["--state", state]
+    may_change = list(may_change)
+    outs = {"-o": None, "--events": None}
+    outs[bad_opt] = bad_path
+    if bad_opt == "--events" or (has_events(seed) and rng.random() < 0.5):
+        other = "--events" if bad_opt == "-o" else "-o"
+        outs[other] = rng.choice(["fine.csv", "good_out.csv"]) if other == "-o" else "fine_events.csv"
+        may_change.append(outs[other])
+    order = [o for o in ("-o", "--events") if outs[o] is not None]
+    rng.shuffle(order)
+    for o in order:
+        argv += opt_args(rng, o, outs[o])
+    return {"argv": argv, "expect": expect, "detail": detail, "opts": OPT_NAMES[bad_opt], "outputs": [],
+            "may_change": may_change, "setup": list(setup), "files": files or {}}
+
+
+def pick_bad_opt(rng, seed):
+    return "--events" if has_events(seed) and rng.random() < 0.5 else "-o"
+
+
+def c_same_file(rng, seed):
+    """-o and --events on one file, spelled the same or otherwise (./x, sub/../x, the absolute path)."""
+    if not has_events(seed):
+        return None
+    name = rng.choice(["out.csv", "run.csv", "sub/x.csv"])
+    spelled, setup = rng.choice([(name, []), ("./" + name, []), ("sub/../" + name, [("dir", "sub")]),
+                                 ("@CASE@/" + name, [])])
+    if name.startswith("sub/"):
+        setup = [("dir", "sub")]
+    a, b = (name, spelled) if rng.random() < 0.5 else (spelled, name)
+    argv = ["simulate", seed.model_rel] + SIM_ARGS + opt_args(rng, "-o", a) + opt_args(rng, "--events", b)
+    return {"argv": argv, "expect": "invalid", "detail": f"-o {a} --events {b} (the same file)",
+            "opts": OPT_NAMES["-o"] + OPT_NAMES["--events"], "outputs": [], "may_change": [], "setup": setup,
+            "files": {}}
+
+
+def c_input_file(rng, seed):
+    """An output on an input: the model, a modal file it names, or the --state file; spelled as given, ./x,
+    sub/../x, the absolute path, or through a symbolic link ("invalid"); through a hard link "either" (a new
+    name of the same file: refused, or written by replacing the link, the input left as it was)."""
+    cands = [("the model", seed.model_rel, None)] + [("a modal file", r, None) for r in seed.modal_rels()]
+    if seed.states:
+        cands.append(("the --state file", seed.states[0][0], seed.states[0]))
+    what, target, st = rng.choice(cands)
+    files = {st[0]: st[1]} if st else None
+    state = None
+    if st:
+        state = rng.choice([st[0], "./" + st[0]])
+    opt = pick_bad_opt(rng, seed)
+    kind = rng.randrange(6)
+    setup, may_change, expect = [], [], "invalid"
+    if kind == 0:
+        path = target
+    elif kind == 1:
+        path = "./" + target
+    elif kind == 2:
+        path, setup = "sub/../" + target, [("dir", "sub")]
+    elif kind == 3:
+        path = "@CASE@/" + target
+    elif kind == 4:
+        path, setup = "link_to_input", [("symlink", "link_to_input", target)]
+    else:
+        path, setup, may_change, expect = "hard_link", [("hardlink", "hard_link", target)], ["hard_link"], "either"
+    return sim_run(rng, seed, opt, path, expect, f"{opt} {path}: {what} ({target})", setup=setup, files=files,
+                   state=state, state_text=st[1] if st else None, may_change=may_change)
+
+
+def c_empty_path(rng, seed):
+    opt = pick_bad_opt(rng, seed)
+    return sim_run(rng, seed, opt, "", "invalid", f"{opt} '' (an empty path)")
+
+
+def c_missing_dir(rng, seed):
+    """A path in a directory that does not exist (or whose parent is a file)."""
+    opt = pick_bad_opt(rng, seed)
+    path = rng.choice(["nodir/out.csv", "no/such/dir/out.csv", "nodir/", "out.csv/x.csv", seed.model_rel + "/out.csv",
+                       "@CASE@/nodir/out.csv", "sub/nodir/out.csv"])
+    setup = [("dir", "sub")] if path.startswith("sub/") else []
+    return sim_run(rng, seed, opt, path, "invalid", f"{opt} {path} (a missing directory)", setup=setup)
+
+
+def c_directory(rng, seed):
+    opt = pick_bad_opt(rng, seed)
+    dirs = [".", "..", "sub", "sub/", "./sub/..", "@CASE@", "@CASE@/sub"]
+    dirs += sorted({os.path.dirname(r) for r in seed.modal_rels() if os.path.dirname(r)})
+    path = rng.choice(dirs)
+    setup = [("dir", "sub")] if "sub" in path else []
+    return sim_run(rng, seed, opt, path, "invalid", f"{opt} {path} (a directory)", setup=setup)
+
+
+def c_control(rng, seed):
+    """Distinct valid paths: exit 0, both written, nothing else changed."""
+    o = rng.choice(["out.csv", "sub/out.csv", "@CASE@/out.csv", "run 1.csv", "r\u00e9sultat.csv", ".hidden.csv"])
+    argv = ["simulate", seed.model_rel] + SIM_ARGS
+    pairs = [("-o", o)]
+    outputs = [o.replace("@CASE@/", "")]
+    if has_events(seed):
+        e = rng.choice(["events.csv", "sub/events.csv", "@CASE@/ev.csv", "sub/../ev2.csv"])
+        pairs.append(("--events", e))
+        outputs.append(os.path.normpath(e.replace("@CASE@/", "")))
+    rng.shuffle(pairs)
+    for opt, path in pairs:
+        argv += opt_args(rng, opt, path)
+    setup = [("dir", "sub")] if any("sub" in p for _, p in pairs) else []
+    return {"argv": argv, "expect": "valid", "detail": " ".join(f"{a} {b}" for a, b in pairs) + " (distinct, valid)",
+            "opts": [], "outputs": outputs, "may_change": [], "setup": setup, "files": {}}
+
+
+CLI_OPS = [
+    ("c_same_file", c_same_file), ("c_input_file", c_input_file), ("c_empty_path", c_empty_path),
+    ("c_missing_dir", c_missing_dir), ("c_directory", c_directory), ("c_control", c_control),
+]
+
+# A gimbal oscillating through lock (tests/apps/test_cli.cpp, "a gimbal oscillating through lock"): only the middle
+# angle moves, about rest 1.67 > pi/2, from angle2 = THETA0 < pi/2, so it reaches lock (|det Gamma| = 1e-6) at
+# t of about 0.22 s for 1.45; every integrator must stop there with exit 1, naming gimbal lock, writing nothing.
+GIMBAL_MODEL = """name: gimbal_oscillator
+bodies:
+  - name: bob
+    parent: ground
+    joint: {{type: gimbal, sequence: xyz, stiffness: [0, 0.5, 0], rest: [0, 1.67, 0]}}
+    mass: 1.0
+    inertia: [0.01, 0.02, 0.03, 0, 0, 0]
+initial:
+  q: {{bob.angle2: {theta0}}}
+"""
+GIMBAL_WEIGHT = 12  # one pair, scheduled this many times a round
+
+
+def g_gimbal_lock(rng, seed):
+    integrator = rng.choice(["rk4", "dopri5", "rkf78", "cvode-bdf"])
+    dt_out = rng.choice(["0.31", "0.01", "0.07", "1", "2.5", repr(round(rng.uniform(0.003, 3.0), 4))])
+    argv = ["simulate", seed.model_rel, "--engine", "generic", "--integrator", integrator, "--t-end", "2",
+            "--dt-out", dt_out, "--no-progress"] + opt_args(rng, "-o", "out.csv")
+    outputs = ["out.csv"]
+    if rng.random() < 0.3:
+        argv += opt_args(rng, "--events", "ev.csv")
+        outputs.append("ev.csv")
+    theta0 = rng.choice(["1.45", "1.45", "1.3", "1.5", "1.55"])
+    return {"argv": argv, "expect": "lock", "detail": f"angle2 from {theta0}: --integrator {integrator} "
+            f"--dt-out {dt_out}" + (" --events ev.csv" if len(outputs) > 1 else ""),
+            "opts": [], "outputs": [], "may_change": [], "setup": [],
+            "files": {seed.model_rel: GIMBAL_MODEL.format(theta0=theta0)}}
+
+
+GIMBAL_OPS = [("g_gimbal_lock", g_gimbal_lock)]
+
+
+def gimbal_seed():
+    rel = "gimbal_oscillator.yaml"
+    return Seed("(generated) " + rel, rel, {rel: SeedFile(rel, GIMBAL_MODEL.format(theta0="1.45"))}, [], "")
+
+
+def setup_case(d, setup):
+    for item in setup:
+        full = os.path.join(d, item[1])
+        if item[0] == "dir":
+            os.makedirs(full, exist_ok=True)
+        elif item[0] == "symlink":
+            os.symlink(item[2], full)
+        elif item[0] == "hardlink":
+            os.link(os.path.join(d, item[2]), full)
+
+
+def snapshot(d):
+    """Every path under d: ("dir",), ("link", target) or ("file", bytes)."""
+    snap = {}
+    for root, dirs, files in os.walk(d):
+        for n in dirs + files:
+            full = os.path.join(root, n)
+            rel = os.path.relpath(full, d)
+            if os.path.islink(full):
+                snap[rel] = ("link", os.readlink(full))
+            elif os.path.isdir(full):
+                snap[rel] = ("dir",)
+            else:
+                with open(full, "rb") as f:
+                    snap[rel] = ("file", f.read())
+    return snap
+
+
+def changed_paths(before, after):
+    return sorted(p for p in set(before) | set(after) if before.get(p) != after.get(p))
+
+
+def classify_run(case, res, before, after):
+    """One outcome class for a "cli" or "gimbal" run (see the docstring), and a short reason."""
+    r = crash_or_timeout(res)
+    if r:
+        return r
+    run = case.run
+    changed = changed_paths(before, after)
+    rc, err = res["rc"], res["stderr"]
+    lines = [l.rstrip("\r") for l in err.split("\n") if l.strip()]
+    first = lines[0][:300] if lines else "(no message)"
+    if rc != 0 and changed:
+        return "written-on-refusal", f"exit {rc}, yet changed: {', '.join(changed[:4])}"
+    if case.expect == "lock":
+        if rc == 1 and "gimbal lock" in err:
+            return "ok-stopped", ""
+        return "missed-lock", f"exit {rc}; expected exit 1 naming gimbal lock: {first}"
+    if rc == 2:
+        if case.expect == "valid":
+            return "wrongly-refused", "exit 2 for valid paths: " + first
+        if not lines:
+            return "unlocated", "unlocated: (no message on stderr)"
+        bad = [l for l in lines if not OPTION_RE.match(l) and l != CLI11_HINT]
+        if bad:
+            return "unlocated", "names no option: " + bad[0][:300]
+        if not any(l.split(":", 1)[0] in run["opts"] for l in lines):
+            return "unlocated", f"names none of {'/'.join(run['opts'])}: {first}"
+        return "ok-refused", ""
+    if rc == 0:
+        if case.expect == "invalid":
+            return "silent-accept", "exit 0 for an output path that must be refused"
+        allowed = set(run["outputs"]) | set(run["may_change"])
+        extra = [p for p in changed if p not in allowed]
+        missing = [p for p in run["outputs"] if after.get(p, ("",))[0] != "file" or not after[p][1]]
+        if extra or missing:
+            return "wrong-files", (f"not written (or empty): {', '.join(missing)}; " if missing else "") + \
+                (f"changed besides the outputs: {', '.join(extra[:4])}" if extra else "")
+        return "ok-valid", ""
+    return "exit1-on-input", "exit 1: " + first
+
+
 # --------------------------------------------------------------------------
 # cases
 
 
 class Case:
-    def __init__(self, idx, seed, target, target_rel, op, expect, detail, files, state_rel):
+    def __init__(self, idx, seed, target, target_rel, op, expect, detail, files, state_rel, run=None):
         self.idx, self.seed, self.target, self.target_rel = idx, seed, target, target_rel
         self.op, self.expect, self.detail = op, expect, detail
         self.files, self.state_rel = files, state_rel
+        self.run = run  # a run operator's dict ("cli" and "gimbal" cases), else None
 
 
 def make_case(idx, rng, seed, target, op_name, fn):
     files = {rel: sf.text for rel, sf in seed.files.items()}
+    if target in ("cli", "gimbal"):
+        run = fn(rng, seed)
+        if run is None:
+            return None
+        files.update(run["files"])
+        return Case(idx, seed, target, seed.model_rel, f"{target}.{op_name}", run["expect"], run["detail"], files,
+                    None, run)
     if target == "state":
         if not seed.states:
             return None
@@ -2178,11 +2617,16 @@ def make_case(idx, rng, seed, target, op_name, fn):
     return Case(idx, seed, target, sf.rel, f"{target}.{op_name}", expect, detail, files, None)
 
 
-def build_pairs(seeds):
-    """Every (seed, target, operator) pair; one round of the schedule visits each once."""
+def build_pairs(seeds, gimbal=None):
+    """Every (seed, target, operator) pair; one round of the schedule visits each once (a weighted pair, as often
+    as its weight)."""
     pairs = []
     for s in seeds:
         for name, fn in MODEL_OPS:
+            if name in EVENTS_ONLY:
+                if has_events(s):
+                    pairs += [(s, "model", name, fn)] * EVENTS_WEIGHT
+                continue
             if name not in MODAL_ONLY:
                 pairs.append((s, "model", name, fn))
             if s.modal_rels() and (name.startswith("t_") or name in MODAL_TOO | MODAL_ONLY):
@@ -2190,6 +2634,15 @@ def build_pairs(seeds):
         if s.states:
             for name, fn in STATE_OPS:
                 pairs.append((s, "state", name, fn))
+        for name, fn in CLI_OPS:
+            if name in EVENTS_ONLY:
+                if has_events(s):
+                    pairs += [(s, "cli", name, fn)] * EVENTS_WEIGHT
+                continue
+            pairs.append((s, "cli", name, fn))
+    if gimbal is not None:
+        for name, fn in GIMBAL_OPS:
+            pairs += [(gimbal, "gimbal", name, fn)] * GIMBAL_WEIGHT
     return pairs
 
 
@@ -2293,7 +2746,7 @@ def main(argv=None):
         n_cases = n_runs = 0
         slowest = (0.0, None)
         budget_end = t_start + args.budget_seconds
-        pairs = build_pairs(seeds)
+        pairs = build_pairs(seeds, gimbal_seed())
         log(f"{len(pairs)} (seed, file, operator) pairs per round")
         for case in generate_cases(rng, pairs):
             if args.case is not None:
@@ -2305,24 +2758,31 @@ def main(argv=None):
                 break
             d = runner.write_case(case.files)
             cmds = []
-            if case.target == "state":
+            if case.run is not None:
+                setup_case(d, case.run["setup"])
+                cmds.append(("simulate", [a.replace("@CASE@", d) for a in case.run["argv"]]))
+            elif case.target == "state":
                 cmds.append(("eval", ["eval", case.seed.model_rel, "--engine", "generic", "--state", case.state_rel]))
             else:
                 cmds.append(("check", ["check", case.seed.model_rel]))
                 cmds.append(("eval", ["eval", case.seed.model_rel, "--engine", "generic"]))
             n_cases += 1
             for cmd, argv_ in cmds:
+                before = snapshot(d) if case.run is not None else None
                 res = runner.run(argv_, d)
                 n_runs += 1
                 if res["seconds"] > slowest[0]:
                     slowest = (res["seconds"], f"case {case.idx} {case.op} {cmd}")
-                cls, why = classify(case.expect, cmd, res, case.files.keys())
+                if case.run is not None:
+                    cls, why = classify_run(case, res, before, snapshot(d))
+                else:
+                    cls, why = classify(case.expect, cmd, res, case.files.keys())
                 counts[cls] += 1
                 by_op[case.op][cls] += 1
                 by_seed[case.seed.name][cls] += 1
                 if args.case is not None or cls in FAIL_CLASSES:
                     ex = {"case": case.idx, "seed": case.seed.name, "file": case.target_rel, "op": case.op,
-                          "mutation": case.detail, "expect": case.expect, "command": "kanegen " + " ".join(argv_),
+                          "mutation": case.detail, "expect": case.expect, "command": "kanegen " + shlex.join(argv_),
                           "exit": res["rc"], "why": why, "stderr": res["stderr"][:1200],
                           "stdout_head": res["stdout"][:300]}
                     if by_op[case.op][cls] <= 8:  # the first few of each operator and class
@@ -2334,9 +2794,9 @@ def main(argv=None):
                         dest = os.path.join(args.keep_failures, cls, f"{case.idx:06d}-{case.op}-{cmd}")
                         if os.path.exists(dest):
                             shutil.rmtree(dest)
-                        shutil.copytree(d, dest)
+                        shutil.copytree(d, dest, symlinks=True)
                         with open(os.path.join(dest, "REPRO.txt"), "w", encoding="utf-8") as f:
-                            f.write(f"cd {dest} && {runner.binary} {' '.join(argv_)}\n"
+                            f.write(f"cd {dest} && {runner.binary} {shlex.join(argv_)}\n"
                                     f"# seed {args.seed} case {case.idx} ({case.seed.name}, {case.target_rel}): "
                                     f"{case.op}: {case.detail}\n# expected: {case.expect}; got exit {res['rc']}: "
                                     f"{cls}: {why}\n")
@@ -2350,17 +2810,18 @@ def main(argv=None):
 
     # ---- report
     cols = [c for c in ALL_CLASSES if counts[c]] or ["ok-valid"]
-    short = {"ok-valid": "ok-val", "ok-refused": "ok-ref", "ok-nonfinite": "ok-nf", "crash": "crash",
-             "timeout": "tmout", "wrongly-refused": "wr-ref", "silent-accept": "silent", "exit1-on-input": "exit1",
-             "unlocated": "unloc", "null-in-json": "null"}
+    short = {"ok-valid": "ok-val", "ok-refused": "ok-ref", "ok-nonfinite": "ok-nf", "ok-stopped": "ok-stp",
+             "crash": "crash", "timeout": "tmout", "written-on-refusal": "writtn", "wrongly-refused": "wr-ref",
+             "silent-accept": "silent", "exit1-on-input": "exit1", "unlocated": "unloc", "null-in-json": "null",
+             "wrong-files": "wr-fil", "missed-lock": "nolock"}
     w = max([len(o) for o in by_op] + [10])
     out = []
     out.append(f"kanegen fuzz: seed {args.seed}, {n_cases} cases, {n_runs} runs, {elapsed:.1f} s "
                f"(budget {args.budget_seconds:g} s), binary {args.kanegen}")
     out.append("")
-    out.append("outcome class      runs")
+    out.append("outcome class        runs")
     for c in ALL_CLASSES:
-        out.append(f"  {c:<16} {counts[c]:6d}{'   <- failure' if c in FAIL_CLASSES and counts[c] else ''}")
+        out.append(f"  {c:<18} {counts[c]:6d}{'   <- failure' if c in FAIL_CLASSES and counts[c] else ''}")
     out.append("")
     out.append(f"{'operator':<{w}} " + " ".join(f"{short[c]:>6}" for c in cols))
     for op in sorted(by_op):

@@ -327,6 +327,8 @@ TEST_CASE("cli: every output path is checked before the run, each fault naming i
       {"-o " + csv + " --events " + csv, "--events", "-o writes the same file"},
       {"-o " + csv + " --events " + (d / "." / "out.csv").string(), "--events", "-o writes the same file"},
       {"-o " + csv + " --events ''", "--events", "empty output path"},
+      {"--events= -o " + csv, "--events", "empty output path"},  // CLI11 alone took -o as --events' value
+      {"--output= --events " + (d / "ev.csv").string(), "-o", "empty output path"},
       {"-o " + model, "-o", "it is an input of this command"},
       {"-o " + csv + " --events " + model, "--events", "it is an input of this command"},
       {"-o " + modal, "-o", "it is an input of this command"},
@@ -347,6 +349,49 @@ TEST_CASE("cli: every output path is checked before the run, each fault naming i
   CHECK(lin.status == 2);
   CHECK(lin.out.find("-o: cannot write") != std::string::npos);
   CHECK(slurp(model) == model_text);
+  const Run lin_empty = run("linearize " + model + " --engine generic -o ''");
+  CHECK(lin_empty.status == 2);
+  CHECK(lin_empty.out.find("-o: cannot write '': empty output path") != std::string::npos);
+  // generate's outputs, modes -o on the modal file it reads
+  for (const std::string& args :
+       {"generate " + model + " -o " + modal, "generate " + model + " -o " + csv + " --entry " + model,
+        "generate " + model + " -o " + csv + " --manifest " + csv, "modes " + model + " --body hub -o " + modal}) {
+    const Run r = run(args);
+    INFO(args << "\n" << r.out);
+    CHECK(r.status == 2);
+    CHECK(r.out.find("cannot write") != std::string::npos);
+    CHECK_FALSE(fs::exists(csv));
+    CHECK(slurp(model) == model_text);
+    CHECK(slurp(modal) == modal_text);
+  }
+  // a sweep's output directory and a replayed run's file
+  const std::string sweep = (d / "s.yaml").string();
+  {
+    std::ofstream(sweep) << "model: flex_hub.yaml\nruns: 2\nt_end: 0.5\ndt_out: 0.1\nengine: generic\n"
+                            "dispersions:\n  - {parameter: tip.mass, distribution: normal, sigma: 0.01, relative: true}\n"
+                            "metrics:\n  - {name: w, column: hub.angle, stat: final}\n";
+    std::ofstream(d / "plain.txt") << "x\n";
+  }
+  struct SweepCase {
+    std::string args, why;
+  };
+  for (const SweepCase& c : std::vector<SweepCase>{
+           {"-o " + model, "is not a directory"},
+           {"-o " + (d / "plain.txt" / "sub").string(), "is not a directory"},
+           {"-o ''", "empty output directory"},
+           {"-o " + (d / "out").string() + " --merge " + (d / "out").string(), "shard directory"},
+           {"--run 0 -o " + modal, "it is an input of this command"},
+           {"--run 0 -o " + sweep, "it is an input of this command"}}) {
+    const Run r = run("sweep " + sweep + " --no-progress " + c.args);
+    INFO(c.args << "\n" << r.out);
+    CHECK(r.status == 2);
+    CHECK(r.out.find("-o: cannot write") != std::string::npos);
+    CHECK(r.out.find(c.why) != std::string::npos);
+    CHECK_FALSE(fs::exists(d / "s.out"));
+    CHECK_FALSE(fs::exists(d / "out"));
+    CHECK(slurp(model) == model_text);
+    CHECK(slurp(modal) == modal_text);
+  }
   // the same command with good paths runs and writes both
   const Run ok = run(sim + "-o " + csv + " --events " + (d / "ev.csv").string());
   INFO(ok.out);
@@ -394,4 +439,30 @@ initial:
         CHECK(std::abs(std::stod(m[1].str()) - t_lock) < 1e-9);
         CHECK_FALSE(fs::exists(csv));  // nothing written
       }
+  // in a sweep, a run that reaches lock is a failed run with its reason (and the time located)
+  const fs::path sweep_dir = temp_dir() / "gimbal_sweep";
+  fs::remove_all(sweep_dir);
+  fs::create_directories(sweep_dir);
+  const fs::path sweep = sweep_dir / "s.yaml";
+  std::ofstream(sweep) << "model: " << model << "\nruns: 2\nt_end: 2\ndt_out: 0.31\nengine: generic\n"
+                       << "integrator: rkf78\nrtol: 1e-12\natol: 1e-14\n"
+                       << "dispersions:\n  - {parameter: bob.mass, distribution: normal, sigma: 0.01, relative: true}\n"
+                       << "metrics:\n  - {name: a, column: bob.angle2, stat: max}\n";
+  const Run sw = run("sweep " + sweep.string() + " --no-progress -o " + (sweep_dir / "out").string());
+  INFO(sw.out);
+  CHECK(sw.status == 0);
+  std::ifstream runs(sweep_dir / "out" / "runs.csv");
+  std::string header, line;
+  std::getline(runs, header);
+  int failed = 0;
+  while (std::getline(runs, line)) {
+    INFO(line);
+    CHECK(line.find("gimbal lock") != std::string::npos);
+    std::smatch m;
+    REQUIRE(std::regex_search(line, m, at_re));
+    CHECK(std::abs(std::stod(m[1].str()) - t_lock) < 1e-9);  // the mass moves neither k nor I_yy
+    ++failed;
+  }
+  CHECK(failed == 2);
+  fs::remove_all(sweep_dir);
 }

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "sim/crosscheck.hpp"
@@ -134,6 +135,23 @@ TEST_CASE("AOT simulator built by kanegen_add_model reproduces the generic engin
   std::stringstream sa(A.back()), sg(G.back());
   for (std::string x, y; std::getline(sa, x, ',') && std::getline(sg, y, ',');)
     CHECK(std::stod(x) == Approx(std::stod(y)).margin(1e-7));
+  // its -o is checked against its inputs before the run, as kanegen simulate's: a copy of the model (the same
+  // text, so the hash check passes) given as --model and as -o is refused and left as it was
+  const fs::path copy = tmp / "double_pendulum.yaml";
+  fs::copy_file(model, copy);
+  std::ifstream in(copy);
+  const std::string text(std::istreambuf_iterator<char>(in), {});
+  const std::string err = (tmp / "err.txt").string();
+  const int status = std::system((std::string(kanegen::test::aot_simulator()) + args + " --model " + copy.string() +
+                                  " -o " + copy.string() + " 2>" + err)
+                                     .c_str());
+  CHECK(WEXITSTATUS(status) == 2);
+  std::ifstream e(err), again(copy);
+  const std::string message(std::istreambuf_iterator<char>(e), {});
+  INFO(message);
+  CHECK(message.find("-o: cannot write") != std::string::npos);
+  CHECK(message.find("it is an input of this command") != std::string::npos);
+  CHECK(std::string(std::istreambuf_iterator<char>(again), {}) == text);
   fs::remove_all(tmp);
 }
 #endif
