@@ -64,7 +64,9 @@ void add_integrated_velocity_terms(KaneContext& ctx, int j, const SV3& S, const 
 }
 
 /// A rich node's terms, one by one (dynamics/body_inertia.hpp, add_node_terms).
-void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV3& g_B, bool with_velocity) {
+/// With `element`, also the node's mass element for the central field (its position also when massless).
+void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV3& g_B, bool with_velocity,
+                    SymMassElement* element) {
   Alg& A = ctx.A;
   const Body& b = ctx.model.bodies[j];
   const FlexibleData& flex = *b.flex;
@@ -76,8 +78,8 @@ void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV
   ctx.C.group = b.name;
   ctx.P.section(fmt::format("body {}: node {} (rotary inertia, foreshortening)", b.name, node.id));
   const SV3& w = s.w_B;
-  if (node.mass != 0.0) {
-    const ex mk = ctx.c(node.mass, nn + "_mass", "kg", "node mass");
+  if (node.mass != 0.0 || element) {
+    const ex mk = node.mass != 0.0 ? ctx.c(node.mass, nn + "_mass", "kg", "node mass") : ex(0);
     // s_k = rho + Phi eta + 1/2 gamma(eta); Phi~ = Phi + G(eta), row a of G = (Gamma^a eta)^T
     std::vector<SV3> Pt(m);
     SV3 sk = ctx.cvec(node.rho_B, nn + "_rho", "m", "node position (undeformed)");
@@ -111,6 +113,8 @@ void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV
       gamma_dd[a] = A.let(dd);
     }
     sk = A.let(sk, ctx.name("s_B", j) + fmt::format("_node{}", node.id));
+    if (element) element->mass = mk, element->s_B = sk, element->Pt = Pt;
+    if (node.mass != 0.0) {
     const SM3 sx = Alg::skew(sk);
     for (int a = 0; a < 3; ++a) {
       M(a, a) = M(a, a) + mk;
@@ -152,6 +156,7 @@ void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV
       }
       for (int i = 0; i < m; ++i) s.h_body[6 + i] = s.h_body[6 + i] + mk * A.dot(Pt[i], bk);
     }
+    }  // node.mass != 0
   }
   if (!node.J_B.isZero(0.0)) {
     // node frame C(Psi eta): J' = C J C^T; w_k = w + H eta_dot, H = (I + g^x) Psi / (1 + g.g), g = Psi eta / 2
@@ -195,6 +200,7 @@ void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV
     }
     for (int i = 0; i < m; ++i)
       for (int l = i; l < m; ++l) M(6 + i, 6 + l) = M(6 + l, 6 + i) = M(6 + i, 6 + l) + A.dot(H[i], JH[l]);
+    if (element) element->I_B = Jp, element->H = H, element->has_inertia = true;
     if (with_velocity) {
       SV3 w_rel;
       for (int a = 0; a < 3; ++a) {
@@ -217,7 +223,8 @@ void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV
 /// plain nodes, B' components) when some of its rigid part's mass, com or
 /// inertia are runtime parameters (given in the model's frame B): the rigid
 /// part's share formed from the parameters, the nodes' share kept as constants.
-void runtime_rigid_part(KaneContext& ctx, int j, ex& mass, SV3& S0, SM3& J0) {
+/// With `rigid`, also the rigid part's mass element (com and inertia in B').
+void runtime_rigid_part(KaneContext& ctx, int j, ex& mass, SV3& S0, SM3& J0, SymMassElement* rigid) {
   const Body& b = ctx.model.bodies[j];
   const BodyMassIntegrals& I = b.integrals;
   const std::string& n = b.name;
@@ -248,6 +255,7 @@ void runtime_rigid_part(KaneContext& ctx, int j, ex& mass, SV3& S0, SM3& J0) {
     for (int cc = 0; cc < 3; ++cc) Qt(r, cc) = ctx.c(Q(cc, r), fmt::format("{}_R_BpB_{}{}", n, r, cc), "", "model axes in the generator's");
   const SV3 cp = A.mul(Qt, c);                         // com in B'
   const SM3 Icp = A.mul(A.mul(Qt, Ic), Qt.transpose());  // inertia about the com in B'
+  if (rigid) rigid->mass = m, rigid->s_B = cp, rigid->I_B = Icp, rigid->has_inertia = true;
   // the nodes' share: what the integrals hold besides the nominal rigid part (0 for a rigid body)
   auto rest = [](double total, double rigid) {
     const double r = total - rigid;
@@ -287,9 +295,21 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
       return p.body == static_cast<int>(j) &&
              (p.kind == ParameterKind::mass || p.kind == ParameterKind::com || p.kind == ParameterKind::inertia);
     });
+    // Central gravity acts on each mass element (dynamics.md, Forces): the rigid part's and each node's.
+    const bool central = ctx.has_central();
+    s.elements.clear();
+    SymMassElement rigid;
     if (runtime_rigid) {
-      runtime_rigid_part(ctx, static_cast<int>(j), mass, S0, J0);
+      runtime_rigid_part(ctx, static_cast<int>(j), mass, S0, J0, central ? &rigid : nullptr);
+      if (central) s.elements.push_back(rigid);
     } else {
+      if (central && (b.rigid.mass != 0.0 || !b.rigid.I_c_B.isZero(0.0))) {
+        rigid.mass = ctx.c(b.rigid.mass, n + "_rigid_mass", "kg", "rigid part's mass");
+        rigid.s_B = ctx.cvec(b.rigid.com_B, n + "_rigid_com", "m", "rigid part's com");
+        rigid.has_inertia = !b.rigid.I_c_B.isZero(0.0);
+        if (rigid.has_inertia) rigid.I_B = ctx.cmat(b.rigid.I_c_B, n + "_rigid_I", "kg m^2", "rigid part's inertia about its com", true);
+        s.elements.push_back(rigid);
+      }
       mass = ctx.c(I.mass, n + "_mass", "kg", "mass (rigid part and plain nodes)");
       S0 = ctx.cvec(I.S0, n + "_S0", "kg m", "first mass moment about O (undeformed)");
       J0 = ctx.cmat(I.J0, n + "_J0", "kg m^2", "inertia about O (undeformed)", true);
@@ -372,7 +392,36 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
     }
     s.h_body.assign(6 + m, ex(0));
     if (with_velocity) add_integrated_velocity_terms(ctx, static_cast<int>(j), S, J, Bc, Q, Pff);
-    for (int k : b.rich_nodes) add_node_terms(ctx, static_cast<int>(j), k, gravity_terms, g_B, with_velocity);
+    if (!central) {
+      for (int k : b.rich_nodes) add_node_terms(ctx, static_cast<int>(j), k, gravity_terms, g_B, with_velocity, nullptr);
+      continue;
+    }
+    // every node is an element: rich nodes as their terms form them, plain ones at rho + Phi eta
+    const int nk = b.flex ? static_cast<int>(b.flex->nodes.size()) : 0;
+    for (int k = 0; k < nk; ++k) {
+      const FlexibleData& flex = *b.flex;
+      const ModalNode& node = flex.nodes[k];
+      if (flex.node_is_rich(k)) {
+        SymMassElement e;
+        add_node_terms(ctx, static_cast<int>(j), k, false, g_B, with_velocity, &e);
+        s.elements.push_back(e);
+        continue;
+      }
+      if (node.mass == 0.0) continue;
+      const std::string nn = fmt::format("{}_node{}", n, node.id);
+      SymMassElement e;
+      e.mass = ctx.c(node.mass, nn + "_mass", "kg", "node mass");
+      SV3 sk = ctx.cvec(node.rho_B, nn + "_rho", "m", "node position (undeformed)");
+      e.Pt.resize(m);
+      for (int i = 0; i < m; ++i) {
+        e.Pt[i] = ctx.cvec(flex.Phi.block(3 * k, i, 3, 1), fmt::format("{}_Phi{}", nn, i + 1), "m",
+                           fmt::format("translational shape of mode {} at the node", i + 1));
+        for (int a = 0; a < 3; ++a) sk[a] = sk[a] + e.Pt[i][a] * s.eta[i];
+      }
+      e.s_B = A.let(sk, ctx.name("s_B", static_cast<int>(j)) + fmt::format("_node{}", node.id));
+      s.elements.push_back(e);
+    }
+    add_central_gravity_forces(ctx, static_cast<int>(j));
   }
 }
 

@@ -220,12 +220,11 @@ const EmittedFunction* EmittedModel::find(const std::string& name) const {
 }
 
 EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
-  if (model_in.central)  // issue 22: the generic engine has it; the generator does not form it yet
-    throw InputError(Diagnostic{model_in.source_path, 0, "gravity.central",
-                                "central gravity is not in the generated code yet; run it with --engine generic"});
   if (options.udot_form != "auto" && options.udot_form != "composite" && options.udot_form != "articulated")
     throw std::invalid_argument("udot form must be auto, composite or articulated");
-  const Model merged = options.merge_fixed ? merge_fixed_bodies(model_in) : model_in;
+  // Central gravity acts on each rigid part (dynamics.md): a body fixed to its parent keeps its own
+  // MacCullagh term, so the tree is not merged (the merged part's term differs at O(size/r)^3).
+  const Model merged = options.merge_fixed && !model_in.central ? merge_fixed_bodies(model_in) : model_in;
   auto frames = [&](const Model& m) { return options.joint_frames ? choose_joint_frames(m) : keep_joint_frames(m); };
   const FramedModel framed = frames(merged);
   const Model& dyn = framed.model;  // used for M, F, u_dot, energy, momentum

@@ -129,7 +129,9 @@ void assign_sensor_outputs(KaneContext& ctx, const std::vector<ex>& wrenches,
         SV3 a = ctx.A.add(ctx.A.add(a_O, ctx.A.cross(alpha, p)), ctx.A.cross(s.w_B, ctx.A.cross(s.w_B, p)));
         const bool gib = ctx.gravity_in_base_acceleration;
         const bool accel = sn.type == SensorType::acceleration;
-        if (gib == accel) {  // acceleration from a - g, or a - g from a
+        if (ctx.has_central()) {  // no base acceleration: a is the acceleration; the field at the point
+          if (!accel) a = ctx.A.sub(a, ctx.A.mul_t(s.R_NB, central_field_at(ctx, ctx.A.add(s.r_NO_N, ctx.A.mul(s.R_NB, p)))));
+        } else if (gib == accel) {  // acceleration from a - g, or a - g from a
           const SV3 g_B = ctx.A.mul_t(s.R_NB, ctx.gravity(1.0, "gravity", "gravity in N"));
           a = accel ? ctx.A.add(a, g_B) : ctx.A.sub(a, g_B);
         }

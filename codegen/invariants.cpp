@@ -1,5 +1,5 @@
 // Energy and momentum (dynamics/invariants.hpp): T = 1/2 Sum z^T M_body z;
-// V = gravity + springs + modal strain energy; p_N, H_N about N's origin
+// V = gravity (uniform or central) + springs + modal strain energy; p_N, H_N about N's origin
 // from the first six rows of M_body z.
 #include <fmt/format.h>
 
@@ -41,6 +41,7 @@ ex compute_potential_energy(KaneContext& ctx) {
       const SV3 RS = ctx.A.mul(s.R_NB, S);
       for (int a = 0; a < 3; ++a) V -= g_N[a] * (s.M_body(0, 0) * s.r_NO_N[a] + RS[a]);
     }
+    if (ctx.has_central()) V += central_potential(ctx, static_cast<int>(j));
     ctx.C.group = b.name;
     for (const SpringSlot& sl : spring_slots(b.joint)) {
       if (sl.q < 0) continue;

@@ -33,6 +33,18 @@
 
 namespace kanegen::codegen {
 
+/// One mass element of a body for the central field (dynamics/central_gravity.hpp):
+/// the rigid part or a node, at s_B (B components, displaced), with the
+/// partials of s_B (Pt) and of its small rotation (H) w.r.t. the body's modal
+/// coordinates, and its inertia about s_B in B axes (node frame turned).
+struct SymMassElement {
+  ex mass;
+  SV3 s_B;
+  std::vector<SV3> Pt, H;  ///< empty: no modal partials (the rigid part; a node without rotary inertia has no H)
+  SM3 I_B;
+  bool has_inertia = false;
+};
+
 struct SymBodyWorkspace {
   SM3 R_PB, R_NB;                 ///< orientation of B in its parent, in N
   SM3 R_PJ, R_JB;                 ///< R_PB = R_PJ R_JB: joint frame in the parent (with a node's turn), B in J
@@ -51,6 +63,7 @@ struct SymBodyWorkspace {
   std::vector<std::array<ex, 6>> S_joint;
   SMat M_body;                    ///< (6+m)^2 generalized mass in z
   std::vector<ex> h_body, g_body; ///< 6+m velocity terms, generalized gravity
+  std::vector<SymMassElement> elements;  ///< with central gravity only (compute_body_terms)
 };
 
 /// One Model's symbolic formulation in one Program.
@@ -104,6 +117,10 @@ struct KaneContext {
            find_parameter(model.parameters, ParameterKind::gravity, -1, 1) >= 0 ||
            find_parameter(model.parameters, ParameterKind::gravity, -1, 2) >= 0;
   }
+  /// Central gravity (gravity: central:): mu and J2 as runtime parameters or named constants.
+  bool has_central() const { return model.central.has_value(); }
+  ex central_mu();
+  ex central_J2();
   /// Name of a quantity of body j for the emitted code, e.g. "w_B_ant2".
   std::string name(const std::string& quantity, int j) const { return quantity + "_" + model.bodies[j].name; }
   /// The prescribed coordinate of body j's joint and its two derivatives at t
@@ -119,6 +136,13 @@ struct KaneContext {
 void compute_kinematics(KaneContext& ctx, bool with_velocity);
 /// Body inertia, velocity and gravity terms (after compute_kinematics).
 void compute_body_terms(KaneContext& ctx, bool with_velocity);
+/// The central field's generalized forces on body j's velocity coordinates,
+/// added to its g_body, from its mass elements (central_gravity.cpp).
+void add_central_gravity_forces(KaneContext& ctx, int j);
+/// The central field's potential of body j's mass elements.
+ex central_potential(KaneContext& ctx, int j);
+/// The central field's acceleration at a point r (N components): point mass and J2.
+SV3 central_field_at(KaneContext& ctx, const SV3& r_N);
 /// compute_kinematics then compute_body_terms: what every dynamics function starts with.
 inline void prepare(KaneContext& ctx, bool with_velocity) {
   compute_kinematics(ctx, with_velocity);

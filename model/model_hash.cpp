@@ -196,6 +196,10 @@ std::string model_hash(const Model& model) {
       m.g_N(p.index) = 0;
       continue;
     }
+    if (p.kind == ParameterKind::central) {
+      (p.index == 0 ? m.central->mu : m.central->J2) = 0;
+      continue;
+    }
     Body& b = m.bodies[p.body];
     switch (p.kind) {
       case ParameterKind::mass: b.rigid.mass = 0; break;
@@ -210,7 +214,8 @@ std::string model_hash(const Model& model) {
         break;
       case ParameterKind::position: b.joint.p_PJ(p.index) = 0; break;
       case ParameterKind::misalignment: break;  // nominal 0: the rotation is the model's
-      case ParameterKind::gravity: break;
+      case ParameterKind::gravity:
+      case ParameterKind::central: break;
     }
   }
   std::string f = model_fingerprint(m) + "runtime parameters";

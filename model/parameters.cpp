@@ -27,11 +27,18 @@ std::vector<RuntimeParameter> expand_parameter(const Model& model, const std::st
     p.nominal = parameter_value(model, p);
     out.push_back(p);
   };
+  if (name == "gravity.mu" || name == "gravity.J2") {
+    if (!model.central)
+      throw std::invalid_argument(fmt::format("'{}': the model has no central gravity (gravity: central:)", name));
+    add(name, name == "gravity.mu" ? "m^3/s^2" : "", ParameterKind::central, -1, name == "gravity.mu" ? 0 : 1);
+    return out;
+  }
   if (name == "gravity" || name.rfind("gravity.", 0) == 0) {
     for (int a = 0; a < 3; ++a)
       if (name == "gravity" || name == std::string("gravity.") + kAxis[a])
         add(std::string("gravity.") + kAxis[a], "m/s^2", ParameterKind::gravity, -1, a);
-    if (out.empty()) throw std::invalid_argument(fmt::format("'{}': expected gravity or gravity.x, .y, .z", name));
+    if (out.empty())
+      throw std::invalid_argument(fmt::format("'{}': expected gravity, gravity.x, .y, .z, gravity.mu or gravity.J2", name));
     return out;
   }
   const auto dot = name.find('.');
@@ -109,6 +116,7 @@ std::vector<RuntimeParameter> expand_parameter(const Model& model, const std::st
 
 double parameter_value(const Model& model, const RuntimeParameter& p) {
   if (p.kind == ParameterKind::gravity) return model.g_N(p.index);
+  if (p.kind == ParameterKind::central) return p.index == 0 ? model.central->mu : model.central->J2;
   const Body& b = model.bodies.at(p.body);
   switch (p.kind) {
     case ParameterKind::mass: return b.rigid.mass;
@@ -121,7 +129,8 @@ double parameter_value(const Model& model, const RuntimeParameter& p) {
     case ParameterKind::damping_ratio: return b.flex->damping_ratio(p.index);
     case ParameterKind::position: return b.joint.p_PJ(p.index);
     case ParameterKind::misalignment: return 0.0;  // relative to the model's rotation
-    case ParameterKind::gravity: break;
+    case ParameterKind::gravity:
+    case ParameterKind::central: break;
   }
   return 0.0;
 }
@@ -147,6 +156,11 @@ void apply_parameters(Model& model, const std::vector<RuntimeParameter>& params,
     if (!std::isfinite(v)) throw bad("a finite number");
     if (p.kind == ParameterKind::gravity) {
       model.g_N(p.index) = v;
+      continue;
+    }
+    if (p.kind == ParameterKind::central) {
+      if (p.index == 0 && !(v > 0)) throw bad("a gravitational parameter mu > 0");
+      (p.index == 0 ? model.central->mu : model.central->J2) = v;
       continue;
     }
     Body& b = model.bodies.at(p.body);
@@ -194,7 +208,8 @@ void apply_parameters(Model& model, const std::vector<RuntimeParameter>& params,
         modes_changed[p.body] = true;
         break;
       }
-      case ParameterKind::gravity: break;
+      case ParameterKind::gravity:
+      case ParameterKind::central: break;
     }
   }
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {

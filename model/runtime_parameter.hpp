@@ -10,6 +10,7 @@ enum class ParameterKind {
   mass, com, inertia, stiffness, damping, rest, frequency, damping_ratio, gravity,
   position,      ///< the joint frame's origin in the parent frame (model components), index 0-2
   misalignment,  ///< the joint frame turned by Rz(z) Ry(y) Rx(x) after its nominal rotation, index 0-2 (rad)
+  central,       ///< the central field (gravity: central:): index 0 mu [m^3/s^2], 1 J2
 };
 
 struct RuntimeParameter {

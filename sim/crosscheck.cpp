@@ -44,6 +44,9 @@ CrosscheckResult crosscheck(Engine& tested, Engine& reference, int samples, unsi
       if (!b.joint.prescribed())
         random_coordinates(b.joint, [&] { return U(rng); }, [&] { return N(rng); }, q.data() + b.q_joint);
       for (int k = 0; k < b.n_modes(); ++k) q(b.q_eta + k) = 0.1 * U(rng);
+      // In a central field the free roots are on orbit: ~7000 km from the central body
+      if (model.central && b.parent < 0 && b.joint.type == JointType::free)
+        q.segment<3>(b.q_joint) += 7.0e6 * Vec3(N(rng), N(rng), N(rng)).normalized();
     }
     for (int i = 0; i < model.nu; ++i) u(i) = U(rng), tau(i) = U(rng);
     VecX w(model.nw);

@@ -24,7 +24,7 @@ struct CrosscheckResult {
 };
 
 /// Random states: angles in [-pi, pi], displacements and positions in
-/// [-1, 1], modal coordinates in [-0.1, 0.1], unit quaternions, speeds and
+/// [-1, 1] (a free root in a central field: 7000 km away in a random direction, plus that), modal coordinates in [-0.1, 0.1], unit quaternions, speeds and
 /// inputs in [-1, 1]; with prescribed motion, times in [-1, 21] s.
 CrosscheckResult crosscheck(Engine& tested, Engine& reference, int samples, unsigned seed);
 
