@@ -33,10 +33,10 @@ void place_on_orbit(Model& model, int root, const InitialOrbit& orbit) {
   const int q = b.q_joint, u = b.u_joint;  // free joint: x y z qw qx qy qz; vx vy vz wx wy wz
   const Mat3& R_NJ = b.joint.R_PJ;
   if (orbit.lvlh) {
-    const Mat3 R_NB = lvlh_frame(target);
+    const Mat3 R_NB = lvlh_frame(target) * orbit.R_LB;
     const Eigen::Quaterniond Q(Mat3(R_NJ.transpose() * R_NB));
     model.q0.segment<4>(q + 3) << Q.w(), Q.x(), Q.y(), Q.z();
-    model.u0.segment<3>(u + 3) = R_NB.transpose() * lvlh_rate_N(target);
+    model.u0.segment<3>(u + 3) = R_NB.transpose() * lvlh_rate_N(target) + orbit.rate_offset_B;
   }
   model.q0.segment<3>(q).setZero();
   model.u0.segment<3>(u).setZero();
@@ -46,6 +46,15 @@ void place_on_orbit(Model& model, int root, const InitialOrbit& orbit) {
   const Mat3 R_NB = R_NJ * Eigen::Quaterniond(qq(0), qq(1), qq(2), qq(3)).normalized().toRotationMatrix();
   model.q0.segment<3>(q) = R_NJ.transpose() * (target.r_N - c);
   model.u0.segment<3>(u) = R_NB.transpose() * (target.v_N - v_c);
+}
+
+OrbitSetNames orbit_set_names(const std::string& root, bool lvlh) {
+  OrbitSetNames n{{root + ".x", root + ".y", root + ".z"}, {root + ".vx", root + ".vy", root + ".vz"}};
+  if (lvlh) {
+    for (const char* c : {".qw", ".qx", ".qy", ".qz"}) n.q.push_back(root + c);
+    for (const char* c : {".wx", ".wy", ".wz"}) n.u.push_back(root + c);
+  }
+  return n;
 }
 
 }  // namespace kanegen

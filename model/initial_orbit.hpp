@@ -10,13 +10,15 @@
 
 namespace kanegen {
 
-struct InitialOrbit {
-  OrbitElements elements;
-  bool lvlh = false;
-};
-
 /// Sets the free root body's position and velocity in model.q0 / model.u0 (and with lvlh its quaternion and
-/// angular velocity) so that the system's centre of mass is on the orbit. `root`: the free root body's index.
+/// angular velocity: the orbit frame's, turned by the offsets) so that the system's centre of mass is on the orbit. `root`: the free root body's index.
 void place_on_orbit(Model& model, int root, const InitialOrbit& orbit);
+
+/// The root body's coordinate and speed names an orbit sets (its position and velocity; with lvlh also its
+/// quaternion and angular velocity): what `initial:` and a sweep may not set as well.
+struct OrbitSetNames {
+  std::vector<std::string> q, u;
+};
+OrbitSetNames orbit_set_names(const std::string& root, bool lvlh);
 
 }  // namespace kanegen

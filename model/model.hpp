@@ -20,6 +20,7 @@
 #include "model/inputs_outputs.hpp"
 #include "model/runtime_parameter.hpp"
 #include "model/modal_integrals.hpp"
+#include "model/orbit.hpp"
 #include "model/prescribed_motion.hpp"
 #include "model/joints/joint.hpp"
 #include "model/joints/joint_traits.hpp"
@@ -127,6 +128,10 @@ struct Model {
   Vec3 g_N = Vec3::Zero();          ///< uniform gravity, N components (zero with a central field)
   /// `gravity: {central: ...}` (model-format.md, "Gravity"): the central body at N's origin, J2 about N's z.
   std::optional<CentralGravity> central;
+  /// `initial: orbit:` as given, and the free root body it places (model/initial_orbit.hpp): q0 and u0 hold
+  /// the placed state; a sweep places each run again with its own masses and dispersed elements.
+  std::optional<InitialOrbit> initial_orbit;
+  int orbit_root = -1;
   std::vector<Body> bodies;         ///< parents before children
   int nq = 0;
   int nu = 0;

@@ -1277,11 +1277,12 @@ class Loader {
     }
   }
 
-  /// `initial: orbit: {a, e, i, raan, argp, nu, attitude: lvlh}` (checked against the rest in build()).
+  /// `initial: orbit: {a, e, i, raan, argp, nu, attitude: lvlh, attitude_offset, rate_offset}` (checked against the rest in build()).
   void read_orbit(const YAML::Node& o, int fallback) {
     if (!ck_.expect_map(o, fallback, "initial.orbit")) return;
     const int l = line_of(o) ? line_of(o) : fallback;
-    ck_.check_keys(o, "initial.orbit", {"a", "e", "i", "raan", "argp", "nu", "attitude"});
+    ck_.check_keys(o, "initial.orbit",
+                   {"a", "e", "i", "raan", "argp", "nu", "attitude", "attitude_offset", "rate_offset"});
     InitialOrbit orb;
     bool ok = true;
     auto get = [&](const char* key, double& out, bool required) {
@@ -1319,7 +1320,27 @@ class Loader {
       }
       orb.lvlh = a && *a == "lvlh";
     }
+    // the root's attitude and rate relative to the orbit frame (model-format.md, Gravity): with lvlh only
+    for (const char* key : {"attitude_offset", "rate_offset"}) {
+      if (!o[key].IsDefined()) continue;
+      const std::string f = std::string("initial.orbit.") + key;
+      const int kl = line_of(o[key]) ? line_of(o[key]) : l;
+      if (!orb.lvlh) {
+        ck_.error(o[key], kl, f, "given without attitude: lvlh; expected attitude: lvlh (the offset is from the orbit frame)");
+        ok = false;
+        continue;
+      }
+      if (std::string(key) == "attitude_offset") {
+        if (auto R = read_rotation(o[key], kl, f)) orb.R_LB = *R;
+        else ok = false;
+      } else if (auto w = ck_.vec3(o[key], kl, f)) {
+        orb.rate_offset_B = *w;
+      } else {
+        ok = false;
+      }
+    }
     if (ok) {
+      orb.line = l;
       orbit_ = orb;
       orbit_line_ = l;
     }
@@ -1341,11 +1362,8 @@ class Loader {
       return -1;
     }
     const std::string& b = model_.bodies[root].name;
-    std::vector<std::string> q_set{b + ".x", b + ".y", b + ".z"}, u_set{b + ".vx", b + ".vy", b + ".vz"};
-    if (orbit_->lvlh) {
-      for (const char* c : {".qw", ".qx", ".qy", ".qz"}) q_set.push_back(b + c);
-      for (const char* c : {".wx", ".wy", ".wz"}) u_set.push_back(b + c);
-    }
+    const OrbitSetNames set = orbit_set_names(b, orbit_->lvlh);
+    const std::vector<std::string>&q_set = set.q, &u_set = set.u;
     bool ok = true;
     for (auto [set, given] : {std::pair{&q_set, &init_q_}, std::pair{&u_set, &init_u_}})
       for (const std::string& n : *set)
@@ -1497,7 +1515,11 @@ class Loader {
       if (k >= 0) model_.u0(k) = g.value;
     }
     if (orbit_)
-      if (const int root = orbit_root(); root >= 0) place_on_orbit(model_, root, *orbit_);
+      if (const int root = orbit_root(); root >= 0) {
+        place_on_orbit(model_, root, *orbit_);
+        model_.initial_orbit = *orbit_;
+        model_.orbit_root = root;
+      }
     std::vector<Diagnostic> bad(diags_.begin(), diags_.end());  // the orbit's faults
     for (std::size_t i = 0; i < parameter_names_.size(); ++i) {
       const auto& [name, line] = parameter_names_[i];

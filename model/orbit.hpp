@@ -14,6 +14,17 @@ struct OrbitElements {
   double a = 0, e = 0, i = 0, raan = 0, argp = 0, nu = 0;
 };
 
+/// `initial: orbit:` (model-format.md, "Gravity"): the elements of the orbit the system's centre of mass is
+/// placed on; with lvlh the root body aligned with the orbit frame L, turned by R_LB, and turning with L plus
+/// rate_offset_B (its angular velocity relative to L, B components).
+struct InitialOrbit {
+  OrbitElements elements;
+  bool lvlh = false;
+  Eigen::Matrix3d R_LB = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d rate_offset_B = Eigen::Vector3d::Zero();
+  int line = 0;  ///< of `orbit:` in the model file (0: not from a file)
+};
+
 struct OrbitState {
   Eigen::Vector3d r_N = Eigen::Vector3d::Zero();  ///< position from the central body, N components
   Eigen::Vector3d v_N = Eigen::Vector3d::Zero();  ///< velocity, N components

@@ -18,6 +18,7 @@
 
 #include "model/diagnostics.hpp"
 #include "model/model_hash.hpp"
+#include "model/initial_orbit.hpp"
 #include "model/model_files.hpp"
 #include "model/model_loader.hpp"
 #include "model/output_file.hpp"
@@ -145,9 +146,42 @@ SweepPlan plan_sweep(const SweepSpec& spec) {
         fault(line, f, fmt::format("'{}': the model has no {} named '{}'", target, q ? "coordinate" : u ? "speed" : "input", name));
         return out;
       }
+      if (const auto& o = plan.model.initial_orbit; o && (q || u)) {  // as initial: refuses it
+        const OrbitSetNames set = orbit_set_names(plan.model.bodies[plan.model.orbit_root].name, o->lvlh);
+        const auto& names = q ? set.q : set.u;
+        const std::string canonical = q ? name : plan.model.u_names[k];
+        if (std::find(names.begin(), names.end(), canonical) != names.end()) {
+          fault(line, f, fmt::format("'{}' is set by the model's initial.orbit{}; expected orbit.<element>{}", target,
+                                     o->lvlh ? " with attitude: lvlh" : "",
+                                     o->lvlh ? ", orbit.attitude_offset.x|y|z or orbit.rate_offset.x|y|z" : ""));
+          return out;
+        }
+      }
       t.kind = q ? SweepPlan::Target::Kind::q : u ? SweepPlan::Target::Kind::u : SweepPlan::Target::Kind::input;
       t.index = k;
       t.nominal = q ? plan.model.q0(k) : u ? plan.model.u0(k) : 0.0;
+      out.push_back(t);
+    } else if (target.rfind("orbit.", 0) == 0) {
+      static const std::vector<std::string> keys = {
+          "a", "e", "i", "raan", "argp", "nu", "attitude_offset.x", "attitude_offset.y", "attitude_offset.z",
+          "rate_offset.x", "rate_offset.y", "rate_offset.z"};
+      const auto& o = plan.model.initial_orbit;
+      const auto it = std::find(keys.begin(), keys.end(), target.substr(6));
+      const int k = it == keys.end() ? -1 : static_cast<int>(it - keys.begin());
+      if (!o || k < 0 || (k >= 6 && !o->lvlh)) {
+        fault(line, f, fmt::format("'{}': {}", target,
+                                   !o ? "the model has no initial.orbit"
+                                   : k < 0 ? "expected orbit.a, .e, .i, .raan, .argp, .nu, .attitude_offset.x|y|z "
+                                             "or .rate_offset.x|y|z"
+                                           : "the offsets from the orbit frame need the model's attitude: lvlh"));
+        return out;
+      }
+      const OrbitElements& el = o->elements;
+      const double nominal[] = {el.a, el.e, el.i, el.raan, el.argp, el.nu, 0, 0, 0,
+                                o->rate_offset_B(0), o->rate_offset_B(1), o->rate_offset_B(2)};
+      t.kind = SweepPlan::Target::Kind::orbit;
+      t.index = k;
+      t.nominal = nominal[k];
       out.push_back(t);
     } else if (target.rfind("events.", 0) == 0) {
       const auto dot = target.rfind('.');
@@ -329,6 +363,8 @@ RunSetup run_setup(const SweepPlan& plan, long index) {
   r.events = model.events;
   const std::vector<double> dev = deviations(plan, index);
   r.values = first_member_values(plan, dev);
+  std::optional<InitialOrbit> orbit = model.initial_orbit;
+  Vec3 turn = Vec3::Zero();  // orbit.attitude_offset.x|y|z
   for (std::size_t i = 0; i < plan.targets.size(); ++i)
     for (const SweepPlan::Target& t : plan.targets[i]) {
       const double v = member_value(plan.spec.dispersions[i], t, dev[i]);
@@ -339,9 +375,31 @@ RunSetup run_setup(const SweepPlan& plan, long index) {
         case SweepPlan::Target::Kind::input: r.state.w(t.index) = v; break;
         case SweepPlan::Target::Kind::event_at: r.events[t.index].at = v; break;
         case SweepPlan::Target::Kind::event_reaches: r.events[t.index].reaches = v; break;
+        case SweepPlan::Target::Kind::orbit: {
+          OrbitElements& el = orbit->elements;
+          double* element[] = {&el.a, &el.e, &el.i, &el.raan, &el.argp, &el.nu};
+          if (t.index < 6) *element[t.index] = v;
+          else if (t.index < 9) turn(t.index - 6) = v;
+          else orbit->rate_offset_B(t.index - 9) = v;
+          break;
+        }
       }
     }
   for (const auto& slot : model.quaternions) r.state.q.segment<4>(slot.q).normalize();
+  if (orbit) {  // each run's centre of mass on its orbit: with its own masses, configuration and elements
+    if (turn.norm() > 0) orbit->R_LB = orbit->R_LB * Eigen::AngleAxisd(turn.norm(), turn.normalized()).toRotationMatrix();
+    try {
+      Model m = model;
+      apply_parameters(m, m.parameters, r.parameters);
+      m.q0 = r.state.q;
+      m.u0 = r.state.u;
+      place_on_orbit(m, model.orbit_root, *orbit);
+      r.state.q = m.q0;
+      r.state.u = m.u0;
+    } catch (const std::exception& e) {
+      r.failure = std::string("the run's orbit: ") + e.what();
+    }
+  }
   SimulationOptions& o = r.options;
   o.t_end = plan.spec.t_end;
   o.dt_out = plan.spec.dt_out;
@@ -374,6 +432,7 @@ RunResult run_one(Engine& engine, const SweepPlan& plan, long index, std::ostrea
   }
   std::vector<FiredEvent> fired;
   try {
+    if (!setup.failure.empty()) throw std::runtime_error(setup.failure);
     engine.set_parameters(p);
     if (controller) o.controller = controller(model, index);
     const SimulationResult sr = simulate(engine, s, o, both ? static_cast<RowSink&>(*both) : metrics);

@@ -27,7 +27,9 @@ struct SweepPlan {
   struct Target {
     /// event_at / event_reaches: "events.<name>.at" / ".reaches" (model-format.md, Locks and events);
     /// input: "inputs.<name>", the named input's value for the whole run
-    enum class Kind { parameter, q, u, input, event_at, event_reaches } kind = Kind::parameter;
+    /// orbit: "orbit.<element>" (index 0-5: a, e, i, raan, argp, nu), "orbit.attitude_offset.x|y|z" (6-8: a
+    /// rotation vector [rad] turning the root after the model's offset), "orbit.rate_offset.x|y|z" (9-11)
+    enum class Kind { parameter, q, u, input, event_at, event_reaches, orbit } kind = Kind::parameter;
     int index = 0;  ///< into model.parameters, q, u, the inputs or model.events
     double nominal = 0.0;
   };
@@ -74,6 +76,7 @@ struct RunSetup {
   VecX parameters;
   std::vector<Event> events;
   SimulationOptions options;  ///< t_end, dt_out, integrator, events and the time limit of the sweep
+  std::string failure;        ///< why the run cannot start (e.g. a dispersed orbit that is not elliptic)
 };
 RunSetup run_setup(const SweepPlan& plan, long index);
 

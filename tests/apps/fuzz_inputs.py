@@ -1669,6 +1669,12 @@ def s_initial_quaternion(rng, seed, sf):
         vals, expect, what = [5e-324, 0.0, 0.0, 0.0], "invalid", "norm 5e-324"
     given = dict(zip(comps, vals))
     ki, init = get(doc.root, "initial")
+    if isinstance(init, yaml.MappingNode):  # initial.orbit with attitude: lvlh sets the root's quaternion
+        ko, orb = get(init, "orbit")
+        if isinstance(orb, yaml.MappingNode):
+            ka, att = get(orb, "attitude")
+            if isinstance(att, yaml.ScalarNode) and att.value == "lvlh":
+                expect, what = "invalid", what + ", but set by initial.orbit's attitude: lvlh"
     edits = []
     if isinstance(init, yaml.MappingNode):
         kq, qn = get(init, "q")

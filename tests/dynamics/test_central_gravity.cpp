@@ -3,6 +3,7 @@
 // the force against the potential's derivative, a Kepler orbit, and E and H
 // kept over orbits by a flexible spacecraft (H_z only, with J2).
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include <random>
 
@@ -215,4 +216,64 @@ TEST_CASE("initial: orbit: refused without a central field, for e >= 1, a <= 0, 
   refused("name: o\ngravity: {central: {mu: 3.986e14}}" + body +
               "initial:\n  u: {sat.wz: 0.1}\n  orbit: {a: 7.0e6, e: 0.1, attitude: lvlh}\n",
           "initial.u.sat.wz");
+}
+
+TEST_CASE("initial: orbit: attitude_offset and rate_offset start the root off the orbit frame (R_NB = R_NL R_LB, "
+          "w_B = R_BL w_L + rate_offset)",
+          "[central]") {
+  const OrbitElements el{6.978e6, 0.001, 1.7, 0.3, 0.0, 0.0};
+  const OrbitState target = state_from_elements(kMu, el);
+  const std::string head = R"(name: offset
+gravity: {central: {mu: 3.986004418e14}}
+bodies:
+  - {name: bus, parent: ground, joint: {type: free}, mass: 200.0, com: [0.1, -0.05, 0.2], inertia: [80, 90, 70, 1, 2, 3]}
+initial:
+  orbit: {a: 6.978e6, e: 0.001, i: 1.7, raan: 0.3, argp: 0.0, nu: 0.0, attitude: lvlh,
+)";
+  const Eigen::Quaterniond Q_LB = Eigen::Quaterniond(0.9, 0.1, -0.3, 0.2).normalized();
+  const Vec3 rate(1.0e-3, -2.0e-3, 5.0e-4);
+  struct Case {
+    std::string keys;
+    Mat3 R_LB;
+    Vec3 rate;
+  };
+  for (const Case& c : std::vector<Case>{
+           {fmt::format("attitude_offset: {{quaternion: [{}, {}, {}, {}]}}, rate_offset: [1.0e-3, -2.0e-3, 5.0e-4]}}",
+                        Q_LB.w(), Q_LB.x(), Q_LB.y(), Q_LB.z()),
+            Q_LB.toRotationMatrix(), rate},
+           {"attitude_offset: {rpy: [0.0, 0.05, 0.0]}}", Eigen::AngleAxisd(0.05, Vec3::UnitY()).toRotationMatrix(),
+            Vec3::Zero()},
+           {"rate_offset: [0.0, 0.0, 1.0e-3]}", Mat3::Identity(), Vec3(0, 0, 1e-3)}}) {
+    INFO(c.keys);
+    const Model model = load_model(test::write_temp("offset.yaml", head + "          " + c.keys + "\n"));
+    const State s = initial_state(model);
+    const Mat3 R_NB = Eigen::Quaterniond(s.q(3), s.q(4), s.q(5), s.q(6)).toRotationMatrix();
+    const Mat3 R_NL = lvlh_frame(target);
+    CHECK((R_NB - R_NL * c.R_LB).norm() <= 1e-12);
+    // the angular velocity relative to the orbit frame, in B, is the offset
+    const Vec3 w_rel_B = s.u.segment<3>(3) - R_NB.transpose() * lvlh_rate_N(target);
+    CHECK((w_rel_B - c.rate).norm() <= 1e-15);
+    // the centre of mass is still on the orbit, with the orbit's velocity
+    GenericEngine engine(model);
+    CHECK((engine.momentum(0.0, s.q, s.u).p_N / 200.0 - target.v_N).norm() <= 1e-12 * target.v_N.norm());
+    const Vec3 com = s.q.head<3>() + R_NB * Vec3(0.1, -0.05, 0.2);
+    CHECK((com - target.r_N).norm() <= 1e-9 * target.r_N.norm());
+  }
+  // without attitude: lvlh, either offset is refused, with its line and field
+  const std::string plain = R"(name: offset
+gravity: {central: {mu: 3.986004418e14}}
+bodies:
+  - {name: bus, parent: ground, joint: {type: free}, mass: 200.0, inertia: [80, 90, 70, 0, 0, 0]}
+initial:
+  orbit: {a: 6.978e6, e: 0.001, )";
+  CHECK_THROWS_WITH(load_model(test::write_temp("offset_bad.yaml", plain + "rate_offset: [0, 0, 1.0e-3]}\n")),
+                    Catch::Contains(":6: initial.orbit.rate_offset: given without attitude: lvlh"));
+  CHECK_THROWS_WITH(load_model(test::write_temp("offset_bad.yaml", plain + "attitude_offset: {rpy: [0, 0.1, 0]}}\n")),
+                    Catch::Contains("initial.orbit.attitude_offset: given without attitude: lvlh"));
+  CHECK_THROWS_WITH(
+      load_model(test::write_temp("offset_bad.yaml", plain + "attitude: lvlh, rate_offset: [0, 1.0e-3]}\n")),
+      Catch::Contains("initial.orbit.rate_offset"));
+  CHECK_THROWS_WITH(
+      load_model(test::write_temp("offset_bad.yaml", plain + "attitude: lvlh, attitude_offset: {rpy: [0, 0.1]}}\n")),
+      Catch::Contains("initial.orbit.attitude_offset.rpy"));
 }

@@ -9,6 +9,7 @@
 
 #include "engine/generic_engine.hpp"
 #include "model/model_loader.hpp"
+#include "model/orbit.hpp"
 #include "model/sweep_spec.hpp"
 #include "sim/row_sink.hpp"
 #include "sim/simulate.hpp"
@@ -166,4 +167,69 @@ dispersions:
   CHECK_FALSE(r.ok());
   CHECK(r.status.find("wall-time limit of 0.5 s") != std::string::npos);
   CHECK(r.wall_s < 5.0);
+}
+
+TEST_CASE("sweep: orbit elements and LVLH offsets dispersed by name, each run's centre of mass on its own orbit; "
+          "the root's state under an orbit refused",
+          "[sweep][central]") {
+  const std::string model = test::source_path("models/gravity_gradient_boom.yaml");
+  const SweepPlan plan = plan_sweep(load_sweep_spec(test::write_temp("orbit_sweep.yaml", "model: " + model + R"(
+runs: 12
+t_end: 1.0
+engine: generic
+dispersions:
+  - {parameter: orbit.a, distribution: normal, sigma: 1.0e4}
+  - {parameter: orbit.i, distribution: uniform, low: -0.1, high: 0.1}
+  - {parameter: orbit.nu, distribution: uniform, low: 0.0, high: 6.0}
+  - {parameter: orbit.attitude_offset.y, distribution: normal, sigma: 0.05}
+  - {parameter: orbit.rate_offset.z, distribution: normal, sigma: 1.0e-3}
+  - {parameter: tip.mass, distribution: normal, sigma: 0.2, relative: true}
+)")));
+  const Model& m = plan.model;
+  REQUIRE(m.initial_orbit);
+  const double mu = m.central->mu;
+  for (long k = 0; k < 12; ++k) {
+    INFO("run " << k);
+    const RunSetup s = run_setup(plan, k);
+    REQUIRE(s.failure.empty());
+    const std::vector<double> v = draw(plan, k);
+    OrbitElements el = m.initial_orbit->elements;
+    el.a = v[0], el.i = v[1], el.nu = v[2];
+    const OrbitState target = state_from_elements(mu, el);
+    // the centre of mass (this run's tip mass) and its velocity, from the generic engine with its parameters
+    GenericEngine e(m);
+    e.set_parameters(s.parameters);
+    const MomentumValues P = e.momentum(0.0, s.state.q, s.state.u);
+    const double mass = 100.0 + 1.0 + v[5];
+    CHECK((P.p_N / mass - target.v_N).norm() <= 1e-10 * target.v_N.norm());
+    const Mat3 R_NB = Eigen::Quaterniond(s.state.q(3), s.state.q(4), s.state.q(5), s.state.q(6)).toRotationMatrix();
+    const Mat3 R_LB = lvlh_frame(target).transpose() * R_NB;
+    CHECK((R_LB - Eigen::AngleAxisd(v[3], Vec3::UnitY()).toRotationMatrix()).norm() <= 1e-12);
+    const Vec3 w_rel = s.state.u.segment<3>(3) - R_NB.transpose() * lvlh_rate_N(target);
+    CHECK((w_rel - Vec3(0, 0, v[4])).norm() <= 1e-15);
+  }
+  // the root's own state is the orbit's: refused, as initial: refuses it
+  for (const std::string& name : {"u.bus.wx", "q.bus.x", "u.bus.vz"})
+    CHECK_THROWS_WITH(plan_sweep(load_sweep_spec(test::write_temp("orbit_bad.yaml", "model: " + model + R"(
+runs: 2
+t_end: 1.0
+dispersions:
+  - {parameter: )" + name + R"(, distribution: normal, sigma: 1.0e-3}
+)"))),
+                      Catch::Contains("is set by the model's initial.orbit"));
+  CHECK_THROWS_WITH(plan_sweep(load_sweep_spec(test::write_temp("orbit_bad.yaml", "model: " + model + R"(
+runs: 2
+t_end: 1.0
+dispersions:
+  - {parameter: orbit.inclination, distribution: normal, sigma: 1.0e-3}
+)"))),
+                    Catch::Contains("expected orbit.a, .e, .i"));
+  // an eccentricity dispersed below 0 fails that run, with its reason
+  const SweepPlan bad = plan_sweep(load_sweep_spec(test::write_temp("orbit_e.yaml", "model: " + model + R"(
+runs: 1
+t_end: 1.0
+dispersions:
+  - {parameter: orbit.e, distribution: uniform, low: -0.2, high: -0.1}
+)")));
+  CHECK_THAT(run_setup(bad, 0).failure, Catch::Contains("the run's orbit"));
 }
