@@ -58,17 +58,22 @@ LatchImpact latch_impact(const MatX& M, const VecX& u_minus, const std::vector<i
   const int nu = static_cast<int>(M.rows());
   const std::vector<int> f = free_speeds(nu, locked_after);
   LatchImpact r;
-  r.u_plus = VecX::Zero(nu);
-  // generalized momentum of the free speeds, before: (M u-)_f
-  const VecX p = M * u_minus;
+  r.u_plus = u_minus;
+  // Only the speeds being stopped enter (no cancellation of the large T of an orbit, docs/decisions.md): the
+  // free speeds' momentum M_ff u_f+ = M_ff u_f- + M_fl u_l- gives the jump du_f = M_ff^-1 M_fl u_l-, and
+  // T- - T+ = 1/2 u_l-' (M_ll - M_lf M_ff^-1 M_fl) u_l- (the Schur complement: >= 0).
+  VecX u_l(static_cast<Eigen::Index>(locked_after.size()));
+  for (std::size_t i = 0; i < locked_after.size(); ++i) u_l(i) = u_minus(locked_after[i]);
+  const MatX M_ll = rows_cols(M, locked_after, locked_after);
+  double lost = u_l.dot(M_ll * u_l);
   if (!f.empty()) {
-    VecX p_f(static_cast<Eigen::Index>(f.size()));
-    for (std::size_t i = 0; i < f.size(); ++i) p_f(i) = p(f[i]);
-    const VecX u_f = solve_free(rows_cols(M, f, f), p_f, f);
-    for (std::size_t i = 0; i < f.size(); ++i) r.u_plus(f[i]) = u_f(i);
+    const VecX c = rows_cols(M, f, locked_after) * u_l;
+    const VecX du_f = solve_free(rows_cols(M, f, f), c, f);
+    for (std::size_t i = 0; i < f.size(); ++i) r.u_plus(f[i]) += du_f(i);
+    lost -= c.dot(du_f);
   }
-  r.T_minus = 0.5 * u_minus.dot(p);
-  r.T_plus = 0.5 * r.u_plus.dot(M * r.u_plus);
+  for (const int k : locked_after) r.u_plus(k) = 0.0;
+  r.energy_lost = 0.5 * lost;
   return r;
 }
 

@@ -19,12 +19,13 @@ void reduced_udot(const MatX& M, const VecX& F, const std::vector<int>& locked, 
 /// there and the speeds u_minus just before, the speeds just after are
 /// u_l+ = 0 and M_ff u_f+ = M_ff u_f- + M_fl u_l- (the free speeds'
 /// generalized momentum conserved), and the kinetic energy lost
-/// dT = 1/2 u-' M u- - 1/2 u+' M u+ >= 0. `locked_after`: every speed locked
-/// after the event (those locked before included; their speeds are 0).
+/// dT = 1/2 u-' M u- - 1/2 u+' M u+ >= 0, formed from the stopped speeds
+/// alone: 1/2 u_l-' (M_ll - M_lf M_ff^-1 M_fl) u_l- (no difference of two
+/// large kinetic energies: an orbit's T is 1e10 J). `locked_after`: every
+/// speed locked after the event (those locked before included; their speeds are 0).
 struct LatchImpact {
   VecX u_plus;
-  double T_minus = 0, T_plus = 0;
-  double energy_lost() const { return T_minus - T_plus; }
+  double energy_lost = 0;
 };
 LatchImpact latch_impact(const MatX& M, const VecX& u_minus, const std::vector<int>& locked_after);
 

@@ -4,6 +4,9 @@
 
 #include <cmath>
 
+#include "dynamics/central_gravity.hpp"
+#include "dynamics/kinematics.hpp"
+#include "dynamics/workspace.hpp"
 #include "engine/generic_engine.hpp"
 #include "model/state_io.hpp"
 
@@ -50,7 +53,39 @@ std::string gimbal_lock_message(const Model& model, int body, const double* q, d
                      to_string(b.joint.type), b.name, measure, angles);
 }
 
+void check_mass_elements_off_the_centre(const Model& model) {
+  if (!model.central) return;
+  Workspace<double> ws(model);
+  compute_kinematics(model, ws, 0.0, model.q0, model.u0);
+  std::vector<Diagnostic> faults;
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const Body& b = model.bodies[i];
+    BodyWorkspace<double>& s = ws.body[i];
+    int element = 0;  // 0: the rigid part (or node 1 of a flexible body without one), then the nodes
+    bool reported = false;
+    for_each_mass_element(b, s, [&](double mass, const Vec3& s_B, const auto*, const Mat3&, const auto*, bool) {
+      const Vec3 r = s.r_NO_N + s.R_NB * s_B;
+      const double r2 = r.squaredNorm(), r5 = r2 * r2 * std::sqrt(r2);
+      // the field (mu m / r^2) and its gradient (mu / r^5 with the inertia) must be numbers
+      if (!reported && !(std::isfinite(model.central->mu * (mass > 0 ? mass : 1.0) / r2) &&
+                         std::isfinite(model.central->mu / r5))) {
+        const bool rigid = element == 0 && (b.rigid.mass != 0.0 || !b.rigid.I_c_B.isZero(0.0));
+        faults.push_back(Diagnostic{
+            model.source_path, b.line, fmt::format("bodies[{}]", i),
+            fmt::format("{} of '{}' is at the attracting centre (|r| = {:.3g} m from N's origin at the initial state), "
+                        "where the central field is singular; expected every mass element away from N's origin "
+                        "(an initial: orbit:, or the root's position)",
+                        rigid ? "the centre of mass" : "a node", b.name, std::sqrt(r2))});
+        reported = true;
+      }
+      ++element;
+    });
+  }
+  if (!faults.empty()) throw InputError(std::move(faults));
+}
+
 void check_mass_matrix_at_initial_state(const Model& model) {
+  check_mass_elements_off_the_centre(model);
   double measure = 0;
   if (const int lb = gimbal_locked_body(model, model.q0.data(), kGimbalLockRefuse, &measure); lb >= 0)
     throw InputError(Diagnostic{model.source_path, model.bodies[lb].line, fmt::format("bodies[{}].joint", lb),

@@ -85,6 +85,8 @@ Invariants invariants_of(const Model& model, const VecX& tau, const VecX& w, boo
   inv.momentum = m.empty();
   // central gravity without J2 is the only thing changing the momenta: H about N's origin holds
   inv.angular_momentum = inv.momentum || (m.size() == 1 && model.central && model.central->J2 == 0.0);
+  // with J2 (axisymmetric about N's z) the only thing changing them: H_z about N's z axis holds
+  inv.angular_momentum_z = !inv.angular_momentum && m.size() == 1 && model.central && model.central->J2 != 0.0;
   return inv;
 }
 

@@ -28,6 +28,8 @@ struct Invariants {
   bool momentum = true;  ///< p and H about N's origin
   /// H about N's origin alone (central gravity without J2 turns p, not H; dynamics.md, "Invariants").
   bool angular_momentum = true;
+  /// H_z alone, about N's z axis (central gravity with J2: the field is axisymmetric about N's z).
+  bool angular_momentum_z = false;
   /// Energy is broken by prescribed motion alone: T + V minus the drivers' work is kept
   /// (sim/driver_work.hpp measures that balance).
   bool energy_with_drivers = false;

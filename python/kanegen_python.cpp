@@ -309,6 +309,10 @@ Run make_run(const RowTable& table, const SimulationResult& r, const Model& m) {
   d["energy_drift"] = r.quality.energy_drift;  // NaN: not an invariant of the scene
   d["energy_balance"] = r.quality.energy_balance;  // E - E0 - drivers' work (prescribed motion), NaN otherwise
   d["H_drift"] = r.quality.H_drift;
+  d["energy_drift_J"] = r.quality.energy_drift_J;  // the same drifts in their units (docs/decisions.md)
+  d["H_drift_Nms"] = r.quality.H_drift_Nms;
+  d["drift_about_centre_of_mass"] = r.quality.about_com;  // relative to the motion about the centre of mass
+  d["H_z_only"] = r.quality.H_z;
   d["error_estimate"] = r.quality.error_estimate;
   d["error_worst"] = r.quality.error_worst;
   d["accuracy"] = r.quality.summary();

@@ -116,7 +116,7 @@ int EventRun::fire(Engine& engine, double t, VecX& x, int crossing) {
       engine.mass_matrix(t, q, M);
       const LatchImpact impact = latch_impact(M, x.tail(nu), locked_speeds(model_, locks_));
       x.tail(nu) = impact.u_plus;
-      f.energy_lost = impact.energy_lost();
+      f.energy_lost = impact.energy_lost;
     }
     engine.set_locks(locks_);
     f.u_after = x.tail(nu);

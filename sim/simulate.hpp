@@ -39,9 +39,16 @@ struct SimulationOptions {
 /// How far a run can be trusted, for its summary.
 struct RunQuality {
   std::string integrator_choice;   ///< why `auto` picked the method ("" if it was named)
-  /// Relative drift of the invariants that hold for the scene (NaN otherwise):
-  /// max |E - E0| / max(|T0|, |V0|, |E0|) and max |H - H0| / |H0| over the output times.
+  /// Relative drift of the invariants that hold for the scene (NaN otherwise), over the output times
+  /// (docs/decisions.md, "Reports in orbit"): max |E - E0| against max(T + |V|) and max |H - H0| against
+  /// max(|H0|, sqrt(2 T_max I_max)) (a zero H is no scale); in a central field both against the motion
+  /// about the centre of mass (T_c, H_c), the orbit's share apart. H_z alone with J2 (H_z).
   double energy_drift = NAN, H_drift = NAN;
+  /// The same in their units, the scales and the totals (with the orbit's share), from the worst segment.
+  double energy_drift_J = NAN, energy_scale_J = NAN, energy_total_J = NAN;
+  double H_drift_Nms = NAN, H_scale_Nms = NAN, H_total_Nms = NAN;
+  bool about_com = false;  ///< the scales are the motion about the centre of mass (a central field)
+  bool H_z = false;        ///< the momentum drift is H_z's (central gravity with J2)
   /// When prescribed motion alone does work (Invariants::energy_with_drivers): the balance
   /// max |E - E0 - W_drivers| / max(T + |V|) over the output times (sim/driver_work.hpp); NaN otherwise.
   double energy_balance = NAN;

@@ -25,6 +25,8 @@
 #include "model/output_file.hpp"
 #include "model/state_io.hpp"
 #include "sim/integrators.hpp"
+#include "sim/mass_properties.hpp"
+#include "sim/motion_about_com.hpp"
 #include "sim/simulate.hpp"
 
 namespace kanegen::bench {
@@ -248,6 +250,26 @@ Drifts invariant_drifts(Engine& g, const InvariantSet& inv, const Trajectory& tr
     q = x.head(m.nq);
     u = x.tail(m.nu);
   };
+  // in a central field the scales are the motion about the centre of mass, the orbit's share apart
+  d.about_com = m.central.has_value() && all_roots_free(m);
+  d.H_z = inv.momentum_z && !inv.momentum;
+  double Tc_max = 0;  // max kinetic energy about the centre of mass (central field), else max T
+  Vec3 Hc0 = Vec3::Zero();
+  for (std::size_t k = 0; k < tr.x.size() && (inv.energy || inv.momentum || inv.momentum_z); ++k) {
+    split(tr.x[k]);
+    if (d.about_com) {
+      const auto c = motion_about_centre_of_mass(g, 0.0, q, u);
+      if (!c) {
+        d.about_com = false;
+        continue;
+      }
+      Tc_max = std::max(Tc_max, c->T_c);
+      if (k == 0) Hc0 = c->H_c_N;
+    } else {
+      Tc_max = std::max(Tc_max, g.energy(q, u).T);
+    }
+  }
+  if (d.about_com && !(Tc_max > 0)) d.about_com = false;  // a point mass: no motion about its centre of mass
   if (inv.energy) {
     double e0 = 0, scale = 0, worst = 0;
     for (std::size_t k = 0; k < tr.x.size(); ++k) {
@@ -257,9 +279,12 @@ Drifts invariant_drifts(Engine& g, const InvariantSet& inv, const Trajectory& tr
       scale = std::max(scale, E.T + std::abs(E.V));
       worst = std::max(worst, std::abs(E.T + E.V - e0));
     }
-    d.energy = scale > 0 ? worst / scale : worst;
+    d.energy_abs = worst;
+    d.E_total = std::abs(e0);
+    d.energy_scale = d.about_com ? Tc_max : scale;
+    d.energy = d.energy_scale > 0 ? worst / d.energy_scale : worst;
   }
-  if (inv.momentum) {
+  if (inv.momentum || inv.momentum_z) {
     Vec3 H0 = Vec3::Zero(), p0 = Vec3::Zero();
     double Tmax = 0, wH = 0, wp = 0;
     for (std::size_t k = 0; k < tr.x.size(); ++k) {
@@ -267,12 +292,27 @@ Drifts invariant_drifts(Engine& g, const InvariantSet& inv, const Trajectory& tr
       const MomentumValues M = g.momentum(q, u);
       Tmax = std::max(Tmax, g.energy(q, u).T);
       if (k == 0) H0 = M.H_N, p0 = M.p_N;
-      wH = std::max(wH, (M.H_N - H0).norm());
+      wH = std::max(wH, d.H_z ? std::abs(M.H_N.z() - H0.z()) : (M.H_N - H0).norm());
       wp = std::max(wp, (M.p_N - p0).norm());
     }
-    d.H = H0.norm() > 0 ? wH / H0.norm() : wH;
-    const double pscale = std::sqrt(2 * total_mass * Tmax);
-    d.p = pscale > 0 ? wp / pscale : wp;
+    // the momentum the motion would carry with all its kinetic energy in a rotation about the largest
+    // principal axis: the floor below which |H0| is not a scale (a zero H gives no false alarm)
+    split(tr.x[0]);
+    State s0;
+    s0.t = tr.t.empty() ? 0.0 : tr.t[0];
+    s0.q = q;
+    s0.u = u;
+    const double I_max = system_mass_properties(m, s0).principal_moments.maxCoeff();
+    const double H_motion = std::sqrt(2.0 * Tc_max * std::max(I_max, 0.0));
+    const double H_ref = d.about_com ? (d.H_z ? std::abs(Hc0.z()) : Hc0.norm()) : (d.H_z ? std::abs(H0.z()) : H0.norm());
+    d.H_abs = wH;
+    d.H_total = d.H_z ? std::abs(H0.z()) : H0.norm();
+    d.H_scale = std::max(H_ref, H_motion);
+    d.H = d.H_scale > 0 ? wH / d.H_scale : wH;
+    if (inv.momentum) {
+      const double pscale = std::sqrt(2 * total_mass * Tmax);
+      d.p = pscale > 0 ? wp / pscale : wp;
+    }
   }
   return d;
 }

@@ -106,6 +106,7 @@ ErrorMeasure trajectory_error(const Model& model, const Trajectory& run, const T
 struct InvariantSet {
   bool energy = false;
   bool momentum = false;
+  bool momentum_z = false;  ///< H_z alone (central gravity with J2); with momentum false
 };
 InvariantSet invariants_of(const Model& model, const VecX& tau);
 
@@ -114,6 +115,13 @@ InvariantSet invariants_of(const Model& model, const VecX& tau);
 /// |p - p0| / sqrt(2 m T_max) (m: the model's whole mass).
 struct Drifts {
   double energy = NAN, H = NAN, p = NAN;
+  /// The same drifts in their units (J, N m s) and the scales they are relative to (docs/decisions.md,
+  /// "Reports in orbit"): in a central field the motion about the centre of mass (T_c's maximum; |H_c| or the
+  /// momentum scale sqrt(2 T_c I_max)), elsewhere max(T + |V|) and max(|H0|, sqrt(2 T I_max)).
+  double energy_abs = NAN, energy_scale = NAN, H_abs = NAN, H_scale = NAN;
+  double E_total = NAN, H_total = NAN;  ///< |E0| and |H0| (with the orbit's share)
+  bool about_com = false;               ///< the scales are the motion about the centre of mass (central field)
+  bool H_z = false;                     ///< H is H_z alone
 };
 Drifts invariant_drifts(Engine& engine, const InvariantSet& inv, const Trajectory& tr);
 

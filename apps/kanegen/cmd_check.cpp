@@ -2,7 +2,9 @@
 #include <fmt/format.h>
 
 #include "apps/kanegen/cli_common.hpp"
+#include "model/events.hpp"
 #include "model/mode_description.hpp"
+#include "model/orbit_plausibility.hpp"
 #include "sim/mass_properties.hpp"
 
 namespace kanegen::cli {
@@ -35,6 +37,46 @@ void print_modes(const Body& b) {
              percent(inertia_sum, d.node_inertia_O));
 }
 
+constexpr double kDeg = 57.29577951308232;
+
+void print_orbit(const Model& model) {
+  const OrbitElements& el = model.initial_orbit->elements;
+  const OrbitDescription d = describe_orbit(model);
+  fmt::print("  orbit of the centre of mass: a {:.10g} m, e {:.6g}, i {:.6g} deg, raan {:.6g} deg, argp {:.6g} deg, "
+             "nu {:.6g} deg{}; period {:.6g} s ({:.4g} min)\n",
+             el.a, el.e, el.i * kDeg, el.raan * kDeg, el.argp * kDeg, el.nu * kDeg,
+             model.initial_orbit->lvlh ? ", attitude: lvlh" : "", d.period, d.period / 60.0);
+  if (d.radius > 0.0)
+    fmt::print("    perigee altitude {:.6g} km, apogee altitude {:.6g} km (over the radius {:.10g} m: {})\n",
+               (d.r_perigee - d.radius) / 1e3, (d.r_apogee - d.radius) / 1e3, d.radius, d.radius_from);
+  else
+    fmt::print("    perigee radius {:.6g} km, apogee radius {:.6g} km (no central radius given)\n", d.r_perigee / 1e3,
+               d.r_apogee / 1e3);
+  for (const Diagnostic& w : d.warnings) fmt::print(stderr, "warning: {}\n", w.str());
+}
+
+std::string body_list(const Model& model, const std::vector<int>& bodies) {
+  std::string s;
+  for (const int b : bodies) s += (s.empty() ? "" : ", ") + model.bodies[b].name;
+  return s;
+}
+
+void print_locks_events(const Model& model) {
+  std::vector<int> locked;
+  for (std::size_t i = 0; i < model.bodies.size(); ++i)
+    if (model.bodies[i].joint.locked) locked.push_back(static_cast<int>(i));
+  if (!locked.empty()) fmt::print("  locked at the start: {}\n", body_list(model, locked));
+  for (const Event& e : model.events) {
+    const std::string when = e.trigger == Event::Trigger::time
+                                 ? fmt::format("at t = {:.10g} s", e.at)
+                                 : fmt::format("when {} reaches {:.10g}", model.q_names[e.coordinate], e.reaches);
+    std::string what;
+    if (!e.lock.empty()) what += "locks " + body_list(model, e.lock);
+    if (!e.release.empty()) what += (what.empty() ? "releases " : "; releases ") + body_list(model, e.release);
+    fmt::print("  event {}: {}, {}\n", e.name, when, what);
+  }
+}
+
 int run(const std::string& path) {
   const Model model = load_checked(path);
   fmt::print("model {}: {} bodies, nq = {}, nu = {}\n", model.name, model.bodies.size(), model.nq, model.nu);
@@ -60,6 +102,8 @@ int run(const std::string& path) {
   std::string dofs;
   for (const auto& n : model.u_names) dofs += (dofs.empty() ? "" : ", ") + n;
   fmt::print("  speeds: {}\n", dofs);
+  print_locks_events(model);
+  if (model.central && model.initial_orbit) print_orbit(model);
   const SystemMassProperties p = system_mass_properties(model, initial_state(model));
   fmt::print("  whole spacecraft at the initial state: mass {:.6g} kg, centre of mass {} m (N)\n", p.mass,
              vec(p.com_N));

@@ -466,3 +466,61 @@ initial:
   CHECK(failed == 2);
   fs::remove_all(sweep_dir);
 }
+
+TEST_CASE("cli: check in orbit prints the period, perigee and apogee, locks and events; warns (exit 0) of an angle "
+          "in degrees, mu in km^3/s^2, a perigee below the radius; refuses a mass at the attracting centre",
+          "[cli][central]") {
+  const double mu = 3.986004418e14, a = 6.978137e6, pi = 3.14159265358979323846;
+  const Run gg = run("check " + src("models/gravity_gradient_boom.yaml"));
+  INFO(gg.out);
+  REQUIRE(gg.status == 0);
+  CHECK(gg.out.find(fmt::format("period {:.6g} s", 2 * pi * std::sqrt(a * a * a / mu))) != std::string::npos);
+  CHECK(gg.out.find(fmt::format("perigee altitude {:.6g} km, apogee altitude {:.6g} km", (a - 6378137.0) / 1e3,
+                                (a - 6378137.0) / 1e3)) != std::string::npos);
+  CHECK(gg.out.find("warning") == std::string::npos);
+  const Run dep = run("check " + src("models/array_deployment.yaml"));
+  CHECK(dep.out.find("event release: at t = 10 s, releases wing_a, wing_b") != std::string::npos);
+  CHECK(dep.out.find("event latch_a: when wing_a.angle reaches 1.570796327, locks wing_a") != std::string::npos);
+
+  const fs::path d = temp_dir();
+  auto model = [&](const std::string& gravity, const std::string& orbit) {
+    const fs::path p = d / "orbit_check.yaml";
+    std::ofstream(p) << "name: orbit_check\ngravity:\n  central: " << gravity << R"(
+bodies:
+  - {name: bus, parent: ground, joint: {type: free}, mass: 100.0, inertia: [16, 20, 14, 0, 0, 0]}
+)" << (orbit.empty() ? "" : "initial:\n  orbit: " + orbit + "\n");
+    return run("check " + p.string());
+  };
+  struct Case {
+    std::string gravity, orbit, field, says;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"{mu: 3.986004418e14}", "{a: 7.0e6, e: 0.0, i: 98.2}", "orbit_check.yaml:7: initial.orbit.i",
+            "98.2 rad is outside [0, pi]; angles are in radians (98.2 degrees would be 1.71391 rad)"},
+           {"{mu: 3.986004418e14}", "{a: 7.0e6, e: 0.0, raan: 270.0}", "initial.orbit.raan", "outside [-2 pi, 2 pi]"},
+           {"{mu: 398600.4418}", "{a: 7.0e6, e: 0.0}", "orbit_check.yaml:7: initial.orbit.a",
+            "looks like mixed units: that mu is the GM of the Earth in km^3/s^2"},
+           {"{mu: 3.986004418e14, J2: 1.08e-3, radius: 6378137.0}", "{a: 6.6e6, e: 0.1}", "initial.orbit.a",
+            "the perigee a (1 - e) = 5.94e+06 m is below the central body's radius 6.37814e+06 m"},
+           {"{mu: 3.986004418e14}", "{a: 6978.0, e: 0.0}", "initial.orbit.a", "a looks like kilometres"}}) {
+    const Run r = model(c.gravity, c.orbit);
+    INFO(c.orbit << "\n" << r.out);
+    CHECK(r.status == 0);
+    CHECK(r.out.find("warning: ") != std::string::npos);
+    CHECK(r.out.find(c.field) != std::string::npos);
+    CHECK(r.out.find(c.says) != std::string::npos);
+  }
+  // in a central field without an orbit the bus starts at N's origin: refused by every command, naming the body
+  const Run at_centre = model("{mu: 3.986004418e14}", "");
+  INFO(at_centre.out);
+  CHECK(at_centre.status == 2);
+  CHECK(at_centre.out.find("orbit_check.yaml:5: bodies[0]: the centre of mass of 'bus' is at the attracting centre") !=
+        std::string::npos);
+  for (const std::string& cmd : std::vector<std::string>{"eval", "simulate --t-end 1 -o " + (d / "never.csv").string()}) {
+    const Run r = run(cmd + " " + (d / "orbit_check.yaml").string() + " --engine generic");
+    INFO(r.out);
+    CHECK(r.status == 2);
+    CHECK(r.out.find("is at the attracting centre") != std::string::npos);
+  }
+  CHECK(!fs::exists(d / "never.csv"));
+}

@@ -123,3 +123,26 @@ TEST_CASE("mass properties: the whole spacecraft's mass, centre of mass and iner
   CHECK(p.principal_moments(0) <= p.principal_moments(1));
   CHECK((p.J_com_N * p.principal_axes_N.col(2) - p.principal_moments(2) * p.principal_axes_N.col(2)).norm() < 1e-9);
 }
+
+TEST_CASE("mass properties: the inertia about the centre of mass is the same at 7,000 km from N's origin as at "
+          "the origin, to round-off (no cancellation)",
+          "[modes][central]") {
+  for (const char* file : {"models/gnc/slew_spacecraft.yaml", "models/flexible_spacecraft.yaml"}) {
+    INFO(file);
+    const Model model = load_model(test::source_path(file));
+    State s = initial_state(model);
+    const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
+    s.q.segment<4>(model.q_index("bus.qw")) << turn.w(), turn.x(), turn.y(), turn.z();
+    for (std::size_t k = 0; k < model.q_names.size(); ++k)  // the arrays deflected
+      if (model.q_names[k].find(".eta") != std::string::npos) s.q(static_cast<int>(k)) = 0.02;
+    s.q.segment<3>(model.q_index("bus.x")).setZero();
+    const SystemMassProperties at_origin = system_mass_properties(model, s);
+    s.q.segment<3>(model.q_index("bus.x")) = Vec3(4.1e6, -3.3e6, 4.6e6);  // |r| = 7.0e6 m
+    const SystemMassProperties far = system_mass_properties(model, s);
+    const double J = at_origin.J_com_N.norm();
+    CHECK((far.J_com_N - at_origin.J_com_N).norm() <= 1e-12 * J);
+    CHECK((far.principal_moments - at_origin.principal_moments).norm() <= 1e-12 * J);
+    CHECK(((far.com_N - Vec3(4.1e6, -3.3e6, 4.6e6)) - at_origin.com_N).norm() <= 1e-9);
+    CHECK(far.mass == at_origin.mass);
+  }
+}

@@ -161,3 +161,52 @@ inputs:
     CHECK(r.quality.invariants_note.find("p, H not conserved: external 1 input (thr)") != std::string::npos);
   }
 }
+
+TEST_CASE("simulate: a zero total H is no scale (no false alarm); in orbit the drifts are in J and N m s against "
+          "the motion about the centre of mass, H_z alone with J2",
+          "[simulate][central]") {
+  // a wheel biased in the null space: H_z = 100 (-0.5 + 1e-12) + 0.5 * 100 = 1e-10 N m s, the wheel's own 50
+  const Model wheel = load_model(test::write_temp("null_wheel.yaml", R"(name: null_wheel
+gravity: [0, 0, 0]
+bodies:
+  - {name: bus, parent: ground, joint: {type: free}, mass: 100.0, inertia: [80, 90, 99.5, 0, 0, 0]}
+  - {name: wheel, parent: bus, joint: {type: revolute, axis: [0, 0, 1]}, mass: 2.0, inertia: [0.3, 0.3, 0.5, 0, 0, 0]}
+initial:
+  u: {bus.wz: -0.499999999999, wheel.angle_rate: 100.0, bus.wx: 1.0e-13}
+)"));
+  {
+    GenericEngine engine(wheel);
+    const State s = initial_state(wheel);
+    REQUIRE(engine.momentum(s.q, s.u).H_N.norm() < 1e-9);
+    SimulationOptions o;
+    o.t_end = 20.0;
+    o.dt_out = 0.5;
+    o.integrator.kind = IntegratorKind::rkf78;
+    RowTable rows;
+    const SimulationResult r = simulate(engine, s, o, rows);
+    INFO(r.quality.summary());
+    CHECK(r.quality.H_drift < 1e-10);
+    CHECK(r.quality.H_scale_Nms >= 50.0);  // at least the wheel's own momentum
+    CHECK(r.quality.H_drift_Nms <= r.quality.H_drift * r.quality.H_scale_Nms * (1 + 1e-12));
+    CHECK_THAT(r.quality.summary(), Catch::Contains("N m s against a scale of"));
+  }
+  // in orbit with J2: H_z, and the scales are the libration's, not the orbit's
+  const Model gg = load_model(test::source_path("models/gravity_gradient_boom.yaml"));
+  GenericEngine engine(gg);
+  SimulationOptions o;
+  o.t_end = 200.0;
+  o.dt_out = 10.0;
+  o.integrator.kind = IntegratorKind::rkf78;
+  RowTable rows;
+  const SimulationResult r = simulate(engine, initial_state(gg), o, rows);
+  INFO(r.quality.summary());
+  CHECK(r.quality.about_com);
+  CHECK(r.quality.H_z);
+  CHECK(std::isnan(r.quality.energy_drift));  // the boom's modal damping
+  // the orbit's H_z is 106 kg r v = 7.2e11 N m s; the motion about the centre of mass: I n, about 0.6 N m s
+  CHECK(r.quality.H_total_Nms > 1e11);
+  CHECK(r.quality.H_scale_Nms < 10.0);
+  CHECK(r.quality.H_scale_Nms > 0.1);
+  CHECK(r.quality.H_drift == Approx(r.quality.H_drift_Nms / r.quality.H_scale_Nms).epsilon(1e-12));
+  CHECK_THAT(r.quality.summary(), Catch::Contains("H_z drift") && Catch::Contains("of the motion about the centre of mass"));
+}

@@ -209,7 +209,7 @@ dispersions:
     CHECK((w_rel - Vec3(0, 0, v[4])).norm() <= 1e-15);
   }
   // the root's own state is the orbit's: refused, as initial: refuses it
-  for (const std::string& name : {"u.bus.wx", "q.bus.x", "u.bus.vz"})
+  for (const char* name : {"u.bus.wx", "q.bus.x", "u.bus.vz"})
     CHECK_THROWS_WITH(plan_sweep(load_sweep_spec(test::write_temp("orbit_bad.yaml", "model: " + model + R"(
 runs: 2
 t_end: 1.0
