@@ -65,6 +65,7 @@ struct EmittedModel {
   std::vector<std::string> q_names, u_names, input_names, output_names;
   std::string constants;        ///< namespace-scope constant declarations, grouped by body
   std::string support_code;     ///< helper functions the bodies call (e.g. prescribed motion), or empty
+  bool orbit_frame_rules = false;  ///< the header needs templates/orbit_frame.inc after support_code
   std::string udot_form;        ///< "composite" or "articulated"
   OpCount udot_composite_ops, udot_articulated_ops;
   std::vector<EmittedFunction> functions;

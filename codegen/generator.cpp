@@ -268,9 +268,13 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     if (has_inputs) args.insert(args.end() - 1, Arg::inputs);
     return at_t(std::move(args));
   };
-  const bool attitude = std::any_of(model_in.sensors.begin(), model_in.sensors.end(),
-                                    [](const Sensor& s) { return s.type == SensorType::attitude; });
+  const bool attitude = std::any_of(model_in.sensors.begin(), model_in.sensors.end(), [](const Sensor& s) {
+    return s.type == SensorType::attitude || s.type == SensorType::attitude_lvlh;
+  });
   if (attitude) out.support_code += attitude_support_code();
+  out.orbit_frame_rules = std::any_of(model_in.sensors.begin(), model_in.sensors.end(),
+                                      [](const Sensor& s) { return orbit_sensor(s.type); });
+  if (out.orbit_frame_rules) out.support_code += orbit_frame_support_code();
 
   {
     Program p;

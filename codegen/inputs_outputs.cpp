@@ -4,6 +4,8 @@
 // generator's bodies and frames by merge_fixed_bodies and choose_joint_frames
 // (model/inputs_outputs.hpp: move_ports), so here every point and axis is
 // already in the frame of ctx.model's body.
+#include <algorithm>
+#include <optional>
 #include <fmt/format.h>
 
 #include "codegen/kane_context.hpp"
@@ -85,10 +87,77 @@ ex joint_input(KaneContext& ctx, int j, int own) {
   return f;
 }
 
+namespace {
+
+/// The system's centre of mass from the central body and its velocity, N
+/// components: (Sum m r_O + R_NB S) / M and p / M (dynamics/sensors.hpp:
+/// system_centre_of_mass), S from M_body's rows 3-5 (S^x).
+std::pair<SV3, SV3> system_centre_of_mass(KaneContext& ctx) {
+  ctx.P.section("the system's centre of mass (orbit-frame outputs)");
+  ex mass = 0;
+  SV3 first{{0, 0, 0}};
+  for (std::size_t j = 0; j < ctx.model.bodies.size(); ++j) {
+    const SymBodyWorkspace& s = ctx.body[j];
+    const SV3 S{{s.M_body(5, 1), s.M_body(3, 2), s.M_body(4, 0)}};
+    const SV3 RS = ctx.A.mul(s.R_NB, S);
+    mass += s.M_body(0, 0);
+    for (int a = 0; a < 3; ++a) first[a] = ctx.A.let(first[a] + s.M_body(0, 0) * s.r_NO_N[a] + RS[a]);
+  }
+  const ex inv_mass = ctx.A.let(1 / mass);
+  const std::vector<ex> pH = compute_momentum(ctx);
+  SV3 r, v;
+  for (int a = 0; a < 3; ++a) r[a] = ctx.P.let(first[a] * inv_mass), v[a] = ctx.P.let(pH[a] * inv_mass);
+  return {r, v};
+}
+
+/// "{a, b, c}" of bound temporaries, adding them to dep.
+std::string array_of(KaneContext& ctx, const std::vector<ex>& v, ex& dep) {
+  OpCount dummy;
+  std::vector<std::string> e;
+  for (const ex& x : v) {
+    const ex b = ctx.P.let(x);
+    e.push_back(print_cpp(b, dummy));
+    dep += b;
+  }
+  return fmt::format("{{{}}}", fmt::join(e, ", "));
+}
+
+std::vector<ex> entries(const SV3& v) { return {v[0], v[1], v[2]}; }
+std::vector<ex> entries(const SM3& R) {
+  std::vector<ex> e;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) e.push_back(R(r, c));
+  return e;
+}
+
+}  // namespace
+
 void assign_sensor_outputs(KaneContext& ctx, const std::vector<ex>& wrenches,
                            const std::vector<std::vector<ex>>& accelerations, const std::string& y) {
   const Model& model = ctx.model;
+  std::optional<std::pair<SV3, SV3>> com;
+  if (std::any_of(model.sensors.begin(), model.sensors.end(), [](const Sensor& sn) { return orbit_sensor(sn.type); }))
+    com = system_centre_of_mass(ctx);
   for (const Sensor& sn : model.sensors) {
+    if (system_sensor(sn.type)) {
+      ctx.P.section(fmt::format("output {}: {}", sn.name, to_string(sn.type)));
+      const auto& [r_c, v_c] = *com;
+      if (sn.type == SensorType::orbit_elements) {
+        ex dep = 0;
+        const std::string r = array_of(ctx, entries(r_c), dep), v = array_of(ctx, entries(v_c), dep);
+        const ex mu = ctx.P.let(ctx.central_mu());
+        dep += mu;
+        OpCount dummy;
+        ctx.P.statement(fmt::format("{{ const T r_c[3] = {}; const T v_c[3] = {}; orbit_elements_output(T({}), r_c, "
+                                    "v_c, {} + {}); }}",
+                                    r, v, print_cpp(mu, dummy), y, sn.offset),
+                        dep);
+      } else {
+        const SV3& c = sn.type == SensorType::com_position ? r_c : v_c;
+        for (int a = 0; a < 3; ++a) ctx.P.assign(fmt::format("{}[{}]", y, sn.offset + a), c[a]);
+      }
+      continue;
+    }
     const int j = sn.body;
     const SymBodyWorkspace& s = ctx.body[j];
     ctx.P.section(fmt::format("output {}: {} of {}", sn.name, to_string(sn.type), model.bodies[j].name));
@@ -104,6 +173,26 @@ void assign_sensor_outputs(KaneContext& ctx, const std::vector<ex>& wrenches,
     };
     switch (sn.type) {
       case SensorType::angular_velocity: put(s.w_B, sn.offset); break;
+      case SensorType::attitude_lvlh:
+      case SensorType::angular_velocity_lvlh: {
+        const auto& [r_c, v_c] = *com;
+        ex dep = 0;
+        const std::string r = array_of(ctx, entries(r_c), dep), v = array_of(ctx, entries(v_c), dep);
+        const std::string R = array_of(ctx, entries(ctx.A.mul(s.R_NB, R_BX)), dep);
+        if (sn.type == SensorType::attitude_lvlh) {
+          ctx.P.statement(fmt::format("{{ const T r_c[3] = {}; const T v_c[3] = {}; const T R_NX[9] = {}; "
+                                      "attitude_lvlh_output(r_c, v_c, R_NX, {} + {}); }}",
+                                      r, v, R, y, sn.offset),
+                          dep);
+        } else {
+          const std::string w = array_of(ctx, entries(ctx.A.mul_t(R_BX, s.w_B)), dep);
+          ctx.P.statement(fmt::format("{{ const T r_c[3] = {}; const T v_c[3] = {}; const T R_NX[9] = {}; const T "
+                                      "w_X[3] = {}; angular_velocity_lvlh_output(r_c, v_c, R_NX, w_X, {} + {}); }}",
+                                      r, v, R, w, y, sn.offset),
+                          dep);
+        }
+        break;
+      }
       case SensorType::attitude: {
         const SM3 R = ctx.A.mul(s.R_NB, R_BX);
         OpCount dummy;
@@ -164,8 +253,16 @@ void assign_sensor_outputs(KaneContext& ctx, const std::vector<ex>& wrenches,
         put(d, sn.offset);
         break;
       }
+      default: break;  // the system's, above
     }
   }
+}
+
+std::string orbit_frame_support_code() {
+  return R"(
+// ---- atan2 of dual numbers (the orbit-frame outputs' Jacobian) ----
+template <int W> inline Dual<W> atan2(const Dual<W>& y, const Dual<W>& x) { Dual<W> r; r.v = std::atan2(y.v, x.v); const double f = 1.0 / (x.v * x.v + y.v * y.v); for (int i = 0; i < W; ++i) r.d[i] = (x.v * y.d[i] - y.v * x.d[i]) * f; return r; }
+)";
 }
 
 std::string attitude_support_code() {

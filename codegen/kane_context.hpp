@@ -211,6 +211,8 @@ void assign_sensor_outputs(KaneContext& ctx, const std::vector<ex>& wrenches,
                            const std::vector<std::vector<ex>>& accelerations, const std::string& y);
 /// Support code of the attitude outputs (quaternion from a rotation matrix).
 std::string attitude_support_code();
+/// atan2 of dual numbers; templates/orbit_frame.inc follows it in the header (assembler.cpp).
+std::string orbit_frame_support_code();
 ex compute_kinetic_energy(KaneContext& ctx);
 ex compute_potential_energy(KaneContext& ctx);
 /// p_N[3], H_N[3]

@@ -7,8 +7,11 @@
 #include "dynamics/central_gravity.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 
+#include "dynamics/invariants.hpp"
 #include "dynamics/workspace.hpp"
+#include "model/orbit.hpp"
 #include "model/model.hpp"
 
 namespace kanegen {
@@ -22,9 +25,33 @@ inline Eigen::Vector4d attitude_quaternion(const Mat3& R) {
   return v(0) < 0 ? Eigen::Vector4d(-v) : v;
 }
 
+/// The system's centre of mass and its velocity, N components (what the
+/// orbit-frame sensors read), from the workspace's kinematics and body terms.
+inline OrbitState system_centre_of_mass(const Model& model, Workspace<double>& ws) {  // ws's Mz: scratch
+  double mass = 0.0;
+  Vec3 S = Vec3::Zero();
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const BodyWorkspace<double>& s = ws.body[i];
+    mass += model.bodies[i].total_mass;
+    S += model.bodies[i].total_mass * s.r_NO_N + s.R_NB * s.S_B;
+  }
+  return {S / mass, compute_momentum(model, ws).p_N / mass};
+}
+
 template <class VecY>
-void compute_sensor_outputs(const Model& model, const Workspace<double>& ws, VecY& y) {
+void compute_sensor_outputs(const Model& model, Workspace<double>& ws, VecY& y) {
+  const bool orbit = std::any_of(model.sensors.begin(), model.sensors.end(),
+                                 [](const Sensor& sn) { return orbit_sensor(sn.type); });
+  const OrbitState c = orbit ? system_centre_of_mass(model, ws) : OrbitState{};
   for (const Sensor& sn : model.sensors) {
+    switch (sn.type) {  // the whole system's
+      case SensorType::com_position: y.template segment<3>(sn.offset) = c.r_N; continue;
+      case SensorType::com_velocity: y.template segment<3>(sn.offset) = c.v_N; continue;
+      case SensorType::orbit_elements:
+        y.template segment<6>(sn.offset) = osculating_elements(model.central->mu, c);
+        continue;
+      default: break;
+    }
     const BodyWorkspace<double>& s = ws.body[sn.body];
     const Body& b = model.bodies[sn.body];
     const Vec3& p = sn.point_B;
@@ -34,6 +61,10 @@ void compute_sensor_outputs(const Model& model, const Workspace<double>& ws, Vec
     Eigen::Matrix<double, 6, 1> v6;
     switch (sn.type) {
       case SensorType::angular_velocity: y.template segment<3>(sn.offset) = R_XB * w_B; break;
+      case SensorType::attitude_lvlh: y.template segment<7>(sn.offset) = attitude_lvlh(c, s.R_NB * sn.R_BX); break;
+      case SensorType::angular_velocity_lvlh:
+        y.template segment<3>(sn.offset) = angular_velocity_lvlh(c, s.R_NB * sn.R_BX, R_XB * w_B);
+        break;
       case SensorType::attitude: y.template segment<4>(sn.offset) = attitude_quaternion(s.R_NB * sn.R_BX); break;
       case SensorType::position: y.template segment<3>(sn.offset) = s.r_NO_N + s.R_NB * p; break;
       case SensorType::velocity: y.template segment<3>(sn.offset) = s.R_NB * (s.v_O_B + w_B.cross(p)); break;
@@ -60,6 +91,7 @@ void compute_sensor_outputs(const Model& model, const Workspace<double>& ws, Vec
         y.template segment<3>(sn.offset) = R_XB * d;
         break;
       }
+      default: break;  // the system's, above
     }
   }
 }

@@ -22,6 +22,11 @@ const char* to_string(SensorType t) {
     case SensorType::specific_force: return "specific_force";
     case SensorType::reaction: return "reaction";
     case SensorType::deflection: return "deflection";
+    case SensorType::attitude_lvlh: return "attitude_lvlh";
+    case SensorType::angular_velocity_lvlh: return "angular_velocity_lvlh";
+    case SensorType::com_position: return "com_position";
+    case SensorType::com_velocity: return "com_velocity";
+    case SensorType::orbit_elements: return "orbit_elements";
   }
   return "?";
 }
@@ -60,6 +65,11 @@ std::vector<std::string> entry_names(const Sensor& s) {
     case SensorType::attitude: return {s.name + ".qw", s.name + ".qx", s.name + ".qy", s.name + ".qz"};
     case SensorType::reaction:
       return {s.name + ".fx", s.name + ".fy", s.name + ".fz", s.name + ".tx", s.name + ".ty", s.name + ".tz"};
+    case SensorType::attitude_lvlh:
+      return {s.name + ".qw", s.name + ".qx",    s.name + ".qy", s.name + ".qz",
+              s.name + ".roll", s.name + ".pitch", s.name + ".yaw"};
+    case SensorType::orbit_elements:
+      return {s.name + ".a", s.name + ".e", s.name + ".i", s.name + ".raan", s.name + ".argp", s.name + ".nu"};
     default: return {s.name + ".x", s.name + ".y", s.name + ".z"};
   }
 }

@@ -63,18 +63,45 @@ enum class SensorType {
   specific_force,    ///< acceleration minus gravity at a body point, body axes (an accelerometer)
   reaction,          ///< the joint's reaction on the body [force; torque about O_B], body axes
   deflection,        ///< elastic displacement of a node of a flexible body, body axes
+  // orbit-frame sensors (a central field; templates/orbit_frame.inc, docs/gnc.md):
+  attitude_lvlh,          ///< quaternion of R_LB (qw >= 0) and its rotation vector: roll, pitch, yaw
+  angular_velocity_lvlh,  ///< w of the body relative to the orbit frame L, body axes (rad/s)
+  com_position,           ///< the system's centre of mass from the central body, N components (no body)
+  com_velocity,           ///< its velocity, N components (no body)
+  orbit_elements,         ///< the centre of mass's osculating a, e, i, raan, argp, nu (no body)
 };
+
+/// Whether a sensor reads the whole system (no body of its own).
+inline bool system_sensor(enum SensorType t) {
+  return t == SensorType::com_position || t == SensorType::com_velocity || t == SensorType::orbit_elements;
+}
+/// Whether a sensor is relative to the central body (needs gravity: central).
+inline bool central_sensor(enum SensorType t) {
+  return t == SensorType::orbit_elements || t == SensorType::attitude_lvlh || t == SensorType::angular_velocity_lvlh;
+}
+/// Whether a sensor needs the system's centre of mass (the orbit-frame sensors).
+inline bool orbit_sensor(enum SensorType t) {
+  return system_sensor(t) || t == SensorType::attitude_lvlh || t == SensorType::angular_velocity_lvlh;
+}
 
 struct Sensor {
   std::string name;
   int line = 0;
   SensorType type = SensorType::angular_velocity;
-  int body = -1;
+  int body = -1;  ///< -1: a system sensor (system_sensor())
   Eigen::Vector3d point_B = Eigen::Vector3d::Zero();   ///< point sensors: the point, body components
   int node = -1;                                       ///< deflection: index into the body's nodes
   Eigen::Matrix3d R_BX = Eigen::Matrix3d::Identity();  ///< output axes in the body frame (see the header comment)
   int offset = 0;                                      ///< first entry in y
-  int size() const { return type == SensorType::attitude ? 4 : type == SensorType::reaction ? 6 : 3; }
+  int size() const {
+    switch (type) {
+      case SensorType::attitude: return 4;
+      case SensorType::reaction: return 6;
+      case SensorType::attitude_lvlh: return 7;
+      case SensorType::orbit_elements: return 6;
+      default: return 3;
+    }
+  }
 };
 
 const char* to_string(InputType t);

@@ -349,8 +349,10 @@ class Loader {
   /// One sensor entry of `outputs:` (a mapping).
   void read_sensor(const YAML::Node& e, const std::string& f, std::set<std::string>& seen) {
     const int l = line_of(e);
-    const std::vector<std::string> types = {"angular_velocity", "attitude",       "position", "velocity",
-                                            "acceleration",     "specific_force", "reaction", "deflection"};
+    const std::vector<std::string> types = {"angular_velocity", "attitude",       "position",      "velocity",
+                                            "acceleration",     "specific_force", "reaction",      "deflection",
+                                            "attitude_lvlh",    "angular_velocity_lvlh",
+                                            "com_position",     "com_velocity",   "orbit_elements"};
     if (!e["type"].IsDefined()) {
       ck_.error(l, f + ".type", "missing; expected one of: " + join(types));
       return;
@@ -376,13 +378,23 @@ class Loader {
       ck_.check_keys(e, f, {"name", "type", "body", "node"});
     else if (s.type == SensorType::reaction)
       ck_.check_keys(e, f, {"name", "type", "joint"});
+    else if (system_sensor(s.type))
+      ck_.check_keys(e, f, {"name", "type"});
     else
       ck_.check_keys(e, f, {"name", "type", "body"});
     auto name = port_name(e, f, seen);
     bool ok = name.has_value();
     if (name) s.name = *name;
-    s.body = port_body(e, f, s.type == SensorType::reaction ? "joint" : "body");
-    ok = ok && s.body >= 0;
+    if (central_sensor(s.type) && !model_.central) {
+      ck_.error(e["type"], l, f + ".type",
+                fmt::format("'{}' is relative to the central body; expected gravity: {{central: {{mu: ...}}}} "
+                            "(model-format.md, \"Gravity\")", *type));
+      ok = false;
+    }
+    if (!system_sensor(s.type)) {
+      s.body = port_body(e, f, s.type == SensorType::reaction ? "joint" : "body");
+      ok = ok && s.body >= 0;
+    }
     if (point && e["point"].IsDefined()) {
       if (auto p = ck_.vec3(e["point"], l, f + ".point")) s.point_B = *p; else ok = false;
     }

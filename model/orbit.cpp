@@ -24,6 +24,23 @@ void check_bound(double mu, double a, double e) {
   if (!(e >= 0 && e < 1)) throw std::invalid_argument("e " + std::to_string(e) + "; expected 0 <= e < 1");
 }
 
+/// The orbit frame's rules (templates/orbit_frame.inc) over double; the
+/// quaternion of a rotation matrix as the attitude output's (qw >= 0).
+namespace rules {
+inline void attitude_quaternion(double R00, double R01, double R02, double R10, double R11, double R12, double R20,
+                                double R21, double R22, double* q) {
+  Mat3 R;
+  R << R00, R01, R02, R10, R11, R12, R20, R21, R22;
+  Eigen::Quaterniond Q(R);
+  Q.normalize();
+  const double sign = Q.w() < 0 ? -1.0 : 1.0;
+  q[0] = sign * Q.w(), q[1] = sign * Q.x(), q[2] = sign * Q.y(), q[3] = sign * Q.z();
+}
+#include "templates/orbit_frame.inc"
+}  // namespace rules
+
+using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+
 }  // namespace
 
 double orbital_period(double mu, double a) { return 2.0 * M_PI * std::sqrt(a * a * a / mu); }
@@ -43,26 +60,29 @@ OrbitElements elements_from_state(double mu, const OrbitState& s) {
   const Vec3& r = s.r_N;
   const Vec3& v = s.v_N;
   if (!r.allFinite() || !v.allFinite() || r.norm() == 0) throw std::invalid_argument("position or velocity not finite");
-  const Vec3 h = r.cross(v);
-  const double rn = r.norm(), energy = 0.5 * v.squaredNorm() - mu / rn;
-  if (!(energy < 0)) throw std::invalid_argument("not a bound orbit (specific energy >= 0)");
-  const Vec3 e_vec = v.cross(h) / mu - r / rn;
-  OrbitElements el;
-  el.a = -mu / (2.0 * energy);
-  el.e = e_vec.norm();
-  el.i = std::atan2(std::hypot(h.x(), h.y()), h.z());
-  const Vec3 n = Vec3::UnitZ().cross(h);  // towards the ascending node
-  const bool equatorial = n.norm() <= 1e-15 * h.norm(), circular = el.e <= 1e-15;
-  el.raan = equatorial ? 0.0 : std::atan2(n.y(), n.x());
-  const Vec3 node = equatorial ? Vec3::UnitX() : Vec3(n / n.norm());
-  const Vec3 across = h.normalized().cross(node);  // in the plane, 90 deg ahead of the node
-  auto angle_in_plane = [&](const Vec3& x) { return std::atan2(x.dot(across), x.dot(node)); };
-  el.argp = circular ? 0.0 : angle_in_plane(e_vec);
-  el.nu = angle_in_plane(r) - el.argp;
-  el.nu = std::remainder(el.nu, 2.0 * M_PI);
-  if (el.argp < 0) el.argp += 2.0 * M_PI;
-  if (el.raan < 0) el.raan += 2.0 * M_PI;
-  return el;
+  if (!(0.5 * v.squaredNorm() - mu / r.norm() < 0)) throw std::invalid_argument("not a bound orbit (specific energy >= 0)");
+  const Eigen::Matrix<double, 6, 1> y = osculating_elements(mu, s);
+  return {y(0), y(1), y(2), y(3), y(4), y(5)};
+}
+
+Eigen::Matrix<double, 6, 1> osculating_elements(double mu, const OrbitState& s) {
+  Eigen::Matrix<double, 6, 1> y;
+  rules::orbit_elements_output(mu, s.r_N.data(), s.v_N.data(), y.data());
+  return y;
+}
+
+Eigen::Matrix<double, 7, 1> attitude_lvlh(const OrbitState& s, const Mat3& R_NX) {
+  const RowMat3 R = R_NX;
+  Eigen::Matrix<double, 7, 1> y;
+  rules::attitude_lvlh_output(s.r_N.data(), s.v_N.data(), R.data(), y.data());
+  return y;
+}
+
+Vec3 angular_velocity_lvlh(const OrbitState& s, const Mat3& R_NX, const Vec3& w_X) {
+  const RowMat3 R = R_NX;
+  Vec3 y;
+  rules::angular_velocity_lvlh_output(s.r_N.data(), s.v_N.data(), R.data(), w_X.data(), y.data());
+  return y;
 }
 
 double eccentric_anomaly(double M, double e) {
@@ -86,15 +106,15 @@ double true_anomaly_at(double mu, const OrbitElements& el, double t) {
 }
 
 Eigen::Matrix3d lvlh_frame(const OrbitState& s) {
-  const Vec3 z = -s.r_N.normalized();
-  const Vec3 y = -s.r_N.cross(s.v_N).normalized();
-  Mat3 R;
-  R.col(0) = y.cross(z);
-  R.col(1) = y;
-  R.col(2) = z;
+  RowMat3 R;
+  rules::lvlh_axes(s.r_N.data(), s.v_N.data(), R.data());
   return R;
 }
 
-Eigen::Vector3d lvlh_rate_N(const OrbitState& s) { return s.r_N.cross(s.v_N) / s.r_N.squaredNorm(); }
+Eigen::Vector3d lvlh_rate_N(const OrbitState& s) {
+  Vec3 w;
+  rules::lvlh_rate(s.r_N.data(), s.v_N.data(), w.data());
+  return w;
+}
 
 }  // namespace kanegen

@@ -53,4 +53,14 @@ Eigen::Matrix3d lvlh_frame(const OrbitState& s);
 /// The orbit frame's angular velocity, N components: h / |r|^2 (about the orbit normal).
 Eigen::Vector3d lvlh_rate_N(const OrbitState& s);
 
+// The orbit-frame sensors' values (model/inputs_outputs.hpp), by the rules of
+// templates/orbit_frame.inc that the generated code shares; s is the system's
+// centre of mass.
+/// attitude_lvlh: [qw, qx, qy, qz] of R_LX (qw >= 0), then its rotation vector [roll, pitch, yaw].
+Eigen::Matrix<double, 7, 1> attitude_lvlh(const OrbitState& s, const Eigen::Matrix3d& R_NX);
+/// angular_velocity_lvlh: w_X - R_XN w_L, X components (w_X: the body's angular velocity in X axes).
+Eigen::Vector3d angular_velocity_lvlh(const OrbitState& s, const Eigen::Matrix3d& R_NX, const Eigen::Vector3d& w_X);
+/// orbit_elements: [a, e, i, raan, argp, nu] of the state (no check that it is bound: a < 0 if not).
+Eigen::Matrix<double, 6, 1> osculating_elements(double mu, const OrbitState& s);
+
 }  // namespace kanegen
