@@ -7,7 +7,11 @@
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <complex>
+#include <iomanip>
 
 #include "engine/generic_engine.hpp"
 #include "model/model_loader.hpp"
@@ -198,4 +202,96 @@ outputs:
       load_model(test::write_temp("bad_sensors.yaml", "gravity: {central: {mu: 3.986004418e14}}\n" + head +
                                                           "  - {name: c, type: com_position, body: bus}\n")),
       Catch::Contains("outputs[0]"));
+}
+
+namespace {
+
+/// The frequencies (rad/s) of a signal sampled every dt that is a sum of
+/// `pairs` undamped sinusoids: Prony's linear prediction of order 2 pairs fitted
+/// by least squares over every signal given, its characteristic roots
+/// exp(+-i w dt) from the companion matrix. Independent of any model.
+std::vector<double> prony_frequencies(const std::vector<std::vector<double>>& signals, double dt, int pairs) {
+  const int p = 2 * pairs;
+  std::vector<Eigen::VectorXd> rows;
+  std::vector<double> rhs;
+  for (const auto& x : signals)
+    for (std::size_t k = p; k < x.size(); ++k) {
+      Eigen::VectorXd r(p);
+      for (int j = 0; j < p; ++j) r(j) = x[k - 1 - j];
+      rows.push_back(r);
+      rhs.push_back(x[k]);
+    }
+  Eigen::MatrixXd A(rows.size(), p);
+  Eigen::VectorXd b(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) A.row(i) = rows[i].transpose(), b(i) = rhs[i];
+  const Eigen::VectorXd a = A.colPivHouseholderQr().solve(b);
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(p, p);  // z^p = a1 z^(p-1) + ... + ap
+  C.row(0) = a.transpose();
+  for (int j = 1; j < p; ++j) C(j, j - 1) = 1.0;
+  std::vector<double> w;
+  const Eigen::EigenSolver<Eigen::MatrixXd> roots(C);
+  for (const auto& z : roots.eigenvalues())
+    if (z.imag() > 0) w.push_back(std::arg(z) / dt);
+  std::sort(w.begin(), w.end());
+  return w;
+}
+
+}  // namespace
+
+TEST_CASE("librations in a circular orbit: pitch at n sqrt(3 (Ix - Iz)/Iy) and the roll-yaw pair at the roots of "
+          "Hughes' characteristic equation, from runs in both engines",
+          "[central][outputs][physics]") {
+  // principal axes along L's: x along track (roll), y against the orbit normal (pitch), z to nadir (yaw);
+  // Iy > Ix > Iz: inside the Lagrange region (gravity-gradient stable)
+  const double Ix = 400.0, Iy = 500.0, Iz = 150.0, a = 6.978137e6;
+  const Model model = load_model(test::write_temp("libration.yaml", fmt::format(R"(name: libration
+gravity: {{central: {{mu: 3.986004418e14}}}}
+bodies:
+  - {{name: bus, parent: ground, joint: {{type: free}}, mass: 500.0, inertia: [{}, {}, {}, 0, 0, 0]}}
+initial:
+  orbit: {{a: {}, e: 0.0, i: 0.9, raan: 0.3, argp: 0.0, nu: 0.0, attitude: lvlh,
+          attitude_offset: {{rpy: [1.0e-6, -1.0e-6, 2.0e-6]}}, rate_offset: [1.0e-9, 0.0, -2.0e-9]}}
+outputs:
+  - {{name: att, type: attitude_lvlh, body: bus}}
+)",
+                                                                                  Ix, Iy, Iz, a)));
+  const double n = std::sqrt(kMu / (a * a * a));
+  const double pitch = n * std::sqrt(3.0 * (Ix - Iz) / Iy);
+  const double kR = (Iy - Iz) / Ix, kY = (Iy - Ix) / Iz;  // Hughes: s^4 + (1 + 3 kR + kR kY) n^2 s^2 + 4 kR kY n^4 = 0
+  const double B = 1.0 + 3.0 * kR + kR * kY, Cc = 4.0 * kR * kY;
+  const double disc = std::sqrt(B * B - 4.0 * Cc);
+  const double slow = n * std::sqrt((B - disc) / 2.0), fast = n * std::sqrt((B + disc) / 2.0);
+  GenericEngine generic(model);
+  auto generated = test::generated_engine(model);
+  for (Engine* e : both(generic, generated)) {
+    INFO(e->name());
+    SimulationOptions o;
+    const double T = 2.0 * M_PI / n;
+    o.t_end = 4.0 * T;
+    o.dt_out = T / 200.0;
+    o.integrator.kind = IntegratorKind::rkf78;
+    o.integrator.rtol = 1e-13;
+    // amplitudes of 1e-6 rad (their products, the nonlinear coupling, 1e-12) need an absolute tolerance far
+    // below them on the quaternion and rates: rtol alone keeps the orbit's 7e6 m to 1e-6 m
+    o.integrator.atol = 1e-16;
+    RowTable rows;
+    simulate(*e, initial_state(model), o, rows);
+    const auto t = rows.column("t");
+    auto uniform = [&](const std::string& name) {  // the rows on the dt_out grid (a last row at t_end may be closer)
+      std::vector<double> x;
+      const auto c = rows.column(name);
+      for (std::size_t k = 0; k < t.size(); ++k)
+        if (std::abs(t[k] - static_cast<double>(x.size()) * o.dt_out) <= 1e-6 * o.dt_out) x.push_back(c[k]);
+      return x;
+    };
+    const auto w_pitch = prony_frequencies({uniform("att.pitch")}, o.dt_out, 1);
+    const auto w_ry = prony_frequencies({uniform("att.roll"), uniform("att.yaw")}, o.dt_out, 2);
+    REQUIRE(w_pitch.size() == 1);
+    REQUIRE(w_ry.size() == 2);
+    INFO(std::setprecision(9) << "pitch " << w_pitch[0] / n << " n against " << pitch / n << " n; roll-yaw " << w_ry[0] / n << ", "
+                  << w_ry[1] / n << " n against " << slow / n << ", " << fast / n << " n");
+    CHECK(std::abs(w_pitch[0] - pitch) <= 2e-6 * pitch);
+    CHECK(std::abs(w_ry[0] - slow) <= 2e-6 * slow);
+    CHECK(std::abs(w_ry[1] - fast) <= 2e-6 * fast);
+  }
 }
