@@ -91,15 +91,14 @@ namespace {
 
 /// The system's centre of mass from the central body and its velocity, N
 /// components: (Sum m r_O + R_NB S) / M and p / M (dynamics/sensors.hpp:
-/// system_centre_of_mass), S from M_body's rows 3-5 (S^x).
+/// system_centre_of_mass).
 std::pair<SV3, SV3> system_centre_of_mass(KaneContext& ctx) {
   ctx.P.section("the system's centre of mass (orbit-frame outputs)");
   ex mass = 0;
   SV3 first{{0, 0, 0}};
   for (std::size_t j = 0; j < ctx.model.bodies.size(); ++j) {
     const SymBodyWorkspace& s = ctx.body[j];
-    const SV3 S{{s.M_body(5, 1), s.M_body(3, 2), s.M_body(4, 0)}};
-    const SV3 RS = ctx.A.mul(s.R_NB, S);
+    const SV3 RS = ctx.A.mul(s.R_NB, first_moment_B(s));
     mass += s.M_body(0, 0);
     for (int a = 0; a < 3; ++a) first[a] = ctx.A.let(first[a] + s.M_body(0, 0) * s.r_NO_N[a] + RS[a]);
   }
@@ -110,8 +109,9 @@ std::pair<SV3, SV3> system_centre_of_mass(KaneContext& ctx) {
   return {r, v};
 }
 
-/// "{a, b, c}" of bound temporaries, adding them to dep.
-std::string array_of(KaneContext& ctx, const std::vector<ex>& v, ex& dep) {
+/// "a, b, c": the values bound as temporaries of the output program, printed
+/// for a statement that calls a support function; each added to dep.
+std::string printed_lets(KaneContext& ctx, const std::vector<ex>& v, ex& dep) {
   OpCount dummy;
   std::vector<std::string> e;
   for (const ex& x : v) {
@@ -119,7 +119,12 @@ std::string array_of(KaneContext& ctx, const std::vector<ex>& v, ex& dep) {
     e.push_back(print_cpp(b, dummy));
     dep += b;
   }
-  return fmt::format("{{{}}}", fmt::join(e, ", "));
+  return fmt::format("{}", fmt::join(e, ", "));
+}
+
+/// "{a, b, c}": printed_lets as an array initializer.
+std::string array_of(KaneContext& ctx, const std::vector<ex>& v, ex& dep) {
+  return "{" + printed_lets(ctx, v, dep) + "}";
 }
 
 std::vector<ex> entries(const SV3& v) { return {v[0], v[1], v[2]}; }
@@ -194,17 +199,9 @@ void assign_sensor_outputs(KaneContext& ctx, const std::vector<ex>& wrenches,
         break;
       }
       case SensorType::attitude: {
-        const SM3 R = ctx.A.mul(s.R_NB, R_BX);
-        OpCount dummy;
-        std::vector<std::string> e;
         ex dep = 0;
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) {
-            const ex v = ctx.P.let(R(r, c));
-            e.push_back(print_cpp(v, dummy));
-            dep += v;
-          }
-        ctx.P.statement(fmt::format("attitude_quaternion({}, {} + {});", fmt::join(e, ", "), y, sn.offset), dep);
+        const std::string R = printed_lets(ctx, entries(ctx.A.mul(s.R_NB, R_BX)), dep);
+        ctx.P.statement(fmt::format("attitude_quaternion({}, {} + {});", R, y, sn.offset), dep);
         break;
       }
       case SensorType::position: put_N(ctx.A.add(s.r_NO_N, ctx.A.mul(s.R_NB, p)), sn.offset); break;

@@ -9,6 +9,8 @@ namespace kanegen::codegen {
 
 using namespace GiNaC;
 
+SV3 first_moment_B(const SymBodyWorkspace& s) { return {{s.M_body(5, 1), s.M_body(3, 2), s.M_body(4, 0)}}; }
+
 ex compute_kinetic_energy(KaneContext& ctx) {
   ex T = 0;
   for (std::size_t j = 0; j < ctx.model.bodies.size(); ++j) {
@@ -37,8 +39,7 @@ ex compute_potential_energy(KaneContext& ctx) {
     const SymBodyWorkspace& s = ctx.body[j];
     if (ctx.has_gravity()) {
       // -g . (m r_O + R_NB S)
-      SV3 S{{s.M_body(5, 1), s.M_body(3, 2), s.M_body(4, 0)}};  // from rows 3-5 = S^x
-      const SV3 RS = ctx.A.mul(s.R_NB, S);
+      const SV3 RS = ctx.A.mul(s.R_NB, first_moment_B(s));
       for (int a = 0; a < 3; ++a) V -= g_N[a] * (s.M_body(0, 0) * s.r_NO_N[a] + RS[a]);
     }
     if (ctx.has_central()) V += central_potential(ctx, static_cast<int>(j));

@@ -216,6 +216,8 @@ std::string orbit_frame_support_code();
 ex compute_kinetic_energy(KaneContext& ctx);
 ex compute_potential_energy(KaneContext& ctx);
 /// p_N[3], H_N[3]
+/// A body's first moment of mass about O_B, B components, from M_body's rows 3-5 (S^x).
+SV3 first_moment_B(const SymBodyWorkspace& s);
 std::vector<ex> compute_momentum(KaneContext& ctx);
 std::vector<ex> compute_qdot(KaneContext& ctx);
 

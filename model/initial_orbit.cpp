@@ -1,8 +1,8 @@
 #include "model/initial_orbit.hpp"
 
 #include "dynamics/body_terms.hpp"
-#include "dynamics/invariants.hpp"
 #include "dynamics/kinematics.hpp"
+#include "dynamics/sensors.hpp"
 #include "dynamics/workspace.hpp"
 
 namespace kanegen {
@@ -10,19 +10,11 @@ namespace kanegen {
 namespace {
 
 /// The system's centre of mass and its velocity (N) at model.q0, model.u0.
-std::pair<Vec3, Vec3> centre_of_mass(const Model& model) {
+OrbitState centre_of_mass(const Model& model) {
   Workspace<double> ws(model);
   compute_kinematics(model, ws, 0.0, model.q0, model.u0);
   compute_body_terms(model, ws);
-  double mass = 0.0;
-  Vec3 S = Vec3::Zero();
-  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
-    const BodyWorkspace<double>& s = ws.body[i];
-    mass += model.bodies[i].total_mass;
-    S += model.bodies[i].total_mass * s.r_NO_N + s.R_NB * s.S_B;
-  }
-  const Momentum<double> P = compute_momentum(model, ws);
-  return {S / mass, P.p_N / mass};
+  return system_centre_of_mass(model, ws);
 }
 
 }  // namespace
@@ -40,12 +32,12 @@ void place_on_orbit(Model& model, int root, const InitialOrbit& orbit) {
   }
   model.q0.segment<3>(q).setZero();
   model.u0.segment<3>(u).setZero();
-  const auto [c, v_c] = centre_of_mass(model);
+  const OrbitState c = centre_of_mass(model);
   // a shift of the root moves every element alike: R_NJ dx in N; a root velocity adds R_NB dv to every element
   const Eigen::Vector4d qq = model.q0.segment<4>(q + 3);
   const Mat3 R_NB = R_NJ * Eigen::Quaterniond(qq(0), qq(1), qq(2), qq(3)).normalized().toRotationMatrix();
-  model.q0.segment<3>(q) = R_NJ.transpose() * (target.r_N - c);
-  model.u0.segment<3>(u) = R_NB.transpose() * (target.v_N - v_c);
+  model.q0.segment<3>(q) = R_NJ.transpose() * (target.r_N - c.r_N);
+  model.u0.segment<3>(u) = R_NB.transpose() * (target.v_N - c.v_N);
 }
 
 OrbitSetNames orbit_set_names(const std::string& root, bool lvlh) {
