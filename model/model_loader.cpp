@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <filesystem>
 #include <map>
@@ -32,7 +33,6 @@ using yamlcheck::num;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr std::size_t kMaxBodies = 1'000;   ///< bodies in a model (docs/limits.md)
 constexpr int kMaxSpeeds = 2'000;           ///< generalized speeds in a model (M is nu x nu)
 constexpr int kMaxBeamElements = 2'000;     ///< elements of a built-in beam
@@ -1106,7 +1106,7 @@ class Loader {
     fd_.D = Eigen::VectorXd::Zero(m);
     const Eigen::VectorXd Y = modal_masses(fd_);  // with the nodes' rotary inertia (dynamics.md)
     for (int c = 0; c < m; ++c) {
-      const double w = 2.0 * kPi * fd_.frequency_hz(c);
+      const double w = 2.0 * std::numbers::pi * fd_.frequency_hz(c);
       fd_.K(c) = w * w * Y(c);
       fd_.D(c) = 2.0 * zeta(c) * w * Y(c);
     }

@@ -1,6 +1,7 @@
 #include "model/orbit_plausibility.hpp"
 
 #include <cmath>
+#include <numbers>
 #include <optional>
 
 #include <fmt/format.h>
@@ -9,7 +10,6 @@ namespace kanegen {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 /// Gravitational parameters (m^3/s^2) and mean radii (m) of the Sun and the planets and the Moon
 /// (IAU 2015 / JPL DE440 values, rounded): to recognize a mu given in the wrong units.
@@ -38,7 +38,7 @@ OrbitDescription describe_orbit(const Model& model) {
   const InitialOrbit& o = *model.initial_orbit;
   const OrbitElements& el = o.elements;
   OrbitDescription d;
-  d.period = 2.0 * kPi * std::sqrt(el.a * el.a * el.a / c.mu);
+  d.period = 2.0 * std::numbers::pi * std::sqrt(el.a * el.a * el.a / c.mu);
   d.r_perigee = el.a * (1.0 - el.e);
   d.r_apogee = el.a * (1.0 + el.e);
   const std::optional<CentralBody> si = body_with_gm(c.mu);
@@ -58,13 +58,13 @@ OrbitDescription describe_orbit(const Model& model) {
     double value, low, high;
     const char* range;
   };
-  for (const Angle& a : {Angle{"i", el.i, 0.0, kPi, "[0, pi]"}, Angle{"raan", el.raan, -2 * kPi, 2 * kPi, "[-2 pi, 2 pi]"},
-                         Angle{"argp", el.argp, -2 * kPi, 2 * kPi, "[-2 pi, 2 pi]"},
-                         Angle{"nu", el.nu, -2 * kPi, 2 * kPi, "[-2 pi, 2 pi]"}})
+  for (const Angle& a : {Angle{"i", el.i, 0.0, std::numbers::pi, "[0, pi]"}, Angle{"raan", el.raan, -2 * std::numbers::pi, 2 * std::numbers::pi, "[-2 pi, 2 pi]"},
+                         Angle{"argp", el.argp, -2 * std::numbers::pi, 2 * std::numbers::pi, "[-2 pi, 2 pi]"},
+                         Angle{"nu", el.nu, -2 * std::numbers::pi, 2 * std::numbers::pi, "[-2 pi, 2 pi]"}})
     if (a.value < a.low || a.value > a.high)
       warn(fmt::format("initial.orbit.{}", a.key),
            fmt::format("{} rad is outside {}; angles are in radians ({} degrees would be {:.6g} rad)", a.value,
-                       a.range, a.value, a.value * kPi / 180.0));
+                       a.range, a.value, a.value * std::numbers::pi / 180.0));
   // mu in km^3/s^2 with a in metres (or the other way round)
   if (const std::optional<CentralBody> km = body_with_gm(c.mu * 1e9))
     warn("initial.orbit.a",

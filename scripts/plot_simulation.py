@@ -17,7 +17,9 @@ Writes, when the columns are there:
                          rate of one sign, e.g. a reaction wheel) is plotted as its rate
                          in P_spinning.png instead, so it does not swamp the others
   P_modes.png            modal coordinates, one panel per flexible body
-  P_sensor_<name>.png    each sensor of the model (outputs with a name), its components
+  P_sensor_<name>.png    each sensor of the model (outputs with a name), its components;
+                         attitude_lvlh as roll, pitch, yaw relative to the orbit frame in
+                         degrees, orbit_elements as a [km], e, i/raan/argp and nu [deg]
   P_inputs.png           the model's named inputs (motor torques, thrusts, ...)
 A coordinate's rate is the column of its name with _rate (model-format.md, Joints).
 P is the model name (from --model) or the CSV file stem, unless --prefix is given.
@@ -338,11 +340,52 @@ def columns_of(h, name):
 # what docs/gnc.md, "Named outputs", says each sensor type reports
 SENSOR_UNITS = {"attitude": "quaternion of R_NB", "angular_velocity": "rad/s, body axes", "position": "m, N",
                 "velocity": "m/s, N", "acceleration": "m/s², body axes", "specific_force": "m/s², body axes",
-                "reaction": "N, N m, body axes", "deflection": "m, body axes"}
+                "reaction": "N, N m, body axes", "deflection": "m, body axes",
+                "angular_velocity_lvlh": "rad/s, body axes, relative to LVLH", "com_position": "m, N",
+                "com_velocity": "m/s, N"}
+
+
+def plot_attitude_lvlh(h, name, out, written):
+    """An attitude_lvlh sensor as roll, pitch and yaw relative to the orbit frame, in degrees."""
+    cols = [f"{name}.{c}" for c in ("roll", "pitch", "yaw")]
+    h.require(cols, f"sensor {name}")
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for c in cols:
+        ax.plot(h.t, np.degrees(h.col(c)), lw=0.7, label=c)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(f"{name} [deg: rotation vector of R_LB]")
+    ax.set_title(f"sensor {name}: attitude relative to LVLH")
+    ax.legend(loc="best", fontsize="small")
+    finish(fig, (ax,), os.path.join(out, f"{h.prefix}_sensor_{name}.png"), written)
+
+
+def plot_orbit_elements(h, name, out, written):
+    """An orbit_elements sensor in four panels: a [km], e, the plane and perigee angles, the true anomaly [deg]."""
+    h.require([f"{name}.{c}" for c in ("a", "e", "i", "raan", "argp", "nu")], f"sensor {name}")
+    fig, axs = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
+    axs[0].plot(h.t, h.col(f"{name}.a") / 1e3, lw=0.7)
+    axs[0].set_ylabel("a [km]")
+    axs[1].plot(h.t, h.col(f"{name}.e"), lw=0.7)
+    axs[1].set_ylabel("e")
+    for c in ("i", "raan", "argp"):
+        axs[2].plot(h.t, np.degrees(h.col(f"{name}.{c}")), lw=0.7, label=f"{name}.{c}")
+    axs[2].set_ylabel("[deg]")
+    axs[2].legend(loc="best", fontsize="small")
+    axs[3].plot(h.t, np.degrees(h.col(f"{name}.nu")), lw=0.7)
+    axs[3].set_ylabel("nu [deg]")
+    axs[3].set_xlabel("time [s]")
+    axs[0].set_title(f"sensor {name}: osculating orbit elements")
+    finish(fig, axs, os.path.join(out, f"{h.prefix}_sensor_{name}.png"), written)
 
 
 def plot_sensors(h, sensors, out, written):
     for name, kind in sensors:
+        if kind == "attitude_lvlh":
+            plot_attitude_lvlh(h, name, out, written)
+            continue
+        if kind == "orbit_elements":
+            plot_orbit_elements(h, name, out, written)
+            continue
         cols = columns_of(h, name)
         h.require(cols or [name], f"sensor {name}")
         plot_lines(h, cols, f"sensor {name} ({kind})", f"{name} [{SENSOR_UNITS.get(kind, 'SI units')}]",

@@ -9,7 +9,7 @@
 
 namespace kanegen::cli {
 
-namespace {
+namespace check_command {
 
 std::string vec(const Vec3& v, const char* fmt_one = "{:.6g}") {
   return fmt::format("[{}, {}, {}]", fmt::format(fmt::runtime(fmt_one), v.x()), fmt::format(fmt::runtime(fmt_one), v.y()),
@@ -115,13 +115,13 @@ int run(const std::string& path) {
   return 0;
 }
 
-}  // namespace
+}  // namespace check_command
 
 Subcommand add_check(CLI::App& app) {
   auto model = std::make_shared<std::string>();
   CLI::App* c = app.add_subcommand("check", "validate a model; print bodies, joints, dofs, modes");
   add_model_option(c, *model);
-  return {c, [model] { return run(*model); }};
+  return {c, [model] { return check_command::run(*model); }};
 }
 
 }  // namespace kanegen::cli

@@ -11,7 +11,7 @@
 
 namespace kanegen::cli {
 
-namespace {
+namespace compile_command {
 
 struct Options {
   std::string model;
@@ -35,10 +35,10 @@ int run(const Options& o) {
   return 0;
 }
 
-}  // namespace
+}  // namespace compile_command
 
 Subcommand add_compile(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<compile_command::Options>();
   CLI::App* c = app.add_subcommand(
       "compile", "build a model's generated code into the JIT cache (what simulate, eval and linearize load)");
   add_model_option(c, o->model);
@@ -46,7 +46,7 @@ Subcommand add_compile(CLI::App& app) {
   c->add_flag("--derivatives", o->derivatives,
               "also the dual-number Jacobians (linearize, implicit integrators; a longer build)");
   c->add_flag("--background", o->background, "at low priority (nice 10) and without messages");
-  return {c, [o] { return run(*o); }};
+  return {c, [o] { return compile_command::run(*o); }};
 }
 
 }  // namespace kanegen::cli

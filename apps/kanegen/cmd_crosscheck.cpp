@@ -7,7 +7,7 @@
 
 namespace kanegen::cli {
 
-namespace {
+namespace crosscheck_command {
 
 struct Options {
   std::string model;
@@ -31,15 +31,15 @@ int run(const Options& o) {
   return r.passed() ? 0 : kExitFailure;
 }
 
-}  // namespace
+}  // namespace crosscheck_command
 
 Subcommand add_crosscheck(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<crosscheck_command::Options>();
   CLI::App* c = app.add_subcommand("crosscheck", "compare generated and generic engines at random states");
   add_model_option(c, o->model);
   c->add_option("--samples", o->samples, "number of random states")->capture_default_str()->check(CLI::PositiveNumber);
   c->add_option("--seed", o->seed, "random seed")->capture_default_str();
-  return {c, [o] { return run(*o); }};
+  return {c, [o] { return crosscheck_command::run(*o); }};
 }
 
 }  // namespace kanegen::cli

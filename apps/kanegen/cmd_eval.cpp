@@ -10,7 +10,7 @@
 
 namespace kanegen::cli {
 
-namespace {
+namespace eval_command {
 
 struct Options {
   std::string model, state, engine = "generated";
@@ -40,16 +40,16 @@ int run(const Options& o) {
   return 0;
 }
 
-}  // namespace
+}  // namespace eval_command
 
 Subcommand add_eval(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<eval_command::Options>();
   CLI::App* c =
       app.add_subcommand("eval", "evaluate M, F, u-dot (and the requested outputs) at one state, as JSON");
   add_model_option(c, o->model);
   c->add_option("--state", o->state, "STATE.json (default: the model's initial state)")->check(CLI::ExistingFile);
   add_engine_option(c, o->engine, o->native);
-  return {c, [o] { return run(*o); }};
+  return {c, [o] { return eval_command::run(*o); }};
 }
 
 }  // namespace kanegen::cli

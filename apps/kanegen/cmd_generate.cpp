@@ -14,7 +14,7 @@
 
 namespace kanegen::cli {
 
-namespace {
+namespace generate_command {
 
 struct Options {
   std::string model, output, entry, manifest, depfile, form = "auto";
@@ -56,10 +56,10 @@ int run(const Options& o) {
   return 0;
 }
 
-}  // namespace
+}  // namespace generate_command
 
 Subcommand add_generate(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<generate_command::Options>();
   CLI::App* c = app.add_subcommand("generate", "write the specialized C++ header of a model");
   add_model_option(c, o->model);
   c->add_option("-o,--output", o->output, "output header (.hpp)")->required();
@@ -69,7 +69,7 @@ Subcommand add_generate(CLI::App& app) {
   c->add_option("--udot-form", o->form, "auto (fewer operations) | composite (M, F, tree LTDL) | articulated (O(n))")
       ->check(CLI::IsMember({"auto", "composite", "articulated"}))
       ->capture_default_str();
-  return {c, [o] { return run(*o); }};
+  return {c, [o] { return generate_command::run(*o); }};
 }
 
 }  // namespace kanegen::cli

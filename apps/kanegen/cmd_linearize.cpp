@@ -17,7 +17,7 @@
 
 namespace kanegen::cli {
 
-namespace {
+namespace linearize_command {
 
 struct Options {
   std::string model, state, engine = "generated", format = "json", output;
@@ -109,10 +109,10 @@ int run(const Options& o) {
   return 0;
 }
 
-}  // namespace
+}  // namespace linearize_command
 
 Subcommand add_linearize(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<linearize_command::Options>();
   CLI::App* c = app.add_subcommand(
       "linearize", "continuous-time A, B, C, D about a state, from exact derivatives of the generated code");
   add_model_option(c, o->model);
@@ -135,7 +135,7 @@ Subcommand add_linearize(CLI::App& app) {
               "body's position without gravity); exact for the other states");
   c->add_flag("--quiet", o->quiet, "no eigenvalue table on stderr");
   add_engine_option(c, o->engine, o->native);
-  return {c, [o] { return run(*o); }};
+  return {c, [o] { return linearize_command::run(*o); }};
 }
 
 }  // namespace kanegen::cli

@@ -15,7 +15,7 @@
 
 namespace kanegen::cli {
 
-namespace {
+namespace modes_command {
 
 struct Options {
   std::string model, body, output;
@@ -46,10 +46,10 @@ int run(const Options& o) {
   return 0;
 }
 
-}  // namespace
+}  // namespace modes_command
 
 Subcommand add_modes(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<modes_command::Options>();
   CLI::App* c =
       app.add_subcommand("modes", "write a flexible body's modes (e.g. of a built-in beam) as a modal file");
   add_model_option(c, o->model);
@@ -58,7 +58,7 @@ Subcommand add_modes(CLI::App& app) {
   c->add_flag("--second-order", o->second_order,
               "compute second_order (foreshortening) data from the shapes if the body has none (nodes along a chain "
               "from the origin)");
-  return {c, [o] { return run(*o); }};
+  return {c, [o] { return modes_command::run(*o); }};
 }
 
 }  // namespace kanegen::cli

@@ -9,7 +9,7 @@
 
 namespace kanegen::cli {
 
-namespace {
+namespace simulate_command {
 
 struct Options {
   std::string model, state, engine = "auto", events;
@@ -69,10 +69,10 @@ int run(const Options& o) {
   return status;
 }
 
-}  // namespace
+}  // namespace simulate_command
 
 Subcommand add_simulate(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<simulate_command::Options>();
   CLI::App* c = app.add_subcommand("simulate", "integrate the equations of motion and write a CSV time history");
   add_model_option(c, o->model);
   add_simulation_options(c, o->sim, true);
@@ -82,7 +82,7 @@ Subcommand add_simulate(CLI::App& app) {
   o->events_option = c->add_option("--events", o->events,
                 "also write the events that fired as CSV (t, name, action, bodies, energy_lost; interface.md)");
   add_engine_option(c, o->engine, o->native, /*with_auto=*/true);
-  return {c, [o] { return run(*o); }};
+  return {c, [o] { return simulate_command::run(*o); }};
 }
 
 }  // namespace kanegen::cli

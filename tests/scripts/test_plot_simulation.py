@@ -3,7 +3,9 @@
 and another spun up from rest by a motor input held: it writes a plot per sensor, the inputs, the modal
 coordinates and the revolute joints; the spinning wheel is moved to the plot
 of rates (its angle grows by ~1000 rad) while the slow wheels stay in the
-joint plot; a missing column is refused with exit status 2.
+joint plot; a missing column is refused with exit status 2. The
+gravity-gradient boom satellite's orbit-frame sensors: roll/pitch/yaw relative to
+LVLH and the osculating elements get their own plots.
 
     test_plot_simulation.py --kanegen build/bin/kanegen
 """
@@ -80,6 +82,30 @@ def main():
         r = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "scripts", "plot_simulation.py"), cut, "--model", MODEL,
                             "-o", os.path.join(tmp, "plots3")], capture_output=True, text=True)
         check(r.returncode == 2 and "tip_a" in r.stderr, "missing sensor columns: exit 2 naming the sensor: " + r.stderr.strip())
+        # in orbit: the orbit-frame sensors of the gravity-gradient boom satellite
+        boom = os.path.join(ROOT, "models", "gravity_gradient_boom.yaml")
+        bcsv = os.path.join(tmp, "boom.csv")
+        r = subprocess.run([a.kanegen, "simulate", boom, "--engine", "generic", "--t-end", "600", "--dt-out", "10",
+                            "-o", bcsv], capture_output=True, text=True)
+        check(r.returncode == 0, f"simulate the boom satellite ran ({r.stderr.strip()[-200:]})")
+        bout = os.path.join(tmp, "boom_plots")
+        r = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "scripts", "plot_simulation.py"), bcsv, "--model", boom,
+                            "-o", bout], capture_output=True, text=True)
+        check(r.returncode == 0, "plot_simulation.py ran on the boom satellite: " + r.stderr.strip())
+        bpngs = sorted(os.listdir(bout)) if os.path.isdir(bout) else []
+        for name in ("sensor_att", "sensor_rate", "sensor_com", "sensor_osc"):
+            check(f"gravity_gradient_boom_{name}.png" in bpngs, f"wrote gravity_gradient_boom_{name}.png")
+        # an attitude_lvlh sensor without its rotation vector columns: refused naming them
+        bh = ps.History(bcsv)
+        cut = os.path.join(tmp, "boom_cut.csv")
+        keep = [k for k, n in enumerate(bh.names) if n not in ("att.roll", "att.pitch", "att.yaw")]
+        with open(bcsv) as f, open(cut, "w") as g:
+            for line in f:
+                cells = line.rstrip("\n").split(",")
+                g.write(",".join(cells[k] for k in keep) + "\n")
+        r = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "scripts", "plot_simulation.py"), cut, "--model", boom,
+                            "-o", os.path.join(tmp, "boom_plots2")], capture_output=True, text=True)
+        check(r.returncode == 2 and "att.roll" in r.stderr, "missing roll/pitch/yaw: exit 2 naming them: " + r.stderr.strip())
     print(f"{len(failures)} failure(s)")
     return 1 if failures else 0
 
