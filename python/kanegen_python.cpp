@@ -316,6 +316,7 @@ Run make_run(const RowTable& table, const SimulationResult& r, const Model& m) {
   d["error_estimate"] = r.quality.error_estimate;
   d["error_worst"] = r.quality.error_worst;
   d["accuracy"] = r.quality.summary();
+  d["warnings"] = r.quality.warnings;
   d["text"] = r.stats.summary();
   for (const FiredEvent& e : r.events) {  // model-format.md, Locks and events
     py::dict ev;

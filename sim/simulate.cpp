@@ -10,6 +10,7 @@
 #include "sim/driver_work.hpp"
 #include "sim/event_run.hpp"
 #include "sim/integrator_choice.hpp"
+#include "sim/modal_range.hpp"
 #include "sim/work_precision.hpp"
 
 #include <fmt/format.h>
@@ -540,6 +541,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     driver_engine->set_locks(initial.locked);
     drivers = std::make_unique<DriverWorkMeter>(*driver_engine, initial.tau);
   }
+  ModalRange modal_range(model);
   auto write = [&](double t, const VecX& x, bool keep) -> bool {
     // x arrives projected; the drift was measured on the raw state by project below.
     if (pending.body >= 0) {
@@ -565,6 +567,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     last_row_t = t;
     q = x.head(nq);
     u = x.tail(nu);
+    modal_range.add(t, q);
     row.assign(1, t);
     row.insert(row.end(), x.data(), x.data() + nq);
     for (const Body& b : model.bodies)  // the prescribed coordinates, after the q's
@@ -667,6 +670,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
   bar.finish();
 
   quality.invariants_note = physics.note();
+  quality.warnings = modal_range.warnings();
   if (physics.energy || physics.angular_momentum || physics.angular_momentum_z) {
     // simulate reports H (or H_z with J2), not p
     const bench::InvariantSet inv{physics.energy, physics.angular_momentum, physics.angular_momentum_z};

@@ -60,6 +60,9 @@ struct RunQuality {
   std::string error_worst;
   /// Why an invariant does not hold here (model/invariants.hpp): "energy not conserved: dampers on 4 joints".
   std::string invariants_note;
+  /// What the run did that the model does not describe well: a flexible body deflected beyond the
+  /// linear range (sim/modal_range.hpp), one line each.
+  std::vector<std::string> warnings;
   /// "energy drift 3.1e-10, |H| drift 2.2e-12, estimated error 4.5e-9 (u link3.angle at t = 9.5)"
   std::string summary() const;
 };

@@ -109,7 +109,9 @@ inline SimulationOptions simulation_options(const SimulationCli& o, const State&
 inline std::string describe_quality(const RunQuality& q) {
   std::string s;
   if (!q.integrator_choice.empty()) s += "integrator auto: " + q.integrator_choice + "\n";
-  return s + "accuracy: " + q.summary() + "\n";
+  s += "accuracy: " + q.summary() + "\n";
+  for (const std::string& w : q.warnings) s += "warning: " + w + "\n";
+  return s;
 }
 
 /// "integration failed at t = ...: reason" and the state there, by name.
