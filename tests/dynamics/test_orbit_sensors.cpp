@@ -61,6 +61,19 @@ VecX outputs(Engine& e, double t, const VecX& q, const VecX& u) {
 
 std::vector<Engine*> both(GenericEngine& g, std::unique_ptr<GeneratedEngine>& gen) { return {&g, gen.get()}; }
 
+/// A run of `orbits` orbits of period T with rkf78 at rtol (atol in m and m/s), `per_orbit` rows each.
+RowTable run_orbits(Engine& e, const Model& model, double T, int orbits, int per_orbit, double rtol, double atol) {
+  SimulationOptions o;
+  o.t_end = orbits * T;
+  o.dt_out = T / per_orbit;
+  o.integrator.kind = IntegratorKind::rkf78;
+  o.integrator.rtol = rtol;
+  o.integrator.atol = atol;
+  RowTable rows;
+  simulate(e, initial_state(model), o, rows);
+  return rows;
+}
+
 }  // namespace
 
 TEST_CASE("orbit-frame sensors read back the initial orbit, the centre of mass and the LVLH offsets, both engines",
@@ -158,14 +171,7 @@ outputs:
   const double T = orbital_period(kMu, el.a);
   for (Engine* e : both(generic, generated)) {
     INFO(e->name());
-    SimulationOptions o;
-    o.t_end = 10 * T;
-    o.dt_out = T / 20;
-    o.integrator.kind = IntegratorKind::rkf78;
-    o.integrator.rtol = 1e-13;
-    o.integrator.atol = 1e-6;  // m and m/s: 1e-13 of 7e6 m
-    RowTable rows;
-    simulate(*e, initial_state(model), o, rows);
+    const RowTable rows = run_orbits(*e, model, T, 10, 20, 1e-13, 1e-6);  // atol: 1e-13 of 7e6 m
     const auto t = rows.column("t");
     double worst_a = 0, worst_e = 0, worst_angle = 0, worst_nu = 0;
     for (std::size_t k = 0; k < t.size(); ++k) {
@@ -210,14 +216,7 @@ outputs:
   const double T = orbital_period(kMu, el.a);
   for (Engine* e : both(generic, generated)) {
     INFO(e->name());
-    SimulationOptions o;
-    o.t_end = 20 * T;
-    o.dt_out = T / 50;
-    o.integrator.kind = IntegratorKind::rkf78;
-    o.integrator.rtol = 1e-12;
-    o.integrator.atol = 1e-5;
-    RowTable rows;
-    simulate(*e, initial_state(model), o, rows);
+    const RowTable rows = run_orbits(*e, model, T, 20, 50, 1e-12, 1e-5);
     const auto t = rows.column("t");
     const auto raan = rows.column("osc.raan");
     const double N = static_cast<double>(t.size());
