@@ -25,6 +25,11 @@ namespace {
 
 std::string errno_text(int e) { return std::strerror(e); }
 
+}  // namespace
+
+// named, not anonymous: OutputFile::Impl holds one (-Wsubobject-linkage in a unity batch)
+namespace output_file_detail {
+
 /// A streambuf writing to a file descriptor; remembers the first write error.
 class FdBuf : public std::streambuf {
  public:
@@ -64,6 +69,11 @@ class FdBuf : public std::streambuf {
   std::vector<char> buf_;
   int error_ = 0;
 };
+
+}  // namespace output_file_detail
+using output_file_detail::FdBuf;
+
+namespace {
 
 std::string directory_of(const std::string& path) {
   const fs::path p(path);
