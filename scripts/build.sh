@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Configures and builds kanegen (Release) into ./build, through ccache when it
 # is installed (cmake/BuildSpeed.cmake: a second clone on the same machine hits
-# its cache) and with precompiled headers.
+# its cache), with Ninja when it is installed and with precompiled headers.
 #   build.sh                     everything: the CLI, the Python module, the
 #                                examples, the benchmarks and peers, the tests
 #   build.sh --demo              the kanegen CLI only (what scripts/demo.sh runs);
@@ -20,6 +20,11 @@ if [[ "${1:-}" == --demo ]]; then
   targets=(--target kanegen)
 else
   args+=(-DKANEGEN_BUILD_TESTS=ON -DKANEGEN_BUILD_BENCH=ON -DKANEGEN_BUILD_EXAMPLES=ON -DKANEGEN_BUILD_PYTHON=ON)
+fi
+# Ninja when installed (install_deps.sh installs it): it schedules the two
+# cores better than make; a tree configured before keeps its generator
+if [[ ! -f build/CMakeCache.txt ]] && command -v ninja >/dev/null; then
+  args+=(-G Ninja)
 fi
 cmake -S . -B build "${args[@]}" >/dev/null
 cmake --build build -j"$(nproc)" "${targets[@]}"

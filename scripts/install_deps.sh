@@ -1,24 +1,32 @@
 #!/usr/bin/env bash
 # Installs kanegen's build and run dependencies from Debian's packages, only
 # those missing (idempotent; needs root or sudo).
-#   install_deps.sh demo   what the CLI and the demo's plots need
-#   install_deps.sh        all of it: also the tests, benchmarks, peers (MuJoCo,
-#                          Simbody), the Python module and Open MPI
+#   install_deps.sh demo-build   what the CLI needs to build and run (compiler,
+#                                cmake, ninja, ccache, the libraries)
+#   install_deps.sh demo-plot    what the demo's plots need (numpy, matplotlib)
+#   install_deps.sh demo         both
+#   install_deps.sh              all of it: also the tests, benchmarks, peers
+#                                (MuJoCo, Simbody), the Python module and Open MPI
 set -euo pipefail
-packages=(
-  build-essential cmake pkg-config ccache
+build_packages=(
+  build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libfmt-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libsundials-dev libginac-dev libspectra-dev libboost-dev zlib1g-dev
-  python3 python3-numpy python3-matplotlib
 )
-if [[ "${1:-all}" != demo ]]; then
-  packages+=(
-    catch2 libbenchmark-dev
-    python3-scipy python3-dev pybind11-dev python3-pybind11
-    libopenmpi-dev openmpi-bin
-    libmujoco-dev libsimbody-dev
-  )
-fi
+plot_packages=(python3 python3-numpy python3-matplotlib)
+case "${1:-all}" in
+  demo-build) packages=("${build_packages[@]}") ;;
+  demo-plot) packages=("${plot_packages[@]}") ;;
+  demo) packages=("${build_packages[@]}" "${plot_packages[@]}") ;;
+  all)
+    packages=("${build_packages[@]}" "${plot_packages[@]}"
+      catch2 libbenchmark-dev
+      python3-scipy python3-dev pybind11-dev python3-pybind11
+      libopenmpi-dev openmpi-bin
+      libmujoco-dev libsimbody-dev)
+    ;;
+  *) echo "install_deps.sh: unknown set '$1' (expected demo-build, demo-plot, demo or nothing)" >&2; exit 2 ;;
+esac
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

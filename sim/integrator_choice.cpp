@@ -57,12 +57,14 @@ MatX jacobian_at(const OdeProblem& p, double t0, const VecX& x0) {
 /// period); BDF's order is at most 5, so it needs more of them.
 double steps_per_period(double rtol, int order) { return 2.0 * M_PI * std::pow(rtol, -1.0 / (order + 1)); }
 
-/// One candidate over [t0, t0 + span]: its cost in right-hand sides (an
-/// exact Jacobian counted as kJacobianEvals of them; a run's choice must not
-/// depend on the machine's load, so no wall time) and the end state (empty if it failed).
+/// One candidate over [t0, t0 + 2 span], in one run: its cost in right-hand
+/// sides at t0 + span and at the end (an exact Jacobian counted as
+/// kJacobianEvals of them; a run's choice must not depend on the machine's
+/// load, so no wall time) and the end state (empty if it failed).
 constexpr double kJacobianEvals = 10.0;
 struct ProbeRun {
-  double cost = INFINITY;
+  double cost_half = INFINITY;  ///< at t0 + span
+  double cost = INFINITY;       ///< at t0 + 2 span
   VecX x_end;
 };
 ProbeRun probe_run(const OdeProblem& p, IntegratorKind kind, double rtol, double t0, const VecX& x0, double span) {
@@ -71,15 +73,28 @@ ProbeRun probe_run(const OdeProblem& p, IntegratorKind kind, double rtol, double
   o.rtol = rtol;
   o.atol = rtol / 100;
   o.max_steps = 1'000'000;
+  double evals = 0;  // the right-hand sides and Jacobians the integrator asks for, counted as they come
+  OdeProblem counted = p;
+  counted.rhs = [&](double t, const double* x, double* xd) {
+    evals += 1.0;
+    return p.rhs(t, x, xd);
+  };
+  if (p.jacobian)
+    counted.jacobian = [&](double t, const double* x, const double* fx, double* J) {
+      evals += kJacobianEvals;
+      return p.jacobian(t, x, fx, J);
+    };
   ProbeRun r;
   try {
-    const IntegratorStats s = integrate(p, o, t0, x0, t0 + span, span, [&](double, const VecX& x) {
+    integrate(counted, o, t0, x0, t0 + 2 * span, span, [&](double t, const VecX& x) {
+      if (t < t0 + 1.5 * span && t > t0 + 0.5 * span) r.cost_half = evals;
       r.x_end = x;
       return true;
     });
-    r.cost = static_cast<double>(s.rhs_evals) + (p.jacobian ? kJacobianEvals * static_cast<double>(s.jac_evals) : 0.0);
+    r.cost = evals;
   } catch (const std::exception&) {
     r.x_end.resize(0);
+    r.cost = r.cost_half = INFINITY;
   }
   return r;
 }
@@ -163,10 +178,10 @@ IntegratorChoice choose_integrator(Engine& engine, const State& initial, double 
                // each candidate over the interval and over twice it: the difference is its cost per
                // interval once started (an implicit method's start-up is many small steps), which
                // projects its cost over the horizon
-               auto projected = [&](IntegratorKind k, ProbeRun& twice) {
-                 const ProbeRun once = probe_run(p, k, rtol, initial.t, x0, c.probe_interval);
-                 twice = probe_run(p, k, rtol, initial.t, x0, 2 * c.probe_interval);
-                 return once.cost + std::max(0.0, twice.cost - once.cost) * (horizon / c.probe_interval - 1.0);
+               // (one run over twice the interval, its cost read at the interval's end)
+               auto projected = [&](IntegratorKind k, ProbeRun& run) {
+                 run = probe_run(p, k, rtol, initial.t, x0, c.probe_interval);
+                 return run.cost_half + std::max(0.0, run.cost - run.cost_half) * (horizon / c.probe_interval - 1.0);
                };
                ProbeRun rk, dirk;
                c.probe_rkf78_evals = projected(IntegratorKind::rkf78, rk);
