@@ -252,6 +252,7 @@ py::dict linear_dict(const LinearModel& lin) {
   d["ignorable_kept_for_outputs"] = lin.ignorable_kept_for_outputs;
   d["residual"] = lin.residual;
   d["method"] = lin.method;
+  d["frame"] = lin.frame;
   py::list modes;
   for (const LinearMode& m : linear_modes(lin)) {
     py::dict md;
@@ -479,7 +480,7 @@ PYBIND11_MODULE(kanegen, m) {
           "linearize",
           [](PyModel& p, const py::object& q, const py::object& u, const py::object& tau, const py::object& inputs,
              double t, const std::vector<std::string>& input_names, const std::vector<std::string>& output_names,
-             bool finite_differences, const py::object& parameters, bool drop_ignorable) {
+             bool finite_differences, const py::object& parameters, bool drop_ignorable, const std::string& frame) {
             return translating([&] {
               const ScopedParameters with(p, parameters);
               LinearizeOptions o;
@@ -487,14 +488,16 @@ PYBIND11_MODULE(kanegen, m) {
               o.outputs = output_names;
               o.finite_differences = finite_differences;
               o.drop_ignorable = drop_ignorable;
+              o.frame = frame;
               return linear_dict(linearize(p.engine(), p.state(t, q, u, tau, inputs), o));
             });
           },
           py::arg("q") = py::none(), py::arg("u") = py::none(), py::arg("tau") = py::none(),
           py::arg("inputs") = py::none(), py::arg("t") = 0.0, py::arg("input_names") = std::vector<std::string>{},
           py::arg("output_names") = std::vector<std::string>{}, py::arg("finite_differences") = false,
-          py::arg("parameters") = py::none(), py::arg("drop_ignorable") = false,
-          "continuous-time A, B, C, D about a state (tangent-space attitude), with names and modes")
+          py::arg("parameters") = py::none(), py::arg("drop_ignorable") = false, py::arg("frame") = "inertial",
+          "continuous-time A, B, C, D about a state (tangent-space attitude), with names and modes; "
+          "frame=\"lvlh\": the free root relative to the orbit frame (docs/gnc.md, \"Linear models in orbit\")")
       .def(
           "simulate",
           [](PyModel& p, double t_end, double dt_out, const py::object& q, const py::object& u, const py::object& tau,

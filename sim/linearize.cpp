@@ -10,6 +10,8 @@
 #include <numeric>
 
 #include "model/diagnostics.hpp"
+#include "sim/dual_number.hpp"
+#include "sim/orbit_relative_state.hpp"
 
 namespace kanegen {
 
@@ -143,7 +145,7 @@ void find_ignorable(LinearModel& lin, const std::vector<int>& body_of) {
   double rest = 0, own = 0;
   for (int i = 0; i < n; ++i) {
     if (cand[i]) lin.ignorable.push_back(lin.state_names[i]);
-    (cand[i] ? own : rest) = std::max(cand[i] ? own : rest, std::abs(lin.x0_dot(i)));
+    (cand[i] ? own : rest) = std::max(cand[i] ? own : rest, std::abs(lin.x0_dot(i)) / lin.residual_scale(i));
   }
   lin.relative_residual = rest;
   lin.relative_equilibrium = !lin.equilibrium && rest <= kEquilibriumTolerance && own > 0;
@@ -154,12 +156,13 @@ void keep_states(LinearModel& lin, const std::vector<int>& keep) {
   const int nk = static_cast<int>(keep.size());
   const bool state_outputs = lin.output_names == lin.state_names;
   MatX A(nk, nk), B(nk, lin.B.cols()), C(lin.C.rows(), nk);
-  VecX xd(nk);
+  VecX xd(nk), scale(nk);
   std::vector<std::string> names;
   for (int r = 0; r < nk; ++r) {
     for (int c = 0; c < nk; ++c) A(r, c) = lin.A(keep[r], keep[c]);
     B.row(r) = lin.B.row(keep[r]);
     xd(r) = lin.x0_dot(keep[r]);
+    scale(r) = lin.residual_scale(keep[r]);
     names.push_back(lin.state_names[keep[r]]);
   }
   for (int c = 0; c < nk; ++c) C.col(c) = lin.C.col(keep[c]);
@@ -171,7 +174,15 @@ void keep_states(LinearModel& lin, const std::vector<int>& keep) {
   } else {
     lin.C = C;
   }
-  lin.A = A, lin.B = B, lin.x0_dot = xd, lin.state_names = names;
+  MatX K(nk, nk);
+  for (int r = 0; r < nk; ++r)
+    for (int c = 0; c < nk; ++c) K(r, c) = lin.kinetic(keep[r], keep[c]);
+  lin.A = A, lin.B = B, lin.x0_dot = xd, lin.residual_scale = scale, lin.state_names = names, lin.kinetic = K;
+}
+
+/// max |x0_dot| / residual_scale: what the equilibrium is judged on.
+double scaled_residual(const LinearModel& lin) {
+  return lin.x0_dot.size() ? lin.x0_dot.cwiseAbs().cwiseQuotient(lin.residual_scale).maxCoeff() : 0.0;
 }
 
 /// The model without the states named `drop` (none of the others depends on them).
@@ -182,8 +193,83 @@ void drop_states(LinearModel& lin, const std::vector<std::string>& drop) {
   keep_states(lin, keep);
   lin.ignorable_dropped = true;
   // without the ignorable rows the point is an equilibrium of what is left when it was a relative one
-  lin.residual = lin.x0_dot.size() ? lin.x0_dot.cwiseAbs().maxCoeff() : 0.0;
+  lin.residual = scaled_residual(lin);
   lin.equilibrium = lin.residual <= kEquilibriumTolerance;
+}
+
+/// The linear model in the orbit frame's chart z = phi(x, t) (sim/orbit_relative_state.hpp), from the
+/// tangent one: with xi the tangent state (x = x0 + T_in xi + ...), P = dz/dxi = J_phi T_in and
+/// z_dot = g(xi) = J_phi(x) x_dot(x) + phi_t,
+///   dg/dxi = phi''[x_dot, T_in] + phi_t'[T_in] + J_phi J T_in,   A_z = dg/dxi P^-1,
+/// the second derivatives exact by nested dual numbers (directions: the flow (x_dot, 1) and each column
+/// of T_in); B_z = P B, C_z = C P^-1. J_phi is taken over the full coordinates (the chart's extension off
+/// the unit quaternions included), since J's quaternion rows may leave the sphere.
+void to_orbit_frame(LinearModel& lin, const Model& model, const State& state, const MatX& J, const MatX& T_in,
+                    const VecX& x_dot) {
+  const OrbitRelativeState chart(model, state);
+  const int nq = model.nq, nu = model.nu, nx = nq + nu, n = chart.size();
+  using D1 = Dual<double>;
+  using D2 = Dual<D1>;
+  MatX J_phi(n, nx);
+  {
+    std::vector<D1> q(nq), u(nu), z(n);
+    const D1 t(state.t);
+    for (int c = 0; c < nx; ++c) {
+      for (int i = 0; i < nq; ++i) q[i] = D1(state.q(i), c == i ? 1.0 : 0.0);
+      for (int k = 0; k < nu; ++k) u[k] = D1(state.u(k), c == nq + k ? 1.0 : 0.0);
+      chart.apply(q.data(), u.data(), t, z.data());
+      for (int r = 0; r < n; ++r) J_phi(r, c) = z[r].d;
+    }
+  }
+  MatX G(n, n);
+  VecX g0(n);
+  {
+    std::vector<D2> q(nq), u(nu), z(n);
+    const D2 t(D1(state.t, 1.0), D1(0.0, 0.0));
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < nq; ++i) q[i] = D2(D1(state.q(i), x_dot(i)), D1(T_in(i, j), 0.0));
+      for (int k = 0; k < nu; ++k) u[k] = D2(D1(state.u(k), x_dot(nq + k)), D1(T_in(nq + k, j), 0.0));
+      chart.apply(q.data(), u.data(), t, z.data());
+      for (int r = 0; r < n; ++r) G(r, j) = z[r].d.d;
+      if (j == 0)
+        for (int r = 0; r < n; ++r) g0(r) = z[r].v.d;
+    }
+  }
+  const MatX P = J_phi * T_in;
+  G += J_phi * (J * T_in);
+  const Eigen::PartialPivLU<MatX> lu(P);
+  const MatX P_inv = lu.inverse();
+  lin.A = G * P_inv;
+  lin.B = P * lin.B;
+  {  // the kinetic energy of the motion relative to the orbit frame: M on the chart's speeds at fixed
+     // coordinates (carrying M through the whole of P^-1 would count the orbit's 7e3 m/s turned by an attitude
+     // perturbation as the mode's energy)
+    const int nu = model.nu;
+    const MatX S = P_inv.bottomRightCorner(nu, nu);
+    const MatX M_u = lin.kinetic.bottomRightCorner(nu, nu);
+    lin.kinetic.setZero();
+    lin.kinetic.bottomRightCorner(nu, nu) = S.transpose() * M_u * S;
+  }
+  const bool state_outputs = lin.output_names == lin.state_names;
+  lin.state_names = chart.names();
+  if (state_outputs) {
+    lin.output_names = lin.state_names;
+  } else {
+    lin.C = lin.C * P_inv;
+  }
+  lin.x0_dot = g0;
+  // the orbit's own scale for the root's translation rows
+  const double speed = std::max(1.0, chart.orbit_rate() * chart.com_position().norm());
+  const double accel = std::max(1.0, chart.orbit_rate() * speed);
+  for (int r = 0; r < n; ++r) {
+    const std::string& name = lin.state_names[r];
+    const std::string root = model.bodies[chart.root()].name;
+    for (const char* a : {".lvlh.x", ".lvlh.y", ".lvlh.z"})
+      if (name == "q." + root + a) lin.residual_scale(r) = speed;
+    for (const char* a : {".lvlh.vx", ".lvlh.vy", ".lvlh.vz"})
+      if (name == "u." + root + a) lin.residual_scale(r) = accel;
+  }
+  lin.frame = "lvlh";
 }
 
 }  // namespace
@@ -208,8 +294,8 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
                      engine.jacobian(t, q0, u0, tau0, J) && engine.input_jacobian(t, q0, u0, tau0, Bw) &&
                      engine.output_jacobian(t, q0, u0, tau0, CD);
   // d(u_dot)/d(tau) = M^-1, exactly (u_dot is linear in tau).
+  MatX M;
   {
-    MatX M;
     engine.mass_matrix(t, q0, M);
     if (engine.has_locks()) {  // the reduced system's: M_ff^-1 on the free speeds
       VecX col;
@@ -294,9 +380,11 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
     lin.input_names.push_back(in_cols[k].name);
     lin.B.col(k).tail(nu) = in_cols[k].w >= 0 ? VecX(Bw.col(in_cols[k].w)) : VecX(Btau.col(in_cols[k].tau));
   }
-  lin.x0_dot = T_out * state_derivative(engine, t, q0, u0, tau0);
-  lin.residual = lin.x0_dot.size() ? lin.x0_dot.cwiseAbs().maxCoeff() : 0.0;
-  lin.equilibrium = lin.residual <= kEquilibriumTolerance;
+  const VecX x_dot = state_derivative(engine, t, q0, u0, tau0);
+  lin.x0_dot = T_out * x_dot;
+  lin.residual_scale = VecX::Ones(n);
+  lin.kinetic = MatX::Zero(n, n);
+  lin.kinetic.bottomRightCorner(nu, nu) = M;
 
   if (state_outputs) {
     lin.C = MatX::Identity(n, n);
@@ -352,6 +440,15 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
   }
   lin.method = exact ? "exact: forward-mode dual numbers through the generated code"
                      : "central differences (step 1e-6 max(1, |x|)) of the " + engine.name() + " engine";
+  if (options.frame == "lvlh") {
+    to_orbit_frame(lin, model, state, J, T_in, x_dot);
+    lin.method += "; the orbit frame's chart exact (nested dual numbers)";
+  } else if (options.frame != "inertial") {
+    throw InputError(Diagnostic{"(command line)", 0, "--frame",
+                                fmt::format("unknown frame '{}'; expected inertial or lvlh", options.frame)});
+  }
+  lin.residual = scaled_residual(lin);
+  lin.equilibrium = lin.residual <= kEquilibriumTolerance;
   if (engine.has_locks()) {  // the reduced system: drop the locked joints' states
     std::vector<int> keep;
     for (int i = 0; i < n; ++i)
@@ -408,10 +505,19 @@ std::vector<LinearMode> linear_modes(const LinearModel& lin) {
       m.natural_frequency_hz = m.damped_frequency_hz = 0.0;
       m.damping_ratio = NAN;
     }
+    // each state's share of the mode's kinetic energy, Re(conj(v_i) (K v)_i): one unit (J) for metres,
+    // radians and modal coordinates; a mode without kinetic energy (a drift of coordinates alone): |v_i|
     std::vector<std::pair<double, int>> part;
+    const Eigen::VectorXcd v = V.col(k);
+    Eigen::VectorXcd Kv = Eigen::VectorXcd::Zero(n);
+    if (lin.kinetic.rows() == n) Kv = lin.kinetic.cast<std::complex<double>>() * v;
+    double energy = 0;
+    for (int i = 0; i < n; ++i) energy += std::abs((std::conj(v(i)) * Kv(i)).real());
+    const double K_scale = lin.kinetic.rows() == n && n ? lin.kinetic.cwiseAbs().maxCoeff() : 0.0;
+    const bool by_energy = energy > 1e-12 * K_scale * v.squaredNorm();
     for (int i = 0; i < n; ++i) {
-      double p = std::abs(V(i, k));
-      if (i >= nqt && mag > 1e-12) p /= mag;
+      double p = by_energy ? std::abs((std::conj(v(i)) * Kv(i)).real()) : std::abs(v(i));
+      if (!by_energy && i >= nqt && mag > 1e-12) p /= mag;
       part.push_back({p, i});
     }
     std::sort(part.begin(), part.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
@@ -441,6 +547,14 @@ nlohmann::ordered_json to_json(const LinearModel& lin, const std::vector<LinearM
   j["attitude"] =
       "each free joint's quaternion is replaced by a small rotation in body axes, q = q0 (x) [1; r/2] "
       "(states q.<body>.rx, .ry, .rz); attitude outputs likewise (rows <sensor>.rx, .ry, .rz)";
+  j["frame"] = lin.frame;
+  if (lin.frame == "lvlh")
+    j["frame_note"] =
+        "the free root body relative to the orbit frame (docs/gnc.md, \"Linear models in orbit\"): lvlh.x the "
+        "along-track arc, lvlh.y the offset against the orbit normal, lvlh.z the drop towards nadir (m), carried "
+        "round at the orbit rate n; lvlh.rx, .ry, .rz its attitude relative to the local orbit frame (a small "
+        "rotation in body axes); lvlh.vx .. vz their rates, lvlh.wx .. wz its angular velocity relative to the "
+        "local orbit frame (B components)";
   j["equilibrium"] = lin.equilibrium;
   j["residual"] = lin.residual;
   j["relative_equilibrium"] = lin.relative_equilibrium;

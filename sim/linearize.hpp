@@ -34,6 +34,10 @@ struct LinearizeOptions {
   /// Leave the ignorable coordinates out of the linear model (LinearModel::ignorable): exact for the
   /// other states, which do not depend on them.
   bool drop_ignorable = false;
+  /// "inertial" (default): the state as the model has it. "lvlh": the free root body's coordinates and
+  /// speeds relative to the orbit frame (sim/orbit_relative_state.hpp; needs a central field), the
+  /// chart in which an LVLH-pointing spacecraft on a circular orbit is an equilibrium.
+  std::string frame = "inertial";
 };
 
 struct LinearModel {
@@ -44,7 +48,18 @@ struct LinearModel {
   VecX x0_dot;        ///< the tangent state's derivative at the point, f(x0)
   VecX y0;            ///< the outputs at the point (tangent rows: attitude rows are 0)
   bool equilibrium = false;
-  double residual = 0;  ///< max |f(x0)|
+  double residual = 0;  ///< max |f(x0)| / residual_scale
+  /// Per state, the scale its x0_dot is judged against for the equilibrium: 1, or in the orbit frame the
+  /// orbit's speed n r0 (rows q.<root>.lvlh.x, y, z) and acceleration n^2 r0 (u.<root>.lvlh.vx, vy, vz),
+  /// at least 1, so that the orbit's own digits (7e3 m/s carried round) do not read as a residual.
+  VecX residual_scale;
+  std::string frame = "inertial";  ///< LinearizeOptions::frame
+  /// The kinetic-energy metric on the states: T of a perturbation dx of the speeds
+  /// is 1/2 dx^T kinetic dx (M on the speed rows; in the orbit frame M carried to the relative speeds at fixed
+  /// coordinates: the kinetic energy of the motion relative to the orbit frame). linear_modes() names a mode's
+  /// dominant states by their share of its kinetic energy, so that metres, radians and modal coordinates are
+  /// compared in one unit (J).
+  MatX kinetic;
   std::string method;   ///< how the derivatives were obtained
   /// Coordinates (tangent states "q.<...>") no other state depends on: A's column of each is zero
   /// outside the rows of ignorable coordinates of the same joint (a balanced wheel's angle; a free
@@ -72,7 +87,9 @@ struct LinearMode {
   /// |lambda| below the eigenvalue noise of a zero eigenvalue (1e-6 sqrt(max(1, |A|_max))): a rigid-body
   /// or ignorable mode (a free body's drift, a wheel's angle), reported as 0 with its states.
   bool zero = false;
-  std::vector<std::string> dominant_states;  ///< largest participation first (speeds weighted by 1/|lambda|)
+  /// Largest share of the mode's kinetic energy first (LinearModel::kinetic: Re(conj(v_i) (K v)_i)); for a
+  /// mode without kinetic energy (a zero mode of the coordinates alone) the largest |v_i| of the coordinates.
+  std::vector<std::string> dominant_states;
 };
 /// |eigenvalue| at or below which linear_modes() reports a mode as zero: 1e-6 sqrt(max(1, max|A|)).
 double zero_mode_tolerance(const LinearModel& lin);

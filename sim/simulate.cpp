@@ -228,12 +228,30 @@ std::vector<std::string> csv_columns(const Model& model) {
   return cols;
 }
 
+namespace {
+
+/// In a central field: where a drift stands against the round-off of the orbit's digits, sqrt(steps)
+/// ulps of the total with the orbit (docs/decisions.md, "Reports in orbit").
+std::string orbit_roundoff(double drift, double total, long steps) {
+  const double ulp = std::numeric_limits<double>::epsilon() * std::abs(total);
+  if (!(ulp > 0) || steps <= 0) return "";
+  const double floor = ulp * std::sqrt(static_cast<double>(steps));
+  return fmt::format("; {:.0f} ulps of that total, its round-off over {} steps ~{:.0f} ulps{}", drift / ulp, steps,
+                     floor / ulp,
+                     drift <= 10.0 * floor ? ": at the orbit's round-off, no measure of the attitude's accuracy "
+                                             "(--estimate-error measures it)"
+                                           : "");
+}
+
+}  // namespace
+
 std::string RunQuality::summary() const {
   std::vector<std::string> parts;
   if (std::isfinite(energy_drift))
     parts.push_back(about_com ? fmt::format("energy drift {:.2e} J: {:.2e} of the motion about the centre of mass "
-                                            "(T_c up to {:.3e} J; |E| with the orbit's {:.3e} J)",
-                                            energy_drift_J, energy_drift, energy_scale_J, energy_total_J)
+                                            "(T_c up to {:.3e} J; |E| with the orbit's {:.3e} J{})",
+                                            energy_drift_J, energy_drift, energy_scale_J, energy_total_J,
+                                            orbit_roundoff(energy_drift_J, energy_total_J, steps))
                               : fmt::format("energy drift {:.2e} ({:.2e} J)", energy_drift, energy_drift_J));
   if (std::isfinite(energy_balance))
     parts.push_back(fmt::format("energy balance with the drivers' work {:.2e} (their work by quadrature on the "
@@ -242,8 +260,9 @@ std::string RunQuality::summary() const {
   if (std::isfinite(H_drift)) {
     const char* H = H_z ? "H_z" : "|H|";
     parts.push_back(about_com ? fmt::format("{} drift {:.2e} N m s: {:.2e} of the motion about the centre of mass "
-                                            "(scale {:.3e} N m s; {} with the orbit's {:.3e} N m s)",
-                                            H, H_drift_Nms, H_drift, H_scale_Nms, H, H_total_Nms)
+                                            "(scale {:.3e} N m s; {} with the orbit's {:.3e} N m s{})",
+                                            H, H_drift_Nms, H_drift, H_scale_Nms, H, H_total_Nms,
+                                            orbit_roundoff(H_drift_Nms, H_total_Nms, steps))
                               : fmt::format("{} drift {:.2e} ({:.2e} N m s against a scale of {:.3e})", H, H_drift,
                                             H_drift_Nms, H_scale_Nms));
   }
@@ -750,6 +769,7 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
       quality.error_worst = fmt::format("the tighter run failed: {}", e.reason);
     }
   }
+  quality.steps = result.stats.steps;
   result.quality = quality;
   result.events = events.fired();
   return result;

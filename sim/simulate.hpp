@@ -48,6 +48,10 @@ struct RunQuality {
   double energy_drift_J = NAN, energy_scale_J = NAN, energy_total_J = NAN;
   double H_drift_Nms = NAN, H_scale_Nms = NAN, H_total_Nms = NAN;
   bool about_com = false;  ///< the scales are the motion about the centre of mass (a central field)
+  /// The integrator's accepted steps: with about_com, a drift of the order of sqrt(steps) ulps of the
+  /// total with the orbit is the orbit's round-off (its digits carried step by step), which the summary
+  /// says rather than reading it as an error of the motion about the centre of mass.
+  long steps = 0;
   bool H_z = false;        ///< the momentum drift is H_z's (central gravity with J2)
   /// When prescribed motion alone does work (Invariants::energy_with_drivers): the balance
   /// max |E - E0 - W_drivers| / max(T + |V|) over the output times (sim/driver_work.hpp); NaN otherwise.

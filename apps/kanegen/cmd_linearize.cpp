@@ -20,7 +20,7 @@ namespace kanegen::cli {
 namespace linearize_command {
 
 struct Options {
-  std::string model, state, engine = "generated", format = "json", output;
+  std::string model, state, engine = "generated", format = "json", output, frame = "inertial";
   std::vector<std::string> inputs, outputs;
   bool native = false, finite_differences = false, quiet = false, drop_ignorable = false;
   CLI::Option* output_option = nullptr;  ///< to tell -o "" (refused) from no -o (JSON on stdout)
@@ -81,6 +81,7 @@ int run(const Options& o) {
   lo.outputs = o.outputs;
   lo.finite_differences = o.finite_differences;
   lo.drop_ignorable = o.drop_ignorable;
+  lo.frame = o.frame;
   const LinearModel lin = linearize(*engine, state, lo);
   const auto modes = linear_modes(lin);
   if (!o.quiet) print_modes(lin, modes);
@@ -133,6 +134,11 @@ Subcommand add_linearize(CLI::App& app) {
   c->add_flag("--drop-ignorable", o->drop_ignorable,
               "leave out the ignorable coordinates (nothing else depends on them: a balanced wheel's angle, a free "
               "body's position without gravity); exact for the other states");
+  c->add_option("--frame", o->frame,
+                "inertial (default): the state as the model has it; lvlh: the free root body's position, attitude "
+                "and rates relative to the orbit frame (a central field: an LVLH-pointing spacecraft on a circular "
+                "orbit is then an equilibrium, its librations eigenvalues)")
+      ->check(CLI::IsMember({"inertial", "lvlh"}));
   c->add_flag("--quiet", o->quiet, "no eigenvalue table on stderr");
   add_engine_option(c, o->engine, o->native);
   return {c, [o] { return linearize_command::run(*o); }};

@@ -14,7 +14,8 @@ and against physics; run by ctest with Debian's python3 and numpy:
   - a closed-loop sweep in the C++ simulator (slew_sim sweep): the same
     tables on 1 and 2 threads, merged shards and mpirun; from Python with
     the law in Python: the same draws and metrics; run k alone = the table;
-  - linearize: a pendulum's A is the closed form;
+  - linearize: a pendulum's A is the closed form; frame="lvlh" gives the CLI's
+    linear model about the orbit frame;
   - the LQR example (reduced horizon) settles and leaves the arrays quiet.
 """
 import argparse
@@ -196,6 +197,18 @@ pend = kanegen.Model(os.path.join(ROOT, "models", "pendulum.yaml"))
 lin = pend.linearize(q=[math.pi / 2])
 check(lin["equilibrium"] and abs(lin["A"][1, 0] + 9.81) <= 1e-13 and lin["A"][0, 1] == 1.0,
       "linearize: pendulum A = [0 1; -g/L 0] hanging")
+
+# ---- linearize about the orbit frame (frame="lvlh"): the CLI's linear model, the same names
+gg_path = os.path.join(ROOT, "models", "gravity_gradient_boom.yaml")
+lin_o = kanegen.Model(gg_path, engine="generic").linearize(frame="lvlh")
+cli_o = json.loads(subprocess.run([os.path.join(args.build, "bin", "kanegen"), "linearize", gg_path, "--frame", "lvlh",
+                                   "--engine", "generic", "--quiet"], check=True, capture_output=True,
+                                  text=True).stdout)
+A_cli = np.array(cli_o["A"])
+check(lin_o["frame"] == "lvlh" and lin_o["state_names"] == cli_o["state_names"]
+      and lin_o["state_names"][:3] == ["q.bus.lvlh.x", "q.bus.lvlh.y", "q.bus.lvlh.z"]
+      and np.max(np.abs(lin_o["A"] - A_cli)) <= 1e-12 * np.max(np.abs(A_cli)),
+      "linearize(frame='lvlh'): the CLI's A and state names (the root relative to the orbit frame)")
 
 # ---- events: the probe separation model's events and latch as the CLI reports them
 sep = kanegen.Model(os.path.join(ROOT, "models", "probe_separation.yaml"), engine="generic")

@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "engine/generic_engine.hpp"
@@ -209,4 +210,10 @@ initial:
   CHECK(r.quality.H_scale_Nms > 0.1);
   CHECK(r.quality.H_drift == Approx(r.quality.H_drift_Nms / r.quality.H_scale_Nms).epsilon(1e-12));
   CHECK_THAT(r.quality.summary(), Catch::Contains("H_z drift") && Catch::Contains("of the motion about the centre of mass"));
+  // that drift is the orbit's round-off: within 10 sqrt(steps) ulps of H_z with the orbit, and the summary says so
+  REQUIRE(r.quality.steps == r.stats.steps);
+  REQUIRE(r.stats.steps > 0);
+  const double ulp = std::numeric_limits<double>::epsilon() * r.quality.H_total_Nms;
+  CHECK(r.quality.H_drift_Nms <= 10.0 * ulp * std::sqrt(static_cast<double>(r.stats.steps)));
+  CHECK_THAT(r.quality.summary(), Catch::Contains("ulps of that total") && Catch::Contains("at the orbit's round-off"));
 }
