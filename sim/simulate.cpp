@@ -696,7 +696,8 @@ SimulationResult simulate(Engine& engine, const State& initial, const Simulation
     // Generated code has only the energy and momentum the model's outputs ask
     // for; the invariants are then measured on the generic engine, at the same
     // states (a few evaluations per output row, after the run).
-    const bool lacks = (inv.energy || inv.momentum) && dynamic_cast<GeneratedEngine*>(&engine) &&
+    // (H_z alone too; and in orbit the scales T_c, H_c need both: sim/motion_about_com)
+    const bool lacks = (inv.energy || inv.momentum || inv.momentum_z) && dynamic_cast<GeneratedEngine*>(&engine) &&
                        !(model.outputs.energy && model.outputs.momentum);
     std::unique_ptr<GenericEngine> measure;
     if (lacks) {
