@@ -10,7 +10,7 @@
 
 #include "bench_support.hpp"
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 
 using namespace kanegen;

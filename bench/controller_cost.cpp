@@ -16,7 +16,7 @@
 
 #include "codegen/jit_generator.hpp"
 #include "engine/jit.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "sim/simulate.hpp"
 

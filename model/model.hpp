@@ -1,6 +1,6 @@
 // The read-only description of a multibody system: tree topology, joints,
 // mass data (rigid part and modal data of flexible bodies), forces, initial
-// state and requested outputs. Built once by load_model() (model_loader.hpp)
+// state and requested outputs. Built once by load_model() (engine/load_model.hpp)
 // and never modified by the engines; all per-evaluation data lives in a
 // Workspace (workspace.hpp).
 //

@@ -1528,8 +1528,7 @@ class Loader {
     }
     if (orbit_)
       if (const int root = orbit_root(); root >= 0) {
-        place_on_orbit(model_, root, *orbit_);
-        model_.initial_orbit = *orbit_;
+        model_.initial_orbit = *orbit_;  // placed by engine/load_model.hpp's load_model()
         model_.orbit_root = root;
       }
     std::vector<Diagnostic> bad(diags_.begin(), diags_.end());  // the orbit's faults
@@ -1569,6 +1568,6 @@ class Loader {
 
 }  // namespace
 
-Model load_model(const std::string& path) { return Loader(path).load(); }
+Model parse_model(const std::string& path) { return Loader(path).load(); }
 
 }  // namespace kanegen

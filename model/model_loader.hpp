@@ -11,6 +11,9 @@ namespace kanegen {
 /// Reads and validates a model file and every modal file it names. On any
 /// fault throws InputError with one Diagnostic per fault found (all of them,
 /// not only the first), each naming file, line and field.
-Model load_model(const std::string& path);
+/// Under `initial: orbit:` the root's state is not yet placed (Model::initial_orbit and orbit_root are set):
+/// placing it needs the system's centre of mass, from the dynamics; engine/load_model.hpp's load_model()
+/// parses and places.
+Model parse_model(const std::string& path);
 
 }  // namespace kanegen

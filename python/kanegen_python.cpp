@@ -26,7 +26,7 @@
 #include "engine/model_checks.hpp"
 #include "engine/resources.hpp"
 #include "model/diagnostics.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/output_file.hpp"
 #include "model/parameters.hpp"
 #include "model/sweep_spec.hpp"

@@ -18,9 +18,9 @@
 
 #include "model/diagnostics.hpp"
 #include "model/model_hash.hpp"
-#include "model/initial_orbit.hpp"
+#include "engine/initial_orbit.hpp"
 #include "model/model_files.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/output_file.hpp"
 #include "model/parameters.hpp"
 #include "model/state_io.hpp"

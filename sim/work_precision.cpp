@@ -21,7 +21,7 @@
 #include "engine/model_checks.hpp"
 #include "engine/resources.hpp"
 #include "model/diagnostics.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/output_file.hpp"
 #include "model/state_io.hpp"
 #include "sim/integrators.hpp"

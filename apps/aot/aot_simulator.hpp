@@ -23,7 +23,7 @@
 #include "engine/model_checks.hpp"
 #include "model/diagnostics.hpp"
 #include "model/model_files.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/output_file.hpp"
 #include "model/state_io.hpp"
 #include "sim/eval_report.hpp"

@@ -20,7 +20,7 @@
 #include "engine/jit_cache.hpp"
 #include "engine/model_checks.hpp"
 #include "model/diagnostics.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 
 namespace kanegen::cli {
 

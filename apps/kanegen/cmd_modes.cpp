@@ -9,7 +9,7 @@
 #include "model/diagnostics.hpp"
 #include "model/modal_data.hpp"
 #include "model/second_order.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/model_files.hpp"
 #include "model/output_file.hpp"
 

@@ -51,7 +51,7 @@
 #include "codegen/jit_generator.hpp"
 #include "engine/generic_engine.hpp"
 #include "engine/jit.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "sim/simulate.hpp"
 #include "sim/work_precision.hpp"

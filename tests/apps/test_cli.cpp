@@ -15,7 +15,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace fs = std::filesystem;

@@ -11,7 +11,7 @@
 #include <random>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/parameters.hpp"
 #include "sim/crosscheck.hpp"
 #include "tests/support/test_support.hpp"

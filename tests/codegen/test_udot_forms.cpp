@@ -9,7 +9,7 @@
 #include <fstream>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "sim/crosscheck.hpp"
 #include "tests/support/test_support.hpp"

@@ -8,7 +8,7 @@
 #include <random>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/orbit.hpp"
 #include "sim/simulate.hpp"
 #include "sim/row_sink.hpp"

@@ -6,7 +6,7 @@
 
 #include "engine/generic_engine.hpp"
 #include "sim/integrators.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "sim/simulate.hpp"
 #include "model/state_io.hpp"
 #include "tests/support/test_support.hpp"

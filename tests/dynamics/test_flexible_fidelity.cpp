@@ -16,7 +16,7 @@
 #include "model/beam.hpp"
 #include "model/modal_data.hpp"
 #include "model/second_order.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "sim/integrators.hpp"
 #include "sim/simulate.hpp"

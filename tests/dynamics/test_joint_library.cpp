@@ -18,7 +18,7 @@
 #include <random>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/rotation.hpp"
 #include "sim/crosscheck.hpp"
 #include "sim/integrators.hpp"

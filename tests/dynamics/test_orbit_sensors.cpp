@@ -14,7 +14,7 @@
 #include <iomanip>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/orbit.hpp"
 #include "sim/row_sink.hpp"
 #include "sim/simulate.hpp"

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "sim/integrators.hpp"
 #include "sim/simulate.hpp"

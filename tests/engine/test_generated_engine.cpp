@@ -14,7 +14,7 @@
 #include "sim/crosscheck.hpp"
 #include "engine/generic_engine.hpp"
 #include "engine/jit.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "sim/simulate.hpp"
 #include "model/state_io.hpp"
 #include "tests/support/test_support.hpp"

@@ -20,7 +20,7 @@
 #include "engine/generic_engine.hpp"
 #include "engine/jit.hpp"
 #include "model/model_hash.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/parameters.hpp"
 #include "model/state_io.hpp"
 #include "tests/support/test_support.hpp"

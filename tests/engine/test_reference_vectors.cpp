@@ -11,7 +11,7 @@
 #include "sim/eval_report.hpp"
 #include "engine/generic_engine.hpp"
 #include "engine/jit.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "tests/support/test_support.hpp"
 
 using namespace kanegen;

@@ -15,7 +15,7 @@
 
 #include "dynamics/body_inertia.hpp"
 #include "model/rotation.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "tests/support/test_support.hpp"
 
 using namespace kanegen;

@@ -10,7 +10,7 @@
 #include "dynamics/invariants.hpp"
 #include "dynamics/kinematics.hpp"
 #include "model/mode_description.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "sim/mass_properties.hpp"
 #include "tests/support/test_support.hpp"
 

@@ -10,7 +10,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/rotation.hpp"
 
 using namespace kanegen;

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "tests/support/test_support.hpp"
 

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "sim/simulate.hpp"
 #include "tests/support/test_support.hpp"

@@ -28,7 +28,7 @@
 #include "sim/integrators.hpp"
 #include "engine/jit.hpp"
 #include "engine/model_checks.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "sim/simulate.hpp"
 #include "model/state_io.hpp"
 #include "tests/support/test_support.hpp"

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "sim/integrator_choice.hpp"
 #include "sim/simulate.hpp"

@@ -12,7 +12,7 @@
 #include <cmath>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "sim/linearize.hpp"
 #include "tests/support/test_support.hpp"

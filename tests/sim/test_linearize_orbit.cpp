@@ -19,7 +19,7 @@
 #include <limits>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "sim/linearize.hpp"
 #include "sim/dual_number.hpp"

@@ -14,7 +14,7 @@
 #include "engine/generic_engine.hpp"
 #include "engine/locks.hpp"
 #include "model/diagnostics.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/rotation.hpp"
 #include "model/state_io.hpp"
 #include "sim/linearize.hpp"

@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "sim/modal_range.hpp"
 #include "sim/row_sink.hpp"
 #include "sim/simulate.hpp"

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "engine/generic_engine.hpp"
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/orbit.hpp"
 #include "model/sweep_spec.hpp"
 #include "sim/row_sink.hpp"

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <unistd.h>
 
-#include "model/model_loader.hpp"
+#include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "tests/support/test_support.hpp"
 #include "sim/work_precision.hpp"
