@@ -18,6 +18,7 @@
 #include "model/orbit.hpp"
 #include "sim/row_sink.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/librations.hpp"
 #include "tests/support/test_support.hpp"
 
 using namespace kanegen;
@@ -306,11 +307,8 @@ outputs:
 )",
                                                                                   Ix, Iy, Iz, a)));
   const double n = std::sqrt(kMu / (a * a * a));
-  const double pitch = n * std::sqrt(3.0 * (Ix - Iz) / Iy);
-  const double kR = (Iy - Iz) / Ix, kY = (Iy - Ix) / Iz;  // Hughes: s^4 + (1 + 3 kR + kR kY) n^2 s^2 + 4 kR kY n^4 = 0
-  const double B = 1.0 + 3.0 * kR + kR * kY, Cc = 4.0 * kR * kY;
-  const double disc = std::sqrt(B * B - 4.0 * Cc);
-  const double slow = n * std::sqrt((B - disc) / 2.0), fast = n * std::sqrt((B + disc) / 2.0);
+  const test::Librations lib = test::rigid_librations(Ix, Iy, Iz, n);
+  const double pitch = lib.pitch, slow = lib.roll_yaw_slow, fast = lib.roll_yaw_fast;
   GenericEngine generic(model);
   auto generated = test::generated_engine(model);
   for (Engine* e : both(generic, generated)) {
