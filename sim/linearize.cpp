@@ -128,8 +128,18 @@ void find_ignorable(LinearModel& lin, const std::vector<int>& body_of) {
   const bool exact = lin.method.rfind("exact", 0) == 0;
   const double small = (exact ? 1e-12 : 1e-6) * std::max(1.0, n ? lin.A.cwiseAbs().maxCoeff() : 0.0);
   auto is_q = [&](int i) { return lin.state_names[i].rfind("q.", 0) == 0; };
+  // in the orbit frame the central field restores the cross-track and radial offsets (Clohessy-Wiltshire's
+  // -n^2 y and 3 n^2 z): never ignorable, though by central differences their n^2 may sink below the noise
+  // threshold of a fast-spinning body's A
+  auto restored = [&](int i) {
+    const std::string& s = lin.state_names[i];
+    auto ends = [&](const std::string& tail) {
+      return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+    };
+    return lin.frame == "lvlh" && (ends(".lvlh.y") || ends(".lvlh.z"));
+  };
   std::vector<bool> cand(n, false);
-  for (int i = 0; i < n; ++i) cand[i] = is_q(i) && body_of[i] >= 0;
+  for (int i = 0; i < n; ++i) cand[i] = is_q(i) && body_of[i] >= 0 && !restored(i);
   for (bool changed = true; changed;) {  // a candidate only other same-joint candidates depend on
     changed = false;
     for (int i = 0; i < n; ++i) {

@@ -226,3 +226,22 @@ TEST_CASE("linearize --frame lvlh: a flexible boom satellite's modes named by th
   CHECK(bending == 2);
   CHECK(pitch == 1);
 }
+
+TEST_CASE("linearize --frame lvlh: the cross-track and radial offsets are never ignorable, even by central "
+          "differences of a fast-spinning body",
+          "[linearize][central]") {
+  // a body spinning at 6 rad/s about its yaw axis: max |A| ~ 10, central differences' threshold 1e-5, above
+  // the field's n^2 ~ 1e-6 on lvlh.y and lvlh.z; the along-track arc stays ignorable
+  std::string text = libration_model(400.0, 500.0, 150.0, 6.978137e6);
+  text.replace(text.find("attitude: lvlh}"), 15, "attitude: lvlh, rate_offset: [0.0, 0.0, 6.0]}");
+  const Model model = load_model(test::write_temp("spinner_lvlh.yaml", text));
+  GenericEngine engine(model);
+  LinearizeOptions o;
+  o.frame = "lvlh";
+  const LinearModel lin = linearize(engine, initial_state(model), o);
+  CHECK_FALSE(lin.equilibrium);
+  INFO(fmt::format("ignorable: {}", fmt::join(lin.ignorable, ", ")));
+  CHECK(std::find(lin.ignorable.begin(), lin.ignorable.end(), "q.bus.lvlh.x") != lin.ignorable.end());
+  CHECK(std::find(lin.ignorable.begin(), lin.ignorable.end(), "q.bus.lvlh.y") == lin.ignorable.end());
+  CHECK(std::find(lin.ignorable.begin(), lin.ignorable.end(), "q.bus.lvlh.z") == lin.ignorable.end());
+}
