@@ -1,0 +1,28 @@
+// The modes of a NASTRAN SOL 103 run as its .f06 prints them (issue 36): the
+// REAL EIGENVALUES table (eigenvalue, cycles, generalized mass) and the REAL
+// EIGENVECTOR blocks (T1 T2 T3 R1 R2 R3 per grid, in each grid's output frame),
+// in the layouts of MSC and NX/Simcenter Nastran; a block continued over pages
+// is joined. A complex eigenvalue solution is refused.
+#pragma once
+
+#include <Eigen/Dense>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace kanegen::nastran {
+
+struct F06Mode {
+  int number = 0;              ///< the mode number NASTRAN prints
+  double eigenvalue = 0.0;     ///< (rad/s)^2
+  double cycles = 0.0;         ///< Hz
+  double generalized_mass = 0.0;
+  /// Per grid id: [T1 T2 T3 R1 R2 R3] in the grid's displacement (CD) frame, as printed.
+  std::map<int, Eigen::Matrix<double, 6, 1>> shapes;
+};
+
+/// Every mode of the eigenvalue table, with its eigenvector where the f06 prints one. Throws InputError (file,
+/// line) for a complex eigenvalue solution, a file without a REAL EIGENVALUES table, or a row it cannot read.
+std::vector<F06Mode> read_f06_modes(const std::string& path);
+
+}  // namespace kanegen::nastran
