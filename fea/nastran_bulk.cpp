@@ -364,23 +364,30 @@ std::map<int, GridMass> lumped_masses(const Bulk& bulk) {
   return out;
 }
 
-WeightSummary weight_summary(const std::map<int, GridMass>& masses, const Bulk& bulk) {
-  // the rigid-body mass matrix about the basic origin, sum of D^T M_g D (grid motion t - [x]x r, r)
-  double mass = 0.0;
-  Mat3 M_tr = Mat3::Zero(), M_rr = Mat3::Zero();
+Eigen::Matrix<double, 6, 6> rigid_body_mass(const std::map<int, GridMass>& masses, const Bulk& bulk,
+                                            const Eigen::Vector3d& x_ref) {
+  Eigen::Matrix<double, 6, 6> MO = Eigen::Matrix<double, 6, 6>::Zero();
   for (const auto& [id, g] : masses) {
-    const Mat3 X = skew(bulk.grids.at(id).x_basic);
-    mass += g.mass;
-    M_tr += -g.mass * X + g.coupling;
-    M_rr += g.mass * X.transpose() * X + g.inertia - X.transpose() * g.coupling - g.coupling.transpose() * X;
+    const Mat3 X = skew(bulk.grids.at(id).x_basic - x_ref);
+    MO.topLeftCorner<3, 3>() += g.mass * Mat3::Identity();
+    MO.topRightCorner<3, 3>() += -g.mass * X + g.coupling;
+    MO.bottomRightCorner<3, 3>() +=
+        g.mass * X.transpose() * X + g.inertia - X.transpose() * g.coupling - g.coupling.transpose() * X;
   }
+  MO.bottomLeftCorner<3, 3>() = MO.topRightCorner<3, 3>().transpose();
+  return MO;
+}
+
+WeightSummary weight_summary(const std::map<int, GridMass>& masses, const Bulk& bulk) {
+  const Eigen::Matrix<double, 6, 6> MO = rigid_body_mass(masses, bulk);
   WeightSummary w;
-  w.mass = mass;
-  if (!(mass > 0.0)) return w;
+  w.mass = MO(0, 0);
+  if (!(w.mass > 0.0)) return w;
+  const Mat3 M_tr = MO.topRightCorner<3, 3>();
   const Vec3 S(-M_tr(2, 1), -M_tr(0, 2), -M_tr(1, 0));  // M_tr = -[S]x, S the first moment
-  w.cg = S / mass;
+  w.cg = S / w.mass;
   const Mat3 C = skew(w.cg);
-  w.inertia_cg = M_rr - mass * C.transpose() * C;
+  w.inertia_cg = MO.bottomRightCorner<3, 3>() - w.mass * C.transpose() * C;
   return w;
 }
 

@@ -88,4 +88,9 @@ struct WeightSummary {
 };
 WeightSummary weight_summary(const std::map<int, GridMass>& masses, const Bulk& bulk);
 
+/// The rigid-body mass matrix about the point x_ref (basic), NASTRAN's weight generator's MO: the sum over grids
+/// of D^T M_g D with D mapping a rigid motion (t, r) at x_ref to the grid's (t - [x - x_ref]x r, r).
+Eigen::Matrix<double, 6, 6> rigid_body_mass(const std::map<int, GridMass>& masses, const Bulk& bulk,
+                                            const Eigen::Vector3d& x_ref = Eigen::Vector3d::Zero());
+
 }  // namespace kanegen::nastran

@@ -95,4 +95,33 @@ std::vector<F06Mode> read_f06_modes(const std::string& path) {
   return out;
 }
 
+std::optional<F06Weight> read_f06_weight(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(Diagnostic{path, 0, "", "cannot read the f06 file"});
+  std::vector<std::string> lines;
+  for (std::string s; std::getline(in, s);) lines.push_back(s);
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    if (squeezed(lines[k]).find("GRIDPOINTWEIGHTGENERATOR") == std::string::npos) continue;
+    F06Weight w;
+    int row = 0;
+    for (std::size_t r = k + 1; r < lines.size() && r < k + 12 && row < 6; ++r) {
+      const std::string& s = lines[r];
+      if (const auto p = s.find("REFERENCE POINT ="); p != std::string::npos) {
+        w.reference_point = std::atoi(s.c_str() + p + 17);
+        continue;
+      }
+      auto w6 = words(s);
+      if (w6.size() != 8 || w6.front() != "*" || w6.back() != "*") continue;  // "* m11 ... m16 *"
+      for (int c = 0; c < 6; ++c) {
+        const auto x = parse_real(w6[1 + c]);
+        if (!x) throw InputError(Diagnostic{path, static_cast<int>(r) + 1, "", "a weight generator row that cannot be read"});
+        w.MO(row, c) = *x;
+      }
+      ++row;
+    }
+    if (row == 6) return w;
+  }
+  return std::nullopt;
+}
+
 }  // namespace kanegen::nastran

@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,5 +25,13 @@ struct F06Mode {
 /// Every mode of the eigenvalue table, with its eigenvector where the f06 prints one. Throws InputError (file,
 /// line) for a complex eigenvalue solution, a file without a REAL EIGENVALUES table, or a row it cannot read.
 std::vector<F06Mode> read_f06_modes(const std::string& path);
+
+/// The grid point weight generator's MO (6 x 6 rigid-body mass matrix about its reference point) and that
+/// point (PARAM GRDPNT: 0 the basic origin, else a grid id), if the f06 prints it.
+struct F06Weight {
+  int reference_point = 0;
+  Eigen::Matrix<double, 6, 6> MO = Eigen::Matrix<double, 6, 6>::Zero();
+};
+std::optional<F06Weight> read_f06_weight(const std::string& path);
 
 }  // namespace kanegen::nastran

@@ -65,3 +65,16 @@ TEST_CASE("nastran f06: a file without real modes is refused with its name", "[n
   CHECK_THROWS_WITH(read_f06_modes(test::write_temp("complex.f06", "  C O M P L E X   E I G E N V A L U E   S U M M A R Y\n")),
                     Catch::Contains("complex.f06:1") && Catch::Contains("complex eigenvalue"));
 }
+
+TEST_CASE("nastran f06: the weight generator's MO equals the importer's rigid-body mass matrix", "[nastran][physics]") {
+  const auto printed = read_f06_weight(shared_run("beam_modes.f06"));
+  REQUIRE(printed);
+  CHECK(printed->reference_point == 0);
+  const Bulk bulk = read_bulk(shared_run("beam_modes.dat"));
+  const Eigen::Matrix<double, 6, 6> MO = rigid_body_mass(lumped_masses(bulk), bulk);
+  INFO("printed MO\n" << printed->MO << "\nimporter's MO\n" << MO);
+  // to the printed 7 digits of each entry (zeros printed as 0.000000E+00 are zero here to round-off)
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j)
+      CHECK(std::abs(MO(i, j) - printed->MO(i, j)) <= 1e-6 * std::abs(printed->MO(i, j)) + 1e-15);
+}
