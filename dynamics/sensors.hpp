@@ -9,7 +9,9 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 
+#include "dynamics/body_terms.hpp"
 #include "dynamics/invariants.hpp"
+#include "dynamics/kinematics.hpp"
 #include "dynamics/workspace.hpp"
 #include "model/orbit.hpp"
 #include "model/model.hpp"
@@ -36,6 +38,14 @@ inline OrbitState system_centre_of_mass(const Model& model, Workspace<double>& w
     S += model.bodies[i].total_mass * s.r_NO_N + s.R_NB * s.S_B;
   }
   return {S / mass, compute_momentum(model, ws).p_N / mass};
+}
+
+/// The same at a state (q, u) at time t, from a workspace of its own.
+inline OrbitState system_centre_of_mass(const Model& model, double t, const VecX& q, const VecX& u) {
+  Workspace<double> ws(model);
+  compute_kinematics(model, ws, t, q, u);
+  compute_body_terms(model, ws);
+  return system_centre_of_mass(model, ws);
 }
 
 template <class VecY>

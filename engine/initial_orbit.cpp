@@ -1,23 +1,8 @@
 #include "engine/initial_orbit.hpp"
 
-#include "dynamics/body_terms.hpp"
-#include "dynamics/kinematics.hpp"
 #include "dynamics/sensors.hpp"
-#include "dynamics/workspace.hpp"
 
 namespace kanegen {
-
-namespace {
-
-/// The system's centre of mass and its velocity (N) at model.q0, model.u0.
-OrbitState placed_centre_of_mass(const Model& model) {
-  Workspace<double> ws(model);
-  compute_kinematics(model, ws, 0.0, model.q0, model.u0);
-  compute_body_terms(model, ws);
-  return system_centre_of_mass(model, ws);
-}
-
-}  // namespace
 
 void place_on_orbit(Model& model, int root, const InitialOrbit& orbit) {
   const Body& b = model.bodies[root];
@@ -32,7 +17,7 @@ void place_on_orbit(Model& model, int root, const InitialOrbit& orbit) {
   }
   model.q0.segment<3>(q).setZero();
   model.u0.segment<3>(u).setZero();
-  const OrbitState c = placed_centre_of_mass(model);
+  const OrbitState c = system_centre_of_mass(model, 0.0, model.q0, model.u0);
   // a shift of the root moves every element alike: R_NJ dx in N; a root velocity adds R_NB dv to every element
   const Eigen::Vector4d qq = model.q0.segment<4>(q + 3);
   const Mat3 R_NB = R_NJ * Eigen::Quaterniond(qq(0), qq(1), qq(2), qq(3)).normalized().toRotationMatrix();

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 
 #include "model/diagnostics.hpp"
 #include "sim/dual_number.hpp"
@@ -214,9 +215,8 @@ void drop_states(LinearModel& lin, const std::vector<std::string>& drop) {
 /// the second derivatives exact by nested dual numbers (directions: the flow (x_dot, 1) and each column
 /// of T_in); B_z = P B, C_z = C P^-1. J_phi is taken over the full coordinates (the chart's extension off
 /// the unit quaternions included), since J's quaternion rows may leave the sphere.
-void to_orbit_frame(LinearModel& lin, const Model& model, const State& state, const MatX& J, const MatX& T_in,
-                    const VecX& x_dot) {
-  const OrbitRelativeState chart(model, state);
+void to_orbit_frame(LinearModel& lin, const OrbitRelativeState& chart, const Model& model, const State& state,
+                    const MatX& J, const MatX& T_in, const VecX& x_dot) {
   const int nq = model.nq, nu = model.nu, nx = nq + nu, n = chart.size();
   using D1 = Dual<double>;
   using D2 = Dual<D1>;
@@ -271,9 +271,9 @@ void to_orbit_frame(LinearModel& lin, const Model& model, const State& state, co
   // the orbit's own scale for the root's translation rows
   const double speed = std::max(1.0, chart.orbit_rate() * chart.com_position().norm());
   const double accel = std::max(1.0, chart.orbit_rate() * speed);
+  const std::string& root = model.bodies[chart.root()].name;
   for (int r = 0; r < n; ++r) {
     const std::string& name = lin.state_names[r];
-    const std::string root = model.bodies[chart.root()].name;
     for (const char* a : {".lvlh.x", ".lvlh.y", ".lvlh.z"})
       if (name == "q." + root + a) lin.residual_scale(r) = speed;
     for (const char* a : {".lvlh.vx", ".lvlh.vy", ".lvlh.vz"})
@@ -290,6 +290,13 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
   const std::vector<InputColumn> in_cols = input_columns(model, options.inputs);
   const bool state_outputs = model.ny == 0 && options.outputs.empty();
   const std::vector<int> out_rows = state_outputs ? std::vector<int>{} : output_rows(model, options.outputs);
+  // the frame, and in the orbit frame its chart (which refuses a model without a central field or a free root),
+  // before any derivative is taken
+  if (options.frame != "inertial" && options.frame != "lvlh")
+    throw InputError(Diagnostic{"(command line)", 0, "--frame",
+                                fmt::format("unknown frame '{}'; expected inertial or lvlh", options.frame)});
+  const std::optional<OrbitRelativeState> orbit_chart =
+      options.frame == "lvlh" ? std::optional<OrbitRelativeState>(std::in_place, model, state) : std::nullopt;
   engine.set_inputs(state.w);
   // With joints locked (State::locked) the linear model is the reduced
   // system's: the locked joints' coordinates and speeds are no states (the
@@ -450,12 +457,9 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
   }
   lin.method = exact ? "exact: forward-mode dual numbers through the generated code"
                      : "central differences (step 1e-6 max(1, |x|)) of the " + engine.name() + " engine";
-  if (options.frame == "lvlh") {
-    to_orbit_frame(lin, model, state, J, T_in, x_dot);
+  if (orbit_chart) {
+    to_orbit_frame(lin, *orbit_chart, model, state, J, T_in, x_dot);
     lin.method += "; the orbit frame's chart exact (nested dual numbers)";
-  } else if (options.frame != "inertial") {
-    throw InputError(Diagnostic{"(command line)", 0, "--frame",
-                                fmt::format("unknown frame '{}'; expected inertial or lvlh", options.frame)});
   }
   lin.residual = scaled_residual(lin);
   lin.equilibrium = lin.residual <= kEquilibriumTolerance;

@@ -5,10 +5,7 @@
 #include <array>
 #include <cmath>
 
-#include "dynamics/body_terms.hpp"
-#include "dynamics/kinematics.hpp"
 #include "dynamics/sensors.hpp"
-#include "dynamics/workspace.hpp"
 #include "model/diagnostics.hpp"
 #include "model/orbit.hpp"
 #include "sim/dual_number.hpp"
@@ -71,10 +68,7 @@ OrbitRelativeState::OrbitRelativeState(const Model& model, const State& state, c
   const Body& b = model.bodies[root_];
 
   // the centre of mass at x0: L, n and h
-  Workspace<double> ws(model);
-  compute_kinematics(model, ws, state.t, state.q, state.u);
-  compute_body_terms(model, ws);
-  const OrbitState c = system_centre_of_mass(model, ws);
+  const OrbitState c = system_centre_of_mass(model, state.t, state.q, state.u);
   r_com_ = c.r_N;
   const Eigen::Vector3d h = c.r_N.cross(c.v_N);
   if (h.norm() <= 1e-12 * c.r_N.norm() * c.v_N.norm())

@@ -52,6 +52,13 @@ std::vector<double> frequencies(const LinearModel& lin) {
   return w;
 }
 
+/// The linear model about the model's initial state in the orbit frame.
+LinearModel in_orbit_frame(Engine& engine, const Model& model) {
+  LinearizeOptions o;
+  o.frame = "lvlh";
+  return linearize(engine, initial_state(model), o);
+}
+
 int index_of(const LinearModel& lin, const std::string& name) {
   const auto it = std::find(lin.state_names.begin(), lin.state_names.end(), name);
   REQUIRE(it != lin.state_names.end());
@@ -72,12 +79,10 @@ TEST_CASE("linearize --frame lvlh: a rigid spacecraft pointing LVLH on a circula
   std::vector<double> expected = {0.0, n, n, slow, pitch, fast};
   std::sort(expected.begin(), expected.end());
 
-  LinearizeOptions o;
-  o.frame = "lvlh";
   GenericEngine generic(model);
   auto generated = test::generated_engine(model);
-  const LinearModel exact = linearize(*generated, initial_state(model), o);
-  const LinearModel diff = linearize(generic, initial_state(model), o);
+  const LinearModel exact = in_orbit_frame(*generated, model);
+  const LinearModel diff = in_orbit_frame(generic, model);
   for (const LinearModel* lin : {&exact, &diff}) {
     INFO(lin->method);
     CHECK(lin->frame == "lvlh");
@@ -205,9 +210,7 @@ TEST_CASE("linearize --frame lvlh: a flexible boom satellite's modes named by th
   text.replace(text.find(", J2: 1.08262668e-3, radius: 6378137.0"), 38, "");
   const Model model = load_model(test::write_temp("boom_no_j2.yaml", text));
   GenericEngine engine(model);
-  LinearizeOptions o;
-  o.frame = "lvlh";
-  const LinearModel lin = linearize(engine, initial_state(model), o);
+  const LinearModel lin = in_orbit_frame(engine, model);
   CHECK(lin.equilibrium);
   const double n = std::sqrt(kMu / std::pow(6.978137e6, 3));
   int bending = 0, pitch = 0;
@@ -236,9 +239,7 @@ TEST_CASE("linearize --frame lvlh: the cross-track and radial offsets are never 
   text.replace(text.find("attitude: lvlh}"), 15, "attitude: lvlh, rate_offset: [0.0, 0.0, 6.0]}");
   const Model model = load_model(test::write_temp("spinner_lvlh.yaml", text));
   GenericEngine engine(model);
-  LinearizeOptions o;
-  o.frame = "lvlh";
-  const LinearModel lin = linearize(engine, initial_state(model), o);
+  const LinearModel lin = in_orbit_frame(engine, model);
   CHECK_FALSE(lin.equilibrium);
   INFO(fmt::format("ignorable: {}", fmt::join(lin.ignorable, ", ")));
   CHECK(std::find(lin.ignorable.begin(), lin.ignorable.end(), "q.bus.lvlh.x") != lin.ignorable.end());
