@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <set>
 
 #include "model/diagnostics.hpp"
@@ -220,12 +222,9 @@ int Card::integer(int i, std::optional<int> fallback) const {
     if (fallback) return *fallback;
     refuse(i, "blank; expected an integer");
   }
-  const std::string& s = fields[i];
-  char* end = nullptr;
-  const long v = std::strtol(s.c_str(), &end, 10);
-  if (end == s.c_str() || *end != '\0' || v < -2147483647L || v > 2147483647L)
-    refuse(i, fmt::format("'{}'; expected an integer", s));
-  return static_cast<int>(v);
+  const auto v = parse_integer(fields[i]);
+  if (!v) refuse(i, fmt::format("'{}'; expected an integer", fields[i]));
+  return *v;
 }
 
 double Card::real(int i, std::optional<double> fallback) const {
@@ -244,6 +243,23 @@ std::vector<Card> read_cards(const std::string& path) {
   Reader r;
   r.read(path, "", 0, 0, false);
   return std::move(r.cards);
+}
+
+std::optional<int> parse_integer(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (end == text.c_str() || *end != '\0' || errno == ERANGE || v < -2147483647L || v > 2147483647L)
+    return std::nullopt;
+  return static_cast<int>(v);
+}
+
+std::vector<std::string> words(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> w;
+  for (std::string x; in >> x;) w.push_back(x);
+  return w;
 }
 
 }  // namespace kanegen::nastran

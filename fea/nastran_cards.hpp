@@ -40,6 +40,12 @@ struct Card {
 /// A number in NASTRAN's real-field forms, or nullopt if the text is none.
 std::optional<double> parse_real(const std::string& text);
 
+/// An integer within int's range written in full ("12", "-3"), or nullopt.
+std::optional<int> parse_integer(const std::string& text);
+
+/// The whitespace-separated words of a line of printed output (an f06, a punch file).
+std::vector<std::string> words(const std::string& line);
+
 /// The bulk data cards of `path` and of the files it includes, in order. A file with a BEGIN BULK line is read
 /// from after it; ENDDATA ends the reading. Throws InputError (file, line) for a file that cannot be read, an
 /// INCLUDE that cannot be found or includes itself, a line that is no card, a continuation without a card.

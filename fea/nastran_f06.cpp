@@ -20,16 +20,9 @@ std::string squeezed(const std::string& s) {
   return out;
 }
 
-std::vector<std::string> words(const std::string& s) {
-  std::istringstream in(s);
-  std::vector<std::string> w;
-  for (std::string x; in >> x;) w.push_back(x);
-  return w;
-}
-
 }  // namespace
 
-std::vector<F06Mode> read_f06_modes(const std::string& path) {
+std::vector<Mode> read_f06_modes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(Diagnostic{path, 0, "", "cannot read the f06 file"});
   std::vector<std::string> lines;
@@ -40,7 +33,7 @@ std::vector<F06Mode> read_f06_modes(const std::string& path) {
   auto refuse = [&](std::size_t k, const std::string& why) {
     throw InputError(Diagnostic{path, static_cast<int>(k) + 1, "", why});
   };
-  std::map<int, F06Mode> modes;
+  std::map<int, Mode> modes;
   bool table = false;
   for (std::size_t k = 0; k < lines.size(); ++k) {
     const std::string sq = squeezed(lines[k]);
@@ -57,8 +50,10 @@ std::vector<F06Mode> read_f06_modes(const std::string& path) {
           k = r - 1;
           break;
         }
-        F06Mode m;
-        m.number = std::stoi(w[0]);
+        Mode m;
+        const auto number = parse_integer(w[0]);
+        if (!number) refuse(r, fmt::format("mode number '{}' cannot be read", w[0]));
+        m.number = *number;
         const auto ev = parse_real(w[2]), cy = parse_real(w[4]), gm = parse_real(w[5]);
         if (!ev || !cy || !gm) refuse(r, "an eigenvalue row that cannot be read");
         m.eigenvalue = *ev, m.cycles = *cy, m.generalized_mass = *gm;
@@ -68,8 +63,11 @@ std::vector<F06Mode> read_f06_modes(const std::string& path) {
     }
     const auto at = sq.find("REALEIGENVECTORNO.");
     if (at == std::string::npos) continue;
-    const int number = std::atoi(sq.c_str() + at + std::string("REALEIGENVECTORNO.").size());
-    F06Mode& m = modes[number];
+    const std::string tail = sq.substr(at + std::string("REALEIGENVECTORNO.").size());
+    const auto parsed = parse_integer(tail.substr(0, tail.find_first_not_of("0123456789")));
+    if (!parsed) refuse(k, "an eigenvector heading without a mode number that can be read");
+    const int number = *parsed;
+    Mode& m = modes[number];
     m.number = number;
     // rows after the "POINT ID. TYPE T1 ..." heading: id, type (G), six values; a page ends the block
     std::size_t r = k + 1;
@@ -85,12 +83,14 @@ std::vector<F06Mode> read_f06_modes(const std::string& path) {
         if (!x) refuse(r, fmt::format("eigenvector {}: '{}' is no number", number, w[2 + c]));
         v(c) = *x;
       }
-      m.shapes[std::stoi(w[0])] = v;
+      const auto grid = parse_integer(w[0]);
+      if (!grid) refuse(r, fmt::format("eigenvector {}: grid id '{}' cannot be read", number, w[0]));
+      m.shapes[*grid] = v;
     }
     k = r - 1;
   }
   if (!table) throw InputError(Diagnostic{path, 0, "", "no REAL EIGENVALUES table (a SOL 103 run's f06 expected)"});
-  std::vector<F06Mode> out;
+  std::vector<Mode> out;
   for (auto& [n, m] : modes) out.push_back(std::move(m));
   return out;
 }
@@ -107,7 +107,11 @@ std::optional<F06Weight> read_f06_weight(const std::string& path) {
     for (std::size_t r = k + 1; r < lines.size() && r < k + 12 && row < 6; ++r) {
       const std::string& s = lines[r];
       if (const auto p = s.find("REFERENCE POINT ="); p != std::string::npos) {
-        w.reference_point = std::atoi(s.c_str() + p + 17);
+        const auto ws = words(s.substr(p + 17));
+        const auto ref = ws.empty() ? std::nullopt : parse_integer(ws.front());
+        if (!ref)
+          throw InputError(Diagnostic{path, static_cast<int>(r) + 1, "", "a weight generator reference point that cannot be read"});
+        w.reference_point = *ref;
         continue;
       }
       auto w6 = words(s);

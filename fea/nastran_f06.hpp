@@ -11,20 +11,13 @@
 #include <string>
 #include <vector>
 
-namespace kanegen::nastran {
+#include "fea/nastran_mode.hpp"
 
-struct F06Mode {
-  int number = 0;              ///< the mode number NASTRAN prints
-  double eigenvalue = 0.0;     ///< (rad/s)^2
-  double cycles = 0.0;         ///< Hz
-  double generalized_mass = 0.0;
-  /// Per grid id: [T1 T2 T3 R1 R2 R3] in the grid's displacement (CD) frame, as printed.
-  std::map<int, Eigen::Matrix<double, 6, 1>> shapes;
-};
+namespace kanegen::nastran {
 
 /// Every mode of the eigenvalue table, with its eigenvector where the f06 prints one. Throws InputError (file,
 /// line) for a complex eigenvalue solution, a file without a REAL EIGENVALUES table, or a row it cannot read.
-std::vector<F06Mode> read_f06_modes(const std::string& path);
+std::vector<Mode> read_f06_modes(const std::string& path);
 
 /// The grid point weight generator's MO (6 x 6 rigid-body mass matrix about its reference point) and that
 /// point (PARAM GRDPNT: 0 the basic origin, else a grid id), if the f06 prints it.

@@ -110,7 +110,7 @@ FlexibleData load_modal_file(const std::string& path, const std::vector<int>& ke
         ok = false;
       }
       if (nd["inertia"].IsDefined()) {
-        if (auto I = ck.inertia(nd["inertia"], l, f + ".inertia"))
+        if (auto I = ck.inertia(nd["inertia"], l, f + ".inertia", /*rigid_body=*/false))
           node.J_B = *I;
         else
           ok = false;

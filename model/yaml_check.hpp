@@ -298,7 +298,10 @@ class Checker {
   /// Inertia matrix: 6 numbers [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 list;
   /// symmetric, positive semi-definite, triangle inequalities on the principal
   /// moments (tolerance 1e-9 of the largest entry).
-  std::optional<Eigen::Matrix3d> inertia(const YAML::Node& n, int fallback, const std::string& field) {
+  /// `rigid_body` false (a modal node's lumped rotary inertia, model-format.md): positive semi-definite only,
+  /// no triangle inequality (a finite-element lumping may put inertia about one axis only).
+  std::optional<Eigen::Matrix3d> inertia(const YAML::Node& n, int fallback, const std::string& field,
+                                         bool rigid_body = true) {
     Eigen::Matrix3d I;
     if (n.IsSequence() && n.size() == 6) {
       auto v = vector(n, fallback, field, 6);
@@ -339,7 +342,7 @@ class Checker {
                         moments));
       return std::nullopt;
     }
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; rigid_body && i < 3; ++i) {
       if (l(i) > l((i + 1) % 3) + l((i + 2) % 3) + tol) {
         error(n, fallback, field,
               fmt::format("principal moments {} violate the triangle inequality; expected each to be at most "

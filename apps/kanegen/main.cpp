@@ -19,7 +19,8 @@ int main(int argc, char** argv) {
                                                  cli::add_modes(app),      cli::add_crosscheck(app),
                                                  cli::add_eval(app),       cli::add_simulate(app),
                                                  cli::add_bench(app),      cli::add_linearize(app),
-                                                 cli::add_sweep(app),      cli::add_compile(app)};
+                                                 cli::add_sweep(app),      cli::add_compile(app),
+                                                 cli::add_import(app)};
   try {
     cli::CommandLineArguments args(argc, argv);
     app.parse(args.argc(), args.argv());

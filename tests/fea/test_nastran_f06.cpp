@@ -28,7 +28,7 @@ std::string shared_run(const std::string& file) {
 TEST_CASE("nastran f06: the shared run's modes, and their generalized masses as phi^T M phi with the importer's "
           "lumped mass",
           "[nastran][physics]") {
-  const std::vector<F06Mode> modes = read_f06_modes(shared_run("beam_modes.f06"));
+  const std::vector<Mode> modes = read_f06_modes(shared_run("beam_modes.f06"));
   REQUIRE(modes.size() == 10);
   // the eigenvalue table as printed (SOURCE.md)
   CHECK(modes[0].cycles == 4.566603e2);
@@ -36,7 +36,7 @@ TEST_CASE("nastran f06: the shared run's modes, and their generalized masses as 
   CHECK(modes[9].generalized_mass == 2.216687e-2);
   const Bulk bulk = read_bulk(shared_run("beam_modes.dat"));
   const auto lumped = lumped_masses(bulk);
-  for (const F06Mode& m : modes) {
+  for (const Mode& m : modes) {
     INFO(fmt::format("mode {}", m.number));
     REQUIRE(m.shapes.size() == 12);  // every grid, the AUTOSPC'd grid 12 as zeros
     // the printed eigenvalue, radians and cycles agree to their 7 printed digits

@@ -1,0 +1,133 @@
+// kanegen import nastran BULK --modes RUN.f06|RUN.pch [--root GRID] [--second-order] -o BODY.modal.yaml:
+// a flexible body's modal data file from a NASTRAN SOL 103 run (issue 36; fea/modal_from_nastran.hpp), with
+// the checks against NASTRAN's own printout printed: the weight generator's rigid-body mass and the generalized
+// masses against the importer's lumped mass, the root still in every mode.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <set>
+
+#include "apps/kanegen/cli_common.hpp"
+#include "fea/modal_from_nastran.hpp"
+#include "fea/nastran_bulk.hpp"
+#include "fea/nastran_f06.hpp"
+#include "fea/nastran_punch.hpp"
+#include "model/diagnostics.hpp"
+#include "model/modal_data.hpp"
+#include "model/output_file.hpp"
+#include "model/second_order.hpp"
+
+namespace kanegen::cli {
+
+namespace import_command {
+
+struct Options {
+  std::string bulk, modes, output;
+  int root = 0;
+  bool second_order = false;
+};
+
+/// A punch file by its extension, else by its first line ("$TITLE", "$EIGENVECTOR", ...: punch lines start with '$').
+bool is_punch(const std::string& path) {
+  std::string ext = path.substr(path.find_last_of('.') == std::string::npos ? path.size() : path.find_last_of('.'));
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".pch" || ext == ".punch") return true;
+  if (ext == ".f06") return false;
+  std::ifstream in(path);
+  for (std::string s; std::getline(in, s);)
+    if (s.find_first_not_of(" \t\r") != std::string::npos) return s[0] == '$';
+  return false;
+}
+
+/// Worse than this, a check is a warning: the importer's mass is not NASTRAN's (printed values have 7 digits).
+constexpr double kCheckTolerance = 1e-4;
+
+int run(const Options& o) {
+  using namespace nastran;
+  const Bulk bulk = read_bulk(o.bulk);
+  std::set<std::string> inputs = {o.bulk, o.modes};
+  for (const auto& [id, g] : bulk.grids) inputs.insert(g.file);
+  check_output_options({{"-o", o.output}}, {inputs.begin(), inputs.end()});
+  const bool punch = is_punch(o.modes);
+  const std::vector<Mode> modes = punch ? read_punch_modes(o.modes) : read_f06_modes(o.modes);
+  const std::optional<F06Weight> weight = punch ? std::nullopt : read_f06_weight(o.modes);
+  ModalImport im = import_modal_data(bulk, o.bulk, modes, o.modes, weight, ModalImportOptions{o.root});
+  FlexibleData& f = im.flex;
+  if (o.second_order) {
+    try {
+      compute_chain_second_order(f);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(Diagnostic{o.bulk, 0, "--second-order", e.what()});
+    }
+  }
+  write_modal_file(f, o.output);
+
+  fmt::print("{}: {} nodes, {} modes from NASTRAN ({}, {}); origin at root grid {}, axes NASTRAN's basic axes\n",
+             o.output, f.nodes.size(), f.modes(), o.bulk, o.modes, im.root);
+  fmt::print("  mass {:.7g} (lumped: NASTRAN's default lumped formulation{})\n", im.total_mass,
+             bulk.wtmass != 1.0 ? fmt::format(", times WTMASS {:g}", bulk.wtmass) : "");
+  std::vector<std::string> warnings;
+  if (im.weight_generator_error) {
+    fmt::print("  weight generator (MO about its reference point): the lumped mass gives it to {:.1e}\n",
+               *im.weight_generator_error);
+    if (*im.weight_generator_error > kCheckTolerance)
+      warnings.push_back(fmt::format("the lumped mass's rigid-body mass differs from NASTRAN's weight generator by "
+                                     "{:.2g} of its largest entry: a mass the importer lumps otherwise than NASTRAN",
+                                     *im.weight_generator_error));
+  } else {
+    fmt::print("  weight generator: not printed ({}); no check of the total mass against NASTRAN\n",
+               punch ? "a punch file has none" : "PARAM GRDPNT not set in the run");
+  }
+  if (!im.generalized_masses.empty()) {
+    const auto worst = std::max_element(im.generalized_masses.begin(), im.generalized_masses.end(),
+                                        [](const auto& a, const auto& b) { return a.relative_error() < b.relative_error(); });
+    fmt::print("  generalized masses: phi^T M phi with the lumped mass equals NASTRAN's to {:.1e} (worst: mode {})\n",
+               worst->relative_error(), worst->mode);
+    for (const auto& g : im.generalized_masses)
+      if (g.relative_error() > kCheckTolerance)
+        warnings.push_back(fmt::format("mode {}: generalized mass {:.7g} with the lumped mass, NASTRAN printed {:.7g} "
+                                       "({:.2g} apart): its shape is normalized with the lumped mass written here",
+                                       g.mode, g.computed, g.printed, g.relative_error()));
+  } else {
+    fmt::print("  generalized masses: {}; the shapes are normalized with the lumped mass\n",
+               punch ? "a punch file prints none" : "none printed");
+  }
+  fmt::print("  root grid {}: still in every mode (largest motion {:.1e} of a mode's largest entry)\n", im.root,
+             im.root_motion);
+  if (o.second_order) fmt::print("  second_order computed from the shapes along the chain of nodes\n");
+  for (int j = 0; j < f.modes(); ++j) fmt::print("  mode {} (NASTRAN's {}): {:.7g} Hz\n", j + 1, im.modes[j], f.frequency_hz(j));
+  for (const std::string& n : im.notes) fmt::print("  note: {}\n", n);
+  for (const std::string& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+  return 0;
+}
+
+}  // namespace import_command
+
+Subcommand add_import(CLI::App& app) {
+  auto o = std::make_shared<import_command::Options>();
+  CLI::App* group = app.add_subcommand("import", "write a flexible body's modal data file from an FEA run");
+  group->require_subcommand(1);
+  CLI::App* c = group->add_subcommand(
+      "nastran",
+      "a NASTRAN SOL 103 run: the bulk data (GRID, CBAR, CBEAM, CROD, CONROD, CONM2 and their properties) and its "
+      "modes (f06 or punch) -> a *.modal.yaml with origin at the clamped root grid, NASTRAN's basic axes, the lumped "
+      "node masses and unit-modal-mass shapes; prints the checks against NASTRAN's weight generator and generalized "
+      "masses");
+  c->add_option("bulk", o->bulk, "the bulk data file (or the whole input file; INCLUDEs are followed)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  c->add_option("--modes", o->modes, "the run's .f06 (eigenvalue table, eigenvectors) or punch file (.pch)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  c->add_option("--root", o->root,
+                "the grid at the body's origin, clamped in the run (default: the single grid with SPC 123456)");
+  c->add_flag("--second-order", o->second_order,
+              "also write second_order (foreshortening) data, computed from the shapes where the nodes form a chain "
+              "from the root");
+  c->add_option("-o,--output", o->output, "output *.modal.yaml")->required();
+  return {c, [o] { return import_command::run(*o); }};
+}
+
+}  // namespace kanegen::cli
