@@ -443,6 +443,7 @@ JitOptions resolved(const JitOptions& opts) {
   if (o.compiler.empty()) o.compiler = "c++";
   if (o.flags.empty()) o.flags = default_jit_flags();
   if (o.include_dir.empty()) o.include_dir = include_dir();
+  if (env("KANEGEN_JIT_QUICK") == "1") o.quick = true;
   return o;
 }
 

@@ -43,6 +43,8 @@ struct JitOptions {
   /// For a command that evaluates a few times (eval): every part at -O0 and
   /// for the baseline ISA only (no second copy for AVX2), the quickest build;
   /// cached separately, and any optimized library already cached is used instead.
+  /// $KANEGEN_JIT_QUICK=1 makes every build of the process quick (a test suite, a
+  /// notebook: where the compile costs more than the run).
   bool quick = false;
   bool quiet = false;       ///< say nothing on stderr (by default a compile and a cache hit are one line each)
   /// Compile only these functions of the table besides the four every engine
@@ -68,7 +70,7 @@ struct JitOptions {
 std::string default_cache_dir();
 /// "-O2 -std=c++20 -fPIC -shared"
 std::string default_jit_flags();
-/// JitOptions with every empty field replaced by its default.
+/// JitOptions with every empty field replaced by its default (and quick set by $KANEGEN_JIT_QUICK=1).
 JitOptions resolved(const JitOptions& opts);
 
 /// A compile of generated code failed. The CLI maps it to exit status 2.
