@@ -129,6 +129,8 @@ void compute_kinematics(const Model& model, Workspace<S>& ws, double t, const Ve
     const V3<S> w_rel = R_PB_j * w_rel_B;       // angular velocity of B relative to J, P components
     s.R_PB = R_PB_j;
     s.p_PO_P = p_PJ + e;
+    s.R_PJ = R_PJ;
+    s.p_PJ_P = p_PJ;
     const M3<S> R_BP = s.R_PB.transpose();
     const V3<S>& d = s.p_PO_P;
 

@@ -20,6 +20,8 @@ struct BodyWorkspace {
 
   M3<S> R_PB;        ///< orientation of B in the parent frame (x_P = R_PB x_B)
   V3<S> p_PO_P;      ///< O_B relative to the parent's origin, parent components
+  M3<S> R_PJ;        ///< the joint frame J in the parent (its `rotation:`; at a node, turned with the node)
+  V3<S> p_PJ_P;      ///< J's origin from the parent's origin (at a node: the node's displaced position), P components
   M3<S> R_NB;        ///< orientation of B in N
   V3<S> r_NO_N;      ///< O_B relative to N's origin, N components
   V3<S> v_O_B;       ///< inertial velocity of O_B, B components

@@ -29,6 +29,7 @@ Subcommand add_compile(CLI::App& app);
 Subcommand add_generate(CLI::App& app);
 Subcommand add_modes(CLI::App& app);
 Subcommand add_import(CLI::App& app);
+Subcommand add_view(CLI::App& app);
 Subcommand add_crosscheck(CLI::App& app);
 Subcommand add_eval(CLI::App& app);
 Subcommand add_simulate(CLI::App& app);

@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
                                                  cli::add_eval(app),       cli::add_simulate(app),
                                                  cli::add_bench(app),      cli::add_linearize(app),
                                                  cli::add_sweep(app),      cli::add_compile(app),
-                                                 cli::add_import(app)};
+                                                 cli::add_import(app),      cli::add_view(app)};
   try {
     cli::CommandLineArguments args(argc, argv);
     app.parse(args.argc(), args.argv());

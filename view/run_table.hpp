@@ -1,0 +1,31 @@
+// A run's CSV as `kanegen simulate` writes it (interface.md): a header of
+// column names, then one row of numbers per output time (two rows at the time
+// of an event: before and after it). Read whole, checked, for `kanegen view`.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "model/model.hpp"
+
+namespace kanegen {
+
+struct RunTable {
+  std::string path;
+  std::vector<std::string> names;  ///< the header's column names
+  MatX rows;                       ///< one row per line after the header
+  /// Column index of `name`, or -1.
+  int column(const std::string& name) const;
+};
+
+/// Reads a CSV written by `kanegen simulate`. Throws InputError naming the file, line and column for a missing
+/// or empty file, a header with an empty or repeated name, a row of another length or with a value that is no
+/// finite number, or times that decrease.
+RunTable read_run_table(const std::string& path);
+
+/// The columns of `model`'s state in the run: the column of each coordinate (model.q_names) then of each speed
+/// (u_names). Throws InputError (the run's file, line 1, field "header") naming the first name missing: a CSV
+/// from another model.
+std::vector<int> state_columns(const RunTable& run, const Model& model);
+
+}  // namespace kanegen
