@@ -4,13 +4,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "dynamics/body_inertia.hpp"
+#include "dynamics/body_terms.hpp"
 #include "dynamics/kinematics.hpp"
 #include "dynamics/sensors.hpp"
 #include "dynamics/workspace.hpp"
 #include "model/diagnostics.hpp"
 #include "model/joints/joint_traits.hpp"
+#include "model/orbit.hpp"
 #include "model/state_io.hpp"
 
 namespace kanegen {
@@ -145,8 +148,21 @@ json view_data(const Model& model, const RunTable* run, const ViewOptions& optio
   }
   Workspace<double> ws(model);
   json poses = json::array(), joints = json::array(), nodes = json::array();
+  json com = json::array(), lvlh = json::array(), attitude = json::array();  // in orbit
+  const int root = model.orbit_root >= 0 ? model.orbit_root : 0;  // the body whose attitude is told against LVLH
   for (std::size_t f = 0; f < states.size(); ++f) {
     compute_kinematics(model, ws, times[f], states[f].first, states[f].second);
+    if (model.central) {  // the system's centre of mass, its LVLH frame, the root's attitude in it
+      compute_body_terms(model, ws);
+      const OrbitState c = system_centre_of_mass(model, ws);
+      const Mat3 R_NL = lvlh_frame(c);
+      com.push_back(vec(c.r_N));
+      const Eigen::Vector4d qL = attitude_quaternion(R_NL);
+      lvlh.push_back(json::array({qL(0), qL(1), qL(2), qL(3)}));
+      const Eigen::Matrix<double, 7, 1> a = attitude_lvlh(c, ws.body[root].R_NB);
+      const double deg = 180.0 / std::numbers::pi;
+      attitude.push_back(json::array({a(4) * deg, a(5) * deg, a(6) * deg}));
+    }
     json pf = json::array(), jf = json::array(), nf = json::array();
     for (std::size_t i = 0; i < model.bodies.size(); ++i) {
       const Body& b = model.bodies[i];
@@ -184,6 +200,22 @@ json view_data(const Model& model, const RunTable* run, const ViewOptions& optio
   d["joints"] = joints;
   d["nodes"] = nodes;
   d["scale"] = extent > 0.0 ? extent : 1.0;
+  if (model.central) {
+    // the central body's radius: as given, else Earth's (WGS 84) for Earth's mu, else unknown (not drawn)
+    double radius = model.central->radius;
+    std::string radius_source = "the model's";
+    if (!(radius > 0.0) && std::abs(model.central->mu / 3.986004418e14 - 1.0) < 1e-3) {
+      radius = 6378137.0;
+      radius_source = "Earth's (WGS 84), from mu";
+    }
+    d["orbit"] = {{"mu", model.central->mu},
+                  {"radius", radius > 0.0 ? radius : 0.0},
+                  {"radius_source", radius > 0.0 ? radius_source : std::string("not given: not drawn")},
+                  {"root", model.bodies[root].name},
+                  {"com_N", com},
+                  {"quat_NL", lvlh},
+                  {"attitude_lvlh_deg", attitude}};
+  }
 
   // Events (two rows at one time) and the plotted columns.
   json events = json::array(), columns = json::object();
@@ -192,13 +224,14 @@ json view_data(const Model& model, const RunTable* run, const ViewOptions& optio
       if (run->rows(i, 0) == run->rows(i - 1, 0)) events.push_back(run->rows(i, 0));
     std::vector<std::string> names = options.columns;
     if (names.empty()) {
-      for (const char* n : {"T", "V"})
-        if (run->column(n) >= 0) names.push_back(n);
+      if (!model.central)  // in orbit T and V are the orbit's (1e10 J): the attitude is told beside the view
+        for (const char* n : {"T", "V"})
+          if (run->column(n) >= 0) names.push_back(n);
       if (!model.bodies.empty() && !model.bodies[0].joint.prescribed()) {  // the root's speeds: a free root's rates
-        const Body& root = model.bodies[0];
-        const int nu = joint_traits(root.joint.type).nu();
-        const int first = root.joint.type == JointType::free ? 3 : 0;
-        for (int i = first; i < nu && names.size() < 5; ++i) names.push_back(model.u_names[root.u_joint + i]);
+        const Body& b0 = model.bodies[0];
+        const int nu = joint_traits(b0.joint.type).nu();
+        const int first = b0.joint.type == JointType::free ? 3 : 0;
+        for (int i = first; i < nu && names.size() < 5; ++i) names.push_back(model.u_names[b0.u_joint + i]);
       }
     }
     for (const std::string& n : names) {

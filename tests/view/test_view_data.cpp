@@ -12,10 +12,13 @@
 #include <filesystem>
 #include <fstream>
 
+#include "dynamics/body_terms.hpp"
 #include "dynamics/kinematics.hpp"
+#include "dynamics/sensors.hpp"
 #include "dynamics/workspace.hpp"
 #include "engine/load_model.hpp"
 #include "model/diagnostics.hpp"
+#include "model/orbit.hpp"
 #include "model/rotation.hpp"
 #include "tests/support/shell.hpp"
 #include "tests/support/test_support.hpp"
@@ -65,6 +68,7 @@ void check_view_against_kinematics(const std::string& model_rel, double t_end, d
   const int nq = static_cast<int>(model.q_names.size()), nu = static_cast<int>(model.u_names.size());
   Workspace<double> ws(model);
   double worst_p = 0, worst_R = 0, worst_node = 0;
+  std::size_t orbit_frames = 0;
   for (std::size_t f = 0; f < rows.size(); ++f) {
     const int r = rows[f];
     CHECK(data["t"][f].get<double>() == run.rows(r, 0));
@@ -72,6 +76,17 @@ void check_view_against_kinematics(const std::string& model_rel, double t_end, d
     for (int i = 0; i < nq; ++i) q(i) = run.rows(r, cols[i]);
     for (int i = 0; i < nu; ++i) u(i) = run.rows(r, cols[nq + i]);
     compute_kinematics(model, ws, run.rows(r, 0), q, u);
+    if (model.central) {  // the centre of mass and its LVLH frame
+      compute_body_terms(model, ws);
+      const OrbitState c = system_centre_of_mass(model, ws);
+      const json& o = data["orbit"];
+      worst_p = std::max(worst_p, (pose_p(o["com_N"][f], 0) - c.r_N).norm() / c.r_N.norm());
+      const json& qL = o["quat_NL"][f];
+      const Mat3 R_NL = quat_to_R<double>(Eigen::Vector4d(qL[0].get<double>(), qL[1].get<double>(), qL[2].get<double>(),
+                                                          qL[3].get<double>()));
+      worst_R = std::max(worst_R, (R_NL - lvlh_frame(c)).cwiseAbs().maxCoeff());
+      ++orbit_frames;
+    }
     const json& P = data["poses"][f];
     const json& J = data["joints"][f];
     for (std::size_t i = 0; i < model.bodies.size(); ++i) {
@@ -107,6 +122,8 @@ void check_view_against_kinematics(const std::string& model_rel, double t_end, d
   CHECK(worst_p <= 1e-12);
   CHECK(worst_R <= 1e-12);
   CHECK(worst_node <= 1e-12);
+  CHECK(orbit_frames == (model.central ? rows.size() : 0));
+  CHECK(data.contains("orbit") == model.central.has_value());
   fs::remove_all(d);
 }
 
