@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <set>
+#include <sstream>
 
 #include "model/diagnostics.hpp"
 
@@ -75,6 +76,36 @@ RunTable read_run_table(const std::string& path) {
   for (std::size_t r = 0; r < rows.size(); ++r)
     for (std::size_t c = 0; c < rows[r].size(); ++c) run.rows(r, c) = rows[r][c];
   return run;
+}
+
+std::vector<RunEvent> read_events_table(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(Diagnostic{path, 0, "", "cannot open the events table"});
+  std::string line;
+  std::getline(in, line);
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line.rfind("t,name,action,bodies", 0) != 0)
+    throw InputError(Diagnostic{path, 1, "header",
+                                fmt::format("'{}'; expected t,name,action,bodies,energy_lost (kanegen simulate --events)",
+                                            line.substr(0, 80))});
+  std::vector<RunEvent> events;
+  for (int number = 2; std::getline(in, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const auto cells = split_commas(line);
+    if (cells.size() < 4) throw InputError(Diagnostic{path, number, "", "fewer than 4 values (t, name, action, bodies)"});
+    RunEvent e;
+    char* end = nullptr;
+    e.t = std::strtod(cells[0].c_str(), &end);
+    if (end == cells[0].c_str() || *end != '\0' || !std::isfinite(e.t))
+      throw InputError(Diagnostic{path, number, "t", fmt::format("'{}' is not a finite number", cells[0])});
+    e.name = cells[1];
+    e.action = cells[2];
+    std::istringstream bodies(cells[3]);
+    for (std::string b; bodies >> b;) e.bodies.push_back(b);
+    events.push_back(std::move(e));
+  }
+  return events;
 }
 
 std::vector<int> state_columns(const RunTable& run, const Model& model) {

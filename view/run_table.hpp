@@ -23,6 +23,17 @@ struct RunTable {
 /// finite number, or times that decrease.
 RunTable read_run_table(const std::string& path);
 
+/// One row of the events table `kanegen simulate --events` writes (interface.md): t, name, action, bodies.
+struct RunEvent {
+  double t = 0;
+  std::string name, action;
+  std::vector<std::string> bodies;
+};
+
+/// Reads an events table. Throws InputError naming the file, line and column for a missing file, a header other
+/// than t,name,action,bodies,energy_lost, or a row that cannot be read.
+std::vector<RunEvent> read_events_table(const std::string& path);
+
 /// The columns of `model`'s state in the run: the column of each coordinate (model.q_names) then of each speed
 /// (u_names). Throws InputError (the run's file, line 1, field "header") naming the first name missing: a CSV
 /// from another model.

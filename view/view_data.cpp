@@ -93,7 +93,7 @@ std::vector<int> view_rows(const RunTable& run, int frames) {
   return rows;
 }
 
-json view_data(const Model& model, const RunTable* run, const ViewOptions& options) {
+json view_data(const Model& model, const RunTable* run, const ViewOptions& options, const std::string& events_path) {
   json d;
   d["model"] = model.name;
   d["description"] = model.description;
@@ -220,8 +220,48 @@ json view_data(const Model& model, const RunTable* run, const ViewOptions& optio
   // Events (two rows at one time) and the plotted columns.
   json events = json::array(), columns = json::object();
   if (run) {
-    for (Eigen::Index i = 1; i < run->rows.rows(); ++i)
-      if (run->rows(i, 0) == run->rows(i - 1, 0)) events.push_back(run->rows(i, 0));
+    // the timeline's marks: two rows at one time; named from the events table where one is at that time
+    for (Eigen::Index i = 1; i < run->rows.rows(); ++i) {
+      if (run->rows(i, 0) != run->rows(i - 1, 0)) continue;
+      const double t = run->rows(i, 0);
+      std::string name;
+      if (options.events)
+        for (const RunEvent& e : *options.events)
+          if (std::abs(e.t - t) <= 1e-9 * std::max(1.0, std::abs(t)))
+            name += (name.empty() ? "" : ", ") + e.name + " (" + e.action + ")";
+      events.push_back({{"t", t}, {"name", name}});
+    }
+    // each frame's locked joints, by body index
+    if (options.events) {
+      std::vector<char> locked(model.bodies.size(), 0);
+      for (std::size_t i = 0; i < model.bodies.size(); ++i) locked[i] = model.bodies[i].joint.locked;
+      std::vector<RunEvent> by_time = *options.events;
+      std::stable_sort(by_time.begin(), by_time.end(), [](const RunEvent& a, const RunEvent& b) { return a.t < b.t; });
+      json per_frame = json::array();
+      std::size_t next = 0;
+      for (std::size_t f = 0; f < rows.size(); ++f) {
+        // a row after an event (the second of its two rows, or any later time) has its locks applied
+        const double t = times[f];
+        const bool after = rows[f] > 0 && run->rows(rows[f] - 1, 0) == t;
+        while (next < by_time.size() &&
+               (by_time[next].t < t || (after && std::abs(by_time[next].t - t) <= 1e-9 * std::max(1.0, std::abs(t))))) {
+          const RunEvent& e = by_time[next++];
+          for (const std::string& name : e.bodies) {
+            const int i = model.body_index(name);
+            if (i < 0)
+              throw InputError(Diagnostic{events_path, 0, "bodies",
+                                          fmt::format("event {}: no body '{}' in model {}", e.name, name, model.name)});
+            if (e.action == "lock") locked[i] = 1;  // "lock+release" does not say which body does which: unchanged
+            if (e.action == "release") locked[i] = 0;
+          }
+        }
+        json l = json::array();
+        for (std::size_t i = 0; i < locked.size(); ++i)
+          if (locked[i]) l.push_back(i);
+        per_frame.push_back(l);
+      }
+      d["locked"] = per_frame;
+    }
     std::vector<std::string> names = options.columns;
     if (names.empty()) {
       if (!model.central)  // in orbit T and V are the orbit's (1e10 J): the attitude is told beside the view

@@ -18,6 +18,9 @@ namespace kanegen {
 struct ViewOptions {
   int frames = 500;                  ///< most frames kept from a run (evenly in time, plus both rows of each event)
   std::vector<std::string> columns;  ///< run columns plotted beside the view; empty: T, V and the root's rates
+  /// The run's events table (kanegen simulate --events): the timeline's marks named, and each frame's locked
+  /// joints (the model's `locked: true` ones, then each lock and release in time order).
+  const std::vector<RunEvent>* events = nullptr;
 };
 
 /// The rows of a run kept as frames: all when there are at most `frames`, else the rows nearest to `frames`
@@ -25,7 +28,9 @@ struct ViewOptions {
 std::vector<int> view_rows(const RunTable& run, int frames);
 
 /// The page's data. `run` null: one frame, the model's initial state. Throws InputError naming the run's file
-/// for a CSV of another model (a coordinate or speed column missing) or an unknown column in options.columns.
-nlohmann::json view_data(const Model& model, const RunTable* run, const ViewOptions& options);
+/// for a CSV of another model (a coordinate or speed column missing) or an unknown column in options.columns,
+/// and the events file (`events_path`) for an event on a body the model does not have.
+nlohmann::json view_data(const Model& model, const RunTable* run, const ViewOptions& options,
+                         const std::string& events_path = "");
 
 }  // namespace kanegen

@@ -18,7 +18,7 @@ namespace kanegen::cli {
 namespace view_command {
 
 struct Options {
-  std::string model, run, output;
+  std::string model, run, output, events;
   int frames = 500;
   std::vector<std::string> columns;
 };
@@ -27,15 +27,21 @@ int run(const Options& o) {
   const Model model = load_model(o.model);
   std::vector<std::string> inputs = model_files(model);
   if (!o.run.empty()) inputs.push_back(o.run);
+  if (!o.events.empty()) inputs.push_back(o.events);
+  if (!o.events.empty() && o.run.empty())
+    throw InputError(Diagnostic{o.events, 0, "--events", "an events table without its run's CSV"});
   check_output_options({{"-o", o.output}}, inputs);
   if (o.frames < 1)
     throw InputError(Diagnostic{o.model, 0, "--frames", fmt::format("{}; expected at least 1 frame", o.frames)});
   std::optional<RunTable> table;
   if (!o.run.empty()) table = read_run_table(o.run);
+  std::vector<RunEvent> events;
+  if (!o.events.empty()) events = read_events_table(o.events);
   ViewOptions vo;
   vo.frames = o.frames;
   vo.columns = o.columns;
-  const nlohmann::json data = view_data(model, table ? &*table : nullptr, vo);
+  if (!o.events.empty()) vo.events = &events;
+  const nlohmann::json data = view_data(model, table ? &*table : nullptr, vo, o.events);
   const std::string page = view_page(data);
   write_file_atomically(o.output, page);
   fmt::print("{}: {} bodies, {} frames{} ({:.2f} MB); open it in a browser (offline)\n", o.output, model.bodies.size(),
@@ -61,6 +67,10 @@ Subcommand add_view(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--columns", o->columns, "run columns plotted beside the view (default: T, V and the root's rates)")
       ->delimiter(',');
+  c->add_option("--events", o->events,
+                "the run's events table (kanegen simulate --events): events named on the timeline, locked joints "
+                "marked frame by frame")
+      ->check(CLI::ExistingFile);
   c->add_option("-o,--output", o->output, "output VIEW.html")->required();
   return {c, [o] { return view_command::run(*o); }};
 }

@@ -48,6 +48,8 @@ def main():
     ap.add_argument("--t-end", default="0.5")
     ap.add_argument("--dt-out", default="0.01")
     ap.add_argument("--screenshot")
+    ap.add_argument("--screenshot-frame", default="0", help="the frame --screenshot keeps (default 0)")
+    ap.add_argument("--events", action="store_true", help="simulate with --events and view with them")
     a = ap.parse_args()
     exe = chromium()
     if not exe:
@@ -62,9 +64,12 @@ def main():
 
     with tempfile.TemporaryDirectory(prefix="kanegen-view-browser-") as d:
         csv, page = os.path.join(d, "run.csv"), os.path.join(d, "view.html")
+        ev = os.path.join(d, "run.events.csv")
         subprocess.run([a.kanegen, "simulate", a.model, "--engine", "generic", "--t-end", a.t_end, "--dt-out",
-                        a.dt_out, "--no-progress", "-o", csv], check=True, capture_output=True)
-        subprocess.run([a.kanegen, "view", a.model, csv, "-o", page], check=True, capture_output=True)
+                        a.dt_out, "--no-progress", "-o", csv] + (["--events", ev] if a.events else []),
+                       check=True, capture_output=True)
+        subprocess.run([a.kanegen, "view", a.model, csv, "-o", page] + (["--events", ev] if a.events else []),
+                       check=True, capture_output=True)
         data = json.loads(re.search(r"const KANEGEN_VIEW = (\{.*?\});</script>", open(page).read(), re.S)
                           .group(1).replace("<\\/", "</"))
         nodes = sum(len(b["nodes"]["ids"]) for b in data["bodies"] if "nodes" in b)
@@ -90,7 +95,8 @@ def main():
             check(status["frames"] == len(data["t"]), f"every frame loaded ({len(data['t'])})")
             check(status["webgl"], "WebGL context")
         shots = []
-        for k, frame in enumerate(["0", "-1"]):
+        frames = ["0", "-1"] + ([a.screenshot_frame] if a.screenshot and a.screenshot_frame != "0" else [])
+        for k, frame in enumerate(frames):
             png = os.path.join(d, f"shot{k}.png")
             subprocess.run(browser_args(exe, profile) + ["--window-size=1100,700", f"--screenshot={png}",
                                                          f"file://{page}?frame={frame}"],
@@ -98,7 +104,7 @@ def main():
             check(os.path.exists(png), f"screenshot of frame {frame}")
             if os.path.exists(png):
                 shots.append(Image.open(png).convert("RGB"))
-        if len(shots) == 2:
+        if len(shots) >= 2:
             view = shots[0].crop((0, 0, shots[0].width - 340, shots[0].height))  # the 3D view, not the side panel
             px = view.getdata()
             drawn = sum(1 for p in px if max(abs(p[i] - BACKGROUND[i]) for i in range(3)) > 24)
@@ -107,7 +113,7 @@ def main():
             diff = ImageChops.difference(shots[0], shots[1]).getbbox()
             check(diff is not None, "the last frame's drawing differs from the first's")
             if a.screenshot:
-                shots[0].save(a.screenshot)
+                shots[-1 if len(shots) == 3 else 0].save(a.screenshot)
                 print("      screenshot: " + a.screenshot)
     print(f"{len(failures)} failure(s)")
     return 1 if failures else 0

@@ -199,3 +199,43 @@ TEST_CASE("view: a run of another model, a missing file, --frames 0 and an unkno
   CHECK(page.find("<script src") == std::string::npos);  // nothing fetched: every script is inline
   fs::remove_all(d);
 }
+
+TEST_CASE("view: with the run's events table, the timeline's events are named and each frame's locked joints follow "
+          "the release and the latches",
+          "[view]") {
+  const fs::path d = scratch("events");
+  const std::string model_path = test::source_path("models/array_deployment.yaml");
+  const std::string csv = (d / "dep.csv").string(), ev = (d / "dep.events.csv").string();
+  const test::ShellRun sim = test::run_kanegen(fmt::format(
+      "simulate {} --engine generic --t-end 20 --dt-out 0.5 --no-progress -o {} --events {}", model_path, csv, ev));
+  INFO(sim.out);
+  REQUIRE(sim.status == 0);
+  const Model model = load_model(model_path);
+  const RunTable run = read_run_table(csv);
+  const std::vector<RunEvent> events = read_events_table(ev);
+  REQUIRE(events.size() == 3);  // the release of both wings, then each wing's latch
+  ViewOptions vo;
+  vo.events = &events;
+  const json data = view_data(model, &run, vo, ev);
+  REQUIRE(data["events"].size() == 3);
+  CHECK(data["events"][0]["name"] == "release (release)");
+  CHECK(data["events"][1]["name"].get<std::string>().find("(lock)") != std::string::npos);
+  const int a = model.body_index("wing_a"), b = model.body_index("wing_b");
+  auto locked_at = [&](std::size_t f, int body) {
+    for (const auto& i : data["locked"][f])
+      if (i.get<int>() == body) return true;
+    return false;
+  };
+  const std::vector<double> t = data["t"].get<std::vector<double>>();
+  for (std::size_t f = 0; f < t.size(); ++f) {
+    const bool second_row = f > 0 && t[f - 1] == t[f];
+    INFO(fmt::format("frame {} at t = {}", f, t[f]));
+    // stowed (locked) until the release's second row, free until its latch's second row, then latched
+    const bool released = t[f] > events[0].t || (t[f] == events[0].t && second_row);
+    const bool latched_a = t[f] > events[1].t || (t[f] == events[1].t && second_row);
+    const bool latched_b = t[f] > events[2].t || (t[f] == events[2].t && second_row);
+    CHECK(locked_at(f, a) == (!released || latched_a));
+    CHECK(locked_at(f, b) == (!released || latched_b));
+  }
+  fs::remove_all(d);
+}
