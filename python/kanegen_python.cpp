@@ -36,6 +36,9 @@
 #include "sim/row_sink.hpp"
 #include "sim/simulate.hpp"
 #include "sim/sweep.hpp"
+#include "view/run_table.hpp"
+#include "view/view_data.hpp"
+#include "view/view_page.hpp"
 
 namespace py = pybind11;
 using namespace kanegen;
@@ -214,6 +217,8 @@ struct Run {
   Signals q, u, inputs, outputs, all;
   py::dict summary;
   py::list events;
+  std::shared_ptr<const Model> model;  ///< the model it ran (for view())
+  std::vector<RunEvent> fired;         ///< its events as the view reads them
 };
 
 Signals signals_of(const RowTable& table, const std::vector<std::string>& names) {
@@ -329,9 +334,33 @@ Run make_run(const RowTable& table, const SimulationResult& r, const Model& m) {
     ev["u_before"] = e.u_before;
     ev["u_after"] = e.u_after;
     run.events.append(ev);
+    RunEvent re{e.t, e.name, e.action, {}};
+    std::istringstream bodies(e.bodies);
+    for (std::string b; bodies >> b;) re.bodies.push_back(b);
+    run.fired.push_back(std::move(re));
   }
   d["events"] = run.events;
+  run.model = std::make_shared<const Model>(m);
   return run;
+}
+
+/// `kanegen view`'s page of a model (run null: its initial state) or of a run, written to `path` (view/).
+std::string write_view(const Model& model, const Run* run, const std::string& path, int frames,
+                       const std::vector<std::string>& columns) {
+  if (frames < 1) throw py::value_error("frames: " + std::to_string(frames) + "; expected at least 1");
+  ViewOptions vo;
+  vo.frames = frames;
+  vo.columns = columns;
+  RunTable table;
+  if (run) {
+    table.path = "the run";
+    table.names = run->all.names;
+    table.rows = run->all.values;
+    vo.events = &run->fired;
+  }
+  const nlohmann::json data = view_data(model, run ? &table : nullptr, vo, "the run's events");
+  write_file_atomically(path, view_page(data));
+  return path;
 }
 
 template <class F>
@@ -390,6 +419,12 @@ PYBIND11_MODULE(kanegen, m) {
       .def("__getitem__", [](const Run& r, const std::string& n) { return r.all.column(n); }, "a column by name")
       .def("__contains__", [](const Run& r, const std::string& n) { return r.all.index(n) >= 0; })
       .def("__len__", [](const Run& r) { return r.t.size(); })
+      .def("view", [](const Run& r, const std::string& path, int frames, const std::vector<std::string>& columns) {
+             return translating([&] { return write_view(*r.model, &r, path, frames, columns); });
+           }, py::arg("path"), py::arg("frames") = 500, py::arg("columns") = std::vector<std::string>{},
+           "writes kanegen view's page of this run to path (one offline HTML file: docs/view.md): bodies, joints, "
+           "flexible nodes, a time slider, the events named, `columns` plotted (default: T, V and the root's "
+           "speeds); at most `frames` frames; returns path")
       .def("__repr__", [](const Run& r) {
         return "Run(" + std::to_string(r.t.size()) + " rows, " + std::to_string(r.all.names.size()) + " columns)";
       });
@@ -404,6 +439,11 @@ PYBIND11_MODULE(kanegen, m) {
            "Loads a model file; engine 'generated' (JIT-compiled, cached) or 'generic'; parameters: model values "
            "to keep as runtime parameters besides the model's own and its springs, dampers and damping ratios "
            "(bus.mass, bus.inertia, ...: model-format.md)")
+      .def("view", [](const PyModel& p, const std::string& path) {
+             return translating([&] { return write_view(p.model(), nullptr, path, 1, {}); });
+           }, py::arg("path"),
+           "writes kanegen view's page of the model at its initial state to path (its 3D sanity check: "
+           "docs/view.md); returns path")
       .def_property_readonly("parameter_names", [](const PyModel& p) {
         std::vector<std::string> n;
         for (const RuntimeParameter& rp : p.model().parameters) n.push_back(rp.name);

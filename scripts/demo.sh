@@ -2,8 +2,8 @@
 # Installs what is missing (scripts/install_deps.sh), builds the CLI only
 # (scripts/build.sh --demo), simulates explorer1_rigid (minor-axis spin
 # turning into major-axis spin through damping in the antenna hinges) and
-# writes its plots and its 3D view (explorer1_rigid_view.html: open it in a
-# browser) to out/explorer1_rigid/. The default engine (auto) runs
+# writes its plots and its 3D view (plot_simulation.py runs kanegen view:
+# explorer1_rigid_view.html, open it in a browser) to out/explorer1_rigid/. The default engine (auto) runs
 # the model's generated code when it is cached; on a first run it starts on
 # the generic engine while the generated code is built in the background.
 # The plots' packages (numpy, matplotlib) install while the CLI compiles.
@@ -29,5 +29,3 @@ if [[ -n $plot_install ]] && ! wait "$plot_install"; then
 fi
 /usr/bin/python3 scripts/plot_simulation.py out/explorer1_rigid/explorer1_rigid.csv \
   --model models/explorer1_rigid.yaml -o out/explorer1_rigid
-./build/bin/kanegen view models/explorer1_rigid.yaml out/explorer1_rigid/explorer1_rigid.csv \
-  --columns T,bus.wx,bus.wy,bus.wz -o out/explorer1_rigid/explorer1_rigid_view.html

@@ -1,5 +1,7 @@
 #!/usr/bin/python3
-"""Plot a `kanegen simulate` CSV time history (interface.md) into PNG files.
+"""Plot a `kanegen simulate` CSV time history (interface.md) into PNG files; with --model, also its 3D view
+(`kanegen view`: <prefix>_view.html, one offline HTML file; the run's events table RUN.events.csv beside the
+CSV names its events).
 
     plot_simulation.py OUT.csv [--model MODEL.yaml] [--axis x|y|z] [--prefix P] -o DIR
 
@@ -29,6 +31,8 @@ Run with /usr/bin/python3 (needs numpy, matplotlib; PyYAML for --model).
 import argparse
 import math
 import os
+import shutil
+import subprocess
 import sys
 
 import numpy as np
@@ -406,6 +410,36 @@ def joint_coordinates(h, body):
             and not n[len(body) + 1:].startswith("eta")]
 
 
+def find_kanegen(given):
+    """The kanegen program: --kanegen, else the one beside this script (bin/ of its install or build tree), else
+    the one on PATH; None if there is none."""
+    if given:
+        return given
+    here = os.path.dirname(os.path.abspath(__file__))
+    for rel in (("..", "..", "..", "bin", "kanegen"), ("..", "build", "bin", "kanegen")):
+        p = os.path.normpath(os.path.join(here, *rel))
+        if os.access(p, os.X_OK):
+            return p
+    return shutil.which("kanegen")
+
+
+def write_view(args, prefix, written):
+    """The run's 3D view (kanegen view: one offline HTML file) beside the plots."""
+    exe = find_kanegen(args.kanegen)
+    if not exe:
+        print("note: no kanegen program found (--kanegen): no 3D view written", file=sys.stderr)
+        return
+    path = os.path.join(args.output, f"{prefix}_view.html")
+    cmd = [exe, "view", args.model, args.csv, "-o", path]
+    events = os.path.splitext(args.csv)[0] + ".events.csv"
+    if os.path.exists(events):
+        cmd[4:4] = ["--events", events]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise InputError(f"kanegen view: {r.stderr.strip()}")
+    written.append(path)
+
+
 def run(args):
     h = History(args.csv)
     model = load_model(args.model) if args.model else None
@@ -489,6 +523,8 @@ def run(args):
     if not written:
         raise InputError(f"{args.csv}: nothing to plot (no free-body, energy, momentum, reaction, joint, "
                          "sensor or input columns)")
+    if args.model:
+        write_view(args, h.prefix, written)
     print("wrote:")
     for p in written:
         print("  " + p)
@@ -502,6 +538,8 @@ def main(argv=None):
     ap.add_argument("--axis", choices=("x", "y", "z"), default="z",
                     help="body axis taken as the long (spin) axis for the nutation angle (default z)")
     ap.add_argument("--prefix", help="file name prefix (default: model name or CSV stem)")
+    ap.add_argument("--kanegen", help="the kanegen program that writes the 3D view beside the plots (with --model; "
+                                      "default: the one beside this script, else on PATH)")
     args = ap.parse_args(argv)
     try:
         run(args)

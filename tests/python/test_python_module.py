@@ -16,6 +16,7 @@ and against physics; run by ctest with Debian's python3 and numpy:
     the law in Python: the same draws and metrics; run k alone = the table;
   - linearize: a pendulum's A is the closed form; frame="lvlh" gives the CLI's
     linear model about the orbit frame;
+  - Run.view writes the 3D view's page the CLI writes for the same run; Model.view the initial state;
   - the LQR example (reduced horizon) settles and leaves the arrays quiet.
 """
 import argparse
@@ -226,6 +227,38 @@ ev_l = sep.eval(locked=["plate", "probe"])
 ev_f = sep.eval(locked=[])
 check(np.all(ev_l["udot"][6:] == 0.0) and abs(ev_f["udot"][6]) > 1.0,
       "eval: locked= gives the reduced system's u_dot (0 for the locked speeds), [] none locked")
+
+# ---- the 3D view from Python: Run.view gives the page the CLI gives for the same run's CSV; Model.view the
+# initial state
+def page_data(path):
+    text = open(path).read()
+    start = text.index("const KANEGEN_VIEW = ") + len("const KANEGEN_VIEW = ")
+    return json.loads(text[start:text.index(";</script>", start)].replace("<\\/", "</"))
+
+
+with tempfile.TemporaryDirectory() as d:
+    page = srun.view(os.path.join(d, "sep.html"), frames=30)
+    csv_path = os.path.join(d, "sep.csv")
+    with open(csv_path, "w", newline="") as f:
+        w = csv.writer(f)
+        cols = srun.columns
+        w.writerow(list(cols))
+        for k in range(len(srun)):
+            w.writerow([repr(float(cols[n][k])) for n in cols])
+    ev_path = os.path.join(d, "sep.events.csv")
+    with open(ev_path, "w") as f:
+        f.write("t,name,action,bodies,energy_lost\n")
+        for e in srun.events:
+            f.write(f"{e['t']!r},{e['name']},{e['action']},{e['bodies']},{e['energy_lost']!r}\n")
+    subprocess.run([os.path.join(args.build, "bin", "kanegen"), "view", os.path.join(ROOT, "models", "probe_separation.yaml"),
+                    csv_path, "--events", ev_path, "--frames", "30", "-o", os.path.join(d, "cli.html")],
+                   check=True, capture_output=True)
+    py_data, cli_data = page_data(page), page_data(os.path.join(d, "cli.html"))
+    same = all(py_data[k] == cli_data[k] for k in ("t", "rows", "poses", "joints", "nodes", "events", "locked", "columns"))
+    check(page.endswith("sep.html") and same and len(py_data["t"]) <= 30 + 2 * len(srun.events),
+          f"Run.view: the page's frames ({len(py_data['t'])}), poses, events and locks are the CLI's for the same run")
+    m0 = page_data(sep.view(os.path.join(d, "model.html")))
+    check(len(m0["t"]) == 1 and len(m0["bodies"]) == len(cli_data["bodies"]), "Model.view: the initial state, every body")
 
 # ---- the LQR example, reduced
 r = subprocess.run([sys.executable, os.path.join(ROOT, "examples", "python", "lqr_slew.py"), "--t-end", "200"],

@@ -46,9 +46,10 @@ def main():
         check(r.returncode == 0, f"simulate ran ({r.stderr.strip()[-200:]})")
         out = os.path.join(tmp, "plots")
         r = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "scripts", "plot_simulation.py"), csv, "--model", MODEL,
-                            "-o", out], capture_output=True, text=True)
+                            "-o", out, "--kanegen", a.kanegen], capture_output=True, text=True)
         check(r.returncode == 0, "plot_simulation.py ran: " + r.stderr.strip())
         pngs = sorted(os.listdir(out)) if os.path.isdir(out) else []
+        check("slew_spacecraft_view.html" in pngs, "wrote the 3D view beside the plots (slew_spacecraft_view.html)")
         for name in ("sensor_star_tracker", "sensor_gyro", "sensor_tip_a", "sensor_tip_b", "inputs", "modes",
                      "joints_revolute", "spinning", "momentum", "omega_bus"):
             check(f"slew_spacecraft_{name}.png" in pngs, f"wrote slew_spacecraft_{name}.png")
