@@ -19,6 +19,16 @@ double now_seconds() {
 
 HandoverEngine::HandoverEngine(const Model& model, std::function<void()> build,
                                std::function<std::unique_ptr<Engine>()> load)
+    : HandoverEngine(
+          model,
+          [build = std::move(build)](const std::function<void()>& started) {
+            started();
+            build();
+          },
+          std::move(load)) {}
+
+HandoverEngine::HandoverEngine(const Model& model, std::function<void(const std::function<void()>& started)> build,
+                               std::function<std::unique_ptr<Engine>()> load)
     : Engine(model),
       generic_(std::make_unique<GenericEngine>(model)),
       build_(std::make_shared<Build>()),
@@ -28,7 +38,13 @@ HandoverEngine::HandoverEngine(const Model& model, std::function<void()> build,
   std::thread([b = build_] {
     std::string error;
     try {
-      b->run();
+      b->run([b] {
+        {
+          std::lock_guard<std::mutex> lock(b->mutex);
+          b->started.store(true, std::memory_order_release);
+        }
+        b->done.notify_all();
+      });
     } catch (const std::exception& ex) {
       error = ex.what();
     } catch (...) {
@@ -47,6 +63,13 @@ bool HandoverEngine::wait(double seconds) const {
   std::unique_lock<std::mutex> lock(build_->mutex);
   return build_->done.wait_for(lock, std::chrono::duration<double>(seconds),
                                [this] { return build_->ready.load(std::memory_order_acquire); });
+}
+
+bool HandoverEngine::wait_started(double seconds) const {
+  std::unique_lock<std::mutex> lock(build_->mutex);
+  return build_->done.wait_for(lock, std::chrono::duration<double>(seconds), [this] {
+    return build_->started.load(std::memory_order_acquire) || build_->ready.load(std::memory_order_acquire);
+  });
 }
 
 std::string HandoverEngine::error() const {

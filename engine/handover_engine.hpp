@@ -36,6 +36,10 @@ class HandoverEngine final : public Engine {
   /// calling thread after it and returns the generated engine (it may throw
   /// likewise).
   HandoverEngine(const Model& model, std::function<void()> build, std::function<std::unique_ptr<Engine>()> load);
+  /// The same with a build that says when it has started what outlives the process (e.g. a spawned
+  /// `kanegen compile`): it calls `started()` then; wait_started() waits for it.
+  HandoverEngine(const Model& model, std::function<void(const std::function<void()>& started)> build,
+                 std::function<std::unique_ptr<Engine>()> load);
 
   /// "generic" before the handover, "generic, then generated from t = 1.25 s" after.
   std::string name() const override;
@@ -50,6 +54,9 @@ class HandoverEngine final : public Engine {
   /// Blocks until the build is done or `seconds` have passed; returns whether it is done.
   bool wait(double seconds = 1e9) const;
   bool build_done() const { return build_->ready.load(std::memory_order_acquire); }
+  /// Blocks until the build has started (or is done) or `seconds` have passed; returns whether it has. A process
+  /// that ends before its background build's child is spawned would leave no build behind: it waits for this.
+  bool wait_started(double seconds = 10.0) const;
   /// Why the build or the load failed ("" while it runs or when it succeeded).
   std::string error() const;
   bool handed_over() const { return compiled_ != nullptr; }
@@ -77,8 +84,9 @@ class HandoverEngine final : public Engine {
 
   /// Shared with the (detached) build thread, which may outlive the engine.
   struct Build {
-    std::function<void()> run;
+    std::function<void(const std::function<void()>& started)> run;
     std::string error;               ///< written by the thread before `ready`
+    std::atomic<bool> started{false};
     std::atomic<bool> ready{false};
     mutable std::mutex mutex;
     mutable std::condition_variable done;

@@ -203,7 +203,9 @@ ModalImport import_modal_data(const Bulk& bulk, const std::string& bulk_path, co
   for (const ModalNode& node : f.nodes) out.total_mass += node.mass;
 
   // The weight generator's MO, input units about its reference point.
-  if (weight) {
+  if (!weight) {
+    out.weight_generator_note = "the modes' file prints no grid point weight generator (PARAM GRDPNT)";
+  } else {
     Vec3 x_ref = Vec3::Zero();
     bool known = true;
     if (weight->reference_point != 0) {
@@ -211,10 +213,15 @@ ModalImport import_modal_data(const Bulk& bulk, const std::string& bulk_path, co
       known = it != bulk.grids.end();
       if (known) x_ref = it->second.x_basic;
     }
-    if (known) {
+    const double scale = weight->MO.cwiseAbs().maxCoeff();
+    if (!known) {
+      out.weight_generator_note =
+          fmt::format("its reference point, grid {}, is not in the bulk data", weight->reference_point);
+    } else if (!(scale > 0.0)) {
+      out.weight_generator_note = "its MO is zero";
+    } else {
       const Eigen::Matrix<double, 6, 6> MO = rigid_body_mass(masses, bulk, x_ref);
-      const double scale = weight->MO.cwiseAbs().maxCoeff();
-      if (scale > 0.0) out.weight_generator_error = (MO - weight->MO).cwiseAbs().maxCoeff() / scale;
+      out.weight_generator_error = (MO - weight->MO).cwiseAbs().maxCoeff() / scale;
     }
   }
 

@@ -52,6 +52,7 @@ struct ModalImport {
   /// The weight generator's MO (f06) against the lumped mass's, about the same point: max |difference| over
   /// max |MO|; nullopt without a weight generator printout.
   std::optional<double> weight_generator_error;
+  std::string weight_generator_note;  ///< why there is no weight generator check (when there is none)
   /// max over modes of the root's largest displacement or rotation over the mode's largest entry.
   double root_motion = 0.0;
 };

@@ -28,12 +28,14 @@ std::vector<Mode> read_punch_modes(const std::string& path) {
   bool complex = false;       // the block's output is complex
   Mode* mode = nullptr;       // the block's mode ($EIGENVALUE line)
   Eigen::Matrix<double, 6, 1>* row = nullptr;  // the grid whose -CONT- row comes next
+  int row_grid = 0;
   int line = 0;
   for (std::string s; std::getline(in, s);) {
     ++line;
     if (!s.empty() && s.back() == '\r') s.pop_back();
     if (s.size() > 72) s.resize(72);  // columns 73-80: the line counter
     if (starts_with(s, "$")) {
+      if (row) refuse(line, fmt::format("grid {}: its -CONT- row (R1 R2 R3) is missing", row_grid));
       row = nullptr;
       std::string key = s.substr(1);
       key.erase(key.find_last_not_of(' ') + 1);
@@ -57,6 +59,8 @@ std::vector<Mode> read_punch_modes(const std::string& path) {
           refuse(line, "an $EIGENVALUE line that cannot be read (expected '$EIGENVALUE = <value> MODE = <n>')");
         if (eigenvectors) {
           if (complex) refuse(line, "a complex eigenvector block; expected the real modes of SOL 103");
+          if (modes.count(*n))
+            refuse(line, fmt::format("mode {} a second time (several subcases?): punch one SOL 103 subcase", *n));
           mode = &modes[*n];
           mode->number = *n;
           mode->eigenvalue = *ev;
@@ -92,15 +96,16 @@ std::vector<Mode> read_punch_modes(const std::string& path) {
     }
     if (w[0].find_first_not_of("0123456789") != std::string::npos || w.size() < 2)
       refuse(line, "an eigenvector row that cannot be read (grid id and type expected)");
-    if (w[1] != "G") {  // a scalar or extra point carries no shape
-      row = nullptr;
-      continue;
-    }
+    if (row) refuse(line, fmt::format("grid {}: its -CONT- row (R1 R2 R3) is missing", row_grid));
+    if (w[1] != "G") continue;  // a scalar or extra point carries no shape
     const auto grid = parse_integer(w[0]);
     if (!grid) refuse(line, fmt::format("grid id '{}' cannot be read", w[0]));
     row = &mode->shapes[*grid];
+    row->setZero();
+    row_grid = *grid;
     values(2, 0);
   }
+  if (row) refuse(line, fmt::format("grid {}: its -CONT- row (R1 R2 R3) is missing at the end of the file", row_grid));
   if (modes.empty()) throw InputError(Diagnostic{path, 0, "", "no $EIGENVECTOR block (a SOL 103 run's punch file expected)"});
   std::vector<Mode> out;
   for (auto& [n, m] : modes) out.push_back(std::move(m));

@@ -251,8 +251,10 @@ json view_data(const Model& model, const RunTable* run, const ViewOptions& optio
             if (i < 0)
               throw InputError(Diagnostic{events_path, 0, "bodies",
                                           fmt::format("event {}: no body '{}' in model {}", e.name, name, model.name)});
-            if (e.action == "lock") locked[i] = 1;  // "lock+release" does not say which body does which: unchanged
-            if (e.action == "release") locked[i] = 0;
+            // the table lists the bodies whose lock changed (sim/event_run.cpp): a lock+release flips each
+            if (e.action == "lock") locked[i] = 1;
+            else if (e.action == "release") locked[i] = 0;
+            else if (e.action == "lock+release") locked[i] = !locked[i];
           }
         }
         json l = json::array();

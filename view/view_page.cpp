@@ -22,17 +22,16 @@ std::string read_file(const std::string& path, const std::string& what) {
   return s.str();
 }
 
-/// Text safe inside <script>: no "</" that could close the element.
-std::string script_safe(const std::string& s) {
+/// JSON safe inside <script>: every '<' written as \u003c (still JSON, still JavaScript), so that no text in
+/// it ("</script>", "<!--") can end or change the element.
+std::string script_safe(const std::string& json) {
   std::string out;
-  out.reserve(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '<' && i + 1 < s.size() && s[i + 1] == '/') {
-      out += "<\\/";
-      ++i;
-      continue;
-    }
-    out += s[i];
+  out.reserve(json.size());
+  for (char c : json) {
+    if (c == '<')
+      out += "\\u003c";
+    else
+      out += c;
   }
   return out;
 }

@@ -28,7 +28,8 @@ namespace {
 const auto kProcessStart = std::chrono::steady_clock::now();  // static initialization: before main
 }  // namespace
 
-void run_background_compile(const std::string& model_path, bool native, const std::string& log_path) {
+void run_background_compile(const std::string& model_path, bool native, const std::string& log_path,
+                            const std::function<void()>& started) {
   std::error_code ec;
   const std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();
   // spawned through /proc/self/exe (this very binary, even if it was replaced
@@ -48,6 +49,7 @@ void run_background_compile(const std::string& model_path, bool native, const st
   const int rc = posix_spawn(&pid, "/proc/self/exe", &fa, nullptr, args.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
   if (rc != 0) throw std::runtime_error(fmt::format("cannot start kanegen compile: {}", std::strerror(rc)));
+  if (started) started();
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
     if (errno == ECHILD) return;  // reaped elsewhere (SIGCHLD ignored): the cache says whether it built
@@ -87,7 +89,10 @@ std::unique_ptr<Engine> make_engine(const Model& model, const std::string& name,
                              (jit_cache::file_stem(model.name) + "-background-build.log"))
                                 .string();
     return std::make_unique<HandoverEngine>(
-        model, [path = model.source_path, native, log] { run_background_compile(path, native, log); },
+        model,
+        [path = model.source_path, native, log](const std::function<void()>& started) {
+          run_background_compile(path, native, log, started);
+        },
         [&model, jit, t0]() -> std::unique_ptr<Engine> {
           JitOptions load = jit;
           load.quiet = true;

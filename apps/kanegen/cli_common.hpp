@@ -59,8 +59,10 @@ void add_model_option(CLI::App* c, std::string& model);
 /// generated code compiled with -march=native).
 void add_engine_option(CLI::App* c, std::string& engine, bool& native, bool with_auto = false);
 /// Runs `kanegen compile MODEL --background` (this executable, low priority,
-/// its messages to `log_path`) and waits for it; throws when it fails.
-void run_background_compile(const std::string& model_path, bool native, const std::string& log_path);
+/// its messages to `log_path`), calls `started` once it is spawned, and waits
+/// for it; throws when it fails.
+void run_background_compile(const std::string& model_path, bool native, const std::string& log_path,
+                            const std::function<void()>& started = {});
 /// Seconds since the process started.
 double seconds_since_start();
 

@@ -77,8 +77,8 @@ int run(const Options& o) {
                                      "{:.2g} of its largest entry: a mass the importer lumps otherwise than NASTRAN",
                                      *im.weight_generator_error));
   } else {
-    fmt::print("  weight generator: not printed ({}); no check of the total mass against NASTRAN\n",
-               punch ? "a punch file has none" : "PARAM GRDPNT not set in the run");
+    fmt::print("  weight generator: no check of the total mass against NASTRAN: {}\n",
+               punch ? "a punch file prints none" : im.weight_generator_note);
   }
   if (!im.generalized_masses.empty()) {
     const auto worst = std::max_element(im.generalized_masses.begin(), im.generalized_masses.end(),

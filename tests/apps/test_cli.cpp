@@ -16,26 +16,15 @@
 #include <unistd.h>
 
 #include "engine/load_model.hpp"
+#include "tests/support/shell.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
-  int status;
-  std::string out;  // stdout and stderr
-};
-
-/// A shell command's exit status and output.
-Run shell(const std::string& cmd) {
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  std::string out;
-  char buf[4096];
-  for (std::size_t n; (n = fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
+using Run = kanegen::test::ShellRun;  // status, out (stdout and stderr)
+using kanegen::test::shell;
 
 Run run(const std::string& args, const std::string& env = "") {
   return shell(env + " " + std::string(kanegen::test::kanegen_binary()) + " " + args);

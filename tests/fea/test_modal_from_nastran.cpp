@@ -91,6 +91,22 @@ TEST_CASE("nastran punch: complex eigenvectors and files without eigenvectors ar
              "$TITLE   = X\n$DISPLACEMENTS\n$REAL OUTPUT\n$SUBCASE ID =           1\n"
              "         1       G      1.0E+00      0.0      0.0\n-CONT-                  0.0      0.0      0.0\n");
   CHECK_THROWS_AS(read_punch_modes((d / "displacements.pch").string()), InputError);
+  // a grid row without its -CONT- row (R1 R2 R3), and a mode punched twice (two subcases): refused at the line
+  write_text(d / "short.pch",
+             "$TITLE   = X\n$EIGENVECTOR\n$REAL OUTPUT\n$EIGENVALUE =  1.0000000E+02  MODE =     1\n"
+             "         1       G      1.0E+00      0.0      0.0\n         2       G      1.0E+00      0.0      0.0\n");
+  try {
+    read_punch_modes((d / "short.pch").string());
+    FAIL("a grid row without its rotations was accepted");
+  } catch (const InputError& e) {
+    CHECK(e.diagnostics().front().str().find("short.pch:6") != std::string::npos);
+    CHECK(e.diagnostics().front().str().find("grid 1: its -CONT- row") != std::string::npos);
+  }
+  write_text(d / "twice.pch",
+             "$TITLE   = X\n$EIGENVECTOR\n$REAL OUTPUT\n$SUBCASE ID =  1\n$EIGENVALUE =  1.0000000E+02  MODE =     1\n"
+             "         1       G      1.0E+00      0.0      0.0\n-CONT-        0.0     0.0     0.0\n"
+             "$TITLE   = X\n$EIGENVECTOR\n$REAL OUTPUT\n$SUBCASE ID =  2\n$EIGENVALUE =  2.0000000E+02  MODE =     1\n");
+  CHECK_THROWS_AS(read_punch_modes((d / "twice.pch").string()), InputError);
   fs::remove_all(d);
 }
 
