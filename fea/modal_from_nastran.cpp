@@ -222,7 +222,42 @@ ModalImport import_modal_data(const Bulk& bulk, const std::string& bulk_path, co
     } else {
       const Eigen::Matrix<double, 6, 6> MO = rigid_body_mass(masses, bulk, x_ref);
       out.weight_generator_error = (MO - weight->MO).cwiseAbs().maxCoeff() / scale;
+      const WeightSummary p = weight_summary(weight->MO, x_ref), l = weight_summary(MO, x_ref);
+      out.printed_weight = p;
+      out.lumped_weight = l;
+      out.mass_error = std::abs(l.mass - p.mass) / p.mass;
+      const double gyration = std::sqrt(std::max(p.inertia_cg.trace(), 0.0) / p.mass);
+      out.cg_error = (l.cg - p.cg).norm() / std::max(gyration, 1e-300);
+      out.inertia_error = (l.inertia_cg - p.inertia_cg).cwiseAbs().maxCoeff() /
+                          std::max(p.inertia_cg.cwiseAbs().maxCoeff(), 1e-300);
+      if (out.mass_error > kMassCheckTolerance)
+        out.mismatches.push_back(fmt::format("mass {:.7g} against the weight generator's {:.7g}", l.mass, p.mass));
+      if (out.cg_error > kMassCheckTolerance)
+        out.mismatches.push_back(fmt::format("centre of mass [{:.7g}, {:.7g}, {:.7g}] against [{:.7g}, {:.7g}, {:.7g}]",
+                                             l.cg.x(), l.cg.y(), l.cg.z(), p.cg.x(), p.cg.y(), p.cg.z()));
+      if (out.inertia_error > kMassCheckTolerance)
+        out.mismatches.push_back(fmt::format("inertia about the centre of mass diag [{:.7g}, {:.7g}, {:.7g}] against "
+                                             "[{:.7g}, {:.7g}, {:.7g}] ({:.2g} of its largest entry apart)",
+                                             l.inertia_cg(0, 0), l.inertia_cg(1, 1), l.inertia_cg(2, 2),
+                                             p.inertia_cg(0, 0), p.inertia_cg(1, 1), p.inertia_cg(2, 2),
+                                             out.inertia_error));
     }
+  }
+  for (const GeneralizedMassCheck& g : out.generalized_masses)
+    if (g.relative_error() > kMassCheckTolerance)
+      out.mismatches.push_back(fmt::format("mode {}: generalized mass {:.7g} with the lumped mass against the "
+                                           "printed {:.7g}",
+                                           g.mode, g.computed, g.printed));
+  if (!out.mismatches.empty() && !options.accept_mass_mismatch) {
+    std::string what;
+    for (const std::string& m : out.mismatches) what += (what.empty() ? "" : "; ") + m;
+    throw InputError(Diagnostic{modes_path, 0, "",
+                                fmt::format("the importer's lumped mass is not NASTRAN's (beyond {:g}): {}. A mass "
+                                            "it lumps otherwise (e.g. MSC Nastran's CBEAM torsion, an unsupported "
+                                            "mass formulation) or another deck than the run's; "
+                                            "--accept-mass-mismatch writes the data anyway, normalized with the "
+                                            "lumped mass",
+                                            kMassCheckTolerance, what)});
   }
 
   // Degenerate pairs: any basis of their plane is as good as NASTRAN's.

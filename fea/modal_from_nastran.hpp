@@ -31,7 +31,13 @@ namespace kanegen::nastran {
 
 struct ModalImportOptions {
   int root = 0;  ///< the clamped grid at the body origin; 0: the single grid with SPC 123456
+  /// Write the data even when the lumped mass is not NASTRAN's (a check beyond kMassCheckTolerance); else
+  /// such a run is refused with the figures.
+  bool accept_mass_mismatch = false;
 };
+
+/// Beyond this relative difference a check against NASTRAN's printout fails (the f06 prints 7 digits).
+inline constexpr double kMassCheckTolerance = 1e-4;
 
 /// One mode's generalized mass: as NASTRAN printed it, and phi^T M phi with the importer's mass (both in
 /// NASTRAN's normalization of the shapes).
@@ -52,6 +58,13 @@ struct ModalImport {
   /// The weight generator's MO (f06) against the lumped mass's, about the same point: max |difference| over
   /// max |MO|; nullopt without a weight generator printout.
   std::optional<double> weight_generator_error;
+  /// With a weight generator printout: its mass, centre of mass and inertia about it, and the lumped mass's
+  /// (input units, basic frame), and their relative differences (the centre of mass's over the radius of
+  /// gyration, the inertia's over its largest entry).
+  std::optional<WeightSummary> printed_weight, lumped_weight;
+  double mass_error = 0.0, cg_error = 0.0, inertia_error = 0.0;
+  /// The checks beyond kMassCheckTolerance, with their figures (empty: all passed).
+  std::vector<std::string> mismatches;
   std::string weight_generator_note;  ///< why there is no weight generator check (when there is none)
   /// max over modes of the root's largest displacement or rotation over the mode's largest entry.
   double root_motion = 0.0;

@@ -379,15 +379,19 @@ Eigen::Matrix<double, 6, 6> rigid_body_mass(const std::map<int, GridMass>& masse
 }
 
 WeightSummary weight_summary(const std::map<int, GridMass>& masses, const Bulk& bulk) {
-  const Eigen::Matrix<double, 6, 6> MO = rigid_body_mass(masses, bulk);
+  return weight_summary(rigid_body_mass(masses, bulk), Vec3::Zero());
+}
+
+WeightSummary weight_summary(const Eigen::Matrix<double, 6, 6>& MO, const Eigen::Vector3d& x_ref) {
   WeightSummary w;
   w.mass = MO(0, 0);
   if (!(w.mass > 0.0)) return w;
   const Mat3 M_tr = MO.topRightCorner<3, 3>();
-  const Vec3 S(-M_tr(2, 1), -M_tr(0, 2), -M_tr(1, 0));  // M_tr = -[S]x, S the first moment
-  w.cg = S / w.mass;
-  const Mat3 C = skew(w.cg);
+  const Vec3 S(-M_tr(2, 1), -M_tr(0, 2), -M_tr(1, 0));  // M_tr = -[S]x, S the first moment about x_ref
+  const Vec3 d = S / w.mass;
+  const Mat3 C = skew(d);
   w.inertia_cg = MO.bottomRightCorner<3, 3>() - w.mass * C.transpose() * C;
+  w.cg = x_ref + d;
   return w;
 }
 

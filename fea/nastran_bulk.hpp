@@ -87,6 +87,8 @@ struct WeightSummary {
   Eigen::Matrix3d inertia_cg = Eigen::Matrix3d::Zero();  ///< I(S): about the centre of mass, basic axes
 };
 WeightSummary weight_summary(const std::map<int, GridMass>& masses, const Bulk& bulk);
+/// The same read from a rigid-body mass matrix MO about the point x_ref (basic): NASTRAN's printed one or ours.
+WeightSummary weight_summary(const Eigen::Matrix<double, 6, 6>& MO, const Eigen::Vector3d& x_ref);
 
 /// The rigid-body mass matrix about the point x_ref (basic), NASTRAN's weight generator's MO: the sum over grids
 /// of D^T M_g D with D mapping a rigid motion (t, r) at x_ref to the grid's (t - [x - x_ref]x r, r).

@@ -19,7 +19,9 @@ if [[ "${1:-}" == --demo ]]; then
   fi
   targets=(--target kanegen)
 else
-  args+=(-DKANEGEN_BUILD_TESTS=ON -DKANEGEN_BUILD_BENCH=ON -DKANEGEN_BUILD_EXAMPLES=ON -DKANEGEN_BUILD_PYTHON=ON)
+  # the example simulators at -O1: the suite runs them for a few seconds (CMakeLists.txt)
+  args+=(-DKANEGEN_BUILD_TESTS=ON -DKANEGEN_BUILD_BENCH=ON -DKANEGEN_BUILD_EXAMPLES=ON -DKANEGEN_BUILD_PYTHON=ON
+         -DKANEGEN_EXAMPLES_OPTIONS=-O1)
 fi
 # Ninja when installed (install_deps.sh installs it): it schedules the two
 # cores better than make; a tree configured before keeps its generator

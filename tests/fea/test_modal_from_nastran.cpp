@@ -136,6 +136,14 @@ TEST_CASE("nastran import: the shared run's modal data, its mass proved against 
     CHECK(g.relative_error() < 1e-6);
   }
   CHECK(im.root_motion == 0.0);
+  // the weight generator's mass, centre of mass and inertia read from its MO, against the lumped mass's
+  REQUIRE(im.printed_weight);
+  CHECK(std::abs(im.printed_weight->mass - 2.610514e-2) <= 1e-6 * 2.610514e-2);
+  CHECK(std::abs(im.printed_weight->cg.x() - 5.496071) <= 1e-6 * 5.496071);
+  CHECK(im.mass_error < 1e-6);
+  CHECK(im.cg_error < 1e-6);
+  CHECK(im.inertia_error < 1e-6);
+  CHECK(im.mismatches.empty());
   // unit modal mass (the contract's formula), frequencies as NASTRAN's cycles
   const VecX Y = modal_masses(f);
   for (int j = 0; j < f.modes(); ++j) CHECK(std::abs(Y(j) - 1.0) < 1e-12);
@@ -237,7 +245,10 @@ TEST_CASE("nastran import: an offset CONM2's mass moves to a node of its own, wi
   REQUIRE(bulk.masses.size() == 1);
   bulk.masses[0].offset_basic = Vec3(0.2, 0.3, -0.4);  // the tip mass off grid 11
   const std::vector<Mode> modes = read_f06_modes(f06);
-  const ModalImport im = import_modal_data(bulk, dat, modes, f06, std::nullopt);
+  // the f06's generalized masses are of the run without the offset: accepted only when asked, and said
+  CHECK_THROWS_AS(import_modal_data(bulk, dat, modes, f06, std::nullopt), InputError);
+  const ModalImport im = import_modal_data(bulk, dat, modes, f06, std::nullopt, ModalImportOptions{0, true});
+  CHECK(!im.mismatches.empty());
   const FlexibleData& f = im.flex;
   REQUIRE(f.nodes.size() == 12);
   const ModalNode& grid11 = f.nodes[10];
@@ -303,6 +314,16 @@ TEST_CASE("cli: kanegen import nastran writes the modal file and prints its chec
   CHECK(ds.empty());
   CHECK(g.has_second_order(10));
 
+  // the imported rod on a bus (docs/from_nastran.md's example): checks and simulates
+  fs::copy_file(test::source_path("tests/data/fea/rod_on_bus.yaml"), d / "rod_on_bus.yaml");
+  const test::ShellRun check = test::run_kanegen("check rod_on_bus.yaml", d.string());
+  INFO(check.out);
+  CHECK(check.status == 0);
+  const test::ShellRun sim = test::run_kanegen(
+      "simulate rod_on_bus.yaml --engine generic --t-end 0.01 --dt-out 0.001 --no-progress -o rod.csv", d.string());
+  INFO(sim.out);
+  CHECK(sim.status == 0);
+  CHECK(fs::exists(d / "rod.csv"));
   // a plate in the deck: refused at its line, nothing written
   {
     std::ofstream(d / "cbar_cbeam.blk", std::ios::app) << "CQUAD4  100     1       1       2       3       4\n";
@@ -319,4 +340,37 @@ TEST_CASE("cli: kanegen import nastran writes the modal file and prints its chec
                                                 d.string());
   CHECK(onto.status == 2);
   fs::remove_all(d);
+}
+
+TEST_CASE("nastran import: a lumped mass that is not NASTRAN's is refused with the figures unless accepted; a run "
+          "without eigenvectors is refused",
+          "[nastran][refusal]") {
+  const std::string dat = shared_run("beam_modes.dat"), f06 = shared_run("beam_modes.f06");
+  Bulk bulk = read_bulk(dat);
+  bulk.masses[0].mass *= 2.0;  // the tip mass doubled: not the run's structure
+  const std::vector<Mode> modes = read_f06_modes(f06);
+  const std::optional<F06Weight> weight = read_f06_weight(f06);
+  try {
+    import_modal_data(bulk, dat, modes, f06, weight);
+    FAIL("a lumped mass 10 % off NASTRAN's was accepted");
+  } catch (const InputError& e) {
+    const std::string what = e.diagnostics().front().str();
+    INFO(what);
+    CHECK(what.find("beam_modes.f06") != std::string::npos);
+    CHECK(what.find("mass 0.02869514 against the weight generator's 0.02610514") != std::string::npos);
+    CHECK(what.find("mode 1: generalized mass") != std::string::npos);
+    CHECK(what.find("--accept-mass-mismatch") != std::string::npos);
+  }
+  const ModalImport accepted = import_modal_data(bulk, dat, modes, f06, weight, ModalImportOptions{0, true});
+  CHECK(accepted.mismatches.size() >= 3);
+  CHECK(std::abs(accepted.mass_error - 2.59e-3 / 2.610514e-2) < 1e-6);
+  // modes without eigenvectors: nothing to import
+  std::vector<Mode> bare = modes;
+  for (Mode& m : bare) m.shapes.clear();
+  try {
+    import_modal_data(read_bulk(dat), dat, bare, f06, weight);
+    FAIL("modes without eigenvectors were accepted");
+  } catch (const InputError& e) {
+    CHECK(e.diagnostics().front().str().find("no mode has an eigenvector") != std::string::npos);
+  }
 }
