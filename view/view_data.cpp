@@ -15,6 +15,7 @@
 #include "model/joints/joint_traits.hpp"
 #include "model/orbit.hpp"
 #include "model/state_io.hpp"
+#include "sim/mass_properties.hpp"
 
 namespace kanegen {
 
@@ -193,6 +194,17 @@ json view_data(const Model& model, const RunTable* run, const ViewOptions& optio
     poses.push_back(pf);
     joints.push_back(jf);
     nodes.push_back(nf);
+  }
+  {  // the whole spacecraft's mass properties at the first frame, as `kanegen check` prints them
+    State s0;
+    s0.t = times[0];
+    s0.q = states[0].first;
+    s0.u = states[0].second;
+    const SystemMassProperties mp = system_mass_properties(model, s0);
+    d["mass_properties"] = {{"t", times[0]},
+                            {"mass", mp.mass},
+                            {"com_N", vec(mp.com_N)},
+                            {"principal_moments", vec(mp.principal_moments)}};
   }
   d["t"] = times;
   d["rows"] = rows;

@@ -20,6 +20,8 @@
 #include "model/diagnostics.hpp"
 #include "model/orbit.hpp"
 #include "model/rotation.hpp"
+#include "model/state_io.hpp"
+#include "sim/mass_properties.hpp"
 #include "tests/support/shell.hpp"
 #include "tests/support/test_support.hpp"
 #include "view/run_table.hpp"
@@ -124,6 +126,18 @@ void check_view_against_kinematics(const std::string& model_rel, double t_end, d
   CHECK(worst_node <= 1e-12);
   CHECK(orbit_frames == (model.central ? rows.size() : 0));
   CHECK(data.contains("orbit") == model.central.has_value());
+  // the whole spacecraft's mass properties at the first frame, as kanegen check prints them
+  {
+    State s0;
+    s0.t = run.rows(rows[0], 0);
+    s0.q = VecX(nq);
+    s0.u = VecX(nu);
+    for (int i = 0; i < nq; ++i) s0.q(i) = run.rows(rows[0], cols[i]);
+    for (int i = 0; i < nu; ++i) s0.u(i) = run.rows(rows[0], cols[nq + i]);
+    const SystemMassProperties mp = system_mass_properties(model, s0);
+    CHECK(data["mass_properties"]["mass"].get<double>() == mp.mass);
+    CHECK((pose_p(data["mass_properties"]["com_N"], 0) - mp.com_N).norm() == 0.0);
+  }
   fs::remove_all(d);
 }
 
