@@ -65,6 +65,8 @@ bool HandoverEngine::wait(double seconds) const {
                                [this] { return build_->ready.load(std::memory_order_acquire); });
 }
 
+HandoverEngine::~HandoverEngine() { wait_started(10.0); }
+
 bool HandoverEngine::wait_started(double seconds) const {
   std::unique_lock<std::mutex> lock(build_->mutex);
   return build_->done.wait_for(lock, std::chrono::duration<double>(seconds), [this] {

@@ -40,6 +40,9 @@ class HandoverEngine final : public Engine {
   /// `kanegen compile`): it calls `started()` then; wait_started() waits for it.
   HandoverEngine(const Model& model, std::function<void(const std::function<void()>& started)> build,
                  std::function<std::unique_ptr<Engine>()> load);
+  /// Waits (at most 10 s) until the build has started: a process that ends at once (a short run) would otherwise
+  /// end before the build thread spawned what outlives it (`kanegen compile`), and leave no build behind.
+  ~HandoverEngine() override;
 
   /// "generic" before the handover, "generic, then generated from t = 1.25 s" after.
   std::string name() const override;
@@ -54,8 +57,7 @@ class HandoverEngine final : public Engine {
   /// Blocks until the build is done or `seconds` have passed; returns whether it is done.
   bool wait(double seconds = 1e9) const;
   bool build_done() const { return build_->ready.load(std::memory_order_acquire); }
-  /// Blocks until the build has started (or is done) or `seconds` have passed; returns whether it has. A process
-  /// that ends before its background build's child is spawned would leave no build behind: it waits for this.
+  /// Blocks until the build has started (or is done) or `seconds` have passed; returns whether it has.
   bool wait_started(double seconds = 10.0) const;
   /// Why the build or the load failed ("" while it runs or when it succeeded).
   std::string error() const;

@@ -123,4 +123,15 @@ std::vector<int> state_columns(const RunTable& run, const Model& model) {
   return cols;
 }
 
+State run_state(const RunTable& run, const Model& model, const std::vector<int>& columns, int row) {
+  const int nq = static_cast<int>(model.q_names.size()), nu = static_cast<int>(model.u_names.size());
+  State s;
+  s.t = run.rows(row, 0);
+  s.q.resize(nq);
+  s.u.resize(nu);
+  for (int i = 0; i < nq; ++i) s.q(i) = run.rows(row, columns[i]);
+  for (int i = 0; i < nu; ++i) s.u(i) = run.rows(row, columns[nq + i]);
+  return s;
+}
+
 }  // namespace kanegen

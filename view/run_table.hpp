@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "model/model.hpp"
+#include "model/state_io.hpp"
 
 namespace kanegen {
 
@@ -38,5 +39,12 @@ std::vector<RunEvent> read_events_table(const std::string& path);
 /// (u_names). Throws InputError (the run's file, line 1, field "header") naming the first name missing: a CSV
 /// from another model.
 std::vector<int> state_columns(const RunTable& run, const Model& model);
+
+}  // namespace kanegen
+
+namespace kanegen {
+
+/// The state (t, q, u) of `model` at row `row` of the run, through the columns state_columns() gave.
+State run_state(const RunTable& run, const Model& model, const std::vector<int>& columns, int row);
 
 }  // namespace kanegen

@@ -128,31 +128,23 @@ json view_data(const Model& model, const RunTable* run, const ViewOptions& optio
   d["bodies"] = bodies;
 
   // The frames: the run's kept rows, or the initial state.
-  std::vector<double> times;
-  std::vector<std::pair<VecX, VecX>> states;
+  std::vector<State> states;
   std::vector<int> rows;
   if (run) {
     const std::vector<int> cols = state_columns(*run, model);
     rows = view_rows(*run, std::max(1, options.frames));
-    const int nq = static_cast<int>(model.q_names.size()), nu = static_cast<int>(model.u_names.size());
-    for (int r : rows) {
-      VecX q(nq), u(nu);
-      for (int i = 0; i < nq; ++i) q(i) = run->rows(r, cols[i]);
-      for (int i = 0; i < nu; ++i) u(i) = run->rows(r, cols[nq + i]);
-      times.push_back(run->rows(r, 0));
-      states.emplace_back(q, u);
-    }
+    for (int r : rows) states.push_back(run_state(*run, model, cols, r));
   } else {
-    const State s = initial_state(model);
-    times.push_back(s.t);
-    states.emplace_back(s.q, s.u);
+    states.push_back(initial_state(model));
   }
+  std::vector<double> times;
+  for (const State& s : states) times.push_back(s.t);
   Workspace<double> ws(model);
   json poses = json::array(), joints = json::array(), nodes = json::array();
   json com = json::array(), lvlh = json::array(), attitude = json::array();  // in orbit
   const int root = model.orbit_root >= 0 ? model.orbit_root : 0;  // the body whose attitude is told against LVLH
   for (std::size_t f = 0; f < states.size(); ++f) {
-    compute_kinematics(model, ws, times[f], states[f].first, states[f].second);
+    compute_kinematics(model, ws, states[f].t, states[f].q, states[f].u);
     if (model.central) {  // the system's centre of mass, its LVLH frame, the root's attitude in it
       compute_body_terms(model, ws);
       const OrbitState c = system_centre_of_mass(model, ws);
@@ -196,11 +188,7 @@ json view_data(const Model& model, const RunTable* run, const ViewOptions& optio
     nodes.push_back(nf);
   }
   {  // the whole spacecraft's mass properties at the first frame, as `kanegen check` prints them
-    State s0;
-    s0.t = times[0];
-    s0.q = states[0].first;
-    s0.u = states[0].second;
-    const SystemMassProperties mp = system_mass_properties(model, s0);
+    const SystemMassProperties mp = system_mass_properties(model, states[0]);
     d["mass_properties"] = {{"t", times[0]},
                             {"mass", mp.mass},
                             {"com_N", vec(mp.com_N)},

@@ -57,9 +57,6 @@ int run(const Options& o) {
     status = kExitFailure;
   }
   if (handover) {
-    // a run that ends at once must not end before its background build's `kanegen compile` is spawned: that
-    // child outlives this process, the thread that spawns it does not (tests/apps/test_cli.cpp, handover)
-    handover->wait_started();
     if (!handover->build_done())
       fmt::print(stderr,
                  "kanegen: run done at {:.2f} s; the generated code of {} goes on building in the background "

@@ -67,17 +67,14 @@ void check_view_against_kinematics(const std::string& model_rel, double t_end, d
   const std::vector<int> rows = data["rows"].get<std::vector<int>>();
   REQUIRE(rows.size() == data["t"].size());
   REQUIRE(rows.size() >= 7);
-  const int nq = static_cast<int>(model.q_names.size()), nu = static_cast<int>(model.u_names.size());
   Workspace<double> ws(model);
   double worst_p = 0, worst_R = 0, worst_node = 0;
   std::size_t orbit_frames = 0;
   for (std::size_t f = 0; f < rows.size(); ++f) {
     const int r = rows[f];
     CHECK(data["t"][f].get<double>() == run.rows(r, 0));
-    VecX q(nq), u(nu);
-    for (int i = 0; i < nq; ++i) q(i) = run.rows(r, cols[i]);
-    for (int i = 0; i < nu; ++i) u(i) = run.rows(r, cols[nq + i]);
-    compute_kinematics(model, ws, run.rows(r, 0), q, u);
+    const State st = run_state(run, model, cols, r);
+    compute_kinematics(model, ws, st.t, st.q, st.u);
     if (model.central) {  // the centre of mass and its LVLH frame
       compute_body_terms(model, ws);
       const OrbitState c = system_centre_of_mass(model, ws);
@@ -128,13 +125,7 @@ void check_view_against_kinematics(const std::string& model_rel, double t_end, d
   CHECK(data.contains("orbit") == model.central.has_value());
   // the whole spacecraft's mass properties at the first frame, as kanegen check prints them
   {
-    State s0;
-    s0.t = run.rows(rows[0], 0);
-    s0.q = VecX(nq);
-    s0.u = VecX(nu);
-    for (int i = 0; i < nq; ++i) s0.q(i) = run.rows(rows[0], cols[i]);
-    for (int i = 0; i < nu; ++i) s0.u(i) = run.rows(rows[0], cols[nq + i]);
-    const SystemMassProperties mp = system_mass_properties(model, s0);
+    const SystemMassProperties mp = system_mass_properties(model, run_state(run, model, cols, rows[0]));
     CHECK(data["mass_properties"]["mass"].get<double>() == mp.mass);
     CHECK((pose_p(data["mass_properties"]["com_N"], 0) - mp.com_N).norm() == 0.0);
   }
