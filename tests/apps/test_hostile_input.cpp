@@ -24,12 +24,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
+struct HostileRun {
   int status;       ///< exit status, or 128 + signal
   std::string out;  ///< stdout and stderr
 };
 
-Run run(const std::string& args) {
+HostileRun run(const std::string& args) {
   const std::string cmd = std::string(kanegen::test::kanegen_binary()) + " " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;
@@ -40,13 +40,6 @@ Run run(const std::string& args) {
 }
 
 /// A fresh directory for one test.
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / fmt::format("kanegen-hostile-{}-{}", getpid(), name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
 std::string write(const fs::path& p, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;
   return p.string();
@@ -77,9 +70,9 @@ const char* kDp = "models/double_pendulum.yaml";
 }  // namespace
 
 TEST_CASE("hostile: deep nesting in a state or a model is refused, located, without a crash", "[hostile]") {
-  const fs::path d = scratch("nesting");
+  const fs::path d = kanegen::test::scratch_dir("hostile", "nesting");
   std::string deep = "{\"q\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
-  Run r = run(fmt::format("eval {} --engine generic --state {}", model(kDp), write(d / "s.json", deep)));
+  HostileRun r = run(fmt::format("eval {} --engine generic --state {}", model(kDp), write(d / "s.json", deep)));
   CHECK(r.status == 2);
   CHECK(located(r.out));
   CHECK(r.out.find("nested deeper") != std::string::npos);
@@ -96,12 +89,12 @@ TEST_CASE("hostile: deep nesting in a state or a model is refused, located, with
 }
 
 TEST_CASE("hostile: a second YAML document, or content after '...', is refused", "[hostile]") {
-  const fs::path d = scratch("documents");
+  const fs::path d = kanegen::test::scratch_dir("hostile", "documents");
   std::ifstream in(model(kDp));
   std::stringstream ss;
   ss << in.rdbuf();
   for (const std::string tail : {"---\nname: other\n", "...\nname: other\n", "--- {name: other}\n"}) {
-    const Run r = run("check " + write(d / "m.yaml", ss.str() + tail));
+    const HostileRun r = run("check " + write(d / "m.yaml", ss.str() + tail));
     INFO(tail << r.out);
     CHECK(r.status == 2);
     CHECK(r.out.find("second YAML document") != std::string::npos);
@@ -112,7 +105,7 @@ TEST_CASE("hostile: a second YAML document, or content after '...', is refused",
 }
 
 TEST_CASE("hostile: STATE.json faults name the file, the line and the field", "[hostile]") {
-  const fs::path d = scratch("state");
+  const fs::path d = kanegen::test::scratch_dir("hostile", "state");
   const std::string m = model("models/explorer1_rigid.yaml");
   struct Case {
     std::string json, field, text;
@@ -130,7 +123,7 @@ TEST_CASE("hostile: STATE.json faults name the file, the line and the field", "[
       {"{\n\n \"q\": {\"bus.qw\": 0, \"bus.qx\": 0, \"bus.qy\": 0, \"bus.qz\": 0}}", ":3: q.bus.qw:", "is zero"},
   };
   for (const Case& c : cases) {
-    const Run r = run(fmt::format("eval {} --engine generic --state {}", m, write(d / "s.json", c.json)));
+    const HostileRun r = run(fmt::format("eval {} --engine generic --state {}", m, write(d / "s.json", c.json)));
     INFO(c.json << "\n-> " << r.out);
     CHECK(r.status == 2);
     CHECK(r.out.find("s.json" + c.field) != std::string::npos);
@@ -140,11 +133,11 @@ TEST_CASE("hostile: STATE.json faults name the file, the line and the field", "[
 }
 
 TEST_CASE("hostile: a quaternion of tiny or huge but non-zero norm is normalized", "[hostile]") {
-  const fs::path d = scratch("quaternion");
+  const fs::path d = kanegen::test::scratch_dir("hostile", "quaternion");
   const std::string m = model("models/explorer1_rigid.yaml");
   for (const char* v : {"5e-324", "1e-160", "1e200", "1.7e308"}) {
     const std::string json = fmt::format("{{\"q\": {{\"bus.qw\": {0}, \"bus.qx\": {0}, \"bus.qy\": 0, \"bus.qz\": 0}}}}", v);
-    const Run r = run(fmt::format("eval {} --engine generic --state {}", m, write(d / "s.json", json)));
+    const HostileRun r = run(fmt::format("eval {} --engine generic --state {}", m, write(d / "s.json", json)));
     INFO(v << ": " << r.out);
     REQUIRE(r.status == 0);
     const auto q = nlohmann::json::parse(r.out)["q"];
@@ -154,8 +147,8 @@ TEST_CASE("hostile: a quaternion of tiny or huge but non-zero norm is normalized
 }
 
 TEST_CASE("hostile: a non-finite result is a failure naming the quantity, never null", "[hostile]") {
-  const fs::path d = scratch("nonfinite");
-  Run r = run(fmt::format("eval {} --engine generic --state {}", model(kDp),
+  const fs::path d = kanegen::test::scratch_dir("hostile", "nonfinite");
+  HostileRun r = run(fmt::format("eval {} --engine generic --state {}", model(kDp),
                           write(d / "s.json", "{\"u\": {\"link1.angle\": 1e200}}")));
   CHECK(r.status == 1);
   CHECK(r.out.find("null") == std::string::npos);
@@ -172,7 +165,7 @@ TEST_CASE("hostile: a non-finite result is a failure naming the quantity, never 
 }
 
 TEST_CASE("hostile: integers are decimal everywhere, names printable, CR line breaks read", "[hostile]") {
-  const fs::path d = scratch("syntax");
+  const fs::path d = kanegen::test::scratch_dir("hostile", "syntax");
   // node id 010 is ten in the modal file and in the model
   write(d / "h.modal.yaml",
         "nodes:\n  - {id: 0, position: [0, 0, 0], mass: 0}\n  - {id: 010, position: [1, 0, 0], mass: 1}\n"
@@ -182,7 +175,7 @@ TEST_CASE("hostile: integers are decimal everywhere, names printable, CR line br
                               "[0, 0, 1]}\n    flexible: {modal: h.modal.yaml}\n  - name: tip\n    parent: hub\n"
                               "    joint: {type: revolute, node: 10, axis: [0, 1, 0]}\n    mass: 0.1\n"
                               "    inertia: [0.001, 0.001, 0.001, 0, 0, 0]\n");
-  Run r = run("check " + m);
+  HostileRun r = run("check " + m);
   INFO(r.out);
   CHECK(r.status == 0);
   // control characters and invalid UTF-8 in a name are refused with the line
@@ -218,7 +211,7 @@ TEST_CASE("hostile: integers are decimal everywhere, names printable, CR line br
 }
 
 TEST_CASE("hostile: every command-line value is checked against its domain up front", "[hostile]") {
-  const fs::path d = scratch("options");
+  const fs::path d = kanegen::test::scratch_dir("hostile", "options");
   const std::string m = model(kDp), out = (d / "o.csv").string();
   struct Case {
     std::string args, option;
@@ -231,21 +224,21 @@ TEST_CASE("hostile: every command-line value is checked against its domain up fr
       {"--t-end 1 --max-steps 0", "--max-steps"},
   };
   for (const Case& c : cases) {
-    const Run r = run(fmt::format("simulate {} --engine generic {} -o {}", m, c.args, out));
+    const HostileRun r = run(fmt::format("simulate {} --engine generic {} -o {}", m, c.args, out));
     INFO(c.args << " -> " << r.out);
     CHECK(r.status == 2);
     CHECK(r.out.rfind(c.option + ":", 0) == 0);
     CHECK_FALSE(fs::exists(out));
   }
   // the rows a huge horizon would write are said
-  const Run rows = run(fmt::format("simulate {} --engine generic --t-end 1e308 --dt-out 0.01 -o {}", m, out));
+  const HostileRun rows = run(fmt::format("simulate {} --engine generic --t-end 1e308 --dt-out 0.01 -o {}", m, out));
   CHECK(rows.out.find("rows") != std::string::npos);
   // an unwritable output: a missing directory, a directory, a FIFO, a symlink, a device
   const fs::path fifo = d / "fifo";
   REQUIRE(mkfifo(fifo.c_str(), 0644) == 0);
   fs::create_symlink(d / "target.csv", d / "link.csv");
   for (const fs::path& bad : {d / "missing" / "o.csv", d, fifo, d / "link.csv", fs::path("/dev/null")}) {
-    const Run r = run(fmt::format("simulate {} --engine generic --t-end 1 -o {}", m, bad.string()));
+    const HostileRun r = run(fmt::format("simulate {} --engine generic --t-end 1 -o {}", m, bad.string()));
     INFO(bad << " -> " << r.out);
     CHECK(r.status == 2);
     CHECK(r.out.find(bad.string()) != std::string::npos);
@@ -256,12 +249,12 @@ TEST_CASE("hostile: every command-line value is checked against its domain up fr
   // generate onto a directory, and next to a user's own x.hpp.tmp
   CHECK(run(fmt::format("generate {} -o {}", m, d.string())).status == 2);
   // every output option is checked before any work, and named
-  const Run dep = run(fmt::format("generate {} -o {} --depfile {}", m, (d / "p.hpp").string(),
+  const HostileRun dep = run(fmt::format("generate {} -o {} --depfile {}", m, (d / "p.hpp").string(),
                                   (d / "missing" / "p.d").string()));
   CHECK(dep.status == 2);
   CHECK(dep.out.rfind("--depfile: cannot write", 0) == 0);
   CHECK_FALSE(fs::exists(d / "p.hpp"));
-  const Run modes = run(fmt::format("modes {} --body boom -o {}", model("models/boom_fea.yaml"), d.string()));
+  const HostileRun modes = run(fmt::format("modes {} --body boom -o {}", model("models/boom_fea.yaml"), d.string()));
   CHECK(modes.status == 2);
   CHECK(modes.out.rfind("-o: cannot write", 0) == 0);
   write(d / "x.hpp.tmp", "mine");
@@ -275,7 +268,7 @@ TEST_CASE("hostile: every command-line value is checked against its domain up fr
 TEST_CASE("hostile: an interrupted or killed simulate leaves nothing behind", "[hostile][signals]") {
   for (const int sig : {SIGINT, SIGTERM, SIGKILL}) {
     INFO("signal " << sig);
-    const fs::path d = scratch(fmt::format("signal{}", sig));
+    const fs::path d = kanegen::test::scratch_dir("hostile", fmt::format("signal{}", sig));
     const std::string out = (d / "run.csv").string();
     const pid_t pid = fork();
     REQUIRE(pid >= 0);
@@ -299,7 +292,7 @@ TEST_CASE("hostile: an interrupted or killed simulate leaves nothing behind", "[
 }
 
 TEST_CASE("hostile: a full disk leaves no file and exits 1", "[hostile][disk]") {
-  const fs::path d = scratch("fulldisk");
+  const fs::path d = kanegen::test::scratch_dir("hostile", "fulldisk");
   if (geteuid() != 0 || mount("tmpfs", d.c_str(), "tmpfs", 0, "size=64k") != 0) {
     WARN("cannot mount a small tmpfs here (needs root and mount permission): full-disk test skipped");
     return;
@@ -309,22 +302,22 @@ TEST_CASE("hostile: a full disk leaves no file and exits 1", "[hostile][disk]") 
     ~Unmount() { umount(p.c_str()); }
   } unmount{d};
   const std::string out = (d / "big.csv").string();
-  const Run r = run(fmt::format("simulate {} --engine generic --t-end 100 --dt-out 0.001 -o {}",
+  const HostileRun r = run(fmt::format("simulate {} --engine generic --t-end 100 --dt-out 0.001 -o {}",
                                 model("models/explorer1_rigid.yaml"), out));
   INFO(r.out);
   CHECK(r.status == 1);
   CHECK(r.out.find("write failed") != std::string::npos);
   CHECK(fs::is_empty(d));
   // generate and modes on the full disk too
-  const Run g = run(fmt::format("generate {} -o {}", model("models/spacecraft_arrays.yaml"), (d / "h.hpp").string()));
+  const HostileRun g = run(fmt::format("generate {} -o {}", model("models/spacecraft_arrays.yaml"), (d / "h.hpp").string()));
   CHECK(g.status == 1);
   CHECK(fs::is_empty(d));
-  const fs::path w = scratch("fulldisk-model");
+  const fs::path w = kanegen::test::scratch_dir("hostile", "fulldisk-model");
   const std::string beam = write(w / "beam.yaml",
                                  "name: beam\nbodies:\n  - name: b\n    parent: ground\n    joint: {type: fixed}\n"
                                  "    flexible:\n      beam: {length: 2, direction: x, mass_per_length: 0.5, "
                                  "EI: [20, 30], elements: 200, modes: 20}\n");
-  const Run m = run(fmt::format("modes {} --body b -o {}", beam, (d / "b.modal.yaml").string()));
+  const HostileRun m = run(fmt::format("modes {} --body b -o {}", beam, (d / "b.modal.yaml").string()));
   INFO(m.out);
   CHECK(m.status == 1);
   CHECK(fs::is_empty(d));
@@ -335,7 +328,7 @@ TEST_CASE("hostile: a full disk leaves no file and exits 1", "[hostile][disk]") 
     for (int i = 0; i < 64 && filler.write(block.data(), block.size()); ++i) {
     }
   }
-  const Run dep = run(fmt::format("generate {} -o {} --depfile {}", model("models/pendulum.yaml"),
+  const HostileRun dep = run(fmt::format("generate {} -o {} --depfile {}", model("models/pendulum.yaml"),
                                   (w / "p.hpp").string(), (d / "p.d").string()));
   INFO(dep.out);
   CHECK(dep.status == 1);
@@ -343,7 +336,7 @@ TEST_CASE("hostile: a full disk leaves no file and exits 1", "[hostile][disk]") 
 }
 
 TEST_CASE("hostile: the limits are checked before allocating, and what is allowed runs quickly", "[hostile][limits]") {
-  const fs::path d = scratch("limits");
+  const fs::path d = kanegen::test::scratch_dir("hostile", "limits");
   // a 3-node modal file with 20,000 modes
   std::string modal = "nodes:\n  - {id: 1, position: [0,0,0], mass: 0}\n  - {id: 2, position: [1,0,0], mass: 1}\n"
                       "  - {id: 3, position: [2,0,0], mass: 1}\nmodes:\n";
@@ -353,7 +346,7 @@ TEST_CASE("hostile: the limits are checked before allocating, and what is allowe
   write(d / "many.modal.yaml", modal);
   const std::string flexible = "name: many\nbodies:\n  - name: b\n    parent: ground\n    joint: {type: revolute, axis: "
                                "[0,0,1]}\n    flexible: {modal: many.modal.yaml}\n";
-  Run r = run("check " + write(d / "many.yaml", flexible));
+  HostileRun r = run("check " + write(d / "many.yaml", flexible));
   CHECK(r.status == 2);
   CHECK(r.out.find("at most 2000 modes") != std::string::npos);
   CHECK(located(r.out));
@@ -374,8 +367,8 @@ TEST_CASE("hostile: the limits are checked before allocating, and what is allowe
 
 TEST_CASE("hostile: a singular mass matrix at the initial state names the speed, the bodies and the line",
           "[hostile]") {
-  const fs::path d = scratch("singular");
-  const Run r = run("check " + write(d / "g.yaml", R"(name: gimbal
+  const fs::path d = kanegen::test::scratch_dir("hostile", "singular");
+  const HostileRun r = run("check " + write(d / "g.yaml", R"(name: gimbal
 bodies:
   - name: base
     parent: ground
@@ -403,7 +396,7 @@ TEST_CASE("hostile: a modal node that is not a mapping is refused, the shapes st
           "[hostile]") {
   // found by tests/apps/fuzz_inputs.py: the shapes were indexed by the node's
   // place in the file while the faulty node was left out (a heap overflow)
-  const fs::path d = scratch("modalnode");
+  const fs::path d = kanegen::test::scratch_dir("hostile", "modalnode");
   std::ifstream in(model("models/fea/boom.modal.yaml"));
   std::stringstream ss;
   ss << in.rdbuf();
@@ -416,7 +409,7 @@ TEST_CASE("hostile: a modal node that is not a mapping is refused, the shapes st
   std::ifstream min(model("models/boom_fea.yaml"));
   std::stringstream ms;
   ms << min.rdbuf();
-  const Run r = run("check " + write(d / "boom_fea.yaml", ms.str()));
+  const HostileRun r = run("check " + write(d / "boom_fea.yaml", ms.str()));
   INFO(r.out);
   CHECK(r.status == 2);
   CHECK(r.out.find("nodes[10]: got '7'; expected a mapping") != std::string::npos);

@@ -16,12 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using kanegen::test::slurp;
 
 std::vector<fs::path> model_files() {
   const auto names = kanegen::test::models_under_test(kanegen::test::model_files());

@@ -18,7 +18,7 @@ using namespace kanegen;
 
 namespace {
 
-constexpr double kMu = 3.986004418e14;
+using test::kMu;
 
 std::string sat(const std::string& gravity, const std::string& extra_body = "", const std::string& initial = "") {
   return "name: orbiter\ngravity: " + gravity + R"(

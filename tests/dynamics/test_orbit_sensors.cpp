@@ -25,7 +25,7 @@ using namespace kanegen;
 
 namespace {
 
-constexpr double kMu = 3.986004418e14;
+using test::kMu;
 
 const char* kSensors = R"(
 outputs:

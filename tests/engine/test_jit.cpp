@@ -56,12 +56,12 @@ struct TempCache {
 };
 
 // The model of pendulum_handwritten.hpp (see the comment there).
-constexpr double kM = 2.0, kL = 0.75, kIyy = 0.1, kG = 9.81, kK = 0.5, kC = 0.2, kRest = 0.1;
+constexpr double kM = 2.0, kL = 0.75, kIyy = 0.1, kGravity = 9.81, kK = 0.5, kC = 0.2, kRest = 0.1;
 
 Model make_handwritten_pendulum() {
   Model m;
   m.name = "pendulum_handwritten";
-  m.g_N = Vec3(0, 0, -kG);
+  m.g_N = Vec3(0, 0, -kGravity);
   Body b;
   b.name = "bob";
   b.parent = -1;
@@ -81,12 +81,7 @@ Model make_handwritten_pendulum() {
   return m;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 /// The hand-written sources (header, entry, manifest) with the model's and
 /// the generator's hashes filled in.
@@ -129,7 +124,7 @@ void check_pendulum_numbers(GeneratedEngine& e) {
   u << w;
   t << tau;
   const double M0 = kM * kL * kL + kIyy;
-  const double F0 = kM * kG * kL * std::cos(th) - kK * (th - kRest) - kC * w + tau;
+  const double F0 = kM * kGravity * kL * std::cos(th) - kK * (th - kRest) - kC * w + tau;
 
   MatX M, Mg;
   VecX F, Fg, ud, udg, qd;

@@ -33,21 +33,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string shared_run(const std::string& file) {
-  return test::source_path("tests/data/fea/pynastran_beam_modes/" + file);
-}
+using test::shared_run;
 
 ModalImport import_f06() {
   const std::string f06 = shared_run("beam_modes.f06");
   return import_modal_data(read_bulk(shared_run("beam_modes.dat")), shared_run("beam_modes.dat"), read_f06_modes(f06),
                            f06, read_f06_weight(f06));
-}
-
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / fmt::format("kanegen-nastran-{}-{}", getpid(), name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
 }
 
 void write_text(const fs::path& p, const std::string& text) {
@@ -75,7 +66,7 @@ TEST_CASE("nastran punch: the eigenvectors of the shared run in the punch layout
 
 TEST_CASE("nastran punch: complex eigenvectors and files without eigenvectors are refused by file and line",
           "[nastran][refusal]") {
-  const fs::path d = scratch("punch");
+  const fs::path d = test::scratch_dir("nastran", "punch");
   write_text(d / "complex.pch",
              "$TITLE   = X\n$SUBTITLE=\n$LABEL   =\n$EIGENVECTOR\n$REAL-IMAGINARY OUTPUT\n$SUBCASE ID =           1\n"
              "$EIGENVALUE =  1.0000000E+02  MODE =     1\n         1       G      1.0E+00      0.0      0.0\n");
@@ -174,7 +165,7 @@ TEST_CASE("nastran import: the punch file gives the modal data the f06 gives", "
 TEST_CASE("nastran import: the written file, loaded in a model, has the weight generator's mass, centre of mass "
           "and inertia, and the clamped model's linear frequencies are NASTRAN's",
           "[nastran][physics]") {
-  const fs::path d = scratch("model");
+  const fs::path d = test::scratch_dir("nastran", "model");
   ModalImport im = import_f06();
   write_modal_file(im.flex, (d / "rod.modal.yaml").string());
   std::vector<Diagnostic> ds;
@@ -286,7 +277,7 @@ TEST_CASE("nastran import: an offset CONM2's mass moves to a node of its own, wi
 TEST_CASE("cli: kanegen import nastran writes the modal file and prints its checks; a bad deck is refused with "
           "file and line, nothing written",
           "[nastran][cli]") {
-  const fs::path d = scratch("cli");
+  const fs::path d = test::scratch_dir("nastran", "cli");
   for (const char* f : {"beam_modes.dat", "cbar_cbeam.blk", "beam_modes.f06", "beam_modes_eigenvectors.pch"})
     fs::copy_file(shared_run(f), d / f);
   const test::ShellRun help = test::run_kanegen("import nastran --help");

@@ -21,9 +21,7 @@ using namespace kanegen::nastran;
 
 namespace {
 
-std::string shared_run(const std::string& file) {
-  return test::source_path("tests/data/fea/pynastran_beam_modes/" + file);
-}
+using test::shared_run;
 
 std::string refusal(const std::string& name, const std::string& text) {
   try {

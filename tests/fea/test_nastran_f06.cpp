@@ -19,9 +19,7 @@ using namespace kanegen::nastran;
 
 namespace {
 
-std::string shared_run(const std::string& file) {
-  return test::source_path("tests/data/fea/pynastran_beam_modes/" + file);
-}
+using test::shared_run;
 
 }  // namespace
 

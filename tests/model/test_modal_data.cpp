@@ -14,14 +14,10 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-std::string data_path(const std::string& rel) { return std::string(kanegen::test::source_dir()) + "/tests/data/" + rel; }
+using test::data_path;
 const std::string kHub = std::string(kanegen::test::source_dir()) + "/tests/reference/v_flex/v_flex_hub.modal.yaml";
 
-std::string dump(const std::vector<Diagnostic>& ds) {
-  std::string s;
-  for (const auto& d : ds) s += d.str() + "\n";
-  return s;
-}
+using test::dump;
 
 std::vector<Diagnostic> faults(const std::string& path, const std::vector<int>& keep = {}) {
   std::vector<Diagnostic> ds;
@@ -29,7 +25,7 @@ std::vector<Diagnostic> faults(const std::string& path, const std::vector<int>& 
   return ds;
 }
 
-void check_single(const std::string& path, int line, const std::string& field, const std::string& text) {
+void check_single_fault(const std::string& path, int line, const std::string& field, const std::string& text) {
   const auto ds = faults(path);
   INFO(dump(ds));
   REQUIRE(ds.size() == 1);
@@ -52,27 +48,27 @@ double modal_mass(const FlexibleData& f, int c) {
 }  // namespace
 
 TEST_CASE("modal: a mode without a shape for some node", "[modal]") {
-  check_single(data_path("bad/modal_missing_shape.modal.yaml"), 13, "modes[1].shapes", "no shape for node 4; expected a shape for every node that carries mass");
+  check_single_fault(data_path("bad/modal_missing_shape.modal.yaml"), 13, "modes[1].shapes", "no shape for node 4; expected a shape for every node that carries mass");
 }
 
 TEST_CASE("modal: a shape for a node that is not listed", "[modal]") {
-  check_single(data_path("bad/modal_extra_shape.modal.yaml"), 11, "modes[0].shapes.9", "no node with id 9");
+  check_single_fault(data_path("bad/modal_extra_shape.modal.yaml"), 11, "modes[0].shapes.9", "no node with id 9");
 }
 
 TEST_CASE("modal: shapes not mass-normalized without the flag", "[modal]") {
-  check_single(data_path("bad/modal_not_normalized.modal.yaml"), 8, "modes[0].shapes", "mass_normalized: false");
+  check_single_fault(data_path("bad/modal_not_normalized.modal.yaml"), 8, "modes[0].shapes", "mass_normalized: false");
 }
 
 TEST_CASE("modal: negative frequency", "[modal]") {
-  check_single(data_path("bad/modal_negative_frequency.modal.yaml"), 7, "modes[0].frequency", "not positive");
+  check_single_fault(data_path("bad/modal_negative_frequency.modal.yaml"), 7, "modes[0].frequency", "not positive");
 }
 
 TEST_CASE("modal: duplicate node id", "[modal]") {
-  check_single(data_path("bad/modal_duplicate_id.modal.yaml"), 5, "nodes[2].id", "duplicate node id 3");
+  check_single_fault(data_path("bad/modal_duplicate_id.modal.yaml"), 5, "nodes[2].id", "duplicate node id 3");
 }
 
 TEST_CASE("modal: zero modal mass with mass_normalized false", "[modal]") {
-  check_single(data_path("bad/zero_modal_mass.modal.yaml"), 7, "modes[0].shapes", "zero modal mass");
+  check_single_fault(data_path("bad/zero_modal_mass.modal.yaml"), 7, "modes[0].shapes", "zero modal mass");
 }
 
 TEST_CASE("modal: several faults reported together, unknown keys with hints", "[modal]") {

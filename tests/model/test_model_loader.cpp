@@ -18,7 +18,7 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-std::string data_path(const std::string& rel) { return std::string(kanegen::test::source_dir()) + "/tests/data/" + rel; }
+using test::data_path;
 
 std::vector<Diagnostic> refusal(const std::string& path) {
   try {
@@ -30,11 +30,7 @@ std::vector<Diagnostic> refusal(const std::string& path) {
   return {};
 }
 
-std::string dump(const std::vector<Diagnostic>& ds) {
-  std::string s;
-  for (const auto& d : ds) s += d.str() + "\n";
-  return s;
-}
+using test::dump;
 
 /// The diagnostic for `field`; fails the test if there is none.
 Diagnostic diag_for(const std::vector<Diagnostic>& ds, const std::string& field) {

@@ -6,12 +6,13 @@
 #include <random>
 
 #include "model/orbit.hpp"
+#include "tests/support/test_support.hpp"
 
 using namespace kanegen;
 using Vec3 = Eigen::Vector3d;
 
 namespace {
-constexpr double kMu = 3.986004418e14;
+using kanegen::test::kMu;
 double angle_diff(double a, double b) { return std::abs(std::remainder(a - b, 2.0 * M_PI)); }
 }  // namespace
 

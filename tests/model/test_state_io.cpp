@@ -20,7 +20,7 @@ Model load_reference_model(const std::string& name);
 namespace {
 
 const std::string kRef = std::string(kanegen::test::source_dir()) + "/tests/reference/";
-std::string data_path(const std::string& rel) { return std::string(kanegen::test::source_dir()) + "/tests/data/" + rel; }
+using test::data_path;
 
 /// Writes `text` to a temporary STATE.json (in this test process's own
 /// directory: ctest runs the test cases of this file in parallel) and returns its path.
@@ -38,11 +38,7 @@ std::vector<Diagnostic> refusal(const Model& m, const std::string& path) {
   return {};
 }
 
-std::string dump(const std::vector<Diagnostic>& ds) {
-  std::string s;
-  for (const auto& d : ds) s += d.str() + "\n";
-  return s;
-}
+using test::dump;
 
 }  // namespace
 

@@ -60,7 +60,7 @@ double quaternion_drift(const Model& model, const double* x) {
   return d;
 }
 
-struct Run {
+struct ExtremeRun {
   IntegratorStats stats;
   double dE = 0;       ///< max |E - E0| / max(|T| + |V|)
   double dE_abs = 0;   ///< max |E - E0|
@@ -81,11 +81,11 @@ struct RunSpec {
 
 /// Integrates the model's ODE from its initial state (make_ode_problem +
 /// integrate, as the bench does) and measures the invariants at the outputs.
-Run run(Engine& engine, const RunSpec& spec) {
+ExtremeRun run(Engine& engine, const RunSpec& spec) {
   const Model& model = engine.model();
   const State s0 = initial_state(model);
   OdeProblem ode = make_ode_problem(engine, s0.tau, nullptr, true, spec.kind != IntegratorKind::rk4);
-  Run r;
+  ExtremeRun r;
   auto project = ode.project;
   ode.project = [&](double* x) {
     r.q_drift = std::max(r.q_drift, quaternion_drift(model, x));
@@ -122,7 +122,7 @@ Run run(Engine& engine, const RunSpec& spec) {
   return r;
 }
 
-std::string cost(const Run& r) {
+std::string cost(const ExtremeRun& r) {
   return r.stats.summary() + fmt::format(" | dE/E {:.2e}, dH/H {:.2e}, quaternion drift {:.2e}", r.dE, r.dH, r.q_drift);
 }
 
@@ -215,11 +215,11 @@ TEST_CASE("stiff_appendage: implicit DIRK steps over the kHz modes, explicit met
   RunSpec spec;
   spec.t_end = T;
   spec.kind = IntegratorKind::arkode_dirk;
-  const Run dirk = run(engine, spec);
+  const ExtremeRun dirk = run(engine, spec);
   spec.kind = IntegratorKind::arkode_erk;
-  const Run erk = run(engine, spec);
+  const ExtremeRun erk = run(engine, spec);
   spec.kind = IntegratorKind::cvode_bdf;
-  const Run bdf = run(engine, spec);
+  const ExtremeRun bdf = run(engine, spec);
   INFO("stiff_appendage, " << T << " s:\n  " << cost(dirk) << "\n  " << cost(erk) << "\n  " << cost(bdf));
   // DIRK (L-stable) takes steps on the time scale of the modal transient's
   // decay, then of the rigid motion; Dormand-Prince is held near its
@@ -232,7 +232,7 @@ TEST_CASE("stiff_appendage: implicit DIRK steps over the kHz modes, explicit met
   // that all three agree on the rigid motion (p, H conserved; the modal part
   // is ~1e-10 and below the tolerances).
   const int w = model.nq + model.bodies[model.body_index("bus")].u_joint + 3;  // bus.wx..wz in x = [q; u]
-  for (const Run* r : {&erk, &bdf}) {
+  for (const ExtremeRun* r : {&erk, &bdf}) {
     CHECK((r->x_end.segment(w, 3) - dirk.x_end.segment(w, 3)).norm() < 1e-8);
     CHECK(r->dH < 1e-7);
   }
@@ -261,7 +261,7 @@ TEST_CASE("stiff_appendage: implicit DIRK steps over the kHz modes, explicit met
   spec.kind = IntegratorKind::rk4;
   spec.t_end = 0.05;
   spec.h = 5e-5;
-  const Run rk4 = run(engine, spec);
+  const ExtremeRun rk4 = run(engine, spec);
   CHECK(rk4.stats.steps == 1000);
   CHECK(rk4.dE < 1e-8);
   State s0 = initial_state(model);
@@ -285,7 +285,7 @@ TEST_CASE("high_spin: |H| and E conserved at 120 rad/s at tight tolerances, too 
   spec.outputs = 100;
   for (IntegratorKind k : {IntegratorKind::arkode_erk, IntegratorKind::cvode_adams}) {
     spec.kind = k;
-    const Run r = run(engine, spec);
+    const ExtremeRun r = run(engine, spec);
     INFO("high_spin, 2 s: " << cost(r));
     CHECK(r.dH < 1e-8);
     CHECK(r.dE < 1e-8);
@@ -294,7 +294,7 @@ TEST_CASE("high_spin: |H| and E conserved at 120 rad/s at tight tolerances, too 
   // RK4 with h = 1 ms (0.12 rad of spin per step) runs, to dH/H ~1e-5 ...
   spec.kind = IntegratorKind::rk4;
   spec.h = 1e-3;
-  const Run rk4 = run(engine, spec);
+  const ExtremeRun rk4 = run(engine, spec);
   CHECK(rk4.dH < 1e-4);
   CHECK(rk4.q_drift < 1e-9);
   // ... with h = 4 ms the quaternion loses 1.3e-6 of its norm per step: the
@@ -324,7 +324,7 @@ TEST_CASE("mass_ratio: a 1e6 mass ratio integrates with E errors far below the s
   VecX ref;
   for (IntegratorKind k : kAdaptive) {
     spec.kind = k;
-    const Run r = run(engine, spec);
+    const ExtremeRun r = run(engine, spec);
     INFO("mass_ratio, 10 s: " << cost(r));
     CHECK(r.dE_abs < 1e-4 * E_sensor);
     CHECK(r.dH < 1e-9);
@@ -344,12 +344,12 @@ TEST_CASE("near_zero_inertia: a 1e-9 kg m^2 degree of freedom integrates, all me
   spec.t_end = 5.0;  // the bench runs 20 s
   spec.kind = IntegratorKind::arkode_erk;
   spec.rtol = 1e-11;
-  const Run ref = run(engine, spec);
+  const ExtremeRun ref = run(engine, spec);
   CHECK(ref.dE < 1e-10);
   spec.rtol = 1e-8;
   for (IntegratorKind k : kAdaptive) {
     spec.kind = k;
-    const Run r = run(engine, spec);
+    const ExtremeRun r = run(engine, spec);
     INFO("near_zero_inertia, 5 s: " << cost(r));
     CHECK(r.dE < 1e-9);
     CHECK(r.dH < 1e-9);
@@ -368,9 +368,9 @@ TEST_CASE("long_horizon: invariant drift per unit time is bounded", "[extreme]")
   spec.outputs = 100;
   spec.rtol = 1e-10;
   spec.kind = IntegratorKind::arkode_erk;
-  const Run erk = run(engine, spec);
+  const ExtremeRun erk = run(engine, spec);
   spec.kind = IntegratorKind::cvode_bdf;
-  const Run bdf = run(engine, spec);
+  const ExtremeRun bdf = run(engine, spec);
   INFO("long_horizon, 1000 s:\n  " << cost(erk) << "\n  " << cost(bdf));
   // Drift rates (per second of simulated time); measured ~1e-12/s (E) and
   // ~1e-15/s (H) for Dormand-Prince, ~1e-10/s (E) for BDF, whose numerical
@@ -379,7 +379,7 @@ TEST_CASE("long_horizon: invariant drift per unit time is bounded", "[extreme]")
   CHECK(erk.dH / T < 1e-13);
   CHECK(bdf.dE / T < 1e-9);
   CHECK(bdf.dH / T < 1e-11);
-  for (const Run* r : {&erk, &bdf}) CHECK(r->q_drift < 1e-9);
+  for (const ExtremeRun* r : {&erk, &bdf}) CHECK(r->q_drift < 1e-9);
 }
 
 TEST_CASE("deep_chain and wide_tree: generated agrees with generic, E and H conserved", "[extreme]") {
@@ -397,7 +397,7 @@ TEST_CASE("deep_chain and wide_tree: generated agrees with generic, E and H cons
     spec.t_end = 2.0;  // the bench runs 20 s
     spec.rtol = 1e-10;
     spec.kind = IntegratorKind::cvode_adams;
-    const Run r = run(generic, spec);
+    const ExtremeRun r = run(generic, spec);
     INFO(name << ", 2 s: " << cost(r));
     CHECK(r.dE < 1e-8);
     CHECK(r.dH < 1e-8);
@@ -468,7 +468,7 @@ TEST_CASE("near_singular: the passage 0 rad from gimbal lock integrates with E a
     const Eigen::SelfAdjointEigenSolver<MatX> e(M);
     max_cond = std::max(max_cond, e.eigenvalues().maxCoeff() / e.eigenvalues().minCoeff());
   };
-  const Run r = run(engine, spec);
+  const ExtremeRun r = run(engine, spec);
   INFO("near_singular, 0.5 s: " << cost(r) << "; min |theta| " << min_theta << ", max |psi_dot| " << max_psi_dot
                                 << ", cond(M) " << cond0 << " -> " << max_cond);
   CHECK(min_theta < 1e-4);        // it went (essentially) through alignment
@@ -482,7 +482,7 @@ TEST_CASE("near_singular: the passage 0 rad from gimbal lock integrates with E a
   spec.rtol = 1e-8;
   for (IntegratorKind k : kAdaptive) {
     spec.kind = k;
-    const Run rk = run(engine, spec);
+    const ExtremeRun rk = run(engine, spec);
     CHECK(rk.dE < 1e-7);
   }
 }

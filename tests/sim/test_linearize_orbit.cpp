@@ -31,7 +31,7 @@ using namespace kanegen;
 
 namespace {
 
-constexpr double kMu = 3.986004418e14;
+using test::kMu;
 
 std::string libration_model(double Ix, double Iy, double Iz, double a, const std::string& extra = "") {
   return fmt::format(R"(name: libration_lvlh

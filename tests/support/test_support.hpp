@@ -2,11 +2,16 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
+#include <unistd.h>
 
 #include "codegen/jit_generator.hpp"
 #include "engine/jit.hpp"
+#include "model/diagnostics.hpp"
 #include "model/model.hpp"
 #include "sim/integrators.hpp"
 #include "tests/support/tolerances.hpp"
@@ -77,5 +82,40 @@ std::vector<std::string> models_under_test(const std::vector<std::string>& files
 
 /// Writes `text` to a fresh temporary file with the given name and returns its path.
 std::string write_temp(const std::string& name, const std::string& text);
+
+/// A file's whole text.
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// tests/data/<rel>.
+inline std::string data_path(const std::string& rel) { return source_path("tests/data/" + rel); }
+
+/// A file of the shared NASTRAN run (tests/data/fea/pynastran_beam_modes/).
+inline std::string shared_run(const std::string& file) {
+  return source_path("tests/data/fea/pynastran_beam_modes/" + file);
+}
+
+/// An empty scratch directory of this process: <tmp>/kanegen-<tag>-<pid>-<name>.
+inline std::filesystem::path scratch_dir(const std::string& tag, const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() /
+                 ("kanegen-" + tag + "-" + std::to_string(getpid()) + "-" + name);
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+/// Diagnostics one per line (a test's INFO).
+inline std::string dump(const std::vector<Diagnostic>& ds) {
+  std::string s;
+  for (const auto& d : ds) s += d.str() + "\n";
+  return s;
+}
+
+/// Earth's gravitational parameter, m^3/s^2 (the tests' orbits).
+constexpr double kMu = 3.986004418e14;
 
 }  // namespace kanegen::test

@@ -33,13 +33,6 @@ using json = nlohmann::json;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / fmt::format("kanegen-view-{}-{}", getpid(), name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
 /// R of a pose's quaternion [.., qw, qx, qy, qz] at `at`.
 Mat3 pose_R(const json& p, std::size_t at) {
   return quat_to_R<double>(Eigen::Vector4d(p[at + 3].get<double>(), p[at + 4].get<double>(), p[at + 5].get<double>(),
@@ -51,7 +44,7 @@ Vec3 pose_p(const json& p, std::size_t at) {
 
 /// Every frame of view_data for a short generic run of `model_rel` against the kinematics at its row.
 void check_view_against_kinematics(const std::string& model_rel, double t_end, double dt) {
-  const fs::path d = scratch(fs::path(model_rel).stem().string());
+  const fs::path d = test::scratch_dir("view", fs::path(model_rel).stem().string());
   const std::string model_path = test::source_path(model_rel), csv = (d / "run.csv").string();
   const test::ShellRun sim = test::run_kanegen(fmt::format("simulate {} --engine generic --t-end {} --dt-out {} "
                                                            "--no-progress -o {}",
@@ -173,7 +166,7 @@ TEST_CASE("view: the frames kept from a long run: evenly in time, the first and 
 TEST_CASE("view: a run of another model, a missing file, --frames 0 and an unknown column are refused with file and "
           "field, nothing written",
           "[view][refusal]") {
-  const fs::path d = scratch("refusals");
+  const fs::path d = test::scratch_dir("view", "refusals");
   const std::string dp = test::source_path("models/double_pendulum.yaml"), sp = test::source_path("models/pendulum.yaml");
   const std::string csv = (d / "dp.csv").string(), out = (d / "v.html").string();
   REQUIRE(test::run_kanegen(fmt::format("simulate {} --engine generic --t-end 0.1 --dt-out 0.05 --no-progress -o {}", dp,
@@ -208,7 +201,7 @@ TEST_CASE("view: a run of another model, a missing file, --frames 0 and an unkno
 TEST_CASE("view: with the run's events table, the timeline's events are named and each frame's locked joints follow "
           "the release and the latches",
           "[view]") {
-  const fs::path d = scratch("events");
+  const fs::path d = test::scratch_dir("view", "events");
   const std::string model_path = test::source_path("models/array_deployment.yaml");
   const std::string csv = (d / "dep.csv").string(), ev = (d / "dep.events.csv").string();
   const test::ShellRun sim = test::run_kanegen(fmt::format(
