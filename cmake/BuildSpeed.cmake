@@ -32,10 +32,15 @@ endfunction()
 # headers each file includes (GiNaC, Eigen, yaml-cpp, CLI11) are parsed and
 # their templates instantiated once per batch, not once per file (a cold
 # build of the CLI alone, no ccache, 2 cores: 3 min 42 s against 5 min 40 s
-# file by file, measured 2026-12-04). The libraries and the CLI only
-# (the tests stay one file per unit, each cached on its own). A developer
-# editing one library file recompiles its batch; -DKANEGEN_UNITY_BUILD=OFF
-# compiles file by file.
+# file by file, measured 2026-12-04). The tests too, six files per batch:
+# most of a test file's time is Eigen's and Catch2's templates instantiated
+# again in every file (the test target cold, no ccache, 2 cores: 105 s wall
+# and 186 CPU-s against 198 s and 325 CPU-s file by file, measured back to
+# back in one clone 2026-12-06). A developer editing one file recompiles its
+# batch; -DKANEGEN_UNITY_BUILD=OFF compiles file by file.
+#   kanegen_unity(target [BATCH_SIZE n] [EXCLUDE source...])
+# EXCLUDE: sources compiled on their own (their own compile definitions, or
+# a file that must not share its unit).
 #
 # The batches are written here, not by CMake's UNITY_BUILD: CMake's batch
 # files #include each source by its absolute path, so a second clone's
@@ -46,13 +51,16 @@ endfunction()
 # A unity target gets no precompiled header: with a handful of batches per
 # target, building each target's .gch costs more than it saves (the CLI alone,
 # cold, no ccache, 2 cores, Ninja: 201 s and 384 CPU-s without them against
-# 240 s and 467 CPU-s with them, measured 2026-12-05). The tests, one file per
-# unit, keep theirs.
-option(KANEGEN_UNITY_BUILD "Compile the libraries and the CLI as unity batches" ON)
+# 240 s and 467 CPU-s with them, measured 2026-12-05).
+option(KANEGEN_UNITY_BUILD "Compile the libraries, the CLI and the tests as unity batches" ON)
 set(KANEGEN_UNITY_BATCH_SIZE 8)
 function(kanegen_unity target)
   if(NOT KANEGEN_UNITY_BUILD)
     return()
+  endif()
+  cmake_parse_arguments(PARSE_ARGV 1 arg "" "BATCH_SIZE" "EXCLUDE")
+  if(NOT arg_BATCH_SIZE)
+    set(arg_BATCH_SIZE ${KANEGEN_UNITY_BATCH_SIZE})
   endif()
   get_target_property(sources ${target} SOURCES)
   get_target_property(source_dir ${target} SOURCE_DIR)
@@ -63,7 +71,7 @@ function(kanegen_unity target)
   set(index 0)
   set(members "")
   foreach(source IN LISTS sources)
-    if(NOT source MATCHES "\\.(cpp|cc|cxx)$")
+    if(NOT source MATCHES "\\.(cpp|cc|cxx)$" OR source IN_LIST arg_EXCLUDE)
       continue()
     endif()
     get_filename_component(path "${source}" ABSOLUTE BASE_DIR "${source_dir}")
@@ -71,7 +79,7 @@ function(kanegen_unity target)
     string(APPEND text "#include \"${rel}\"\n")
     list(APPEND members "${path}")
     math(EXPR count "${count} + 1")
-    if(count EQUAL KANEGEN_UNITY_BATCH_SIZE)
+    if(count EQUAL arg_BATCH_SIZE)
       set(file "${unity_dir}/${target}_${index}.cpp")
       file(CONFIGURE OUTPUT "${file}" CONTENT "// kanegen_unity (cmake/BuildSpeed.cmake)\n${text}")
       list(APPEND batch_files "${file}")

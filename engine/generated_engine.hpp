@@ -36,6 +36,9 @@ class GeneratedEngine final : public Engine {
   /// Path of the shared library the code came from, empty when linked in.
   const std::string& library_path() const { return library_path_; }
   void set_library_path(std::string path) { library_path_ = std::move(path); }
+  /// The u-dot form of the code ("composite" or "articulated"; empty when not known, e.g. linked in).
+  const std::string& udot_form() const { return udot_form_; }
+  void set_udot_form(std::string form) { udot_form_ = std::move(form); }
 
   /// x_dot = [q_dot; u_dot] straight from x = [q; u] (nq + nu doubles, tau nu
   /// doubles): no copies, no size checks, for an integrator's right-hand
@@ -71,6 +74,7 @@ class GeneratedEngine final : public Engine {
   const KanegenGeneratedApi* api_;
   std::shared_ptr<void> library_;
   std::string library_path_;
+  std::string udot_form_;
   KanegenFunctionPtr qdot_ = nullptr, mass_matrix_ = nullptr, forcing_ = nullptr, udot_ = nullptr,
                      jacobian_ = nullptr, energy_ = nullptr, momentum_ = nullptr, reactions_ = nullptr,
                      outputs_ = nullptr, input_jacobian_ = nullptr, output_jacobian_ = nullptr;

@@ -142,8 +142,9 @@ struct CompileStep {
 /// difference the right-hand side instead (LibraryRecord::jacobian_for_integration).
 constexpr long kMaxJacobianUdotOps = 6000;
 
-/// Changes whenever plan_compile() chooses differently (part of the cache key).
-constexpr int kCompilePlanVersion = 4;
+/// Changes whenever plan_compile() chooses differently or the record holds more (part of the cache key).
+/// 5: the record names the u-dot form (LibraryRecord::udot_form).
+constexpr int kCompilePlanVersion = 5;
 
 /// The generated functions are compiled one per translation unit, in
 /// parallel, and linked. With the default flags each part gets an
@@ -374,6 +375,7 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
   jit_cache::LibraryRecord record = jit_cache::make_record(out_path.string(), manifest.api_symbol);
   const ManifestFunction* udot_fn = manifest.find("udot");
   record.jacobian_for_integration = !(udot_fn && udot_fn->ops > kMaxJacobianUdotOps);
+  record.udot_form = manifest.udot_form;
   fs::rename(out_path, so_path, ec);
   if (ec)
     throw std::runtime_error(fmt::format("kanegen: cannot move the compiled library to {}: {}", so_path.string(),
@@ -384,9 +386,10 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
 
 /// dlopen + dlsym of a verified library; throws std::runtime_error.
 std::unique_ptr<GeneratedEngine> open_library(const Model& model, const std::string& path,
-                                              const std::string& api_symbol, const std::string& generator_hash,
-                                              const std::vector<RuntimeParameter>& implicit,
-                                              bool jacobian_for_integration) {
+                                              const jit_cache::LibraryRecord& record,
+                                              const std::string& generator_hash,
+                                              const std::vector<RuntimeParameter>& implicit) {
+  const std::string& api_symbol = record.api_symbol;
   void* h = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!h) {
     const char* e = dlerror();
@@ -398,7 +401,8 @@ std::unique_ptr<GeneratedEngine> open_library(const Model& model, const std::str
   if (!fn) throw std::runtime_error(fmt::format("kanegen: {}: no symbol {}", path, api_symbol));
   auto e = std::make_unique<GeneratedEngine>(model, fn(), std::move(handle), generator_hash, implicit);
   e->set_library_path(path);
-  e->set_jacobian_for_integration(jacobian_for_integration);
+  e->set_jacobian_for_integration(record.jacobian_for_integration);
+  e->set_udot_form(record.udot_form);
   return e;
 }
 
@@ -411,7 +415,7 @@ std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::st
                                                const std::vector<RuntimeParameter>& implicit = {}) {
   if (const auto record = jit_cache::verified_record(so_path)) {
     if (announce(o)) fmt::print(stderr, "kanegen: generated code for {} from the cache ({})\n", model.name, so_path);
-    return open_library(model, so_path, record->api_symbol, generator_hash, implicit, record->jacobian_for_integration);
+    return open_library(model, so_path, *record, generator_hash, implicit);
   }
   const auto t_gen = std::chrono::steady_clock::now();
   const GeneratedSources sources = make_sources();
@@ -422,7 +426,7 @@ std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::st
   build_library(sources, manifest, so_path, o);
   const auto record = jit_cache::verified_record(so_path);
   if (!record) throw std::runtime_error(fmt::format("kanegen: the library just built at {} does not verify", so_path));
-  return open_library(model, so_path, record->api_symbol, generator_hash, implicit, record->jacobian_for_integration);
+  return open_library(model, so_path, *record, generator_hash, implicit);
 }
 
 }  // namespace

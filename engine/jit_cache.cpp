@@ -62,6 +62,7 @@ std::optional<LibraryRecord> verified_record(const std::string& so_path) {
     r.size = j.at("size").get<long long>();
     r.checksum = j.at("fnv1a64").get<std::string>();
     r.jacobian_for_integration = j.value("jacobian_for_integration", true);
+    r.udot_form = j.value("udot_form", "");
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;
   }
@@ -73,7 +74,11 @@ std::optional<LibraryRecord> verified_record(const std::string& so_path) {
 LibraryRecord make_record(const std::string& library_file, const std::string& api_symbol) {
   const std::string bytes = read_all(library_file);
   if (bytes.empty()) throw std::runtime_error(fmt::format("kanegen: cannot read the compiled library {}", library_file));
-  return {api_symbol, static_cast<long long>(bytes.size()), fnv1a64_hex(bytes)};
+  LibraryRecord r;
+  r.api_symbol = api_symbol;
+  r.size = static_cast<long long>(bytes.size());
+  r.checksum = fnv1a64_hex(bytes);
+  return r;
 }
 
 void write_record(const std::string& so_path, const LibraryRecord& r) {
@@ -84,6 +89,7 @@ void write_record(const std::string& so_path, const LibraryRecord& r) {
   j["size"] = r.size;
   j["fnv1a64"] = r.checksum;
   j["jacobian_for_integration"] = r.jacobian_for_integration;
+  j["udot_form"] = r.udot_form;
   {
     std::ofstream out(tmp, std::ios::binary);
     out << j.dump() << "\n";

@@ -20,6 +20,8 @@ struct LibraryRecord {
   std::string checksum;  ///< fnv1a64 hex of the library's bytes
   /// The compiled Jacobian is fast enough for the implicit integrators (else it serves linearize only).
   bool jacobian_for_integration = true;
+  /// The u-dot form the generator chose or was told ("composite", "articulated"; empty in older records).
+  std::string udot_form;
 };
 
 /// <dir>/<stem>-<key>.json for a library path <dir>/<stem>-<key>.so.

@@ -108,6 +108,45 @@ VecX state_derivative(Engine& e, double t, const VecX& q, const VecX& u, const V
   return x;
 }
 
+/// J = d[q_dot; u_dot]/d[q; u], Bw = d(u_dot)/dw and CD = dy/d[q; u; w; tau], exact (dual numbers through the
+/// generated code); false when the engine has no such derivatives. With joints locked they are the reduced
+/// system's (dynamics.md, Locks): its u_dot is the free system's g(x, tau0 + E_l lambda(x)) with the locking
+/// force lambda that holds u_dot_l = 0, so d(u_dot) = P dg, P = I - M^-1 E_l S^-1 E_l', S = E_l' M^-1 E_l, with
+/// dg taken at tau* = tau0 + E_l lambda0 (where g equals the reduced u_dot) and u_l = 0 (the reduced system's
+/// speeds). The outputs are the free system's at tau0 under locks too (Engine::outputs), and so is CD.
+bool exact_derivatives(Engine& engine, double t, const VecX& q0, const VecX& u0, const VecX& tau0, MatX& J,
+                       MatX& Bw, MatX& CD) {
+  if (!engine.has_locks())
+    return engine.jacobian(t, q0, u0, tau0, J) && engine.input_jacobian(t, q0, u0, tau0, Bw) &&
+           engine.output_jacobian(t, q0, u0, tau0, CD);
+  const std::vector<int> locked = engine.locked_u();
+  const int nu = static_cast<int>(u0.size()), nl = static_cast<int>(locked.size());
+  VecX u = u0;
+  for (const int k : locked) u(k) = 0.0;
+  MatX M;
+  VecX F, ud;
+  engine.mass_matrix(t, q0, M);
+  engine.forcing(t, q0, u, tau0, F);
+  engine.udot(t, q0, u, tau0, ud);  // the reduced system's
+  VecX tau_star = tau0;
+  const VecX locking = M * ud - F;  // zero on the free rows
+  for (const int k : locked) tau_star(k) += locking(k);
+  {
+    const ScopedLocks free_system(engine, LockSet{});
+    if (!engine.jacobian(t, q0, u, tau_star, J) || !engine.input_jacobian(t, q0, u, tau_star, Bw) ||
+        !engine.output_jacobian(t, q0, u0, tau0, CD))
+      return false;
+  }
+  MatX E_l = MatX::Zero(nu, nl);
+  for (int c = 0; c < nl; ++c) E_l(locked[c], c) = 1.0;
+  const MatX Minv_El = M.ldlt().solve(E_l);
+  const MatX S = E_l.transpose() * Minv_El;
+  const MatX P = MatX::Identity(nu, nu) - Minv_El * S.ldlt().solve(E_l.transpose());
+  J.bottomRows(nu) = P * J.bottomRows(nu).eval();
+  Bw = P * Bw;
+  return true;
+}
+
 }  // namespace
 
 Eigen::Matrix<double, 4, 3> quaternion_xi(const Eigen::Vector4d& q) {
@@ -299,8 +338,7 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
       options.frame == "lvlh" ? std::optional<OrbitRelativeState>(std::in_place, model, state) : std::nullopt;
   engine.set_inputs(state.w);
   // With joints locked (State::locked) the linear model is the reduced
-  // system's: the locked joints' coordinates and speeds are no states (the
-  // derivatives then come from central differences of the reduced u-dot).
+  // system's: the locked joints' coordinates and speeds are no states.
   const ScopedLocks locks(engine, state.locked);
   const double t = state.t;
   const VecX &q0 = state.q, &u0 = state.u, &tau0 = state.tau;
@@ -308,8 +346,7 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
   // ---- full-coordinate derivatives: J = d[q_dot; u_dot]/d[q; u], Bw, Btau, CD
   MatX J(nx, nx), Bw(nu, model.nw), Btau(nu, nu), CD(model.ny, nq + 2 * nu + model.nw);
   const bool exact = !options.finite_differences && engine.has_jacobian() &&
-                     engine.jacobian(t, q0, u0, tau0, J) && engine.input_jacobian(t, q0, u0, tau0, Bw) &&
-                     engine.output_jacobian(t, q0, u0, tau0, CD);
+                     exact_derivatives(engine, t, q0, u0, tau0, J, Bw, CD);
   // d(u_dot)/d(tau) = M^-1, exactly (u_dot is linear in tau).
   MatX M;
   {

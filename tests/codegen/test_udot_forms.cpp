@@ -27,15 +27,17 @@ TEST_CASE("both u-dot forms agree with the generic engine on every model", "[.][
   for (const auto& f : test::models_under_test(test::all_models())) {
     const Model model = load_model(f);
     GenericEngine generic(model);
-    for (const char* form : {"composite", "articulated"}) {
-      INFO(fs::path(f).filename().string() << " " << form);
-      auto e = test::generated_engine(model, form);
+    const auto engines = test::generated_engines_in_both_forms(model);
+    REQUIRE(engines.size() == 2);
+    for (const auto& e : engines) {
+      INFO(fs::path(f).filename().string() << " " << e->udot_form());
       const CrosscheckResult r = crosscheck(*e, generic, 4, 11);
       for (const auto& [q, v] : r.worst) {
         INFO(q << " " << v);
         CHECK(v <= CrosscheckResult::tolerance(q));
       }
     }
+    CHECK(engines[0]->udot_form() != engines[1]->udot_form());  // one of each
   }
 }
 
@@ -63,10 +65,10 @@ TEST_CASE("the per-model tests run on every model, flexible ones and node childr
 }
 
 TEST_CASE("jit: the suite's build of a model in every u-dot form", "[.][jit][per-model]") {
-  // ctest's fixture "jit: <model>": builds the code every test of the model loads
+  // ctest's fixture "jit: <model>": builds the code every test of the model loads, each form once
   for (const auto& f : test::models_under_test(test::all_models())) {
     const Model model = load_model(f);
-    for (const char* form : {"auto", "composite", "articulated"}) CHECK(test::generated_engine(model, form) != nullptr);
+    CHECK(test::generated_engines_in_both_forms(model).size() == 2);
   }
 }
 

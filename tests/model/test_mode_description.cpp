@@ -103,7 +103,7 @@ TEST_CASE("mass properties: the whole spacecraft's mass, centre of mass and iner
   // rigid rotation w about the com (bus speeds such that v_com = 0, wheels and arrays carried along):
   // T = 1/2 w^T J_com w, as the engine's kinetic energy
   Workspace<double> ws(model);
-  for (const Vec3 w_N : {Vec3(0.1, 0, 0), Vec3(0, 0.2, 0), Vec3(0.03, -0.05, 0.07)}) {
+  for (const Vec3& w_N : {Vec3(0.1, 0, 0), Vec3(0, 0.2, 0), Vec3(0.03, -0.05, 0.07)}) {
     const Mat3 R = turn.toRotationMatrix();
     const Vec3 w_B = R.transpose() * w_N;
     const Vec3 v_O_B = -w_B.cross(com_B);  // v_O = v_com + w x (O - com)

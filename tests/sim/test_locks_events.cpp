@@ -621,6 +621,9 @@ events:
 }
 
 TEST_CASE("locks: linearize at a state with a joint locked gives the model with that joint fixed", "[locks][linearize]") {
+  // in both engines: the generic by central differences, the generated exactly (the free system's dual-number
+  // Jacobian projected onto the reduced system, sim/linearize.cpp); the free joints moving, so the locking
+  // torque carries gravity, springs and the coupling of the motion
   const double th = 0.7;
   const std::string locked_joint =
       "{type: revolute, axis: [0, 0, 1], position: [0.6, 0.05, 0], stiffness: 2, rest: 0.3, locked: true}";
@@ -630,25 +633,36 @@ TEST_CASE("locks: linearize at a state with a joint locked gives the model with 
   const Model fixed = load_model(test::write_temp("lin_fixed.yaml", chain_model(fixed_joint)));
   State sl = initial_state(locked), sf = initial_state(fixed);
   sl.q(locked.q_index("mid.angle")) = th;
-  for (const auto& n : {"link1.angle", "tip.angle"}) {
-    sl.q(locked.q_index(n)) = 0.4;
-    sf.q(fixed.q_index(n)) = 0.4;
+  for (const auto& [n, q, u] : {std::tuple{"link1.angle", 0.4, 0.3}, std::tuple{"tip.angle", -0.2, -0.5}}) {
+    sl.q(locked.q_index(n)) = sf.q(fixed.q_index(n)) = q;
+    sl.u(locked.u_index(std::string(n) + "_rate")) = sf.u(fixed.u_index(std::string(n) + "_rate")) = u;
   }
-  GenericEngine el(locked), ef(fixed);
-  const LinearModel a = linearize(el, sl, {});
-  const LinearModel b = linearize(ef, sf, {});
-  REQUIRE(a.state_names == b.state_names);
-  CHECK(test::rel_err(a.A, b.A) < 1e-6);
-  // tau columns: M_ff^-1 against the fixed model's M^-1 (the locked speed's column is zero)
-  for (std::size_t k = 0; k < a.input_names.size(); ++k) {
-    const auto it = std::find(b.input_names.begin(), b.input_names.end(), a.input_names[k]);
-    if (it == b.input_names.end()) {
-      CHECK(a.B.col(k).isZero(0.0));
-      continue;
+  for (int k = 0; k < 3; ++k) sl.u(k) = sf.u(k) = 0.1 * (k + 1);  // the base's angular velocity
+  for (const bool generated : {false, true}) {
+    INFO((generated ? "generated" : "generic"));
+    std::unique_ptr<Engine> el, ef;
+    if (generated) {
+      el = test::generated_engine(locked), ef = test::generated_engine(fixed);
+    } else {
+      el = std::make_unique<GenericEngine>(locked), ef = std::make_unique<GenericEngine>(fixed);
     }
-    CHECK(test::rel_err(a.B.col(k), b.B.col(it - b.input_names.begin()), 1.0) < 1e-9);
+    const LinearModel a = linearize(*el, sl, {});
+    const LinearModel b = linearize(*ef, sf, {});
+    INFO(a.method);
+    CHECK(a.method.rfind(generated ? "exact" : "central", 0) == 0);
+    REQUIRE(a.state_names == b.state_names);
+    CHECK(test::rel_err(a.A, b.A) < (generated ? 1e-12 : 1e-6));
+    // tau columns: M_ff^-1 against the fixed model's M^-1 (the locked speed's column is zero)
+    for (std::size_t k = 0; k < a.input_names.size(); ++k) {
+      const auto it = std::find(b.input_names.begin(), b.input_names.end(), a.input_names[k]);
+      if (it == b.input_names.end()) {
+        CHECK(a.B.col(k).isZero(0.0));
+        continue;
+      }
+      CHECK(test::rel_err(a.B.col(k), b.B.col(it - b.input_names.begin()), 1.0) < 1e-9);
+    }
+    CHECK(!el->has_locks());  // the engine's locks are back as they were
   }
-  CHECK(!el.has_locks());                 // the engine's locks are back as they were
 }
 
 TEST_CASE("events: a sweep disperses an event's time and records another event's time and energy lost",

@@ -57,6 +57,19 @@ inline std::unique_ptr<GeneratedEngine> generated_engine(const Model& model, con
   return jit_load(model, codegen::jit_code_generator(g), jit_options());
 }
 
+/// The model's code in both u-dot forms, each compiled once: the generator's own choice ("auto", which
+/// the crosscheck and most tests load) and the other form by name. (Loading the chosen form by name
+/// too would compile the same code a second time.) The form is the one the cache's record names.
+inline std::vector<std::unique_ptr<GeneratedEngine>> generated_engines_in_both_forms(const Model& model) {
+  std::vector<std::unique_ptr<GeneratedEngine>> e;
+  e.push_back(generated_engine(model, "auto"));
+  const std::string chosen = e[0]->udot_form();
+  if (chosen != "composite" && chosen != "articulated")
+    throw std::runtime_error("the JIT cache's record of " + model.name + " names no u-dot form");
+  e.push_back(generated_engine(model, chosen == "composite" ? "articulated" : "composite"));
+  return e;
+}
+
 /// Largest relative drifts along a run: E = T + V relative to max |T| + |V|;
 /// p and H relative to their initial norms (floored at 1).
 struct Drift {
