@@ -114,6 +114,8 @@ VecX state_derivative(Engine& e, double t, const VecX& q, const VecX& u, const V
 /// force lambda that holds u_dot_l = 0, so d(u_dot) = P dg, P = I - M^-1 E_l S^-1 E_l', S = E_l' M^-1 E_l, with
 /// dg taken at tau* = tau0 + E_l lambda0 (where g equals the reduced u_dot) and u_l = 0 (the reduced system's
 /// speeds). The outputs are the free system's at tau0 under locks too (Engine::outputs), and so is CD.
+/// false too when the free system's M is singular while the reduced one's is not (a massless body on a
+/// locked joint): central differences of the reduced u_dot then.
 bool exact_derivatives(Engine& engine, double t, const VecX& q0, const VecX& u0, const VecX& tau0, MatX& J,
                        MatX& Bw, MatX& CD) {
   if (!engine.has_locks())
@@ -131,15 +133,19 @@ bool exact_derivatives(Engine& engine, double t, const VecX& q0, const VecX& u0,
   VecX tau_star = tau0;
   const VecX locking = M * ud - F;  // zero on the free rows
   for (const int k : locked) tau_star(k) += locking(k);
-  {
+  const Eigen::LLT<MatX> M_llt(M);
+  if (M_llt.info() != Eigen::Success) return false;
+  try {
     const ScopedLocks free_system(engine, LockSet{});
     if (!engine.jacobian(t, q0, u, tau_star, J) || !engine.input_jacobian(t, q0, u, tau_star, Bw) ||
         !engine.output_jacobian(t, q0, u0, tau0, CD))
       return false;
+  } catch (const SingularMassMatrix&) {
+    return false;
   }
   MatX E_l = MatX::Zero(nu, nl);
   for (int c = 0; c < nl; ++c) E_l(locked[c], c) = 1.0;
-  const MatX Minv_El = M.ldlt().solve(E_l);
+  const MatX Minv_El = M_llt.solve(E_l);
   const MatX S = E_l.transpose() * Minv_El;
   const MatX P = MatX::Identity(nu, nu) - Minv_El * S.ldlt().solve(E_l.transpose());
   J.bottomRows(nu) = P * J.bottomRows(nu).eval();

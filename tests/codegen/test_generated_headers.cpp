@@ -100,7 +100,11 @@ TEST_CASE("generated code takes one sin and one cos per joint angle in each func
   // (GCC then fuses the pair into one sincos call at -O1 and above); the values are the library's, so their
   // accuracy is std::sin's and std::cos's. Checked on every committed header (generated/, which
   // "headers regenerate" keeps equal to the generator's output).
-  const std::regex fn_re(R"(\n(?:template <class T>\n)?(?:void|int) ([a-z_0-9]+)\([^)]*\) \{\n)");
+  // functions, split parts (KANEGEN_NOINLINE ... void udot_part0(...)) too; a function and its parts are one
+  // evaluation, so an angle's sin is taken once among them
+  const std::regex fn_re(R"(\n(?:template <class T>\n)?(?:[A-Z_]+ )*(?:void|int) ([a-z_0-9]+)\([^)]*\) \{\n)");
+  const std::regex part_re(R"(_part[0-9]+$)");
+  const std::regex any_call_re(R"(\b(sin|cos)\()");
   const std::regex call_re(R"(\b(sin|cos)\(([^()]*(?:\([^()]*\))?[^()]*)\))");
   int headers = 0, calls = 0;
   for (const auto& m : kanegen::test::model_files()) {
@@ -110,21 +114,30 @@ TEST_CASE("generated code takes one sin and one cos per joint angle in each func
     std::vector<std::pair<std::string, std::size_t>> starts;  // function name, body start
     for (std::sregex_iterator it(text.begin(), text.end(), fn_re), end; it != end; ++it)
       starts.emplace_back((*it)[1].str(), static_cast<std::size_t>(it->position() + it->length()));
+    std::map<std::string, std::map<std::string, int>> seen;  // function (parts joined) -> call -> count
     for (std::size_t f = 0; f < starts.size(); ++f) {
       const std::size_t stop = text.find("\n}\n", starts[f].second);
       const std::string body = text.substr(starts[f].second, stop - starts[f].second);
-      std::map<std::string, int> seen;
+      auto& in_function = seen[std::regex_replace(starts[f].first, part_re, "")];
+      int matched = 0, all = 0;
       for (std::sregex_iterator it(body.begin(), body.end(), call_re), end; it != end; ++it) {
         // skip the dual numbers' own definitions (std::sin of a.v)
         if (it->position() > 0 && body[static_cast<std::size_t>(it->position()) - 1] == ':') continue;
-        ++seen[(*it)[1].str() + "(" + (*it)[2].str() + ")"];
-        ++calls;
+        ++in_function[(*it)[1].str() + "(" + (*it)[2].str() + ")"];
+        ++matched;
       }
-      for (const auto& [call, count] : seen) {
-        INFO(name << ": " << starts[f].first << ": " << call);
+      for (std::sregex_iterator it(body.begin(), body.end(), any_call_re), end; it != end; ++it)
+        if (it->position() == 0 || body[static_cast<std::size_t>(it->position()) - 1] != ':') ++all;
+      INFO(name << ": " << starts[f].first);
+      CHECK(matched == all);  // no call the pattern above could not read
+      calls += matched;
+    }
+    CHECK(seen.count("udot") == 1);
+    for (const auto& [function, in_function] : seen)
+      for (const auto& [call, count] : in_function) {
+        INFO(name << ": " << function << ": " << call);
         CHECK(count == 1);
       }
-    }
   }
   CHECK(headers >= 20);
   CHECK(calls >= 500);  // the headers do call them (1,037 calls in 26 headers on 2026-12-06)
