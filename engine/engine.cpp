@@ -116,7 +116,19 @@ void Engine::set_parameters(const VecX& p) {
 void Engine::outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y) {
   check_sizes(q, {&u, &tau});
   y.resize(model_.ny);
-  do_outputs(t, q, u, tau, y);
+  if (locked_u_.empty()) {
+    do_outputs(t, q, u, tau, y);
+    return;
+  }
+  // the reduced system's (dynamics.md, Locks): the free system's outputs with the locking torque applied on the
+  // locked speeds, which is what holds them still, at u_l = 0; accelerations, accelerometers and reactions
+  // then are those of the reduced motion
+  VecX ud;
+  udot(t, q, u, tau, ud);  // leaves M_lock_, F_lock_ (F with tau) and u_lock_ at this state
+  tau_lock_ = tau;
+  const VecX locking = M_lock_ * ud - F_lock_;
+  for (const int k : locked_u_) tau_lock_(k) += locking(k);
+  do_outputs(t, q, u_lock_, tau_lock_, y);
 }
 
 bool Engine::input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B) {

@@ -75,7 +75,7 @@ class Engine {
   /// (as MuJoCo's mjData.ctrl). Throws std::invalid_argument on a wrong size.
   void set_inputs(const VecX& w);
   /// The joints locked from now on (per body, model/events.hpp; dynamics.md
-  /// "Locks"): udot() and the outputs give the reduced system's accelerations,
+  /// "Locks"): udot() and outputs() give the reduced system's accelerations,
   /// the reactions at a locked joint include the locking wrench (pass the
   /// reduced u_dot). Empty or all free: none locked. Throws
   /// std::invalid_argument for a wrong size or a joint that cannot lock.
@@ -93,7 +93,8 @@ class Engine {
   const VecX& parameters() const { return p_; }
   static VecX nominal_parameters(const Model& model);
   /// The named outputs y (model().ny values) at the state, with the current
-  /// inputs and tau (accelerations and reactions depend on them).
+  /// inputs and tau (accelerations and reactions depend on them); with joints
+  /// locked, the reduced system's (set_locks).
   void outputs(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& y);
   /// Exact d(u_dot)/dw (nu x nw), if this engine provides it. Throws SingularMassMatrix.
   bool input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B);
@@ -145,7 +146,7 @@ class Engine {
   LockSet locks_;
   std::vector<int> locked_u_;
   MatX M_lock_;  ///< workspace of the reduced u_dot
-  VecX F_lock_, u_lock_;
+  VecX F_lock_, u_lock_, tau_lock_;
 };
 
 /// Sets an engine's locks for a scope (a run, an evaluation at a state) and

@@ -113,8 +113,9 @@ VecX state_derivative(Engine& e, double t, const VecX& q, const VecX& u, const V
 /// system's (dynamics.md, Locks): its u_dot is the free system's g(x, tau0 + E_l lambda(x)) with the locking
 /// force lambda that holds u_dot_l = 0, so d(u_dot) = P dg, P = I - M^-1 E_l S^-1 E_l', S = E_l' M^-1 E_l, with
 /// dg taken at tau* = tau0 + E_l lambda0 (where g equals the reduced u_dot) and u_l = 0 (the reduced system's
-/// speeds). The outputs are the free system's at tau0 under locks too (Engine::outputs), and so is CD.
-/// false too when the free system's M is singular while the reduced one's is not (a massless body on a
+/// speeds). The outputs under locks are the free system's at tau* too (Engine::outputs), so CD is the free
+/// system's plus the locking torque's share: dy = CD_free + CD_tau E dlambda, dlambda = -S^-1 E' dg over every
+/// column (q, u, w, tau). false too when the free system's M is singular while the reduced one's is not (a massless body on a
 /// locked joint): central differences of the reduced u_dot then.
 bool exact_derivatives(Engine& engine, double t, const VecX& q0, const VecX& u0, const VecX& tau0, MatX& J,
                        MatX& Bw, MatX& CD) {
@@ -138,7 +139,7 @@ bool exact_derivatives(Engine& engine, double t, const VecX& q0, const VecX& u0,
   try {
     const ScopedLocks free_system(engine, LockSet{});
     if (!engine.jacobian(t, q0, u, tau_star, J) || !engine.input_jacobian(t, q0, u, tau_star, Bw) ||
-        !engine.output_jacobian(t, q0, u0, tau0, CD))
+        !engine.output_jacobian(t, q0, u, tau_star, CD))
       return false;
   } catch (const SingularMassMatrix&) {
     return false;
@@ -147,6 +148,19 @@ bool exact_derivatives(Engine& engine, double t, const VecX& q0, const VecX& u0,
   for (int c = 0; c < nl; ++c) E_l(locked[c], c) = 1.0;
   const MatX Minv_El = M_llt.solve(E_l);
   const MatX S = E_l.transpose() * Minv_El;
+  if (CD.rows() > 0) {
+    // dg over CD's columns [q; u; w; tau], the locked rows: J's, Bw's and M^-1's (= (M^-1 E)')
+    const int nx = static_cast<int>(J.cols()), nw = static_cast<int>(Bw.cols());
+    MatX G_l(nl, CD.cols());
+    for (int r = 0; r < nl; ++r) {
+      G_l.block(r, 0, 1, nx) = J.row(J.rows() - nu + locked[r]);
+      G_l.block(r, nx, 1, nw) = Bw.row(locked[r]);
+    }
+    G_l.rightCols(nu) = Minv_El.transpose();
+    MatX CD_tau_l(CD.rows(), nl);
+    for (int c = 0; c < nl; ++c) CD_tau_l.col(c) = CD.col(nx + nw + locked[c]);
+    CD -= CD_tau_l * S.ldlt().solve(G_l);
+  }
   const MatX P = MatX::Identity(nu, nu) - Minv_El * S.ldlt().solve(E_l.transpose());
   J.bottomRows(nu) = P * J.bottomRows(nu).eval();
   Bw = P * Bw;

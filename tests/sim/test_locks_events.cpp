@@ -630,9 +630,17 @@ TEST_CASE("locks: linearize at a state with a joint locked gives the model with 
   const std::string fixed_joint =
       fmt::format("{{type: fixed, position: [0.6, 0.05, 0], rotation: {{axis_angle: [[0, 0, 1], {:.17g}]}}}}", th);
   // a named input on a free joint beyond the locked one: its column of B is P times the free system's
+  // and sensors beyond it that read accelerations: an accelerometer and the tip's joint reaction
   const std::string input = "inputs:\n  - {name: push, type: joint_torque, joint: tip}\n";
-  const Model locked = load_model(test::write_temp("lin_locked.yaml", chain_model(locked_joint) + input));
-  const Model fixed = load_model(test::write_temp("lin_fixed.yaml", chain_model(fixed_joint) + input));
+  auto with_sensors = [&](std::string m) {
+    const std::string was = "outputs: [reactions]\n";
+    m.replace(m.find(was), was.size(),
+              "outputs:\n  - reactions\n  - {name: imu, type: specific_force, body: tip, point: [0.1, 0.05, 0]}\n"
+              "  - {name: hold, type: reaction, joint: tip}\n");
+    return m + input;
+  };
+  const Model locked = load_model(test::write_temp("lin_locked.yaml", with_sensors(chain_model(locked_joint))));
+  const Model fixed = load_model(test::write_temp("lin_fixed.yaml", with_sensors(chain_model(fixed_joint))));
   State sl = initial_state(locked), sf = initial_state(fixed);
   sl.q(locked.q_index("mid.angle")) = th;
   for (const auto& [n, q, u] : {std::tuple{"link1.angle", 0.4, 0.3}, std::tuple{"tip.angle", -0.2, -0.5}}) {
@@ -660,6 +668,26 @@ TEST_CASE("locks: linearize at a state with a joint locked gives the model with 
     CHECK(a.method.rfind(generated ? "exact" : "central", 0) == 0);
     REQUIRE(a.state_names == b.state_names);
     CHECK(test::rel_err(a.A, b.A) < (generated ? 1e-12 : 1e-6));
+    // the outputs while locked are the reduced motion's: the fixed model's, and so are C and D
+    {
+      VecX ya, yb;
+      const ScopedLocks held(*el, sl.locked);
+      el->set_inputs(sl.w), ef->set_inputs(sf.w);
+      el->outputs(sl.t, sl.q, sl.u, sl.tau, ya);
+      ef->outputs(sf.t, sf.q, sf.u, sf.tau, yb);
+      CHECK(test::rel_err(ya, yb, 1.0) < 1e-12);
+    }
+    REQUIRE(a.output_names == b.output_names);
+    CHECK(test::rel_err(a.y0, b.y0, 1.0) < 1e-12);
+    CHECK(test::rel_err(a.C, b.C) < (generated ? 1e-12 : 1e-6));
+    for (std::size_t k = 0; k < a.input_names.size(); ++k) {
+      const auto it = std::find(b.input_names.begin(), b.input_names.end(), a.input_names[k]);
+      INFO(a.input_names[k]);
+      if (it == b.input_names.end())  // the locked speed's torque: held by the lock, no output sees it
+        CHECK(a.D.col(k).cwiseAbs().maxCoeff() <= (generated ? 1e-12 : 1e-6) * a.D.cwiseAbs().maxCoeff());
+      else
+        CHECK(test::rel_err(a.D.col(k), b.D.col(it - b.input_names.begin()), 1.0) < (generated ? 1e-12 : 1e-6));
+    }
     // the named input's column, and the tau columns: M_ff^-1 against the fixed model's M^-1 (the locked
     // speed's column is zero)
     REQUIRE(a.input_names[0] == "push");
