@@ -120,15 +120,20 @@ void Engine::outputs(double t, const VecX& q, const VecX& u, const VecX& tau, Ve
     do_outputs(t, q, u, tau, y);
     return;
   }
-  // the reduced system's (dynamics.md, Locks): the free system's outputs with the locking torque applied on the
-  // locked speeds, which is what holds them still, at u_l = 0; accelerations, accelerometers and reactions
-  // then are those of the reduced motion
-  VecX ud;
-  udot(t, q, u, tau, ud);  // leaves M_lock_, F_lock_ (F with tau) and u_lock_ at this state
-  tau_lock_ = tau;
-  const VecX locking = M_lock_ * ud - F_lock_;
-  for (const int k : locked_u_) tau_lock_(k) += locking(k);
+  // the reduced system's: the free system's outputs at u_l = 0 with the locking torque applied; accelerations,
+  // accelerometers and reactions then are those of the reduced motion
+  tau_lock_ = locked_tau(t, q, u, tau);  // leaves u_lock_ (u_l = 0)
   do_outputs(t, q, u_lock_, tau_lock_, y);
+}
+
+VecX Engine::locked_tau(double t, const VecX& q, const VecX& u, const VecX& tau) {
+  if (locked_u_.empty()) return tau;
+  VecX ud;
+  udot(t, q, u, tau, ud);  // the reduced u_dot; leaves M_lock_, F_lock_ (F with tau) and u_lock_ at this state
+  VecX tau_star = tau;
+  const VecX locking = M_lock_ * ud - F_lock_;  // zero on the free rows
+  for (const int k : locked_u_) tau_star(k) += locking(k);
+  return tau_star;
 }
 
 bool Engine::input_jacobian(double t, const VecX& q, const VecX& u, const VecX& tau, MatX& B) {

@@ -84,6 +84,9 @@ class Engine {
   bool has_locks() const { return !locked_u_.empty(); }
   /// The speeds the locks hold at zero (ascending).
   const std::vector<int>& locked_u() const { return locked_u_; }
+  /// tau plus the locking torque on the locked speeds, the one that holds them still: the free system's
+  /// u_dot at u_l = 0 with it applied is the reduced system's (dynamics.md, Locks). tau when none is locked.
+  VecX locked_tau(double t, const VecX& q, const VecX& u, const VecX& tau);
   const VecX& inputs() const { return w_; }
   /// Values of the model's runtime parameters (model().parameters, in order;
   /// docs/sweeps.md), used by every evaluation from now on; the nominal values

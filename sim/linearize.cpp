@@ -115,25 +115,18 @@ VecX state_derivative(Engine& e, double t, const VecX& q, const VecX& u, const V
 /// dg taken at tau* = tau0 + E_l lambda0 (where g equals the reduced u_dot) and u_l = 0 (the reduced system's
 /// speeds). The outputs under locks are the free system's at tau* too (Engine::outputs), so CD is the free
 /// system's plus the locking torque's share: dy = CD_free + CD_tau E dlambda, dlambda = -S^-1 E' dg over every
-/// column (q, u, w, tau). false too when the free system's M is singular while the reduced one's is not (a massless body on a
-/// locked joint): central differences of the reduced u_dot then.
-bool exact_derivatives(Engine& engine, double t, const VecX& q0, const VecX& u0, const VecX& tau0, MatX& J,
-                       MatX& Bw, MatX& CD) {
+/// column (q, u, w, tau). false too when the free system's M (`M`, at q0) is singular while the reduced one's
+/// is not (a massless body on a locked joint): central differences of the reduced u_dot then.
+bool exact_derivatives(Engine& engine, double t, const VecX& q0, const VecX& u0, const VecX& tau0, const MatX& M,
+                       MatX& J, MatX& Bw, MatX& CD) {
   if (!engine.has_locks())
     return engine.jacobian(t, q0, u0, tau0, J) && engine.input_jacobian(t, q0, u0, tau0, Bw) &&
            engine.output_jacobian(t, q0, u0, tau0, CD);
-  const std::vector<int> locked = engine.locked_u();
+  const std::vector<int> locked = engine.locked_u();  // a copy: the free system's scope below clears them
   const int nu = static_cast<int>(u0.size()), nl = static_cast<int>(locked.size());
   VecX u = u0;
   for (const int k : locked) u(k) = 0.0;
-  MatX M;
-  VecX F, ud;
-  engine.mass_matrix(t, q0, M);
-  engine.forcing(t, q0, u, tau0, F);
-  engine.udot(t, q0, u, tau0, ud);  // the reduced system's
-  VecX tau_star = tau0;
-  const VecX locking = M * ud - F;  // zero on the free rows
-  for (const int k : locked) tau_star(k) += locking(k);
+  const VecX tau_star = engine.locked_tau(t, q0, u, tau0);
   const Eigen::LLT<MatX> M_llt(M);
   if (M_llt.info() != Eigen::Success) return false;
   try {
@@ -147,7 +140,7 @@ bool exact_derivatives(Engine& engine, double t, const VecX& q0, const VecX& u0,
   MatX E_l = MatX::Zero(nu, nl);
   for (int c = 0; c < nl; ++c) E_l(locked[c], c) = 1.0;
   const MatX Minv_El = M_llt.solve(E_l);
-  const MatX S = E_l.transpose() * Minv_El;
+  const Eigen::LDLT<MatX> S(E_l.transpose() * Minv_El);
   if (CD.rows() > 0) {
     // dg over CD's columns [q; u; w; tau], the locked rows: J's, Bw's and M^-1's (= (M^-1 E)')
     const int nx = static_cast<int>(J.cols()), nw = static_cast<int>(Bw.cols());
@@ -159,9 +152,9 @@ bool exact_derivatives(Engine& engine, double t, const VecX& q0, const VecX& u0,
     G_l.rightCols(nu) = Minv_El.transpose();
     MatX CD_tau_l(CD.rows(), nl);
     for (int c = 0; c < nl; ++c) CD_tau_l.col(c) = CD.col(nx + nw + locked[c]);
-    CD -= CD_tau_l * S.ldlt().solve(G_l);
+    CD -= CD_tau_l * S.solve(G_l);
   }
-  const MatX P = MatX::Identity(nu, nu) - Minv_El * S.ldlt().solve(E_l.transpose());
+  const MatX P = MatX::Identity(nu, nu) - Minv_El * S.solve(E_l.transpose());
   J.bottomRows(nu) = P * J.bottomRows(nu).eval();
   Bw = P * Bw;
   return true;
@@ -365,21 +358,19 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
 
   // ---- full-coordinate derivatives: J = d[q_dot; u_dot]/d[q; u], Bw, Btau, CD
   MatX J(nx, nx), Bw(nu, model.nw), Btau(nu, nu), CD(model.ny, nq + 2 * nu + model.nw);
-  const bool exact = !options.finite_differences && engine.has_jacobian() &&
-                     exact_derivatives(engine, t, q0, u0, tau0, J, Bw, CD);
-  // d(u_dot)/d(tau) = M^-1, exactly (u_dot is linear in tau).
   MatX M;
-  {
-    engine.mass_matrix(t, q0, M);
-    if (engine.has_locks()) {  // the reduced system's: M_ff^-1 on the free speeds
-      VecX col;
-      for (int k = 0; k < nu; ++k) {
-        reduced_udot(M, VecX::Unit(nu, k), engine.locked_u(), col);
-        Btau.col(k) = col;
-      }
-    } else {
-      Btau = M.llt().solve(MatX::Identity(nu, nu));
+  engine.mass_matrix(t, q0, M);
+  const bool exact = !options.finite_differences && engine.has_jacobian() &&
+                     exact_derivatives(engine, t, q0, u0, tau0, M, J, Bw, CD);
+  // d(u_dot)/d(tau) = M^-1, exactly (u_dot is linear in tau).
+  if (engine.has_locks()) {  // the reduced system's: M_ff^-1 on the free speeds
+    VecX col;
+    for (int k = 0; k < nu; ++k) {
+      reduced_udot(M, VecX::Unit(nu, k), engine.locked_u(), col);
+      Btau.col(k) = col;
     }
+  } else {
+    Btau = M.llt().solve(MatX::Identity(nu, nu));
   }
   VecX y0 = VecX::Zero(model.ny);
   if (model.ny > 0) engine.outputs(t, q0, u0, tau0, y0);
