@@ -190,7 +190,7 @@ TEST_CASE("cli: gimbal lock is refused at a state and stops a run, naming the jo
   CHECK(!fs::exists(csv));
 }
 
-TEST_CASE("cli: no CSV header of any model repeats a name; the older speed names are accepted on input", "[cli][joints]") {
+TEST_CASE("cli: no CSV header of any model repeats a name, the older speed names are accepted on input", "[cli][joints]") {
   const fs::path d = temp_dir();
   for (const std::string& f : kanegen::test::model_files()) {
     const kanegen::Model m = kanegen::load_model(f);
@@ -224,7 +224,7 @@ TEST_CASE("cli: no CSV header of any model repeats a name; the older speed names
   CHECK(both.out.find("name the same speed") != std::string::npos);
 }
 
-TEST_CASE("cli: a first simulate starts on the generic engine at once; the background build serves the next run",
+TEST_CASE("cli: a first simulate starts on the generic engine at once, the background build serves the next run",
           "[cli][handover]") {
   const fs::path cache = temp_dir() / "cold-cache";
   fs::remove_all(cache);
@@ -254,7 +254,7 @@ TEST_CASE("cli: a first simulate starts on the generic engine at once; the backg
   fs::remove_all(cache);
 }
 
-TEST_CASE("cli: events: simulate --events writes the events table and two rows at each event; eval takes locked",
+TEST_CASE("cli: events: simulate --events writes the events table and two rows at each event, eval takes locked",
           "[cli][locks]") {
   const fs::path d = temp_dir();
   const std::string csv = (d / "sep.csv").string(), events = (d / "sep.events.csv").string();
@@ -293,7 +293,7 @@ TEST_CASE("cli: events: simulate --events writes the events table and two rows a
   CHECK(b.out.find("bad_event.yaml:8: events[0].lock[0]: no body named 'b'") != std::string::npos);
 }
 
-TEST_CASE("cli: every output path is checked before the run, each fault naming its option; nothing written",
+TEST_CASE("cli: every output path is checked before the run, each fault naming its option, nothing written",
           "[cli][outputs]") {
   const fs::path d = temp_dir() / "outputs";
   fs::create_directories(d);
@@ -456,8 +456,8 @@ initial:
   fs::remove_all(sweep_dir);
 }
 
-TEST_CASE("cli: check in orbit prints the period, perigee and apogee, locks and events; warns (exit 0) of an angle "
-          "in degrees, mu in km^3/s^2, a perigee below the radius; refuses a mass at the attracting centre",
+TEST_CASE("cli: check in orbit prints the period, perigee and apogee, locks and events, warns (exit 0) of an angle "
+          "in degrees, mu in km^3/s^2, a perigee below the radius, refuses a mass at the attracting centre",
           "[cli][central]") {
   const double mu = 3.986004418e14, a = 6.978137e6, pi = 3.14159265358979323846;
   const Run gg = run("check " + src("models/gravity_gradient_boom.yaml"));

@@ -101,7 +101,7 @@ bodies:
   CHECK(worst <= 1e-8);
 }
 
-TEST_CASE("central gravity: a flexible spinning spacecraft keeps E and H over orbits; with J2, E and H_z", "[central]") {
+TEST_CASE("central gravity: a flexible spinning spacecraft keeps E and H over orbits, with J2, E and H_z", "[central]") {
   const double r0 = 7.0e6, v0 = std::sqrt(kMu / r0);
   const std::string beam = R"(  - name: boom
     parent: sat
@@ -167,7 +167,7 @@ bodies:
 )", "expected a free root joint");
 }
 
-TEST_CASE("initial: orbit: the system's centre of mass on the orbit; attitude: lvlh aligned and turning", "[central]") {
+TEST_CASE("initial: orbit: the system's centre of mass on the orbit, attitude: lvlh aligned and turning", "[central]") {
   const OrbitElements el{7.1e6, 0.05, 0.9, 0.4, 1.2, 0.7};
   const std::string text = R"(name: placed
 gravity: {central: {mu: 3.986004418e14}}

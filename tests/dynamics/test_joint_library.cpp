@@ -252,7 +252,7 @@ TEST_CASE("joints: universal, gimbal, cylindrical and planar equal revolute/pris
   CHECK(worst < test::kRoundoff);
 }
 
-TEST_CASE("joints: a ball joint equals a gimbal at the same attitude and angular velocity; its damper is -c w",
+TEST_CASE("joints: a ball joint equals a gimbal at the same attitude and angular velocity, its damper is -c w",
           "[joints]") {
   const Model ball = load_model(test::write_temp("ball.yaml", ball_model(false, 0.0)));
   const Model damped = load_model(test::write_temp("ball_damped.yaml", ball_model(false, 0.7)));

@@ -82,7 +82,7 @@ TEST_CASE("handover engine: a build ready at the start runs the generated code, 
   CHECK(std::vector<double>(a.begin(), a.begin() + n_state) == std::vector<double>(b.begin(), b.begin() + n_state));
 }
 
-TEST_CASE("handover engine: a build ready during the run takes over; the run agrees with both engines alone",
+TEST_CASE("handover engine: a build ready during the run takes over, the run agrees with both engines alone",
           "[handover][generated]") {
   const Model model = load_model(test::source_path("models/explorer1_rigid.yaml"));
   auto generated = test::generated_engine(model);  // cached before the clock matters

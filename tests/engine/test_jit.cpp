@@ -595,7 +595,7 @@ TEST_CASE("jit_load of v_double3d matches the generic engine", "[jit][generator]
   CHECK(st1.st_mtim.tv_nsec == st0.st_mtim.tv_nsec);
 }
 
-TEST_CASE("a quick build without derivatives is cached apart; a full library, once cached, serves it", "[jit]") {
+TEST_CASE("a quick build without derivatives is cached apart, a full library, once cached, serves it", "[jit]") {
   const TempCache cache;
   const Model m = make_handwritten_pendulum();
   JitOptions lean = cache.options();

@@ -274,7 +274,7 @@ TEST_CASE("nastran import: an offset CONM2's mass moves to a node of its own, wi
   CHECK(Eigen::SelfAdjointEigenSolver<Mat3>(centre.J_B).eigenvalues().minCoeff() >= -1e-15);
 }
 
-TEST_CASE("cli: kanegen import nastran writes the modal file and prints its checks; a bad deck is refused with "
+TEST_CASE("cli: kanegen import nastran writes the modal file and prints its checks, a bad deck is refused with "
           "file and line, nothing written",
           "[nastran][cli]") {
   const fs::path d = test::scratch_dir("nastran", "cli");
@@ -333,7 +333,7 @@ TEST_CASE("cli: kanegen import nastran writes the modal file and prints its chec
   fs::remove_all(d);
 }
 
-TEST_CASE("nastran import: a lumped mass that is not NASTRAN's is refused with the figures unless accepted; a run "
+TEST_CASE("nastran import: a lumped mass that is not NASTRAN's is refused with the figures unless accepted, a run "
           "without eigenvectors is refused",
           "[nastran][refusal]") {
   const std::string dat = shared_run("beam_modes.dat"), f06 = shared_run("beam_modes.f06");

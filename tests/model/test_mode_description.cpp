@@ -61,7 +61,7 @@ TEST_CASE("mode description: a cantilever's bending modes, their directions and 
   CHECK(std::abs(d.node_mass - (mass - arm.flex->nodes[0].mass)) < 1e-12 * mass);  // the clamped root node left out
 }
 
-TEST_CASE("mode description: a complete set of modes carries every moving node's mass; torsion and axial named", "[modes]") {
+TEST_CASE("mode description: a complete set of modes carries every moving node's mass, torsion and axial named", "[modes]") {
   // 8 elements, lumped masses, slopes condensed: 8 modes per bending plane, 8 axial, 8 torsion
   const Model m = beam_model(
       "{length: 2.0, direction: x, mass_per_length: 3.0, EI: [900.0, 400.0], GJ: 50.0, EA: 1.0e5, "

@@ -16,7 +16,7 @@ using kanegen::test::kMu;
 double angle_diff(double a, double b) { return std::abs(std::remainder(a - b, 2.0 * M_PI)); }
 }  // namespace
 
-TEST_CASE("orbit: elements to state and back; vis-viva, angular momentum", "[orbit]") {
+TEST_CASE("orbit: elements to state and back, vis-viva, angular momentum", "[orbit]") {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   for (int k = 0; k < 200; ++k) {

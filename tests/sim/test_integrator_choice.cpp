@@ -146,7 +146,7 @@ TEST_CASE("auto: a spinning spacecraft with strongly damped whips is accuracy-bo
   CHECK_THAT(c.reason, Catch::Contains("accuracy-bound"));
 }
 
-TEST_CASE("auto: variants of the physical Explorer I (stiffer, more damped whips; twice the spin) stay explicit",
+TEST_CASE("auto: variants of the physical Explorer I (stiffer, more damped whips, twice the spin) stay explicit",
           "[integrators]") {
   // The same scene made harder both ways: the whips' modes faster and more
   // damped (EI x4, 20 % damping), or the spin doubled. The spin-rate

@@ -168,7 +168,7 @@ TEST_CASE("linearize: exact derivatives agree with central differences", "[linea
   CHECK((exact.x0_dot - fd.x0_dot).cwiseAbs().maxCoeff() <= 1e-11 * (1 + fd.x0_dot.cwiseAbs().maxCoeff()));
 }
 
-TEST_CASE("linearize: spinning wheels are a relative equilibrium; ignorable coordinates, zero modes, --drop-ignorable",
+TEST_CASE("linearize: spinning wheels are a relative equilibrium, ignorable coordinates, zero modes, --drop-ignorable",
           "[linearize][generated]") {
   // The slew spacecraft at rest with its three wheels spinning (balanced wheels, no gravity): u_dot = 0,
   // only the wheel angles move; nothing depends on them, nor on the bus position and attitude.

@@ -102,7 +102,7 @@ Mat3 skew(const Vec3& v) {
 
 }  // namespace
 
-TEST_CASE("locks: a latch conserves p and H to round-off and loses the rigid-body impact's energy; the panel stops",
+TEST_CASE("locks: a latch conserves p and H to round-off and loses the rigid-body impact's energy, the panel stops",
           "[locks]") {
   const Model model = load_model(test::write_temp("latch_panel.yaml", kLatchModel));
   REQUIRE(model.events.size() == 2);
@@ -448,7 +448,7 @@ TEST_CASE("locks: while locked, u-dot and reactions equal those of the model wit
   }
 }
 
-TEST_CASE("locks: a locked free joint released moves afterwards as a separate free body; the release changes no speed",
+TEST_CASE("locks: a locked free joint released moves afterwards as a separate free body, the release changes no speed",
           "[locks][events]") {
   const std::string text = R"(
 name: separation

@@ -165,7 +165,7 @@ inputs:
   }
 }
 
-TEST_CASE("simulate: a zero total H is no scale (no false alarm); in orbit the drifts are in J and N m s against "
+TEST_CASE("simulate: a zero total H is no scale (no false alarm), in orbit the drifts are in J and N m s against "
           "the motion about the centre of mass, H_z alone with J2",
           "[simulate][central]") {
   // a wheel biased in the null space: H_z = 100 (-0.5 + 1e-12) + 0.5 * 100 = 1e-10 N m s, the wheel's own 50

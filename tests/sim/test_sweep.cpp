@@ -105,7 +105,7 @@ dispersions:
   CHECK_THROWS_WITH(plan_sweep(load_sweep_spec(twice)), Catch::Contains("dispersed twice"));
 }
 
-TEST_CASE("sweep: a closed-loop run equals a single simulate of its draw; 1 and 2 threads agree", "[sweep][generated]") {
+TEST_CASE("sweep: a closed-loop run equals a single simulate of its draw, 1 and 2 threads agree", "[sweep][generated]") {
   const SweepPlan plan = plan_sweep(load_sweep_spec(test::write_temp("closed.yaml", slew_sweep(R"(
 runs: 4
 seed: 3
@@ -169,7 +169,7 @@ dispersions:
   CHECK(r.wall_s < 5.0);
 }
 
-TEST_CASE("sweep: orbit elements and LVLH offsets dispersed by name, each run's centre of mass on its own orbit; "
+TEST_CASE("sweep: orbit elements and LVLH offsets dispersed by name, each run's centre of mass on its own orbit, "
           "the root's state under an orbit refused",
           "[sweep][central]") {
   const std::string model = test::source_path("models/gravity_gradient_boom.yaml");
