@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <optional>
 
@@ -177,9 +178,14 @@ namespace {
 /// LinearModel::ignorable and the relative equilibrium, from A and x0_dot. `body_of`: per state its joint's body.
 void find_ignorable(LinearModel& lin, const std::vector<int>& body_of) {
   const int n = static_cast<int>(lin.A.rows());
-  // exact derivatives: zero is zero to rounding; central differences carry ~1e-8 of noise
+  // exact derivatives: zero is zero to rounding; central differences carry ~1e-8 of noise. Small against the
+  // entry's own row: a yaw stiffness of n^2 (Iy - Ix)/Iz ~ 8e-7 1/s^2 is most of its row, though far below the
+  // unit entries of the kinematic rows (a threshold on max |A| dropped a libration angle as ignorable)
   const bool exact = lin.method.rfind("exact", 0) == 0;
-  const double small = (exact ? 1e-12 : 1e-6) * std::max(1.0, n ? lin.A.cwiseAbs().maxCoeff() : 0.0);
+  // (a row of nothing but noise is judged against 1e-6 max |A| instead)
+  const VecX row_scale = n ? VecX(lin.A.cwiseAbs().rowwise().maxCoeff()) : VecX();
+  const double floor = 1e-6 * std::max(1.0, n ? lin.A.cwiseAbs().maxCoeff() : 0.0);
+  auto small = [&](int r) { return (exact ? 1e-12 : 1e-6) * std::max(row_scale(r), floor); };
   auto is_q = [&](int i) { return lin.state_names[i].rfind("q.", 0) == 0; };
   // in the orbit frame the central field restores the cross-track and radial offsets (Clohessy-Wiltshire's
   // -n^2 y and 3 n^2 z): never ignorable, though by central differences their n^2 may sink below the noise
@@ -198,7 +204,7 @@ void find_ignorable(LinearModel& lin, const std::vector<int>& body_of) {
     for (int i = 0; i < n; ++i) {
       if (!cand[i]) continue;
       for (int j = 0; j < n; ++j)
-        if (std::abs(lin.A(j, i)) > small && !(cand[j] && body_of[j] == body_of[i])) {
+        if (std::abs(lin.A(j, i)) > small(j) && !(cand[j] && body_of[j] == body_of[i])) {
           cand[i] = false, changed = true;
           break;
         }
@@ -260,6 +266,44 @@ void drop_states(LinearModel& lin, const std::vector<std::string>& drop) {
   lin.equilibrium = lin.residual <= kEquilibriumTolerance;
 }
 
+/// Each entry of x = [q; u]'s scale for a difference step: max(1, the norm of the vector it belongs to): a free
+/// joint's position, a quaternion, a free joint's velocity, a quaternion's angular velocity (so that a step
+/// turning the orbit's 7.5e3 m/s by 1e-6 rad counts as 1e-6 of the velocity, not as 7.5e-3 of a zero entry);
+/// max(1, |x_i|) for the others.
+VecX entry_scales(const Model& model, const VecX& x) {
+  VecX s = x.cwiseAbs().cwiseMax(1.0);
+  auto group = [&](int from, int size) {
+    s.segment(from, size).setConstant(std::max(1.0, x.segment(from, size).norm()));
+  };
+  for (const auto& slot : model.quaternions) {
+    const bool free = model.bodies[slot.body].joint.type == JointType::free;
+    group(slot.q, 4);
+    group(model.nq + slot.u, 3);
+    if (free) {  // q = [r, quaternion], u = [v, w]
+      group(slot.q - 3, 3);
+      group(model.nq + slot.u - 3, 3);
+    }
+  }
+  return s;
+}
+
+/// The rate of the orbit frame's chart and the outputs at a full state x = [q; u]: g(x) = J_phi(x) x_dot(x) +
+/// phi_t, y(x). Set for central differences only.
+using ChartRates = std::function<void(const VecX& x, VecX& g, VecX& y)>;
+
+/// g(x) = dz/dt along the flow: the chart through dual numbers carrying x_dot and dt = 1.
+VecX chart_rate(const OrbitRelativeState& chart, const VecX& q, const VecX& u, const VecX& x_dot, double t) {
+  using D1 = Dual<double>;
+  const int nq = static_cast<int>(q.size()), nu = static_cast<int>(u.size());
+  std::vector<D1> qq(nq), uu(nu), z(chart.size());
+  for (int i = 0; i < nq; ++i) qq[i] = D1(q(i), x_dot(i));
+  for (int k = 0; k < nu; ++k) uu[k] = D1(u(k), x_dot(nq + k));
+  chart.apply(qq.data(), uu.data(), D1(t, 1.0), z.data());
+  VecX g(chart.size());
+  for (int r = 0; r < chart.size(); ++r) g(r) = z[r].d;
+  return g;
+}
+
 /// The linear model in the orbit frame's chart z = phi(x, t) (sim/orbit_relative_state.hpp), from the
 /// tangent one: with xi the tangent state (x = x0 + T_in xi + ...), P = dz/dxi = J_phi T_in and
 /// z_dot = g(xi) = J_phi(x) x_dot(x) + phi_t,
@@ -267,8 +311,15 @@ void drop_states(LinearModel& lin, const std::vector<std::string>& drop) {
 /// the second derivatives exact by nested dual numbers (directions: the flow (x_dot, 1) and each column
 /// of T_in); B_z = P B, C_z = C P^-1. J_phi is taken over the full coordinates (the chart's extension off
 /// the unit quaternions included), since J's quaternion rows may leave the sphere.
+/// With `rates` (central differences: g and the outputs y at a full state x), A_z and C_z are differenced in
+/// the chart's own coordinates instead: column j along x0 +- h d_j, d_j = T_in P^-1 e_j (a unit step of z_j,
+/// to first order), h such that no entry of x moves by more than 1e-5 of its scale (entry_scales; near the optimum
+/// eps^(1/3) of central differences: the position rows subtract the orbit's 7.5e3 m/s, so their round-off is
+/// eps 7.5e3 / h; 1.8e-7 against the exact A at 1e-5, 2.2e-6 at 1e-6). Differencing in x and
+/// turning the result by P^-1 would multiply the differences' round-off by P^-1's orbital speed: an attitude
+/// step at fixed body-axis velocity turns the orbit's 7.5e3 m/s, and P^-1 undoes that (A off by 2e-3 so).
 void to_orbit_frame(LinearModel& lin, const OrbitRelativeState& chart, const Model& model, const State& state,
-                    const MatX& J, const MatX& T_in, const VecX& x_dot) {
+                    const MatX& J, const MatX& T_in, const VecX& x_dot, const MatX& R_y, const ChartRates& rates) {
   const int nq = model.nq, nu = model.nu, nx = nq + nu, n = chart.size();
   using D1 = Dual<double>;
   using D2 = Dual<D1>;
@@ -298,10 +349,28 @@ void to_orbit_frame(LinearModel& lin, const OrbitRelativeState& chart, const Mod
     }
   }
   const MatX P = J_phi * T_in;
-  G += J_phi * (J * T_in);
   const Eigen::PartialPivLU<MatX> lu(P);
   const MatX P_inv = lu.inverse();
-  lin.A = G * P_inv;
+  MatX Y_z;  // dy/dz by differences
+  if (rates) {
+    const VecX x0 = (VecX(nx) << state.q, state.u).finished();
+    const MatX D = T_in * P_inv;
+    Y_z.resize(model.ny, n);
+    VecX gp, gm, yp(model.ny), ym(model.ny);
+    const VecX scale = entry_scales(model, x0);
+    for (int j = 0; j < n; ++j) {
+      const double reach = D.col(j).cwiseAbs().cwiseQuotient(scale).maxCoeff();
+      const double h = 1e-5 / std::max(reach, 1e-300);
+      rates(x0 + h * D.col(j), gp, yp);
+      rates(x0 - h * D.col(j), gm, ym);
+      G.col(j) = (gp - gm) / (2 * h);
+      Y_z.col(j) = (yp - ym) / (2 * h);
+    }
+    lin.A = G;
+  } else {
+    G += J_phi * (J * T_in);
+    lin.A = G * P_inv;
+  }
   lin.B = P * lin.B;
   {  // the kinetic energy of the motion relative to the orbit frame: M on the chart's speeds at fixed
      // coordinates (carrying M through the whole of P^-1 would count the orbit's 7e3 m/s turned by an attitude
@@ -317,7 +386,7 @@ void to_orbit_frame(LinearModel& lin, const OrbitRelativeState& chart, const Mod
   if (state_outputs) {
     lin.output_names = lin.state_names;
   } else {
-    lin.C = lin.C * P_inv;
+    lin.C = rates ? MatX(R_y * Y_z) : MatX(lin.C * P_inv);
   }
   lin.x0_dot = g0;
   // the orbit's own scale for the root's translation rows
@@ -451,32 +520,29 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
   lin.kinetic = MatX::Zero(n, n);
   lin.kinetic.bottomRightCorner(nu, nu) = M;
 
+  MatX R_y;  // the output rows' map from the sensors' entries (none with state outputs)
   if (state_outputs) {
     lin.C = MatX::Identity(n, n);
     lin.D = MatX::Zero(n, m);
     lin.output_names = lin.state_names;
     lin.y0 = VecX::Zero(n);
   } else {
-    // output rows, attitude quaternions turned into small rotations
-    std::vector<MatX> C_rows, D_rows;
-    std::vector<double> y_rows;
+    // output rows as combinations of the sensors' entries, Y = R_y y: entries as they are, attitude
+    // quaternions turned into small rotations of the output frame
+    std::vector<std::pair<Eigen::RowVectorXd, double>> rows;  // R_y's row, y0's
     for (std::size_t k = 0; k < out_rows.size();) {
       const int row = out_rows[k];
       const Sensor& s = sensor_of(model, row);
-      auto D_of = [&](const MatX& rows) {
-        MatX Dk(rows.rows(), m);
-        for (int c = 0; c < m; ++c)
-          Dk.col(c) = in_cols[c].w >= 0 ? VecX(rows.col(nx + in_cols[c].w)) : VecX(rows.col(nx + model.nw + in_cols[c].tau));
-        return Dk;
-      };
       const bool whole_quaternion = s.type == SensorType::attitude && row == s.offset && k + 3 < out_rows.size() &&
                                     out_rows[k + 3] == s.offset + 3;
       if (whole_quaternion) {
         const Eigen::Matrix<double, 3, 4> P = 2.0 * quaternion_xi(y0.segment<4>(s.offset)).transpose();
-        const MatX rows = P * CD.middleRows(s.offset, 4);
-        C_rows.push_back(rows.leftCols(nx) * T_in);
-        D_rows.push_back(D_of(rows));
-        for (const char* a : {".rx", ".ry", ".rz"}) lin.output_names.push_back(s.name + a), y_rows.push_back(0.0);
+        for (int a = 0; a < 3; ++a) {
+          Eigen::RowVectorXd r = Eigen::RowVectorXd::Zero(model.ny);
+          r.segment<4>(s.offset) = P.row(a);
+          rows.push_back({r, 0.0});
+        }
+        for (const char* a : {".rx", ".ry", ".rz"}) lin.output_names.push_back(s.name + a);
         k += 4;
       } else {
         if (s.type == SensorType::attitude)
@@ -484,30 +550,36 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
                                       fmt::format("'{}': an attitude output is linearized as a whole (a small "
                                                   "rotation); expected '{}'",
                                                   model.output_names[row], s.name)});
-        const MatX rows = CD.row(row);
-        C_rows.push_back(rows.leftCols(nx) * T_in);
-        D_rows.push_back(D_of(rows));
+        rows.push_back({Eigen::RowVectorXd::Unit(model.ny, row), y0(row)});
         lin.output_names.push_back(model.output_names[row]);
-        y_rows.push_back(y0(row));
         ++k;
       }
     }
-    const int p = static_cast<int>(lin.output_names.size());
-    lin.C.resize(p, n);
+    const int p = static_cast<int>(rows.size());
+    R_y.resize(p, model.ny);
+    lin.y0.resize(p);
+    for (int r = 0; r < p; ++r) R_y.row(r) = rows[r].first, lin.y0(r) = rows[r].second;
+    const MatX CD_y = R_y * CD;
+    lin.C = CD_y.leftCols(nx) * T_in;
     lin.D.resize(p, m);
-    int r = 0;
-    for (std::size_t k = 0; k < C_rows.size(); ++k) {
-      lin.C.middleRows(r, C_rows[k].rows()) = C_rows[k];
-      lin.D.middleRows(r, D_rows[k].rows()) = D_rows[k];
-      r += static_cast<int>(C_rows[k].rows());
-    }
-    lin.y0 = Eigen::Map<const VecX>(y_rows.data(), p);
+    for (int c = 0; c < m; ++c)
+      lin.D.col(c) = in_cols[c].w >= 0 ? VecX(CD_y.col(nx + in_cols[c].w)) : VecX(CD_y.col(nx + model.nw + in_cols[c].tau));
   }
   lin.method = exact ? "exact: forward-mode dual numbers through the generated code"
                      : "central differences (step 1e-6 max(1, |x|)) of the " + engine.name() + " engine";
   if (orbit_chart) {
-    to_orbit_frame(lin, *orbit_chart, model, state, J, T_in, x_dot);
-    lin.method += "; the orbit frame's chart exact (nested dual numbers)";
+    ChartRates rates;
+    if (!exact)
+      rates = [&](const VecX& x, VecX& g, VecX& y) {
+        const VecX q = x.head(nq), u = x.tail(nu);
+        g = chart_rate(*orbit_chart, q, u, state_derivative(engine, t, q, u, tau0), t);
+        if (model.ny) engine.outputs(t, q, u, tau0, y);
+      };
+    to_orbit_frame(lin, *orbit_chart, model, state, J, T_in, x_dot, R_y, rates);
+    lin.method = exact ? lin.method + "; the orbit frame's chart exact (nested dual numbers)"
+                       : "central differences in the orbit frame's chart (each relative coordinate stepped, no entry "
+                         "of the state moved by more than 1e-5 of its vector's max(1, |v|)) of the " + engine.name() +
+                             " engine";
   }
   lin.residual = scaled_residual(lin);
   lin.equilibrium = lin.residual <= kEquilibriumTolerance;
