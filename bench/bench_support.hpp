@@ -41,8 +41,15 @@ long batch_size(F&& f, double seconds) {
 
 /// Median ns per call of each function, timed interleaved: in each of
 /// `rounds` rounds one batch of each (batches of about `batch_seconds`).
-inline std::vector<double> interleaved_ns_per_call(const std::vector<std::function<void()>>& fns, int rounds,
-                                                   double batch_seconds) {
+/// Per function, the median and the least of its `rounds` interleaved slices (ns per call): the least is
+/// what the function costs when nothing else disturbs it (an outside rerun's figure), the median what a
+/// loaded machine gives.
+struct InterleavedTimes {
+  std::vector<double> median, min;
+};
+
+inline InterleavedTimes interleaved_times(const std::vector<std::function<void()>>& fns, int rounds,
+                                          double batch_seconds) {
   using Clock = std::chrono::steady_clock;
   std::vector<long> batch;
   for (const auto& f : fns) batch.push_back(batch_size(f, batch_seconds));
@@ -53,12 +60,18 @@ inline std::vector<double> interleaved_ns_per_call(const std::vector<std::functi
       for (long i = 0; i < batch[e]; ++i) fns[e]();
       ns[e].push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / batch[e]);
     }
-  std::vector<double> median;
+  InterleavedTimes out;
   for (auto& v : ns) {
     std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    median.push_back(v[v.size() / 2]);
+    out.median.push_back(v[v.size() / 2]);
+    out.min.push_back(*std::min_element(v.begin(), v.end()));
   }
-  return median;
+  return out;
+}
+
+inline std::vector<double> interleaved_ns_per_call(const std::vector<std::function<void()>>& fns, int rounds,
+                                                   double batch_seconds) {
+  return interleaved_times(fns, rounds, batch_seconds).median;
 }
 
 }  // namespace kanegen::bench

@@ -116,9 +116,27 @@ std::string parts_text(const EmittedFunction& f) {
   return s;
 }
 
+/// The kernels of a compact function (outlined_code.hpp).
+std::string kernels_text(const EmittedFunction& f) {
+  std::string s;
+  for (std::size_t i = 0; i < f.kernels.size(); ++i) {
+    s += fmt::format("\n// {}, kernel {} of {}\ntemplate <class T>\nKANEGEN_NOINLINE KANEGEN_DISPATCH void "
+                     "{}_kernel{}(T* w, const int* x, const double* c) {{\n",
+                     f.name, i + 1, f.kernels.size(), f.name, i);
+    s += "  using std::cos; using std::sin; using std::sqrt;\n  (void)c;\n";
+    s += f.kernels[i];
+    s += "}\n";
+  }
+  return s + "\n" + f.kernel_tables;
+}
+
 std::string function_text(const EmittedFunction& f) {
   std::string s = fmt::format("\n// ---- {} {}\n", f.title, std::string(f.title.size() < 74 ? 74 - f.title.size() : 3, '-'));
   if (!f.parts.empty()) s += parts_text(f) + "\n";
+  if (!f.kernels.empty())
+    s += fmt::format("\n// Compact code: {} kernels, {} calls, one per group of a body's code (outlined_code.hpp)\n",
+                     f.kernels.size(), f.kernel_calls) +
+         kernels_text(f) + "\n";
   s += f.note;
   if (f.templated) s += "template <class T>\n";
   s += fmt::format("{}{} {}({}) {{\n", f.templated ? "" : "inline ", f.returns_status ? "int" : "void", f.name,
@@ -150,6 +168,9 @@ std::string op_counts(const EmittedModel& m) {
     if (f.name == "udot")
       s += fmt::format(" -- {} form; composite {}, articulated {}", m.udot_form, m.udot_composite_ops.total(),
                        m.udot_articulated_ops.total());
+    if (!f.kernels.empty())
+      s += fmt::format("; compact code: {} kernels ({} operations of code), {} calls", f.kernels.size(),
+                       f.kernel_ops.total(), f.kernel_calls);
     s += "\n";
   }
   return s;

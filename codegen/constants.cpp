@@ -111,6 +111,10 @@ GiNaC::ex Constants::derived_unsigned(const GiNaC::ex& e) {
     group = kDerivedGroup;
     r = value(v, fmt::format("k{:08x}", static_cast<std::uint32_t>(h ^ (h >> 32))), "", "= " + text);
     group = saved;
+    if (GiNaC::is_a<GiNaC::symbol>(r)) {
+      Entry& entry = by_name_.at(GiNaC::ex_to<GiNaC::symbol>(r).get_name());
+      if (entry.derived_from.is_zero()) entry.derived_from = e;
+    }
 
   }
   derived_.emplace(e, r);
@@ -173,6 +177,29 @@ std::set<std::string> Constants::names() const {
   std::set<std::string> s;
   for (const auto& [n, e] : by_name_) s.insert(n);
   return s;
+}
+
+std::string Constants::role(const std::string& name) const {
+  auto it = by_name_.find(name);
+  if (it == by_name_.end()) return name;
+  const Entry& e = it->second;
+  if (!e.derived_from.is_zero()) return "(" + role_of(e.derived_from) + ")";
+  const std::string prefix = e.group + "_";
+  return name.rfind(prefix, 0) == 0 ? name.substr(prefix.size()) : name;
+}
+
+std::string Constants::role_of(const GiNaC::ex& e) const {
+  if (GiNaC::is_a<GiNaC::symbol>(e)) return role(GiNaC::ex_to<GiNaC::symbol>(e).get_name());
+  if (GiNaC::is_a<GiNaC::numeric>(e)) {
+    OpCount unused;
+    return print_cpp(e, unused);
+  }
+  std::vector<std::string> operands;
+  for (std::size_t i = 0; i < e.nops(); ++i) operands.push_back(role_of(e.op(i)));
+  const bool commutative = GiNaC::is_a<GiNaC::add>(e) || GiNaC::is_a<GiNaC::mul>(e);
+  if (commutative) std::sort(operands.begin(), operands.end());
+  const std::string head = GiNaC::is_a<GiNaC::add>(e) ? "+" : GiNaC::is_a<GiNaC::mul>(e) ? "*" : GiNaC::is_a<GiNaC::power>(e) ? "^" : "f";
+  return head + "(" + fmt::format("{}", fmt::join(operands, ",")) + ")";
 }
 
 std::string Constants::emit(const std::string& grp, const std::string& indent) const {

@@ -31,6 +31,10 @@ class Constants {
   std::vector<std::string> groups() const;
   /// Every constant's name (to keep temporaries from shadowing one).
   std::set<std::string> names() const;
+  /// What a constant is, without naming its body: a model constant's name less its group's prefix
+  /// ("link3_R_PJ_yy" -> "R_PJ_yy"), a derived one's expression in such roles, operands sorted. Two bodies'
+  /// corresponding constants have one role (outlined_code.hpp orders kernels' operands by it).
+  std::string role(const std::string& name) const;
 
   std::string group;  ///< group of the constants created next (set by the passes)
 
@@ -39,7 +43,9 @@ class Constants {
     double value;
     std::string unit, what, group;
     GiNaC::symbol sym;
+    GiNaC::ex derived_from;  ///< a derived constant's expression (else 0)
   };
+  std::string role_of(const GiNaC::ex& e) const;
   bool is_constant(const GiNaC::ex& e) const;
   double evaluate(const GiNaC::ex& e) const;
   GiNaC::ex derived(const GiNaC::ex& e);

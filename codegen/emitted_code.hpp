@@ -46,6 +46,12 @@ struct EmittedFunction {
   /// ... that `body` runs first (same parameters plus the workspace T* w of
   /// `workspace` entries); empty for a function emitted in one piece.
   std::vector<std::string> parts;
+  /// Compact functions (outlined_code.hpp): bodies of the kernels NAME_kernel0, ... (T* w, const int* x,
+  /// const double* c) that `body` calls `kernel_calls` times, with the workspace T w[workspace] it declares.
+  std::vector<std::string> kernels;
+  int kernel_calls = 0;
+  std::string kernel_tables;  ///< the calls' tables (namespace scope, before the function)
+  OpCount kernel_ops;  ///< the kernels' own code (each once); `ops` counts every call's
   int workspace = 0;
   OpCount ops;
   std::string note;             ///< extra comment lines for the header section (may be empty)

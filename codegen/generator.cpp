@@ -9,6 +9,7 @@
 #include "codegen/kane_context.hpp"
 #include "codegen/joint_frames.hpp"
 #include "codegen/merge_fixed.hpp"
+#include "codegen/outlined_code.hpp"
 #include "kanegen_generator_hash.h"
 #include "model/model_hash.hpp"
 
@@ -32,6 +33,8 @@ std::string body_comment(const Model& model, const Body& b) {
   return s + "\n";
 }
 
+void finish_straight(const Program& p, EmittedFunction& f, const GeneratorOptions& options);
+
 /// One function's Program, checked and printed into `f`.
 void finish(const Program& p, const Constants& C, EmittedFunction& f, const GeneratorOptions& options) {
   const std::set<std::string> constants = C.names();
@@ -39,6 +42,29 @@ void finish(const Program& p, const Constants& C, EmittedFunction& f, const Gene
     if (constants.count(n))
       throw std::logic_error(fmt::format("generator: temporary '{}' would shadow a model constant", n));
   f.body = p.emit(kIndent, f.ops);
+  const bool compact_wanted =
+      options.udot_code == "compact" || (options.udot_code == "auto" && f.ops.total() > kCompactAboveOps);
+  if (compact_wanted && f.templated && f.name == "udot") {
+    OpCount ops;
+    OutlinedBody o = outline(p, f.name, C, kIndent, ops);
+    if (ops.total() != f.ops.total())
+      throw std::logic_error(fmt::format("generator: {} outlined counts {} operations, straight-line {}", f.name,
+                                         ops.total(), f.ops.total()));
+    const bool shared = o.kernel_ops.total() <= kCompactShare * static_cast<double>(f.ops.total());
+    if (options.udot_code == "auto" && !shared) return finish_straight(p, f, options);
+    f.body = std::move(o.main);
+    f.kernels = std::move(o.kernels);
+    f.kernel_calls = o.calls;
+    f.kernel_tables = std::move(o.tables);
+    f.kernel_ops = o.kernel_ops;
+    f.workspace = o.workspace;
+    return;
+  }
+  finish_straight(p, f, options);
+}
+
+/// f as straight-line code, in parts when it is large (f.body already holds the one-piece code).
+void finish_straight(const Program& p, EmittedFunction& f, const GeneratorOptions& options) {
   if (options.split_above > 0 && f.ops.total() > options.split_above && f.templated) {
     OpCount ops;
     ChunkedBody c = p.emit_chunked(kIndent, ops, options.part_ops);
@@ -210,7 +236,8 @@ std::string generator_identity(const GeneratorOptions& options) {
          (options.merge_fixed ? "" : "-unmerged") + (options.joint_frames ? "" : "-model-frames") +
          (options.split_above == GeneratorOptions{}.split_above && options.part_ops == GeneratorOptions{}.part_ops
               ? ""
-              : fmt::format("-split{}-{}", options.split_above, options.part_ops));
+              : fmt::format("-split{}-{}", options.split_above, options.part_ops)) +
+         (options.udot_code == "auto" ? "" : "-" + options.udot_code);
 }
 
 const EmittedFunction* EmittedModel::find(const std::string& name) const {

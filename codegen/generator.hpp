@@ -21,7 +21,20 @@ struct GeneratorOptions {
   /// model (0: never split).
   long split_above = 12000;
   long part_ops = 3000;
+  /// u-dot as "straight-line" code (one function), "compact" code (kernels shared by the bodies whose code
+  /// has the same shape, outlined_code.hpp) or "auto": compact when the straight-line code is beyond the
+  /// instruction cache (more than kCompactAboveOps operations) and its kernels' own code is at most
+  /// kCompactShare of it (the bodies share it).
+  std::string udot_code = "auto";
 };
+
+/// The cost model of udot_code "auto", from the speed report (docs/speed.md, "Compact code"): straight-line
+/// code runs at ~0.15 ns per operation while it fits the 32 KB instruction cache and at ~0.24 beyond it;
+/// compact code at ~0.18 once bodies share kernels. Measured at the baseline ISA: chain_16 (8,362 operations,
+/// 11 kernels for 46 calls) 1.35x faster compact, tree_15 (5,167, 28 kernels for 38 calls) 1.07x, chain_8
+/// (3,281) 0.96x, bus_4 (1,681) 0.90x.
+inline constexpr long kCompactAboveOps = 6000;
+inline constexpr double kCompactShare = 0.5;
 
 EmittedModel generate(const Model& model, const GeneratorOptions& options = {});
 

@@ -106,6 +106,25 @@ std::string Program::emit(const std::string& indent, OpCount& ops) const {
   return out;
 }
 
+Program::Listing Program::listing(const std::string& indent) const {
+  std::set<std::string> needed;
+  const std::vector<bool> live = liveness(needed);
+  Listing out;
+  out.preludes = used_preludes(needed, indent);
+  const std::string* pending = nullptr;
+  for (std::size_t k = 0; k < temps_.size(); ++k) {
+    if (!temps_[k].section.empty()) {
+      pending = &temps_[k].section;
+      continue;
+    }
+    if (!live[k]) continue;
+    out.temps.push_back({temps_[k].sym, temps_[k].value, pending ? *pending : std::string()});
+    pending = nullptr;
+  }
+  for (const Stmt& s : stmts_) out.statements.push_back({s.lhs, s.text, s.value});
+  return out;
+}
+
 ChunkedBody Program::emit_chunked(const std::string& indent, OpCount& ops, long max_chunk_ops) const {
   std::set<std::string> needed;
   const std::vector<bool> live = liveness(needed);

@@ -67,6 +67,25 @@ class Program {
   /// Names of the temporaries bound so far.
   const std::set<std::string>& names() const { return names_; }
 
+  /// What emit() prints, as data (for other emissions, outlined_code.hpp): the live temporaries in order,
+  /// each with the section marker printed above it (empty: none), then the statements.
+  struct LiveTemp {
+    GiNaC::symbol sym;
+    ex value;
+    std::string section;  ///< the marker that precedes it, or empty
+  };
+  struct Statement {
+    std::string lhs;   ///< empty: a verbatim statement `text` that depends on `value`
+    std::string text;
+    ex value;
+  };
+  struct Listing {
+    std::vector<LiveTemp> temps;
+    std::vector<Statement> statements;
+    std::string preludes;  ///< the preludes some live expression needs, indented, one per line
+  };
+  Listing listing(const std::string& indent) const;
+
  private:
   /// Which temporaries some statement needs; `needed` gets their symbols.
   std::vector<bool> liveness(std::set<std::string>& needed) const;

@@ -48,20 +48,25 @@ def run(cmd, env=None, timeout=3600):
 def udot_ops(kanegen, model):
     with tempfile.TemporaryDirectory() as d:
         _, out, err = run([kanegen, "generate", model, "-o", os.path.join(d, "m.hpp")])
-        m = re.search(r"u_dot (\d+) operations \((\w+) form\)", out + err)
-        return (int(m.group(1)), m.group(2)) if m else (None, "?")
+        m = re.search(r"u_dot (\d+) operations \((\w+) form, ([^)]*)\)", out + err)
+        if not m:
+            return None, "?"
+        code = "compact" if m.group(3).startswith("compact") else "straight-line"
+        return int(m.group(1)), f"{m.group(2)}, {code}"
 
 
 def peer_udot(bindir, model, quick, rows):
     name = os.path.splitext(os.path.basename(model))[0]
     ops, form = udot_ops(os.path.join(bindir, "kanegen"), model)
-    row = dict(model=name, ops=ops, form=form)
+    row = dict(model=name, ops=ops, form=form, floor=floor_ops(model))
     mj = os.path.join(bindir, "kanegen_peer_mujoco")
     if os.path.exists(mj):
         code, out, err = run([mj, model, "--kanegen", "--native", "--rounds", "11" if quick else "31"])
         if code == 0:
             j = json.loads(out)
             row.update({k: j.get(k) for k in ("ns_mujoco", "ns_generated", "ns_generated_native", "ns_generated_baseline", "ns_generic",
+                                               "min_ns_mujoco", "min_ns_generated", "min_ns_generated_native",
+                                               "min_ns_generated_baseline", "min_ns_generic",
                                                "max_rel_diff_generated", "kanegen_jit_seconds",
                                                "backward_error_mujoco", "cond_M")})
             row["nu"] = len(j["u_names"])
@@ -98,6 +103,98 @@ def fmt_ns(v):
 
 def ratio(a, b):
     return "—" if a is None or b is None or b == 0 else f"{a / b:.1f}×"
+
+
+def floor_ops(model_path):
+    """Featherstone's articulated-body count for revolute joints in joint-local frames, 429 n - 348, plus 6 n
+    for sin/cos and the springs (../shared/perf/udot-floor-analysis.md), for a model of revolute joints only;
+    None for others (a free base)."""
+    text = open(model_path).read()
+    joints = re.findall(r"type: (\w+)", text)
+    if not joints or any(j != "revolute" for j in joints):
+        return None
+    n = len(joints)
+    return 429 * n - 348 + 6 * n
+
+
+def udot_section(rows, provenance):
+    """The u-dot table; `provenance`: the line saying when and how this section was measured on its own (None
+    when the page's first line says it)."""
+    def t(r, k):  # the least slice where the run gave it, else the median
+        return r.get("min_" + k, r.get(k))
+
+    L = ["## u-dot per evaluation against MuJoCo and Simbody", ""]
+    if provenance:
+        L += [provenance, ""]
+    L += ["Arbitrary geometry: the models of `../shared/bench-models/` (random revolute axes, rotated joint "
+          "frames, full inertias, springs, gravity; `bus_4` a free bus with four hinged panels) and "
+          "`chain_24_seed7`, another draw of `scripts/make_bench_chain.py`. ns per evaluation, the *least* of "
+          "the interleaved slices (1 ms batches; the least is what an undisturbed rerun measures, the median "
+          "follows the machine's load): kanegen's generated u-dot compiled for baseline x86-64 alone "
+          "(*baseline*: the instruction set of Debian's MuJoCo build, and what a harness compiling the header at "
+          "-O2 gets; the headline ratio), at the JIT's default flags (*dispatched*: an AVX2 clone picked at load "
+          "time on this CPU) and with `--native` (`-march=native`), kanegen's generic engine and MuJoCo 2.2's "
+          "`mj_forward` interleaved in one process; Simbody 3.7 (`realize` to Acceleration) in its own process "
+          "right after (its median). *code*: straight-line, or compact (kernels shared by bodies of one shape, "
+          "docs/decisions.md); *floor*: Featherstone's articulated-body count for revolute joints in joint-local "
+          "frames, 429 n − 348, plus 6 n for sin/cos and springs (`../shared/perf/udot-floor-analysis.md`), and "
+          "the operations against it. u-dot of MuJoCo and Simbody checked against kanegen's before timing: "
+          "largest relative difference (last columns), accepted up to 1e-12, or, where M is ill-conditioned (two "
+          "correct solvers then differ by up to cond(M)·1e-16), a normwise backward error of the peer's u-dot in "
+          "kanegen's M u-dot = F below 1e-14 (given in brackets with cond(M)).", "",
+          "| model | nu | u-dot ops (form, code) | floor (ops / floor) | baseline | ns/op | dispatched | native | "
+          "generic | MuJoCo | **MuJoCo / baseline** | MuJoCo / dispatched | MuJoCo / native | Simbody | "
+          "Simbody / baseline | diff MuJoCo | diff Simbody |",
+          "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        fl = r.get("floor")
+        fl_txt = "—" if not fl or not r.get("ops") else f"{fl:,} ({r['ops'] / fl:.2f})"
+        if "mujoco_error" in r:
+            L.append(f"| {r['model']} | | {r['ops']} ({r['form']}) | {fl_txt} | MuJoCo run failed: "
+                     f"{r['mujoco_error']} | | | | | | | | | | | | |")
+            continue
+        sd = r.get("simbody_diff")
+        base = t(r, "ns_generated_baseline")
+        per_op = "—" if base is None or not r.get("ops") else f"{base / r['ops']:.3f}"
+        L.append(f"| {r['model']} | {r.get('nu', '')} | {r['ops']:,} ({r['form']}) | {fl_txt} | "
+                 f"{fmt_ns(base)} | {per_op} | {fmt_ns(t(r, 'ns_generated'))} | "
+                 f"{fmt_ns(t(r, 'ns_generated_native'))} | {fmt_ns(t(r, 'ns_generic'))} | "
+                 f"{fmt_ns(t(r, 'ns_mujoco'))} | **{ratio(t(r, 'ns_mujoco'), base)}** | "
+                 f"{ratio(t(r, 'ns_mujoco'), t(r, 'ns_generated'))} | "
+                 f"{ratio(t(r, 'ns_mujoco'), t(r, 'ns_generated_native'))} | {fmt_ns(r.get('ns_simbody'))} | "
+                 f"{ratio(r.get('ns_simbody'), base)} | "
+                 f"{r.get('max_rel_diff_generated', float('nan')):.1e}{bw(r.get('backward_error_mujoco'), r)} | "
+                 f"{'—' if sd is None else format(sd, '.1e')}{bw(r.get('simbody_backward'), r)} |")
+    L.append("")
+    return L
+
+
+def udot_models(work):
+    """The u-dot section's models: the bench models and another draw of the chain generator."""
+    tree_draw = os.path.join(work, "chain_24_seed7.yaml")
+    run([sys.executable, os.path.join(ROOT, "scripts", "make_bench_chain.py"), "24", "--seed", "7", "-o", tree_draw])
+    return [os.path.join(SHARED, m + ".yaml") for m in
+            ("chain_2", "chain_4", "chain_8", "chain_16", "chain_32", "chain_64", "tree_15", "bus_4")] + [tree_draw]
+
+
+def loadavg():
+    return float(open("/proc/loadavg").read().split()[0])
+
+
+def rewrite_udot_section(rows, provenance):
+    """docs/speed.md with its u-dot section replaced (the other sections as their runs wrote them)."""
+    path = os.path.join(ROOT, "docs", "speed.md")
+    lines = open(path).read().split("\n")
+    start = next(i for i, l in enumerate(lines) if l.startswith("## u-dot per evaluation"))
+    end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")), len(lines))
+    lines[start:end] = udot_section(rows, provenance)
+    note = " The u-dot section was measured again on its own (`--only udot`; its first line says when)."
+    for i, l in enumerate(lines):
+        if l.startswith("**Every figure on this page") and note.strip() not in l:
+            lines[i] = l + note
+            break
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
 
 
 def work_precision(bindir, img):
@@ -384,10 +481,12 @@ def main():
                     "(possibly interrupted) run instead of measuring; the sections it did not reach are left out. "
                     "Repeat to merge the logs of runs of separate sections (e.g. one from --only auto)")
     ap.add_argument("--log-commit", help="with --from-log: the commit(s) those runs measured")
-    ap.add_argument("--models", help="with --only auto: these models of the suite only (comma-separated); a later "
+    ap.add_argument("--models", help="with --only auto or udot: these models only (comma-separated; udot then "
+                    "prints the section instead of writing the page); with auto a later "
                     "log's rows replace an earlier one's in --from-log")
-    ap.add_argument("--only", choices=["auto"], help="measure one section only and print its rows on stderr "
-                    "(for --from-log); the page is not written")
+    ap.add_argument("--only", choices=["auto", "udot"], help="measure one section only: auto prints its rows on "
+                    "stderr (for --from-log) and writes no page; udot rewrites the u-dot section of docs/speed.md in "
+                    "place, with its own provenance (when, commit, load average)")
     a = ap.parse_args()
     bindir = os.path.join(a.build, "bin")
     started = time.time()
@@ -396,6 +495,28 @@ def main():
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
     cxx = run(["c++", "--version"])[1].splitlines()[0]
 
+    if a.only == "udot":
+        work = tempfile.mkdtemp(prefix="kanegen_speed_")
+        load_before = loadavg()
+        print("u-dot against the peers", file=sys.stderr)
+        rows = []
+        for m in udot_models(work):
+            if a.models and os.path.splitext(os.path.basename(m))[0] not in a.models.split(","):
+                continue
+            peer_udot(bindir, m, a.quick, rows)
+        shutil.rmtree(work, ignore_errors=True)
+        provenance = (f"*This section: `/usr/bin/python3 scripts/speed_report.py --only udot"
+                      f"{' --quick' if a.quick else ''}` on {datetime.datetime.now():%Y-%m-%d %H:%M} (commit {commit}"
+                      f"{' + local changes' if dirty else ''}; {(time.time() - started) / 60:.0f} min), {cpu} "
+                      f"({os.cpu_count()} cores), {cxx}; load average {load_before:.2f} before, {loadavg():.2f} "
+                      "after (1 min).*")
+        if a.models:
+            print("\n".join(udot_section(rows, provenance)))
+            print("(--models: the page is not written)", file=sys.stderr)
+            return
+        rewrite_udot_section(rows, provenance)
+        print(f"rewrote the u-dot section of docs/speed.md in {(time.time() - started) / 60:.1f} min", file=sys.stderr)
+        return
     if a.only == "auto":
         work = tempfile.mkdtemp(prefix="kanegen_speed_")
         print("auto against every method", file=sys.stderr)
@@ -421,14 +542,10 @@ def main():
         work = tempfile.mkdtemp(prefix="kanegen_speed_")
         chain128 = os.path.join(work, "chain_128.yaml")
         run([sys.executable, os.path.join(ROOT, "scripts", "make_bench_chain.py"), "128", "--seed", "1", "-o", chain128])
-        tree_draw = os.path.join(work, "chain_24_seed7.yaml")
-        run([sys.executable, os.path.join(ROOT, "scripts", "make_bench_chain.py"), "24", "--seed", "7", "-o", tree_draw])
-
         print("u-dot against the peers", file=sys.stderr)
         rows = []
-        for m in ("chain_2", "chain_4", "chain_8", "chain_16", "chain_32", "chain_64", "tree_15", "bus_4"):
-            peer_udot(bindir, os.path.join(SHARED, m + ".yaml"), a.quick, rows)
-        peer_udot(bindir, tree_draw, a.quick, rows)
+        for m in udot_models(work):
+            peer_udot(bindir, m, a.quick, rows)
         print("work-precision", file=sys.stderr)
         img = os.path.join(ROOT, "docs", "img", "speed_work_precision.png")
         wp, wp_err = work_precision(bindir, img)
@@ -462,39 +579,7 @@ def main():
           f"{(time.time() - started) / 60:.0f} min{', quick mode' if a.quick else ''}), on ") + f"{cpu} "
          f"({os.cpu_count()} cores, shared and noisy), {cxx}.** Ratios measured in one process are steadier "
          "than absolute times.", ""]
-    L += ["## u-dot per evaluation against MuJoCo and Simbody", "",
-          "Arbitrary geometry: the models of `../shared/bench-models/` (random revolute axes, rotated joint "
-          "frames, full inertias, springs, gravity; `bus_4` a free bus with four hinged panels) and "
-          "`chain_24_seed7`, another draw of `scripts/make_bench_chain.py`. Median ns per evaluation: kanegen's "
-          "generated u-dot compiled for baseline x86-64 alone (*baseline*: the instruction set of Debian's "
-          "MuJoCo build, and what a harness compiling the header at -O2 gets; the headline ratio), at the "
-          "JIT's default flags (*dispatched*: an AVX2 clone picked at load time on this CPU) and with `--native` "
-          "(`-march=native`), kanegen's "
-          "generic engine and MuJoCo 2.2's `mj_forward` interleaved in one process; Simbody 3.7 (`realize` "
-          "to Acceleration) in its own process right after. u-dot of MuJoCo and Simbody checked against "
-          "kanegen's before timing: largest relative difference (last columns), accepted up to 1e-12, or, where "
-          "M is ill-conditioned (two correct solvers then differ by up to cond(M)·1e-16), a normwise backward "
-          "error of the peer's u-dot in kanegen's M u-dot = F below 1e-14 (given in brackets with cond(M)).", "",
-          "| model | nu | u-dot ops (form) | baseline | dispatched | native | generic | MuJoCo | "
-          "**MuJoCo / baseline** | MuJoCo / dispatched | MuJoCo / native | Simbody | Simbody / baseline | "
-          "diff MuJoCo | diff Simbody |",
-          "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
-    for r in rows:
-        if "mujoco_error" in r:
-            L.append(f"| {r['model']} | | {r['ops']} ({r['form']}) | MuJoCo run failed: {r['mujoco_error']} "
-                     "| | | | | | | | | | | |")
-            continue
-        sd = r.get("simbody_diff")
-        L.append(f"| {r['model']} | {r.get('nu', '')} | {r['ops']:,} ({r['form']}) | "
-                 f"{fmt_ns(r.get('ns_generated_baseline'))} | {fmt_ns(r.get('ns_generated'))} | "
-                 f"{fmt_ns(r.get('ns_generated_native'))} | {fmt_ns(r.get('ns_generic'))} | "
-                 f"{fmt_ns(r.get('ns_mujoco'))} | **{ratio(r.get('ns_mujoco'), r.get('ns_generated_baseline'))}** | "
-                 f"{ratio(r.get('ns_mujoco'), r.get('ns_generated'))} | "
-                 f"{ratio(r.get('ns_mujoco'), r.get('ns_generated_native'))} | {fmt_ns(r.get('ns_simbody'))} | "
-                 f"{ratio(r.get('ns_simbody'), r.get('ns_generated_baseline'))} | "
-                 f"{r.get('max_rel_diff_generated', float('nan')):.1e}{bw(r.get('backward_error_mujoco'), r)} | "
-                 f"{'—' if sd is None else format(sd, '.1e')}{bw(r.get('simbody_backward'), r)} |")
-    L.append("")
+    L += udot_section(rows, None)
     if wp:
         L += ["## Work-precision: chain_8 over 10 s", "",
               "![work-precision](img/speed_work_precision.png)", "",

@@ -17,7 +17,7 @@ namespace kanegen::cli {
 namespace generate_command {
 
 struct Options {
-  std::string model, output, entry, manifest, depfile, form = "auto";
+  std::string model, output, entry, manifest, depfile, form = "auto", code = "auto";
 };
 
 int run(const Options& o) {
@@ -33,6 +33,7 @@ int run(const Options& o) {
   check_output_options(outputs, model_files(model));
   codegen::GeneratorOptions opt;
   opt.udot_form = o.form;
+  opt.udot_code = o.code;
   const codegen::EmittedModel emitted = codegen::generate(model, opt);
   // The entry file includes the header by its file name: both go in one directory.
   const std::string header_name = std::filesystem::path(o.output).filename().string();
@@ -51,8 +52,11 @@ int run(const Options& o) {
     write_file_atomically(o.depfile, deps + "\n");
   }
   const auto* udot = emitted.find("udot");
-  fmt::print(stderr, "{}: u_dot {} operations ({} form), M {}, F {}\n", o.output, udot->ops.total(), emitted.udot_form,
-             emitted.find("mass_matrix")->ops.total(), emitted.find("forcing")->ops.total());
+  const std::string code = udot->kernels.empty() ? "straight-line code"
+                                                 : fmt::format("compact code: {} kernels, {} calls", udot->kernels.size(),
+                                                               udot->kernel_calls);
+  fmt::print(stderr, "{}: u_dot {} operations ({} form, {}), M {}, F {}\n", o.output, udot->ops.total(),
+             emitted.udot_form, code, emitted.find("mass_matrix")->ops.total(), emitted.find("forcing")->ops.total());
   return 0;
 }
 
@@ -68,6 +72,10 @@ Subcommand add_generate(CLI::App& app) {
   c->add_option("--depfile", o->depfile, "also write a Make-style dependency file (model and modal files)");
   c->add_option("--udot-form", o->form, "auto (fewer operations) | composite (M, F, tree LTDL) | articulated (O(n))")
       ->check(CLI::IsMember({"auto", "composite", "articulated"}))
+      ->capture_default_str();
+  c->add_option("--udot-code", o->code,
+                "auto (by size) | straight-line (one function) | compact (kernels shared by bodies of one shape)")
+      ->check(CLI::IsMember({"auto", "straight-line", "compact"}))
       ->capture_default_str();
   return {c, [o] { return generate_command::run(*o); }};
 }

@@ -363,12 +363,16 @@ int main(int argc, char** argv) {
   Options opt;
   add_options(app, opt);
   std::string xml_out, wp_ref;
-  bool with_kanegen = false, native = false;
+  bool with_kanegen = false, native = false, compact = false;
   int rounds = 31;
   double t_end = 10.0;
   app.add_option("--xml", xml_out, "also write the generated MJCF to this file");
   app.add_flag("--kanegen", with_kanegen, "also check and time kanegen's generated and generic engines, interleaved");
   app.add_flag("--native", native, "also time kanegen's generated code compiled with -march=native");
+  app.add_flag("--compact", compact,
+               "also time kanegen's u-dot as compact code (kernels shared by bodies, --udot-code compact), baseline ISA");
+  std::string compact_form = "auto";
+  app.add_option("--compact-form", compact_form, "the u-dot form of --compact's code (auto, composite, articulated)");
   app.add_option("--rounds", rounds, "interleaved timing rounds (default 31)");
   app.add_option("--work-precision", wp_ref, "reference end state (STATE.json): error against wall time")
       ->check(CLI::ExistingFile);
@@ -397,6 +401,13 @@ int main(int argc, char** argv) {
     kanegen::JitOptions jb;
     jb.dispatch = false;
     auto generated_baseline = kanegen::jit_load(km, kanegen::codegen::jit_code_generator(), jb);
+    std::unique_ptr<kanegen::GeneratedEngine> generated_compact;
+    if (compact) {
+      kanegen::codegen::GeneratorOptions go;
+      go.udot_code = "compact";
+      go.udot_form = compact_form;
+      generated_compact = kanegen::jit_load(km, kanegen::codegen::jit_code_generator(go), jb);
+    }
     std::unique_ptr<kanegen::GeneratedEngine> generated_native;
     if (native) {
       kanegen::JitOptions jn;
@@ -437,6 +448,18 @@ int main(int argc, char** argv) {
         status = 1;
       }
       engines.push_back([&] { generated_baseline->udot(q, u, tau, ud_base); });
+      kanegen::VecX ud_compact;
+      if (generated_compact) {
+        generated_compact->udot(q, u, tau, ud_compact);
+        j["max_rel_diff_generated_compact_baseline"] = max_rel(ud_compact, ud);
+        j["max_rel_diff_compact_vs_straight"] = max_rel(ud_compact, ud_base);
+        if (!(max_rel(ud_compact, ud) <= opt.tol || backward_error(M, F, ud_compact) <= kBackwardTol)) {
+          std::cerr << "mujoco_peer: compact u-dot differs from MuJoCo's: not timed\n";
+          status = 1;
+        } else {
+          engines.push_back([&] { generated_compact->udot(q, u, tau, ud_compact); });
+        }
+      }
       if (generated_native) {
         generated_native->udot(q, u, tau, ud_nat);
         j["max_rel_diff_generated_native"] = max_rel(ud_nat, ud);
@@ -447,12 +470,14 @@ int main(int argc, char** argv) {
           engines.push_back([&] { generated_native->udot(q, u, tau, ud_nat); });
         }
       }
-      const auto ns = kanegen::bench::interleaved_ns_per_call(engines, rounds, 1e-3);
-      j["ns_mujoco"] = ns[0];
-      j["ns_generated"] = ns[1];
-      j["ns_generic"] = ns[2];
-      j["ns_generated_baseline"] = ns[3];
-      if (ns.size() > 4) j["ns_generated_native"] = ns[4];
+      const auto times = kanegen::bench::interleaved_times(engines, rounds, 1e-3);
+      std::vector<std::string> names{"mujoco", "generated", "generic", "generated_baseline"};
+      if (generated_compact && names.size() < engines.size()) names.push_back("generated_compact_baseline");
+      if (generated_native && names.size() < engines.size()) names.push_back("generated_native");
+      for (std::size_t k = 0; k < names.size(); ++k) {
+        j["ns_" + names[k]] = times.median[k];      // median of the slices
+        j["min_ns_" + names[k]] = times.min[k];     // the least slice
+      }
     }
     if (status == 0 && !wp_ref.empty()) {
       const kanegen::State ref = kanegen::load_state(km, wp_ref);

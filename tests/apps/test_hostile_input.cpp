@@ -29,7 +29,7 @@ struct HostileRun {
   std::string out;  ///< stdout and stderr
 };
 
-HostileRun run(const std::string& args) {
+HostileRun run_hostile(const std::string& args) {
   const std::string cmd = std::string(kanegen::test::kanegen_binary()) + " " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;
@@ -72,18 +72,18 @@ const char* kDp = "models/double_pendulum.yaml";
 TEST_CASE("hostile: deep nesting in a state or a model is refused, located, without a crash", "[hostile]") {
   const fs::path d = kanegen::test::scratch_dir("hostile", "nesting");
   std::string deep = "{\"q\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
-  HostileRun r = run(fmt::format("eval {} --engine generic --state {}", model(kDp), write(d / "s.json", deep)));
+  HostileRun r = run_hostile(fmt::format("eval {} --engine generic --state {}", model(kDp), write(d / "s.json", deep)));
   CHECK(r.status == 2);
   CHECK(located(r.out));
   CHECK(r.out.find("nested deeper") != std::string::npos);
   std::string yaml = "name: x\nbodies: " + std::string(100000, '[') + std::string(100000, ']') + "\n";
-  r = run("check " + write(d / "m.yaml", yaml));
+  r = run_hostile("check " + write(d / "m.yaml", yaml));
   CHECK(r.status == 2);
   CHECK(located(r.out));
   // block nesting ("- - - - ...") is bounded by the YAML parser's depth guard
   std::string block = "name: x\nbodies:\n  ";
   for (int i = 0; i < 5000; ++i) block += "- ";
-  r = run("check " + write(d / "b.yaml", block + "x\n"));
+  r = run_hostile("check " + write(d / "b.yaml", block + "x\n"));
   CHECK(r.status == 2);
   CHECK(located(r.out));
 }
@@ -94,14 +94,14 @@ TEST_CASE("hostile: a second YAML document, or content after '...', is refused",
   std::stringstream ss;
   ss << in.rdbuf();
   for (const std::string tail : {"---\nname: other\n", "...\nname: other\n", "--- {name: other}\n"}) {
-    const HostileRun r = run("check " + write(d / "m.yaml", ss.str() + tail));
+    const HostileRun r = run_hostile("check " + write(d / "m.yaml", ss.str() + tail));
     INFO(tail << r.out);
     CHECK(r.status == 2);
     CHECK(r.out.find("second YAML document") != std::string::npos);
     CHECK(located(r.out));
   }
   // a document end with only comments after it is fine
-  CHECK(run("check " + write(d / "ok.yaml", ss.str() + "...\n# the end\n")).status == 0);
+  CHECK(run_hostile("check " + write(d / "ok.yaml", ss.str() + "...\n# the end\n")).status == 0);
 }
 
 TEST_CASE("hostile: STATE.json faults name the file, the line and the field", "[hostile]") {
@@ -123,7 +123,7 @@ TEST_CASE("hostile: STATE.json faults name the file, the line and the field", "[
       {"{\n\n \"q\": {\"bus.qw\": 0, \"bus.qx\": 0, \"bus.qy\": 0, \"bus.qz\": 0}}", ":3: q.bus.qw:", "is zero"},
   };
   for (const Case& c : cases) {
-    const HostileRun r = run(fmt::format("eval {} --engine generic --state {}", m, write(d / "s.json", c.json)));
+    const HostileRun r = run_hostile(fmt::format("eval {} --engine generic --state {}", m, write(d / "s.json", c.json)));
     INFO(c.json << "\n-> " << r.out);
     CHECK(r.status == 2);
     CHECK(r.out.find("s.json" + c.field) != std::string::npos);
@@ -137,7 +137,7 @@ TEST_CASE("hostile: a quaternion of tiny or huge but non-zero norm is normalized
   const std::string m = model("models/explorer1_rigid.yaml");
   for (const char* v : {"5e-324", "1e-160", "1e200", "1.7e308"}) {
     const std::string json = fmt::format("{{\"q\": {{\"bus.qw\": {0}, \"bus.qx\": {0}, \"bus.qy\": 0, \"bus.qz\": 0}}}}", v);
-    const HostileRun r = run(fmt::format("eval {} --engine generic --state {}", m, write(d / "s.json", json)));
+    const HostileRun r = run_hostile(fmt::format("eval {} --engine generic --state {}", m, write(d / "s.json", json)));
     INFO(v << ": " << r.out);
     REQUIRE(r.status == 0);
     const auto q = nlohmann::json::parse(r.out)["q"];
@@ -148,7 +148,7 @@ TEST_CASE("hostile: a quaternion of tiny or huge but non-zero norm is normalized
 
 TEST_CASE("hostile: a non-finite result is a failure naming the quantity, never null", "[hostile]") {
   const fs::path d = kanegen::test::scratch_dir("hostile", "nonfinite");
-  HostileRun r = run(fmt::format("eval {} --engine generic --state {}", model(kDp),
+  HostileRun r = run_hostile(fmt::format("eval {} --engine generic --state {}", model(kDp),
                           write(d / "s.json", "{\"u\": {\"link1.angle\": 1e200}}")));
   CHECK(r.status == 1);
   CHECK(r.out.find("null") == std::string::npos);
@@ -159,7 +159,7 @@ TEST_CASE("hostile: a non-finite result is a failure naming the quantity, never 
   ss << in.rdbuf();
   std::string text = ss.str();
   text.replace(text.find("gravity: [0, 0, -9.81]"), 22, "gravity: [0, 0, -1.7e308]");
-  r = run(fmt::format("eval {} --engine generic", write(d / "m.yaml", text)));
+  r = run_hostile(fmt::format("eval {} --engine generic", write(d / "m.yaml", text)));
   CHECK(r.status == 1);
   CHECK(r.out.find("null") == std::string::npos);
 }
@@ -175,19 +175,19 @@ TEST_CASE("hostile: integers are decimal everywhere, names printable, CR line br
                               "[0, 0, 1]}\n    flexible: {modal: h.modal.yaml}\n  - name: tip\n    parent: hub\n"
                               "    joint: {type: revolute, node: 10, axis: [0, 1, 0]}\n    mass: 0.1\n"
                               "    inertia: [0.001, 0.001, 0.001, 0, 0, 0]\n");
-  HostileRun r = run("check " + m);
+  HostileRun r = run_hostile("check " + m);
   INFO(r.out);
   CHECK(r.status == 0);
   // control characters and invalid UTF-8 in a name are refused with the line
-  r = run("check " + write(d / "c.yaml", "name: a\x01" "b\nbodies: []\n"));
+  r = run_hostile("check " + write(d / "c.yaml", "name: a\x01" "b\nbodies: []\n"));
   CHECK(r.status == 2);
   CHECK(r.out.find("c.yaml:1:") != std::string::npos);
-  r = run("check " + write(d / "u.yaml", "name: ok\nbodies:\n  - name: \xff\xfe\n"));
+  r = run_hostile("check " + write(d / "u.yaml", "name: ok\nbodies:\n  - name: \xff\xfe\n"));
   CHECK(r.status == 2);
   CHECK(r.out.find("u.yaml:3:") != std::string::npos);
   CHECK(r.out.find("UTF-8") != std::string::npos);
   // an escaped line break in the description would end the header's comment line: refused
-  r = run("check " + write(d / "e.yaml", std::string("name: ok\ndescription: \"a\\nb\"\n") +
+  r = run_hostile("check " + write(d / "e.yaml", std::string("name: ok\ndescription: \"a\\nb\"\n") +
                                              "bodies:\n  - {name: b, parent: ground, joint: {type: revolute, axis: "
                                              "[0,0,1]}, mass: 1, com: [1,0,0]}\n"));
   CHECK(r.status == 2);
@@ -200,12 +200,12 @@ TEST_CASE("hostile: integers are decimal everywhere, names printable, CR line br
   for (char& c : cr)
     if (c == '\n') c = '\r';
   for (char c : ss.str()) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
-  CHECK(run("check " + write(d / "cr.yaml", cr)).status == 0);
-  CHECK(run("check " + write(d / "crlf.yaml", crlf)).status == 0);
+  CHECK(run_hostile("check " + write(d / "cr.yaml", cr)).status == 0);
+  CHECK(run_hostile("check " + write(d / "crlf.yaml", crlf)).status == 0);
   // a 300-character model name is valid (cache file names stay short)
   std::string text = ss.str();
   text.replace(text.find("name: double_pendulum"), 21, "name: " + std::string(300, 'n'));
-  r = run(fmt::format("eval {}", write(d / "long.yaml", text)));
+  r = run_hostile(fmt::format("eval {}", write(d / "long.yaml", text)));
   INFO(r.out.substr(0, 300));
   CHECK(r.status == 0);
 }
@@ -224,21 +224,21 @@ TEST_CASE("hostile: every command-line value is checked against its domain up fr
       {"--t-end 1 --max-steps 0", "--max-steps"},
   };
   for (const Case& c : cases) {
-    const HostileRun r = run(fmt::format("simulate {} --engine generic {} -o {}", m, c.args, out));
+    const HostileRun r = run_hostile(fmt::format("simulate {} --engine generic {} -o {}", m, c.args, out));
     INFO(c.args << " -> " << r.out);
     CHECK(r.status == 2);
     CHECK(r.out.rfind(c.option + ":", 0) == 0);
     CHECK_FALSE(fs::exists(out));
   }
   // the rows a huge horizon would write are said
-  const HostileRun rows = run(fmt::format("simulate {} --engine generic --t-end 1e308 --dt-out 0.01 -o {}", m, out));
+  const HostileRun rows = run_hostile(fmt::format("simulate {} --engine generic --t-end 1e308 --dt-out 0.01 -o {}", m, out));
   CHECK(rows.out.find("rows") != std::string::npos);
   // an unwritable output: a missing directory, a directory, a FIFO, a symlink, a device
   const fs::path fifo = d / "fifo";
   REQUIRE(mkfifo(fifo.c_str(), 0644) == 0);
   fs::create_symlink(d / "target.csv", d / "link.csv");
   for (const fs::path& bad : {d / "missing" / "o.csv", d, fifo, d / "link.csv", fs::path("/dev/null")}) {
-    const HostileRun r = run(fmt::format("simulate {} --engine generic --t-end 1 -o {}", m, bad.string()));
+    const HostileRun r = run_hostile(fmt::format("simulate {} --engine generic --t-end 1 -o {}", m, bad.string()));
     INFO(bad << " -> " << r.out);
     CHECK(r.status == 2);
     CHECK(r.out.find(bad.string()) != std::string::npos);
@@ -247,18 +247,18 @@ TEST_CASE("hostile: every command-line value is checked against its domain up fr
   CHECK(fs::is_symlink(d / "link.csv"));
   CHECK_FALSE(fs::exists(d / "target.csv"));
   // generate onto a directory, and next to a user's own x.hpp.tmp
-  CHECK(run(fmt::format("generate {} -o {}", m, d.string())).status == 2);
+  CHECK(run_hostile(fmt::format("generate {} -o {}", m, d.string())).status == 2);
   // every output option is checked before any work, and named
-  const HostileRun dep = run(fmt::format("generate {} -o {} --depfile {}", m, (d / "p.hpp").string(),
+  const HostileRun dep = run_hostile(fmt::format("generate {} -o {} --depfile {}", m, (d / "p.hpp").string(),
                                   (d / "missing" / "p.d").string()));
   CHECK(dep.status == 2);
   CHECK(dep.out.rfind("--depfile: cannot write", 0) == 0);
   CHECK_FALSE(fs::exists(d / "p.hpp"));
-  const HostileRun modes = run(fmt::format("modes {} --body boom -o {}", model("models/boom_fea.yaml"), d.string()));
+  const HostileRun modes = run_hostile(fmt::format("modes {} --body boom -o {}", model("models/boom_fea.yaml"), d.string()));
   CHECK(modes.status == 2);
   CHECK(modes.out.rfind("-o: cannot write", 0) == 0);
   write(d / "x.hpp.tmp", "mine");
-  CHECK(run(fmt::format("generate {} -o {}", m, (d / "x.hpp").string())).status == 0);
+  CHECK(run_hostile(fmt::format("generate {} -o {}", m, (d / "x.hpp").string())).status == 0);
   std::ifstream mine(d / "x.hpp.tmp");
   std::string kept;
   std::getline(mine, kept);
@@ -302,14 +302,14 @@ TEST_CASE("hostile: a full disk leaves no file and exits 1", "[hostile][disk]") 
     ~Unmount() { umount(p.c_str()); }
   } unmount{d};
   const std::string out = (d / "big.csv").string();
-  const HostileRun r = run(fmt::format("simulate {} --engine generic --t-end 100 --dt-out 0.001 -o {}",
+  const HostileRun r = run_hostile(fmt::format("simulate {} --engine generic --t-end 100 --dt-out 0.001 -o {}",
                                 model("models/explorer1_rigid.yaml"), out));
   INFO(r.out);
   CHECK(r.status == 1);
   CHECK(r.out.find("write failed") != std::string::npos);
   CHECK(fs::is_empty(d));
   // generate and modes on the full disk too
-  const HostileRun g = run(fmt::format("generate {} -o {}", model("models/spacecraft_arrays.yaml"), (d / "h.hpp").string()));
+  const HostileRun g = run_hostile(fmt::format("generate {} -o {}", model("models/spacecraft_arrays.yaml"), (d / "h.hpp").string()));
   CHECK(g.status == 1);
   CHECK(fs::is_empty(d));
   const fs::path w = kanegen::test::scratch_dir("hostile", "fulldisk-model");
@@ -317,7 +317,7 @@ TEST_CASE("hostile: a full disk leaves no file and exits 1", "[hostile][disk]") 
                                  "name: beam\nbodies:\n  - name: b\n    parent: ground\n    joint: {type: fixed}\n"
                                  "    flexible:\n      beam: {length: 2, direction: x, mass_per_length: 0.5, "
                                  "EI: [20, 30], elements: 200, modes: 20}\n");
-  const HostileRun m = run(fmt::format("modes {} --body b -o {}", beam, (d / "b.modal.yaml").string()));
+  const HostileRun m = run_hostile(fmt::format("modes {} --body b -o {}", beam, (d / "b.modal.yaml").string()));
   INFO(m.out);
   CHECK(m.status == 1);
   CHECK(fs::is_empty(d));
@@ -328,7 +328,7 @@ TEST_CASE("hostile: a full disk leaves no file and exits 1", "[hostile][disk]") 
     for (int i = 0; i < 64 && filler.write(block.data(), block.size()); ++i) {
     }
   }
-  const HostileRun dep = run(fmt::format("generate {} -o {} --depfile {}", model("models/pendulum.yaml"),
+  const HostileRun dep = run_hostile(fmt::format("generate {} -o {} --depfile {}", model("models/pendulum.yaml"),
                                   (w / "p.hpp").string(), (d / "p.d").string()));
   INFO(dep.out);
   CHECK(dep.status == 1);
@@ -346,7 +346,7 @@ TEST_CASE("hostile: the limits are checked before allocating, and what is allowe
   write(d / "many.modal.yaml", modal);
   const std::string flexible = "name: many\nbodies:\n  - name: b\n    parent: ground\n    joint: {type: revolute, axis: "
                                "[0,0,1]}\n    flexible: {modal: many.modal.yaml}\n";
-  HostileRun r = run("check " + write(d / "many.yaml", flexible));
+  HostileRun r = run_hostile("check " + write(d / "many.yaml", flexible));
   CHECK(r.status == 2);
   CHECK(r.out.find("at most 2000 modes") != std::string::npos);
   CHECK(located(r.out));
@@ -358,9 +358,9 @@ TEST_CASE("hostile: the limits are checked before allocating, and what is allowe
                              "elements: {}, modes: 4}}\n",
                              elements));
   };
-  r = run("check " + beam(2000));
+  r = run_hostile("check " + beam(2000));
   CHECK(r.status == 0);
-  r = run("check " + beam(2001));
+  r = run_hostile("check " + beam(2001));
   CHECK(r.status == 2);
   CHECK(r.out.find("1..2000") != std::string::npos);
 }
@@ -368,7 +368,7 @@ TEST_CASE("hostile: the limits are checked before allocating, and what is allowe
 TEST_CASE("hostile: a singular mass matrix at the initial state names the speed, the bodies and the line",
           "[hostile]") {
   const fs::path d = kanegen::test::scratch_dir("hostile", "singular");
-  const HostileRun r = run("check " + write(d / "g.yaml", R"(name: gimbal
+  const HostileRun r = run_hostile("check " + write(d / "g.yaml", R"(name: gimbal
 bodies:
   - name: base
     parent: ground
@@ -409,7 +409,7 @@ TEST_CASE("hostile: a modal node that is not a mapping is refused, the shapes st
   std::ifstream min(model("models/boom_fea.yaml"));
   std::stringstream ms;
   ms << min.rdbuf();
-  const HostileRun r = run("check " + write(d / "boom_fea.yaml", ms.str()));
+  const HostileRun r = run_hostile("check " + write(d / "boom_fea.yaml", ms.str()));
   INFO(r.out);
   CHECK(r.status == 2);
   CHECK(r.out.find("nodes[10]: got '7'; expected a mapping") != std::string::npos);
