@@ -106,15 +106,17 @@ def ratio(a, b):
 
 
 def floor_ops(model_path):
-    """Featherstone's articulated-body count for revolute joints in joint-local frames, 429 n - 348, plus 6 n
-    for sin/cos and the springs (../shared/perf/udot-floor-analysis.md), for a model of revolute joints only;
-    None for others (a free base)."""
+    """The operation floor of ../shared/perf/udot-floor-analysis.md for a model of revolute joints only (None
+    for others, e.g. a free base): the cheaper of Featherstone's articulated-body count in joint-local frames,
+    429 n - 348, and the composite route for a chain (RNEA 174 n - 135, CRBA 16 n^2 + 59 n - 75, dense LTDL and
+    two solves n^3/3 + 2.5 n^2), plus 6 n for sin/cos and the springs."""
     text = open(model_path).read()
-    joints = re.findall(r"type: (\w+)", text)
-    if not joints or any(j != "revolute" for j in joints):
+    joints = [j for j in re.findall(r"type: (\w+)", text) if j != "fixed"]  # (a prismatic joint costs the same)
+    if not joints or any(j not in ("revolute", "prismatic") for j in joints):
         return None
     n = len(joints)
-    return 429 * n - 348 + 6 * n
+    composite = 174 * n - 135 + 16 * n * n + 59 * n - 75 + n ** 3 / 3 + 2.5 * n * n
+    return round(min(429 * n - 348, composite) + 6 * n)
 
 
 def udot_section(rows, provenance):
@@ -136,9 +138,10 @@ def udot_section(rows, provenance):
           "time on this CPU) and with `--native` (`-march=native`), kanegen's generic engine and MuJoCo 2.2's "
           "`mj_forward` interleaved in one process; Simbody 3.7 (`realize` to Acceleration) in its own process "
           "right after (its median). *code*: straight-line, or compact (kernels shared by bodies of one shape, "
-          "docs/decisions.md); *floor*: Featherstone's articulated-body count for revolute joints in joint-local "
-          "frames, 429 n − 348, plus 6 n for sin/cos and springs (`../shared/perf/udot-floor-analysis.md`), and "
-          "the operations against it. u-dot of MuJoCo and Simbody checked against kanegen's before timing: "
+          "docs/decisions.md); *floor*: for one-degree-of-freedom joints, the cheaper of Featherstone's articulated-body count "
+          "in joint-local frames, 429 n − 348, and the composite route for a chain (RNEA + CRBA + dense LTDL; a tree's is cheaper), "
+          "plus 6 n for sin/cos and springs (`../shared/perf/udot-floor-analysis.md`), and the operations "
+          "against it. u-dot of MuJoCo and Simbody checked against kanegen's before timing: "
           "largest relative difference (last columns), accepted up to 1e-12, or, where M is ill-conditioned (two "
           "correct solvers then differ by up to cond(M)·1e-16), a normwise backward error of the peer's u-dot in "
           "kanegen's M u-dot = F below 1e-14 (given in brackets with cond(M)).", "",
