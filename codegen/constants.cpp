@@ -62,6 +62,21 @@ double Constants::evaluate(const GiNaC::ex& e) const {
   return GiNaC::ex_to<GiNaC::numeric>(v).to_double();
 }
 
+GiNaC::ex Constants::companion(const GiNaC::ex& like, const std::string& suffix, double v, const std::string& what) {
+  const auto it = by_name_.find(GiNaC::ex_to<GiNaC::symbol>(like).get_name());
+  if (it == by_name_.end()) throw std::logic_error("constants: a companion of a symbol that is no constant");
+  const std::string saved = group;
+  group = it->second.group;
+  const GiNaC::ex r = value(v, it->first + "_" + suffix, "", what);
+  group = saved;
+  return r;
+}
+
+std::optional<double> Constants::numeric_value(const GiNaC::ex& e) const {
+  if (!is_constant(e)) return std::nullopt;
+  return evaluate(e);
+}
+
 GiNaC::ex Constants::derived(const GiNaC::ex& e) {
   // GiNaC may hold the same quantity as -(a b) in one run and (-a) b in the
   // next (its term order follows hash values): a derived constant is free of

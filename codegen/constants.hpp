@@ -8,6 +8,7 @@
 #include <ginac/ginac.h>
 
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -27,6 +28,12 @@ class Constants {
   GiNaC::ex fold(const GiNaC::ex& e);
   /// Declarations of one group, in creation order.
   std::string emit(const std::string& group, const std::string& indent) const;
+  /// A constant derived from the constant symbol `like` and named after it ("<like>_<suffix>", in its group):
+  /// a quantity that every body has (a turn's double-angle terms), so that its role is the same for every
+  /// body, unlike fold()'s hashed names and normalized signs. `like` must be a constant symbol.
+  GiNaC::ex companion(const GiNaC::ex& like, const std::string& suffix, double v, const std::string& what);
+  /// The value of an expression made of constants and numbers only (nullopt otherwise).
+  std::optional<double> numeric_value(const GiNaC::ex& e) const;
   /// Groups in order of first use.
   std::vector<std::string> groups() const;
   /// Every constant's name (to keep temporaries from shadowing one).

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <map>
 #include <sstream>
 #include <tuple>
@@ -47,6 +48,26 @@ struct Group {
   std::vector<int> temps;  ///< indices into the listing's temporaries, in order
 };
 
+/// a < b with runs of digits compared as numbers ("t999" < "t1000").
+bool natural_less(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
+      std::size_t ie = i, je = j;
+      while (ie < a.size() && std::isdigit(static_cast<unsigned char>(a[ie]))) ++ie;
+      while (je < b.size() && std::isdigit(static_cast<unsigned char>(b[je]))) ++je;
+      const std::string da = a.substr(i, ie - i), db = b.substr(j, je - j);
+      if (da.size() != db.size()) return da.size() < db.size();
+      if (da != db) return da < db;
+      i = ie, j = je;
+      continue;
+    }
+    if (a[i] != b[j]) return a[i] < b[j];
+    ++i, ++j;
+  }
+  return a.size() - i < b.size() - j;
+}
+
 /// One group's canonical form: its locals numbered in order, its inputs and constants numbered in a
 /// traversal that orders operands by shape (numbers, locals, "an input", "a constant"), not by name.
 class Canonical {
@@ -65,13 +86,18 @@ class Canonical {
       return;
     }
     // operands by shape; equal shapes by their printed text (canonical, so the header's bytes do not depend on
-    // GiNaC's address-based order)
+    // GiNaC's address-based order), numbers in it compared as numbers: temporaries are numbered in the order
+    // the generator makes them, the same for every body, and t999 must come before t1000 as t99 before t100
     std::vector<std::tuple<std::string, std::string, std::size_t>> operands;
     for (std::size_t i = 0; i < e.nops(); ++i) {
       OpCount unused;
       operands.emplace_back(shape(e.op(i)), print_cpp(e.op(i), unused), i);
     }
-    if (is_a<add>(e) || is_a<mul>(e)) std::sort(operands.begin(), operands.end());
+    if (is_a<add>(e) || is_a<mul>(e))
+      std::sort(operands.begin(), operands.end(), [](const auto& a, const auto& b) {
+        if (std::get<0>(a) != std::get<0>(b)) return std::get<0>(a) < std::get<0>(b);
+        return natural_less(std::get<1>(a), std::get<1>(b));
+      });
     for (const auto& o : operands) visit(e.op(std::get<2>(o)));
   }
 

@@ -3,6 +3,10 @@
 // forces and the applied generalized forces that every symbolic pass shares.
 #include <fmt/format.h>
 
+#include <cmath>
+#include <limits>
+#include <optional>
+
 #include "codegen/kane_context.hpp"
 
 namespace kanegen::codegen {
@@ -92,7 +96,89 @@ std::vector<ex> transform_wrench_to_parent(KaneContext& ctx, int cidx, const std
   return out;
 }
 
+namespace {
+
+/// R as a turn about coordinate axis k: row and column k those of the identity, the (i, j) block [c -s; s c]
+/// ((i, j, k) cyclic), checked symbolically or, for model constants, by value (to 4 ulp). With it the terms
+/// of the turned matrices' (i, j) blocks: ss = s^2, cs = c s, S2 = 2 c s, C2 = c^2 - s^2 (for a turn by model
+/// constants, constants named after its cosine: every body's have one role, outlined_code.hpp).
+struct AxisTurn {
+  int i, j, k;
+  ex c, s;
+  ex ss, cs, S2, C2;
+};
+
+std::optional<AxisTurn> axis_turn(KaneContext& ctx, const SM3& R) {
+  auto same = [&](const ex& a, const ex& b) {
+    if ((a - b).is_zero()) return true;
+    const auto va = ctx.C.numeric_value(a), vb = ctx.C.numeric_value(b);
+    return va && vb && std::abs(*va - *vb) <= 4 * std::numeric_limits<double>::epsilon();
+  };
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    bool ok = (R(k, k) - 1).is_zero();
+    for (int t = 0; t < 3 && ok; ++t)
+      if (t != k) ok = R(k, t).is_zero() && R(t, k).is_zero();
+    if (!ok || R(i, i).is_zero() || R(j, i).is_zero()) continue;  // a quarter turn: the plain product is as cheap
+    if (!same(R(j, j), R(i, i)) || !same(R(i, j), -R(j, i))) continue;
+    AxisTurn t{i, j, k, R(i, i), R(j, i), 0, 0, 0, 0};
+    const auto vc = ctx.C.numeric_value(t.c), vs = ctx.C.numeric_value(t.s);
+    if (vc && vs && is_a<symbol>(t.c)) {
+      t.ss = ctx.C.companion(t.c, "ss", *vs * *vs, "a turn's sin^2");
+      t.cs = ctx.C.companion(t.c, "cs", *vc * *vs, "a turn's cos sin");
+      t.S2 = ctx.C.companion(t.c, "S2", 2 * *vc * *vs, "a turn's sin of the double angle");
+      t.C2 = ctx.C.companion(t.c, "C2", *vc * *vc - *vs * *vs, "a turn's cos of the double angle");
+    } else {
+      t.ss = ctx.A.let(t.s * t.s);
+      t.cs = ctx.A.let(t.c * t.s);
+      t.S2 = 2 * t.cs;
+      t.C2 = ctx.A.let(1 - 2 * t.ss);
+    }
+    return t;
+  }
+  return std::nullopt;
+}
+
+/// R J R^T for a turn about a coordinate axis, J symmetric: with d = J_ii - J_jj and w = d ss + J_ij S2 the
+/// (i, j) block is [J_ii - w, d cs + J_ij C2; ., J_jj + w] (9 operations instead of 21); column k by R.
+SM3 turn_symmetric(KaneContext& ctx, const AxisTurn& t, const SM3& J) {
+  const int i = t.i, j = t.j, k = t.k;
+  SM3 out;
+  const ex d = ctx.A.let(J(i, i) - J(j, j));
+  const ex w = ctx.A.let(d * t.ss + J(i, j) * t.S2);
+  out(i, i) = ctx.A.let(J(i, i) - w);
+  out(j, j) = ctx.A.let(J(j, j) + w);
+  out(i, j) = out(j, i) = ctx.A.let(d * t.cs + J(i, j) * t.C2);
+  out(i, k) = out(k, i) = ctx.A.let(t.c * J(i, k) - t.s * J(j, k));
+  out(j, k) = out(k, j) = ctx.A.let(t.s * J(i, k) + t.c * J(j, k));
+  out(k, k) = J(k, k);
+  return out;
+}
+
+/// R B R^T for a turn about a coordinate axis, B any 3 x 3: with d = B_ii - B_jj, e = B_ij + B_ji,
+/// w = d ss + e cs and v = d cs - e ss the (i, j) block is [B_ii - w, B_ij + v; B_ji + v, B_jj + w] (12
+/// operations instead of 24); row and column k by R.
+SM3 turn_matrix(KaneContext& ctx, const AxisTurn& t, const SM3& B) {
+  const int i = t.i, j = t.j, k = t.k;
+  SM3 out;
+  const ex d = ctx.A.let(B(i, i) - B(j, j)), e = ctx.A.let(B(i, j) + B(j, i));
+  const ex w = ctx.A.let(d * t.ss + e * t.cs), v = ctx.A.let(d * t.cs - e * t.ss);
+  out(i, i) = ctx.A.let(B(i, i) - w);
+  out(j, j) = ctx.A.let(B(j, j) + w);
+  out(i, j) = ctx.A.let(B(i, j) + v);
+  out(j, i) = ctx.A.let(B(j, i) + v);
+  out(i, k) = ctx.A.let(t.c * B(i, k) - t.s * B(j, k));
+  out(j, k) = ctx.A.let(t.s * B(i, k) + t.c * B(j, k));
+  out(k, i) = ctx.A.let(t.c * B(k, i) - t.s * B(k, j));
+  out(k, j) = ctx.A.let(t.s * B(k, i) + t.c * B(k, j));
+  out(k, k) = B(k, k);
+  return out;
+}
+
+}  // namespace
+
 SM3 rotate_symmetric(KaneContext& ctx, const SM3& R, const SM3& J) {
+  if (const auto t = axis_turn(ctx, R)) return turn_symmetric(ctx, *t, J);
   SM3 RJ = ctx.A.mul(R, J), out;
   for (int a = 0; a < 3; ++a)
     for (int c = a; c < 3; ++c)
@@ -100,7 +186,10 @@ SM3 rotate_symmetric(KaneContext& ctx, const SM3& R, const SM3& J) {
   return out;
 }
 
-SM3 rotate_matrix(KaneContext& ctx, const SM3& R, const SM3& B) { return ctx.A.mul(ctx.A.mul(R, B), R.transpose()); }
+SM3 rotate_matrix(KaneContext& ctx, const SM3& R, const SM3& B) {
+  if (const auto t = axis_turn(ctx, R)) return turn_matrix(ctx, *t, B);
+  return ctx.A.mul(ctx.A.mul(R, B), R.transpose());
+}
 
 SMat transform_inertia_to_parent(KaneContext& ctx, int j, const SMat& I) {
   const SymBodyWorkspace& s = ctx.body[j];
@@ -115,15 +204,17 @@ SMat transform_inertia_to_parent(KaneContext& ctx, int j, const SMat& I) {
   // move to the parent's origin: X = [I -P; 0 I], P = p^x; X^T I X =
   // [A, B - A P; B^T + P A, C + P B + (P B)^T - P A P]
   const SM3 P = Alg::skew(s.p_BP_J);
-  const SM3 AP = ctx.A.mul(Am, P), PB = ctx.A.mul(P, Bm);
+  const SM3 AP = ctx.A.mul(Am, P);
   SM3 B2, C2;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) B2(r, c) = ctx.A.let(Bm(r, c) - AP(r, c));
+  // C + P B + (P B)^T - P A P = C + P B2 + (P B)^T (P B2 = P B - P A P): the upper triangle of P B2 and the
+  // lower one of P B, 6 entries each, instead of all of P B and the upper triangle of P A P
   for (int r = 0; r < 3; ++r)
     for (int c = r; c < 3; ++c) {
-      ex pap = 0;  // (P A P)(r, c) = -(A P)^T... = sum_t P(r, t) (A P)(t, c)
-      for (int t = 0; t < 3; ++t) pap += P(r, t) * AP(t, c);
-      C2(r, c) = C2(c, r) = ctx.A.let(Cm(r, c) + PB(r, c) + PB(c, r) - pap);
+      ex pb2 = 0, pb = 0;  // (P B2)(r, c), (P B)(c, r)
+      for (int t = 0; t < 3; ++t) pb2 += P(r, t) * B2(t, c), pb += P(c, t) * Bm(t, r);
+      C2(r, c) = C2(c, r) = ctx.A.let(Cm(r, c) + ctx.A.let(pb2) + ctx.A.let(pb));
     }
   // turn into P components
   Am = rotate_symmetric(ctx, s.R_PJ, Am);

@@ -16,9 +16,9 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot               0 (0 add, 0 mul, 0 div, 0 func)
-//   mass_matrix       51 (20 add, 29 mul, 0 div, 2 func)
+//   mass_matrix       45 (19 add, 24 mul, 0 div, 2 func)
 //   forcing          136 (53 add, 79 mul, 0 div, 4 func)
-//   udot             192 (74 add, 113 mul, 1 div, 4 func) -- composite form; composite 192, articulated 270
+//   udot             186 (73 add, 108 mul, 1 div, 4 func) -- composite form; composite 186, articulated 235
 //   energy            97 (34 add, 57 mul, 2 div, 4 func)
 //   momentum         156 (57 add, 95 mul, 0 div, 4 func)
 //   reactions        256 (108 add, 144 mul, 0 div, 4 func)
@@ -95,6 +95,10 @@ inline constexpr double link2_J0_xz = -0.0661071136868038;  // inertia about O (
 inline constexpr double link2_J0_yy = 0.13832854437869826;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link2_J0_yz = -0.00159208039997985;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link2_J0_zz = 0.08182000000000002;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link2_R_PJ_yy_ss = 0.9977067182958012;  // a turn's sin^2
+inline constexpr double link2_R_PJ_yy_cs = -0.04783327882577192;  // a turn's cos sin
+inline constexpr double link2_R_PJ_yy_S2 = -0.09566655765154385;  // a turn's sin of the double angle
+inline constexpr double link2_R_PJ_yy_C2 = -0.9954134365916023;  // a turn's cos of the double angle
 inline constexpr double link1_R_BBp_xx = 0.8692335601383587;  // the model's body axes from the generator's (joint_frames.hpp)
 inline constexpr double link1_R_BBp_xy = -0.49440167670548435;  // the model's body axes from the generator's (joint_frames.hpp)
 inline constexpr double link1_R_BBp_zx = -0.49440167670548435;  // the model's body axes from the generator's (joint_frames.hpp)
@@ -122,37 +126,33 @@ inline constexpr double k20edf4c2 = 0.00505244041256677;  // = ka903064d*link2_J
 inline constexpr double k2d09fd55 = 0.28548000000000007;  // = link2_J0_xx + link2_J0_yy + link2_J0_zz
 inline constexpr double k359ff293 = -4.850080448480802;  // = link1_R_PJ_zx*minus_gravity_z
 inline constexpr double k3a62d85f = 0.14490798722409443;  // = link2_mass*link2_p_J_z*link2_p_J_z
+inline constexpr double k3e46bb28 = 0.1263778729177485;  // = -k912e4bf7 + k9938a779
 inline constexpr double k56a6b3da = -0.022165734618012186;  // = k97f57875*link2_R_PJ_zz
 inline constexpr double k56b964fd = -0.4623329800347569;  // = k97f57875*link2_R_PJ_yz
 inline constexpr double k59499beb = 2.1316707680882865;  // = kb7e5959a*link2_S0_x
 inline constexpr double k59fbd54e = 0.08256192657043199;  // = link2_S0_z*link2_p_J_z
 inline constexpr double k59fbd957 = 0.012367933498049596;  // = link2_S0_z*link2_p_J_y
 inline constexpr double k59fbda24 = 0.14603123810324428;  // = link2_S0_z*link2_p_J_x
-inline constexpr double k5a157e01 = 0.003251823533422136;  // = k778d9160*link2_p_J_y
 inline constexpr double k5bfb74db = -8.5271812249573;  // = link1_R_PJ_zy*minus_gravity_z
-inline constexpr double k7153affb = 0.028699967295463154;  // = k9cd2416f*link2_R_PJ_zz
-inline constexpr double k7154599c = 0.5986240309774807;  // = k9cd2416f*link2_R_PJ_yz
-inline constexpr double k72815a3b = 0.03839508166451469;  // = k778d9397*link2_p_J_y
-inline constexpr double k72816788 = 0.45334018924248337;  // = k778d9397*link2_p_J_x
+inline constexpr double k61224f02 = 0.37179173796137877;  // = -k1190128e + link2_mass
 inline constexpr double k7584c250 = -0.008045221116868602;  // = link2_R_PJ_zz*link2_S0_z
 inline constexpr double k778d903d = 0.2948640234658285;  // = link2_mass*link2_p_J_z
 inline constexpr double k778d9160 = 0.044171191064462836;  // = link2_mass*link2_p_J_y
 inline constexpr double k778d9397 = 0.5215401360830152;  // = link2_mass*link2_p_J_x
 inline constexpr double k872e6b78 = 0.03407542536229187;  // = k18351ad3 + k59fbd957
-inline constexpr double k87a182b3 = 0.0013759690225193123;  // = kbaa7a689*link2_R_PJ_zz
 inline constexpr double k912e4bf7 = 0.011919692238265832;  // = -ka903064d*link2_J0_xz + link2_J0_xx
 inline constexpr double k97f57875 = 0.46286402346582856;  // = k778d903d + link2_S0_z
 inline constexpr double k98569865 = 1.6;  // = 1.0 + link2_mass
 inline constexpr double k9938a779 = 0.13829756515601432;  // = -ka904c900*link2_J0_yz + link2_J0_yy
-inline constexpr double k9cd2416f = -0.599311620600242;  // = link2_R_PJ_yz*link2_mass
 inline constexpr double ka6ba76ae = 0.7633720296074418;  // = 2.0*k59fbd54e + k3a62d85f + kcd353d42
+inline constexpr double ka7b3ad17 = 0.07299708875739648;  // = -link2_J0_xx + link2_J0_yy
 inline constexpr double ka903064d = -0.8079578793302834;  // = kb7e5959a*link2_J0_xz
 inline constexpr double ka904c900 = -0.019458328036908456;  // = kb7e5959a*link2_J0_yz
 inline constexpr double kb7e5959a = 12.22195062331948;  // = 1.0/link2_J0_zz
-inline constexpr double kbaa7a689 = -0.028732932560245;  // = link2_R_PJ_zz*link2_mass
 inline constexpr double kc16c934c = 0.3132836638983805;  // = 2.0*k59fbd54e + k1835183a + k3a62d85f
 inline constexpr double kc3b8c593 = 0.40233694297716693;  // = k59fbda24 + kcd3534fc
 inline constexpr double kc435ddc0 = -0.0033937912490833535;  // = k59499beb*link2_J0_yz
+inline constexpr double kc7236622 = 0.14091860180884874;  // = -k1adb1eba + link2_S0_z
 inline constexpr double kcd3534fc = 0.2563057048739227;  // = link2_mass*link2_p_J_x*link2_p_J_z
 inline constexpr double kcd353bb1 = 0.03839508166451469;  // = link2_mass*link2_p_J_x*link2_p_J_y
 inline constexpr double kcd353d42 = 0.4533401892424834;  // = link2_mass*link2_p_J_x*link2_p_J_x
@@ -206,27 +206,28 @@ void mass_matrix(const T* q, T* M) {
   // ---- body link2: composite inertia (inward)
   const T t34 = link2_S0_x*t6;
   const T t35 = link2_S0_x*t7;
-  const T t39 = link2_J0_xx*t7 + link2_J0_xy*t6;
-  const T t40 = link2_J0_xy*t7 + link2_J0_yy*t6;
-  const T t41 = link2_J0_xz*t7 + link2_J0_yz*t6;
-  const T t44 = t39*t7 + t40*t6;
-  const T t48 = 2.0*link2_p_J_x*t34 + ka6ba76ae + t44;
-  const T t49 = -k872e6b78 - link2_p_J_z*t35 + t41;
+  const T t36 = t7*t7;
+  const T t37 = t6*t7;
+  const T t39 = 2.0*link2_J0_xy*t37 - ka7b3ad17*t36;
+  const T t41 = link2_J0_yy + t39;
+  const T t44 = link2_J0_xz*t7 + link2_J0_yz*t6;
+  const T t48 = 2.0*link2_p_J_x*t34 + ka6ba76ae + t41;
+  const T t49 = -k872e6b78 - link2_p_J_z*t35 + t44;
   const T t50 = 2.0*link2_p_J_x*t34 + 2.0*link2_p_J_y*t35 + k006006a7;
-  const T t59 = link2_R_PJ_zy*t48 + link2_R_PJ_zz*t49;
-  const T t60 = link2_R_PJ_zy*t49 + link2_R_PJ_zz*t50;
-  const T t63 = link2_R_PJ_zy*t59 + link2_R_PJ_zz*t60;
-  const T t69 = link1_J0_zz + t63;
+  const T t55 = t48 - t50;
+  const T t56 = link2_R_PJ_yy_S2*t49 + link2_R_PJ_yy_ss*t55;
+  const T t58 = t50 + t56;
+  const T t67 = link1_J0_zz + t58;
   // ---- body link2: its columns of M (walked to the root)
-  const T t76 = -link2_S0_x*t7;
-  const T t78 = link2_p_J_z*t76;
-  const T t79 = link2_p_J_x*t34 - link2_p_J_y*t76;
-  const T t81 = t41 + t78;
-  const T t82 = link2_J0_zz + t79;
-  const T t86 = link2_R_PJ_zy*t81 + link2_R_PJ_zz*t82;
-  M[0] = t69;
-  M[1] = t86;
-  M[2] = t86;
+  const T t74 = -link2_S0_x*t7;
+  const T t76 = link2_p_J_z*t74;
+  const T t77 = link2_p_J_x*t34 - link2_p_J_y*t74;
+  const T t79 = t44 + t76;
+  const T t80 = link2_J0_zz + t77;
+  const T t84 = link2_R_PJ_zy*t79 + link2_R_PJ_zz*t80;
+  M[0] = t67;
+  M[1] = t84;
+  M[2] = t84;
   M[3] = link2_J0_zz;
 }
 
@@ -352,57 +353,58 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body link2: composite inertia (inward)
   const T t66 = link2_S0_x*t8;
   const T t67 = link2_S0_x*t9;
-  const T t71 = link2_J0_xx*t9 + link2_J0_xy*t8;
-  const T t72 = link2_J0_xy*t9 + link2_J0_yy*t8;
-  const T t73 = link2_J0_xz*t9 + link2_J0_yz*t8;
-  const T t76 = t71*t9 + t72*t8;
-  const T t80 = 2.0*link2_p_J_x*t66 + ka6ba76ae + t76;
-  const T t81 = -k872e6b78 - link2_p_J_z*t67 + t73;
+  const T t68 = t9*t9;
+  const T t69 = t8*t9;
+  const T t71 = 2.0*link2_J0_xy*t69 - ka7b3ad17*t68;
+  const T t73 = link2_J0_yy + t71;
+  const T t76 = link2_J0_xz*t9 + link2_J0_yz*t8;
+  const T t80 = 2.0*link2_p_J_x*t66 + ka6ba76ae + t73;
+  const T t81 = -k872e6b78 - link2_p_J_z*t67 + t76;
   const T t82 = 2.0*link2_p_J_x*t66 + 2.0*link2_p_J_y*t67 + k006006a7;
-  const T t91 = link2_R_PJ_zy*t80 + link2_R_PJ_zz*t81;
-  const T t92 = link2_R_PJ_zy*t81 + link2_R_PJ_zz*t82;
-  const T t95 = link2_R_PJ_zy*t91 + link2_R_PJ_zz*t92;
-  const T t101 = link1_J0_zz + t95;
+  const T t87 = t80 - t82;
+  const T t88 = link2_R_PJ_yy_S2*t81 + link2_R_PJ_yy_ss*t87;
+  const T t90 = t82 + t88;
+  const T t99 = link1_J0_zz + t90;
   // ---- body link2: its columns of M (walked to the root)
-  const T t108 = -link2_S0_x*t9;
-  const T t110 = link2_p_J_z*t108;
-  const T t111 = link2_p_J_x*t66 - link2_p_J_y*t108;
-  const T t113 = t110 + t73;
-  const T t114 = link2_J0_zz + t111;
-  const T t118 = link2_R_PJ_zy*t113 + link2_R_PJ_zz*t114;
+  const T t106 = -link2_S0_x*t9;
+  const T t108 = link2_p_J_z*t106;
+  const T t109 = link2_p_J_x*t66 - link2_p_J_y*t106;
+  const T t111 = t108 + t76;
+  const T t112 = link2_J0_zz + t109;
+  const T t116 = link2_R_PJ_zy*t111 + link2_R_PJ_zz*t112;
   // ---- body link1: bias force
-  const T t123 = -link1_S0_x*t7 + link1_S0_y*t6;
+  const T t121 = -link1_S0_x*t7 + link1_S0_y*t6;
   // ---- body link2: bias force
-  const T t124 = -link2_S0_z*t41 - link2_mass*t43 - t57;
-  const T t125 = link2_S0_z*t40 - link2_mass*t44 - t58;
-  const T t126 = link2_S0_x*t41 - link2_mass*t34 - t59;
-  const T t127 = link2_S0_z*t44 - ((link2_J0_xx*t40 + link2_J0_xy*t41) + t63);
-  const T t128 = link2_S0_x*t34 - ((link2_J0_xy*t40 + link2_J0_yy*t41) + (link2_S0_z*t43 + t64));
-  const T t129 = -((link2_J0_xz*t40 + link2_J0_yz*t41) + (link2_S0_x*t44 + t65));
+  const T t122 = -link2_S0_z*t41 - link2_mass*t43 - t57;
+  const T t123 = link2_S0_z*t40 - link2_mass*t44 - t58;
+  const T t124 = link2_S0_x*t41 - link2_mass*t34 - t59;
+  const T t125 = link2_S0_z*t44 - ((link2_J0_xx*t40 + link2_J0_xy*t41) + t63);
+  const T t126 = link2_S0_x*t34 - ((link2_J0_xy*t40 + link2_J0_yy*t41) + (link2_S0_z*t43 + t64));
+  const T t127 = -((link2_J0_xz*t40 + link2_J0_yz*t41) + (link2_S0_x*t44 + t65));
   // ---- body link2: generalized forces (inward)
-  const T t130 = t129 + tau[1];
-  const T t131 = t124*t8 - t125*t9;
-  const T t132 = t124*t9 + t125*t8;
-  const T t134 = -link2_p_J_x*t126 + link2_p_J_z*t131;
-  const T t135 = link2_p_J_x*t132 - link2_p_J_y*t131;
-  const T t137 = t127*t9 + t128*t8;
-  const T t139 = t134 + t137;
-  const T t140 = t129 + t135;
-  const T t144 = link2_R_PJ_zy*t139 + link2_R_PJ_zz*t140;
-  const T t149 = t123 + t144;
+  const T t128 = t127 + tau[1];
+  const T t129 = t122*t8 - t123*t9;
+  const T t130 = t122*t9 + t123*t8;
+  const T t132 = -link2_p_J_x*t124 + link2_p_J_z*t129;
+  const T t133 = link2_p_J_x*t130 - link2_p_J_y*t129;
+  const T t135 = t125*t9 + t126*t8;
+  const T t137 = t132 + t135;
+  const T t138 = t127 + t133;
+  const T t142 = link2_R_PJ_zy*t137 + link2_R_PJ_zz*t138;
+  const T t147 = t121 + t142;
   // ---- body link1: generalized forces (inward)
-  const T t150 = t149 + tau[0];
+  const T t148 = t147 + tau[0];
   // ---- M u_dot = F: L^T D L along the dof tree
-  const T t151 = kb7e5959a*t118;
-  const T t152 = t101 - t118*t151;
-  const T t154 = -t130*t151 + t150;
-  const T t155 = t154/t152;
-  const T t156 = kb7e5959a*t130;
-  const T t157 = -t151*t155 + t156;
-  if (!(t152 > 1e-14*t101)) return 1;
+  const T t149 = kb7e5959a*t116;
+  const T t150 = -t116*t149 + t99;
+  const T t152 = -t128*t149 + t148;
+  const T t153 = t152/t150;
+  const T t154 = kb7e5959a*t128;
+  const T t155 = -t149*t153 + t154;
+  if (!(t150 > 1e-14*t99)) return 1;
   if (!(link2_J0_zz > 0.0)) return 2;
-  udot[0] = t155;
-  udot[1] = t157;
+  udot[0] = t153;
+  udot[1] = t155;
   return 0;
 }
 

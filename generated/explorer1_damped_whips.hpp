@@ -18,7 +18,7 @@
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
 //   mass_matrix     2619 (1027 add, 1528 mul, 64 div, 0 func)
 //   forcing         3466 (1308 add, 2094 mul, 64 div, 0 func)
-//   udot            6503 (2590 add, 3822 mul, 91 div, 0 func) -- composite form; composite 6503, articulated 7132
+//   udot            6503 (2590 add, 3822 mul, 91 div, 0 func) -- composite form; composite 6503, articulated 7088
 //   energy          4305 (1720 add, 2508 mul, 77 div, 0 func)
 //   momentum        3544 (1381 add, 2097 mul, 65 div, 1 func)
 

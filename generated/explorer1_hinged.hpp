@@ -16,9 +16,9 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
-//   mass_matrix      196 (88 add, 100 mul, 0 div, 8 func)
+//   mass_matrix      168 (84 add, 76 mul, 0 div, 8 func)
 //   forcing          430 (176 add, 246 mul, 0 div, 8 func)
-//   udot             865 (364 add, 482 mul, 11 div, 8 func) -- composite form; composite 865, articulated 1037
+//   udot             837 (360 add, 458 mul, 11 div, 8 func) -- composite form; composite 837, articulated 969
 //   energy           233 (84 add, 132 mul, 9 div, 8 func)
 //   momentum         560 (229 add, 321 mul, 1 div, 9 func)
 
@@ -118,51 +118,46 @@ inline constexpr double bus_J0_zz = 0.04024325554;  // inertia about O (undeform
 
 // derived: constant subexpressions, evaluated here exactly
 inline constexpr double k01983bd6 = 0.0018478739627948004;  // = ant1_J0_xx + ant1_J0_yy + ant1_J0_zz
+inline constexpr double k0796b03a = 0.0009239368488172001;  // = -ant2_J0_xx + ant2_J0_yy
 inline constexpr double k0a0d0185 = 0.002209670608740434;  // = -ant2_S0_x*kcc6cb094 + ant2_mass
-inline constexpr double k0db3b1c0 = 5.105222974456e-05;  // = ant3_p_J_x*k5ebff7ff
 inline constexpr double k114bd089 = 0.0010633759912985602;  // = ant4_J0_zz + k120a1de7 + ke2e84ada
 inline constexpr double k120a1de7 = 5.105222974456e-05;  // = ant4_mass*ant4_p_J_x*ant4_p_J_x
 inline constexpr double k120a1f28 = -6.7173986506e-05;  // = ant4_mass*ant4_p_J_x*ant4_p_J_y
 inline constexpr double k171ae147 = 0.0010633759912985602;  // = ant2_J0_zz + k436c28d2 + kd2ddb594
 inline constexpr double k1722e183 = 8.838682435000001e-05;  // = ant3_mass*ant3_p_J_y*ant3_p_J_y
 inline constexpr double k17c33d87 = 13.95232263487;  // = ant3_mass + k4a18a489
+inline constexpr double k18b5b6fd = 0.006629011826259567;  // = ant4_mass - kf403a077
 inline constexpr double k210dde67 = 13.961161317305;  // = ant2_mass + k17c33d87
 inline constexpr double k27aefc3f = 1082.3249506900117;  // = 1.0/ant1_J0_zz
+inline constexpr double k27f0a6c9 = 0.0009239368488172001;  // = -ant1_J0_xx + ant1_J0_yy
 inline constexpr double k28e7ac51 = 0.0010633759912985602;  // = ant1_J0_zz + k4940cc95 + k6dac2802
-inline constexpr double k2ad316b1 = -6.717398650599999e-05;  // = ant3_p_J_y*k5ebff7ff
-inline constexpr double k2d0111a0 = 8.838682435000001e-05;  // = ant3_p_J_y*k5ebff52c
 inline constexpr double k30f1a2bf = 5.105222974456e-05;  // = ant3_mass*ant3_p_J_x*ant3_p_J_x
 inline constexpr double k30f1a66c = -6.7173986506e-05;  // = ant3_mass*ant3_p_J_x*ant3_p_J_y
+inline constexpr double k349cc8b8 = 0.006629011826259567;  // = ant3_mass - kf60b70e0
 inline constexpr double k3f6dc0c4 = 0.0010633759912985602;  // = ant3_J0_zz + k1722e183 + k30f1a2bf
-inline constexpr double k3fce5e85 = -6.717398650599999e-05;  // = ant2_p_J_y*ka477f534
 inline constexpr double k436c28d2 = 5.105222974456e-05;  // = ant2_mass*ant2_p_J_x*ant2_p_J_x
 inline constexpr double k436c29a1 = -6.7173986506e-05;  // = ant2_mass*ant2_p_J_x*ant2_p_J_y
+inline constexpr double k4811ff8f = 0.006629011826259567;  // = ant2_mass - k0a0d0185
 inline constexpr double k4940cc95 = 8.838682435000001e-05;  // = ant1_mass*ant1_p_J_y*ant1_p_J_y
 inline constexpr double k4a18a489 = 13.943483952435;  // = ant4_mass + bus_mass
-inline constexpr double k4bb7cc2c = 5.105222974456e-05;  // = ant2_p_J_x*ka477f534
 inline constexpr double k4fd48471 = 0.00067173986506;  // = ant1_mass*ant1_p_J_x
 inline constexpr double k4fd48522 = -0.0008838682435;  // = ant1_mass*ant1_p_J_y
 inline constexpr double k58048099 = 0.0018478739627948004;  // = ant2_J0_xx + ant2_J0_yy + ant2_J0_zz
 inline constexpr double k5ebff52c = -0.0008838682435;  // = ant3_mass*ant3_p_J_y
 inline constexpr double k5ebff7ff = 0.00067173986506;  // = ant3_mass*ant3_p_J_x
-inline constexpr double k6936b32b = 8.838682435000001e-05;  // = ant4_p_J_y*kb4598b21
 inline constexpr double k6a61888a = 1082.3249506900117;  // = 1.0/ant4_J0_zz
-inline constexpr double k6c002b58 = -6.717398650599999e-05;  // = ant4_p_J_y*kb4598452
 inline constexpr double k6dac2802 = 5.105222974456e-05;  // = ant1_mass*ant1_p_J_x*ant1_p_J_x
 inline constexpr double k6dac28f5 = -6.7173986506e-05;  // = ant1_mass*ant1_p_J_x*ant1_p_J_y
 inline constexpr double k71ea316f = 0.0018478739627948004;  // = ant3_J0_xx + ant3_J0_yy + ant3_J0_zz
 inline constexpr double k76fc5947 = 1082.3249506900117;  // = 1.0/ant3_J0_zz
 inline constexpr double k831f4c64 = 0.002209670608740434;  // = -ant1_S0_x*kd4ea43be + ant1_mass
-inline constexpr double k88814d1a = -6.717398650599999e-05;  // = ant1_p_J_y*k4fd48471
-inline constexpr double k8f00d060 = 5.105222974456e-05;  // = ant1_p_J_x*k4fd48471
-inline constexpr double k973bd023 = 8.838682435000001e-05;  // = ant2_p_J_y*ka477ec67
+inline constexpr double k9cafa986 = 0.0009239368488172001;  // = -ant3_J0_xx + ant3_J0_yy
 inline constexpr double ka12c911f = 0.0018478739627948004;  // = ant4_J0_xx + ant4_J0_yy + ant4_J0_zz
 inline constexpr double ka477ec67 = -0.0008838682435;  // = ant2_mass*ant2_p_J_y
 inline constexpr double ka477f534 = 0.00067173986506;  // = ant2_mass*ant2_p_J_x
+inline constexpr double ka8269305 = 0.0009239368488172001;  // = -ant4_J0_xx + ant4_J0_yy
 inline constexpr double kb4598452 = 0.00067173986506;  // = ant4_mass*ant4_p_J_x
 inline constexpr double kb4598b21 = -0.0008838682435;  // = ant4_mass*ant4_p_J_y
-inline constexpr double kb4f484c5 = 8.838682435000001e-05;  // = ant1_p_J_y*k4fd48522
-inline constexpr double kc75ca83b = 5.105222974456e-05;  // = ant4_p_J_x*kb4598452
 inline constexpr double kcc6cb094 = 2.6785714285752937;  // = ant2_S0_x*kfb86315a
 inline constexpr double kcf35cde3 = 2.6785714285752937;  // = ant3_S0_x*k76fc5947
 inline constexpr double kd2ddb594 = 8.838682435000001e-05;  // = ant2_mass*ant2_p_J_y*ant2_p_J_y
@@ -170,6 +165,7 @@ inline constexpr double kd4ea43be = 2.6785714285752937;  // = ant1_S0_x*k27aefc3
 inline constexpr double ke0717566 = 13.96999999974;  // = ant1_mass + k210dde67
 inline constexpr double ke25b6aa2 = 2.6785714285752937;  // = ant4_S0_x*k6a61888a
 inline constexpr double ke2e84ada = 8.838682435000001e-05;  // = ant4_mass*ant4_p_J_y*ant4_p_J_y
+inline constexpr double ked4677d0 = 0.006629011826259567;  // = ant1_mass - k831f4c64
 inline constexpr double kf403a077 = 0.002209670608740434;  // = -ant4_S0_x*ke25b6aa2 + ant4_mass
 inline constexpr double kf60b70e0 = 0.002209670608740434;  // = -ant3_S0_x*kcf35cde3 + ant3_mass
 inline constexpr double kfb86315a = 1082.3249506900117;  // = 1.0/ant2_J0_zz
@@ -258,16 +254,15 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant4: composite inertia (inward)
   const T t79 = ant4_S0_x*t65;
   const T t80 = ant4_S0_x*t66;
-  const T t81 = ant4_J0_xx*t65;
-  const T t82 = -ant4_J0_yy*t66;
-  const T t83 = ant4_J0_xx*t66;
-  const T t84 = ant4_J0_yy*t65;
-  const T t85 = t65*t81 - t66*t82;
-  const T t86 = t65*t82 + t66*t81;
-  const T t87 = t65*t84 + t66*t83;
+  const T t81 = t66*t66;
+  const T t82 = t65*t66;
+  const T t84 = -ka8269305*t81;
+  const T t85 = ant4_J0_xx - t84;
+  const T t86 = ant4_J0_yy + t84;
+  const T t87 = -ka8269305*t82;
   const T t88 = 2.0*ant4_p_J_y*t80 + ke2e84ada + t85;
-  const T t89 = t86 - ((ant4_p_J_x*t80 + ant4_p_J_y*t79) + k120a1f28);
-  const T t90 = 2.0*ant4_p_J_x*t79 + k120a1de7 + t87;
+  const T t89 = t87 - ((ant4_p_J_x*t80 + ant4_p_J_y*t79) + k120a1f28);
+  const T t90 = 2.0*ant4_p_J_x*t79 + k120a1de7 + t86;
   const T t91 = 2.0*ant4_p_J_x*t79 + 2.0*ant4_p_J_y*t80 + k114bd089;
   const T t92 = kb4598452 + t79;
   const T t93 = kb4598b21 + t80;
@@ -277,16 +272,15 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant3: composite inertia (inward)
   const T t97 = ant3_S0_x*t51;
   const T t98 = ant3_S0_x*t52;
-  const T t99 = ant3_J0_xx*t51;
-  const T t100 = -ant3_J0_yy*t52;
-  const T t101 = ant3_J0_xx*t52;
-  const T t102 = ant3_J0_yy*t51;
-  const T t103 = -t100*t52 + t51*t99;
-  const T t104 = t100*t51 + t52*t99;
-  const T t105 = t101*t52 + t102*t51;
+  const T t99 = t52*t52;
+  const T t100 = t51*t52;
+  const T t102 = -k9cafa986*t99;
+  const T t103 = ant3_J0_xx - t102;
+  const T t104 = ant3_J0_yy + t102;
+  const T t105 = -k9cafa986*t100;
   const T t106 = 2.0*ant3_p_J_y*t98 + k1722e183 + t103;
-  const T t107 = t104 - ((ant3_p_J_x*t98 + ant3_p_J_y*t97) + k30f1a66c);
-  const T t108 = 2.0*ant3_p_J_x*t97 + k30f1a2bf + t105;
+  const T t107 = t105 - ((ant3_p_J_x*t98 + ant3_p_J_y*t97) + k30f1a66c);
+  const T t108 = 2.0*ant3_p_J_x*t97 + k30f1a2bf + t104;
   const T t109 = 2.0*ant3_p_J_x*t97 + 2.0*ant3_p_J_y*t98 + k3f6dc0c4;
   const T t110 = k5ebff7ff + t97;
   const T t111 = k5ebff52c + t98;
@@ -298,16 +292,15 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant2: composite inertia (inward)
   const T t117 = ant2_S0_x*t37;
   const T t118 = ant2_S0_x*t38;
-  const T t119 = ant2_J0_xx*t37;
-  const T t120 = -ant2_J0_yy*t38;
-  const T t121 = ant2_J0_xx*t38;
-  const T t122 = ant2_J0_yy*t37;
-  const T t123 = t119*t37 - t120*t38;
-  const T t124 = t119*t38 + t120*t37;
-  const T t125 = t121*t38 + t122*t37;
+  const T t119 = t38*t38;
+  const T t120 = t37*t38;
+  const T t122 = -k0796b03a*t119;
+  const T t123 = ant2_J0_xx - t122;
+  const T t124 = ant2_J0_yy + t122;
+  const T t125 = -k0796b03a*t120;
   const T t126 = 2.0*ant2_p_J_y*t118 + kd2ddb594 + t123;
-  const T t127 = t124 - ((ant2_p_J_x*t118 + ant2_p_J_y*t117) + k436c29a1);
-  const T t128 = 2.0*ant2_p_J_x*t117 + k436c28d2 + t125;
+  const T t127 = t125 - ((ant2_p_J_x*t118 + ant2_p_J_y*t117) + k436c29a1);
+  const T t128 = 2.0*ant2_p_J_x*t117 + k436c28d2 + t124;
   const T t129 = 2.0*ant2_p_J_x*t117 + 2.0*ant2_p_J_y*t118 + k171ae147;
   const T t130 = ka477f534 + t117;
   const T t131 = ka477ec67 + t118;
@@ -322,16 +315,15 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant1: composite inertia (inward)
   const T t140 = ant1_S0_x*t23;
   const T t141 = ant1_S0_x*t24;
-  const T t142 = ant1_J0_xx*t23;
-  const T t143 = -ant1_J0_yy*t24;
-  const T t144 = ant1_J0_xx*t24;
-  const T t145 = ant1_J0_yy*t23;
-  const T t146 = t142*t23 - t143*t24;
-  const T t147 = t142*t24 + t143*t23;
-  const T t148 = t144*t24 + t145*t23;
+  const T t142 = t24*t24;
+  const T t143 = t23*t24;
+  const T t145 = -k27f0a6c9*t142;
+  const T t146 = ant1_J0_xx - t145;
+  const T t147 = ant1_J0_yy + t145;
+  const T t148 = -k27f0a6c9*t143;
   const T t149 = 2.0*ant1_p_J_y*t141 + k4940cc95 + t146;
-  const T t150 = t147 - ((ant1_p_J_x*t141 + ant1_p_J_y*t140) + k6dac28f5);
-  const T t151 = 2.0*ant1_p_J_x*t140 + k6dac2802 + t148;
+  const T t150 = t148 - ((ant1_p_J_x*t141 + ant1_p_J_y*t140) + k6dac28f5);
+  const T t151 = 2.0*ant1_p_J_x*t140 + k6dac2802 + t147;
   const T t152 = 2.0*ant1_p_J_x*t140 + 2.0*ant1_p_J_y*t141 + k28e7ac51;
   const T t153 = k4fd48471 + t140;
   const T t154 = k4fd48522 + t141;
@@ -872,16 +864,15 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant4: composite inertia (inward)
   const T t220 = ant4_S0_x*t134;
   const T t221 = ant4_S0_x*t135;
-  const T t222 = ant4_J0_xx*t134;
-  const T t223 = -ant4_J0_yy*t135;
-  const T t224 = ant4_J0_xx*t135;
-  const T t225 = ant4_J0_yy*t134;
-  const T t226 = t134*t222 - t135*t223;
-  const T t227 = t134*t223 + t135*t222;
-  const T t228 = t134*t225 + t135*t224;
+  const T t222 = t135*t135;
+  const T t223 = t134*t135;
+  const T t225 = -ka8269305*t222;
+  const T t226 = ant4_J0_xx - t225;
+  const T t227 = ant4_J0_yy + t225;
+  const T t228 = -ka8269305*t223;
   const T t229 = 2.0*ant4_p_J_y*t221 + ke2e84ada + t226;
-  const T t230 = t227 - ((ant4_p_J_x*t221 + ant4_p_J_y*t220) + k120a1f28);
-  const T t231 = 2.0*ant4_p_J_x*t220 + k120a1de7 + t228;
+  const T t230 = t228 - ((ant4_p_J_x*t221 + ant4_p_J_y*t220) + k120a1f28);
+  const T t231 = 2.0*ant4_p_J_x*t220 + k120a1de7 + t227;
   const T t232 = 2.0*ant4_p_J_x*t220 + 2.0*ant4_p_J_y*t221 + k114bd089;
   const T t233 = kb4598452 + t220;
   const T t234 = kb4598b21 + t221;
@@ -891,16 +882,15 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant3: composite inertia (inward)
   const T t238 = ant3_S0_x*t98;
   const T t239 = ant3_S0_x*t99;
-  const T t240 = ant3_J0_xx*t98;
-  const T t241 = -ant3_J0_yy*t99;
-  const T t242 = ant3_J0_xx*t99;
-  const T t243 = ant3_J0_yy*t98;
-  const T t244 = t240*t98 - t241*t99;
-  const T t245 = t240*t99 + t241*t98;
-  const T t246 = t242*t99 + t243*t98;
+  const T t240 = t99*t99;
+  const T t241 = t98*t99;
+  const T t243 = -k9cafa986*t240;
+  const T t244 = ant3_J0_xx - t243;
+  const T t245 = ant3_J0_yy + t243;
+  const T t246 = -k9cafa986*t241;
   const T t247 = 2.0*ant3_p_J_y*t239 + k1722e183 + t244;
-  const T t248 = t245 - ((ant3_p_J_x*t239 + ant3_p_J_y*t238) + k30f1a66c);
-  const T t249 = 2.0*ant3_p_J_x*t238 + k30f1a2bf + t246;
+  const T t248 = t246 - ((ant3_p_J_x*t239 + ant3_p_J_y*t238) + k30f1a66c);
+  const T t249 = 2.0*ant3_p_J_x*t238 + k30f1a2bf + t245;
   const T t250 = 2.0*ant3_p_J_x*t238 + 2.0*ant3_p_J_y*t239 + k3f6dc0c4;
   const T t251 = k5ebff7ff + t238;
   const T t252 = k5ebff52c + t239;
@@ -912,16 +902,15 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant2: composite inertia (inward)
   const T t258 = ant2_S0_x*t62;
   const T t259 = ant2_S0_x*t63;
-  const T t260 = ant2_J0_xx*t62;
-  const T t261 = -ant2_J0_yy*t63;
-  const T t262 = ant2_J0_xx*t63;
-  const T t263 = ant2_J0_yy*t62;
-  const T t264 = t260*t62 - t261*t63;
-  const T t265 = t260*t63 + t261*t62;
-  const T t266 = t262*t63 + t263*t62;
+  const T t260 = t63*t63;
+  const T t261 = t62*t63;
+  const T t263 = -k0796b03a*t260;
+  const T t264 = ant2_J0_xx - t263;
+  const T t265 = ant2_J0_yy + t263;
+  const T t266 = -k0796b03a*t261;
   const T t267 = 2.0*ant2_p_J_y*t259 + kd2ddb594 + t264;
-  const T t268 = t265 - ((ant2_p_J_x*t259 + ant2_p_J_y*t258) + k436c29a1);
-  const T t269 = 2.0*ant2_p_J_x*t258 + k436c28d2 + t266;
+  const T t268 = t266 - ((ant2_p_J_x*t259 + ant2_p_J_y*t258) + k436c29a1);
+  const T t269 = 2.0*ant2_p_J_x*t258 + k436c28d2 + t265;
   const T t270 = 2.0*ant2_p_J_x*t258 + 2.0*ant2_p_J_y*t259 + k171ae147;
   const T t271 = ka477f534 + t258;
   const T t272 = ka477ec67 + t259;
@@ -936,16 +925,15 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant1: composite inertia (inward)
   const T t281 = ant1_S0_x*t26;
   const T t282 = ant1_S0_x*t27;
-  const T t283 = ant1_J0_xx*t26;
-  const T t284 = -ant1_J0_yy*t27;
-  const T t285 = ant1_J0_xx*t27;
-  const T t286 = ant1_J0_yy*t26;
-  const T t287 = t26*t283 - t27*t284;
-  const T t288 = t26*t284 + t27*t283;
-  const T t289 = t26*t286 + t27*t285;
+  const T t283 = t27*t27;
+  const T t284 = t26*t27;
+  const T t286 = -k27f0a6c9*t283;
+  const T t287 = ant1_J0_xx - t286;
+  const T t288 = ant1_J0_yy + t286;
+  const T t289 = -k27f0a6c9*t284;
   const T t290 = 2.0*ant1_p_J_y*t282 + k4940cc95 + t287;
-  const T t291 = t288 - ((ant1_p_J_x*t282 + ant1_p_J_y*t281) + k6dac28f5);
-  const T t292 = 2.0*ant1_p_J_x*t281 + k6dac2802 + t289;
+  const T t291 = t289 - ((ant1_p_J_x*t282 + ant1_p_J_y*t281) + k6dac28f5);
+  const T t292 = 2.0*ant1_p_J_x*t281 + k6dac2802 + t288;
   const T t293 = 2.0*ant1_p_J_x*t281 + 2.0*ant1_p_J_y*t282 + k28e7ac51;
   const T t294 = k4fd48471 + t281;
   const T t295 = k4fd48522 + t282;

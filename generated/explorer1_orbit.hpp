@@ -17,9 +17,9 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
-//   mass_matrix      144 (60 add, 76 mul, 0 div, 8 func)
+//   mass_matrix      116 (56 add, 52 mul, 0 div, 8 func)
 //   forcing         1084 (394 add, 660 mul, 16 div, 14 func)
-//   udot            1467 (554 add, 872 mul, 27 div, 14 func) -- composite form; composite 1467, articulated 1627
+//   udot            1439 (550 add, 848 mul, 27 div, 14 func) -- composite form; composite 1439, articulated 1563
 //   energy           639 (216 add, 379 mul, 30 div, 14 func)
 //   momentum         520 (209 add, 301 mul, 1 div, 9 func)
 //   outputs          387 (149 add, 228 mul, 1 div, 9 func)
@@ -143,19 +143,22 @@ inline constexpr double central_radius_sq = 40680631590769;  // the central body
 // derived: constant subexpressions, evaluated here exactly
 inline constexpr double k01127cf3 = 5488728083586000;  // = bus_rigid_mass*central_mu
 inline constexpr double k01983bd6 = 0.010453365000000003;  // = ant1_J0_xx + ant1_J0_yy + ant1_J0_zz
+inline constexpr double k0796b03a = 0.005226645000000001;  // = -ant2_J0_xx + ant2_J0_yy
 inline constexpr double k0a0d0185 = 0.012500023915801071;  // = -ant2_S0_x*kcc6cb094 + ant2_mass
-inline constexpr double k0db3b1c0 = 0.00028879999999999997;  // = ant3_p_J_x*k5ebff7ff
 inline constexpr double k12014c17 = 0.002613365;  // = ant4_rigid_I_xx + ant4_rigid_I_yy + ant4_rigid_I_zz
 inline constexpr double k120a1de7 = 0.0002888;  // = ant4_mass*ant4_p_J_x*ant4_p_J_x
 inline constexpr double k17c33d87 = 13.870000000000001;  // = ant3_mass + k4a18a489
+inline constexpr double k18b5b6fd = 0.03749997608419893;  // = ant4_mass - kf403a077
 inline constexpr double k210dde67 = 13.920000000000002;  // = ant2_mass + k17c33d87
 inline constexpr double k27aefc3f = 191.32640859285164;  // = 1.0/ant1_J0_zz
+inline constexpr double k27f0a6c9 = 0.005226645000000001;  // = -ant1_J0_xx + ant1_J0_yy
 inline constexpr double k30f1a2bf = 0.0002888;  // = ant3_mass*ant3_p_J_x*ant3_p_J_x
+inline constexpr double k349cc8b8 = 0.03749997608419893;  // = ant3_mass - kf60b70e0
 inline constexpr double k390cdd92 = 44041937119.417366;  // = central_J2*central_radius_sq
 inline constexpr double k3b64351a = 19930022090000;  // = ant1_rigid_mass*central_mu
 inline constexpr double k436c28d2 = 0.0002888;  // = ant2_mass*ant2_p_J_x*ant2_p_J_x
+inline constexpr double k4811ff8f = 0.03749997608419893;  // = ant2_mass - k0a0d0185
 inline constexpr double k4a18a489 = 13.82;  // = ant4_mass + bus_mass
-inline constexpr double k4bb7cc2c = 0.00028879999999999997;  // = ant2_p_J_x*ka477f534
 inline constexpr double k4fd48471 = 0.0038;  // = ant1_mass*ant1_p_J_x
 inline constexpr double k58048099 = 0.010453365000000003;  // = ant2_J0_xx + ant2_J0_yy + ant2_J0_zz
 inline constexpr double k5aec22d9 = 0.002613365;  // = ant1_rigid_I_xx + ant1_rigid_I_yy + ant1_rigid_I_zz
@@ -172,16 +175,16 @@ inline constexpr double k85255b5f = 0.07158196134574088;  // = 1.0/(((ant1_mass 
 inline constexpr double k856b3cf2 = 19930022090000;  // = ant2_rigid_mass*central_mu
 inline constexpr double k87fb8c2e = 0.005515470000000001;  // = ant3_J0_zz + k30f1a2bf
 inline constexpr double k8999ace9 = 8.77756779676379e+23;  // = k390cdd92*ka1e89763
-inline constexpr double k8f00d060 = 0.00028879999999999997;  // = ant1_p_J_x*k4fd48471
+inline constexpr double k9cafa986 = 0.005226645000000001;  // = -ant3_J0_xx + ant3_J0_yy
 inline constexpr double ka12c911f = 0.010453365000000003;  // = ant4_J0_xx + ant4_J0_yy + ant4_J0_zz
 inline constexpr double ka1e89763 = 19930022090000;  // = ant3_rigid_mass*central_mu
 inline constexpr double ka477f534 = 0.0038;  // = ant2_mass*ant2_p_J_x
 inline constexpr double ka76cdd21 = 0.005515470000000001;  // = ant1_J0_zz + k6dac2802
+inline constexpr double ka8269305 = 0.005226645000000001;  // = -ant4_J0_xx + ant4_J0_yy
 inline constexpr double kb4598452 = 0.0038;  // = ant4_mass*ant4_p_J_x
 inline constexpr double kbb7f1399 = 0.002613365;  // = ant2_rigid_I_xx + ant2_rigid_I_yy + ant2_rigid_I_zz
 inline constexpr double kbd3c43fa = 8.77756779676379e+23;  // = k390cdd92*k5d2588fa
 inline constexpr double kc0c96d13 = 2.4173421712287478e+26;  // = k01127cf3*k390cdd92
-inline constexpr double kc75ca83b = 0.00028879999999999997;  // = ant4_p_J_x*kb4598452
 inline constexpr double kc81f9097 = 0.005515470000000001;  // = ant4_J0_zz + k120a1de7
 inline constexpr double kcc6cb094 = 2.6785697202999232;  // = ant2_S0_x*kfb86315a
 inline constexpr double kce91b81e = 0.002613365;  // = ant3_rigid_I_xx + ant3_rigid_I_yy + ant3_rigid_I_zz
@@ -190,6 +193,7 @@ inline constexpr double kd4ea43be = 2.6785697202999232;  // = ant1_S0_x*k27aefc3
 inline constexpr double ke0717566 = 13.970000000000002;  // = ant1_mass + k210dde67
 inline constexpr double ke25b6aa2 = 2.6785697202999232;  // = ant4_S0_x*k6a61888a
 inline constexpr double ke7801bc5 = 9.537001;  // = bus_rigid_I_xx + bus_rigid_I_yy + bus_rigid_I_zz
+inline constexpr double ked4677d0 = 0.03749997608419893;  // = ant1_mass - k831f4c64
 inline constexpr double kf403a077 = 0.012500023915801071;  // = -ant4_S0_x*ke25b6aa2 + ant4_mass
 inline constexpr double kf60b70e0 = 0.012500023915801071;  // = -ant3_S0_x*kcf35cde3 + ant3_mass
 inline constexpr double kfad0ac5e = 8.77756779676379e+23;  // = k390cdd92*k3b64351a
@@ -398,15 +402,14 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant4: composite inertia (inward)
   const T t284 = ant4_S0_x*t65;
   const T t285 = ant4_S0_x*t66;
-  const T t286 = ant4_J0_xx*t65;
-  const T t287 = -ant4_J0_yy*t66;
-  const T t288 = ant4_J0_xx*t66;
-  const T t289 = ant4_J0_yy*t65;
-  const T t290 = t286*t65 - t287*t66;
-  const T t291 = t286*t66 + t287*t65;
-  const T t292 = t288*t66 + t289*t65;
-  const T t293 = -ant4_p_J_x*t285 + t291;
-  const T t294 = 2.0*ant4_p_J_x*t284 + k120a1de7 + t292;
+  const T t286 = t66*t66;
+  const T t287 = t65*t66;
+  const T t289 = -ka8269305*t286;
+  const T t290 = ant4_J0_xx - t289;
+  const T t291 = ant4_J0_yy + t289;
+  const T t292 = -ka8269305*t287;
+  const T t293 = -ant4_p_J_x*t285 + t292;
+  const T t294 = 2.0*ant4_p_J_x*t284 + k120a1de7 + t291;
   const T t295 = 2.0*ant4_p_J_x*t284 + kc81f9097;
   const T t296 = kb4598452 + t284;
   const T t297 = bus_J0_xx + t295;
@@ -415,15 +418,14 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant3: composite inertia (inward)
   const T t300 = ant3_S0_x*t51;
   const T t301 = ant3_S0_x*t52;
-  const T t302 = ant3_J0_xx*t51;
-  const T t303 = -ant3_J0_yy*t52;
-  const T t304 = ant3_J0_xx*t52;
-  const T t305 = ant3_J0_yy*t51;
-  const T t306 = t302*t51 - t303*t52;
-  const T t307 = t302*t52 + t303*t51;
-  const T t308 = t304*t52 + t305*t51;
-  const T t309 = -ant3_p_J_x*t301 + t307;
-  const T t310 = 2.0*ant3_p_J_x*t300 + k30f1a2bf + t308;
+  const T t302 = t52*t52;
+  const T t303 = t51*t52;
+  const T t305 = -k9cafa986*t302;
+  const T t306 = ant3_J0_xx - t305;
+  const T t307 = ant3_J0_yy + t305;
+  const T t308 = -k9cafa986*t303;
+  const T t309 = -ant3_p_J_x*t301 + t308;
+  const T t310 = 2.0*ant3_p_J_x*t300 + k30f1a2bf + t307;
   const T t311 = 2.0*ant3_p_J_x*t300 + k87fb8c2e;
   const T t312 = k5ebff7ff + t300;
   const T t313 = t297 + t306;
@@ -434,15 +436,14 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant2: composite inertia (inward)
   const T t318 = ant2_S0_x*t37;
   const T t319 = ant2_S0_x*t38;
-  const T t320 = ant2_J0_xx*t37;
-  const T t321 = -ant2_J0_yy*t38;
-  const T t322 = ant2_J0_xx*t38;
-  const T t323 = ant2_J0_yy*t37;
-  const T t324 = t320*t37 - t321*t38;
-  const T t325 = t320*t38 + t321*t37;
-  const T t326 = t322*t38 + t323*t37;
-  const T t327 = -ant2_p_J_x*t319 + t325;
-  const T t328 = 2.0*ant2_p_J_x*t318 + k436c28d2 + t326;
+  const T t320 = t38*t38;
+  const T t321 = t37*t38;
+  const T t323 = -k0796b03a*t320;
+  const T t324 = ant2_J0_xx - t323;
+  const T t325 = ant2_J0_yy + t323;
+  const T t326 = -k0796b03a*t321;
+  const T t327 = -ant2_p_J_x*t319 + t326;
+  const T t328 = 2.0*ant2_p_J_x*t318 + k436c28d2 + t325;
   const T t329 = 2.0*ant2_p_J_x*t318 + k6dcb7660;
   const T t330 = ka477f534 + t318;
   const T t331 = t313 + t329;
@@ -456,15 +457,14 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant1: composite inertia (inward)
   const T t339 = ant1_S0_x*t23;
   const T t340 = ant1_S0_x*t24;
-  const T t341 = ant1_J0_xx*t23;
-  const T t342 = -ant1_J0_yy*t24;
-  const T t343 = ant1_J0_xx*t24;
-  const T t344 = ant1_J0_yy*t23;
-  const T t345 = t23*t341 - t24*t342;
-  const T t346 = t23*t342 + t24*t341;
-  const T t347 = t23*t344 + t24*t343;
-  const T t348 = -ant1_p_J_x*t340 + t346;
-  const T t349 = 2.0*ant1_p_J_x*t339 + k6dac2802 + t347;
+  const T t341 = t24*t24;
+  const T t342 = t23*t24;
+  const T t344 = -k27f0a6c9*t341;
+  const T t345 = ant1_J0_xx - t344;
+  const T t346 = ant1_J0_yy + t344;
+  const T t347 = -k27f0a6c9*t342;
+  const T t348 = -ant1_p_J_x*t340 + t347;
+  const T t349 = 2.0*ant1_p_J_x*t339 + k6dac2802 + t346;
   const T t350 = 2.0*ant1_p_J_x*t339 + ka76cdd21;
   const T t351 = k4fd48471 + t339;
   const T t352 = t331 + t345;
@@ -1553,15 +1553,14 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant4: composite inertia (inward)
   const T t417 = ant4_S0_x*t128;
   const T t418 = ant4_S0_x*t129;
-  const T t419 = ant4_J0_xx*t128;
-  const T t420 = -ant4_J0_yy*t129;
-  const T t421 = ant4_J0_xx*t129;
-  const T t422 = ant4_J0_yy*t128;
-  const T t423 = t128*t419 - t129*t420;
-  const T t424 = t128*t420 + t129*t419;
-  const T t425 = t128*t422 + t129*t421;
-  const T t426 = -ant4_p_J_x*t418 + t424;
-  const T t427 = 2.0*ant4_p_J_x*t417 + k120a1de7 + t425;
+  const T t419 = t129*t129;
+  const T t420 = t128*t129;
+  const T t422 = -ka8269305*t419;
+  const T t423 = ant4_J0_xx - t422;
+  const T t424 = ant4_J0_yy + t422;
+  const T t425 = -ka8269305*t420;
+  const T t426 = -ant4_p_J_x*t418 + t425;
+  const T t427 = 2.0*ant4_p_J_x*t417 + k120a1de7 + t424;
   const T t428 = 2.0*ant4_p_J_x*t417 + kc81f9097;
   const T t429 = kb4598452 + t417;
   const T t430 = bus_J0_xx + t428;
@@ -1570,15 +1569,14 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant3: composite inertia (inward)
   const T t433 = ant3_S0_x*t94;
   const T t434 = ant3_S0_x*t95;
-  const T t435 = ant3_J0_xx*t94;
-  const T t436 = -ant3_J0_yy*t95;
-  const T t437 = ant3_J0_xx*t95;
-  const T t438 = ant3_J0_yy*t94;
-  const T t439 = t435*t94 - t436*t95;
-  const T t440 = t435*t95 + t436*t94;
-  const T t441 = t437*t95 + t438*t94;
-  const T t442 = -ant3_p_J_x*t434 + t440;
-  const T t443 = 2.0*ant3_p_J_x*t433 + k30f1a2bf + t441;
+  const T t435 = t95*t95;
+  const T t436 = t94*t95;
+  const T t438 = -k9cafa986*t435;
+  const T t439 = ant3_J0_xx - t438;
+  const T t440 = ant3_J0_yy + t438;
+  const T t441 = -k9cafa986*t436;
+  const T t442 = -ant3_p_J_x*t434 + t441;
+  const T t443 = 2.0*ant3_p_J_x*t433 + k30f1a2bf + t440;
   const T t444 = 2.0*ant3_p_J_x*t433 + k87fb8c2e;
   const T t445 = k5ebff7ff + t433;
   const T t446 = t430 + t439;
@@ -1589,15 +1587,14 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant2: composite inertia (inward)
   const T t451 = ant2_S0_x*t60;
   const T t452 = ant2_S0_x*t61;
-  const T t453 = ant2_J0_xx*t60;
-  const T t454 = -ant2_J0_yy*t61;
-  const T t455 = ant2_J0_xx*t61;
-  const T t456 = ant2_J0_yy*t60;
-  const T t457 = t453*t60 - t454*t61;
-  const T t458 = t453*t61 + t454*t60;
-  const T t459 = t455*t61 + t456*t60;
-  const T t460 = -ant2_p_J_x*t452 + t458;
-  const T t461 = 2.0*ant2_p_J_x*t451 + k436c28d2 + t459;
+  const T t453 = t61*t61;
+  const T t454 = t60*t61;
+  const T t456 = -k0796b03a*t453;
+  const T t457 = ant2_J0_xx - t456;
+  const T t458 = ant2_J0_yy + t456;
+  const T t459 = -k0796b03a*t454;
+  const T t460 = -ant2_p_J_x*t452 + t459;
+  const T t461 = 2.0*ant2_p_J_x*t451 + k436c28d2 + t458;
   const T t462 = 2.0*ant2_p_J_x*t451 + k6dcb7660;
   const T t463 = ka477f534 + t451;
   const T t464 = t446 + t462;
@@ -1611,15 +1608,14 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant1: composite inertia (inward)
   const T t472 = ant1_S0_x*t26;
   const T t473 = ant1_S0_x*t27;
-  const T t474 = ant1_J0_xx*t26;
-  const T t475 = -ant1_J0_yy*t27;
-  const T t476 = ant1_J0_xx*t27;
-  const T t477 = ant1_J0_yy*t26;
-  const T t478 = t26*t474 - t27*t475;
-  const T t479 = t26*t475 + t27*t474;
-  const T t480 = t26*t477 + t27*t476;
-  const T t481 = -ant1_p_J_x*t473 + t479;
-  const T t482 = 2.0*ant1_p_J_x*t472 + k6dac2802 + t480;
+  const T t474 = t27*t27;
+  const T t475 = t26*t27;
+  const T t477 = -k27f0a6c9*t474;
+  const T t478 = ant1_J0_xx - t477;
+  const T t479 = ant1_J0_yy + t477;
+  const T t480 = -k27f0a6c9*t475;
+  const T t481 = -ant1_p_J_x*t473 + t480;
+  const T t482 = 2.0*ant1_p_J_x*t472 + k6dac2802 + t479;
   const T t483 = 2.0*ant1_p_J_x*t472 + ka76cdd21;
   const T t484 = k4fd48471 + t472;
   const T t485 = t464 + t478;

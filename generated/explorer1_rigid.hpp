@@ -16,9 +16,9 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
-//   mass_matrix      144 (60 add, 76 mul, 0 div, 8 func)
+//   mass_matrix      116 (56 add, 52 mul, 0 div, 8 func)
 //   forcing          386 (156 add, 222 mul, 0 div, 8 func)
-//   udot             769 (316 add, 434 mul, 11 div, 8 func) -- composite form; composite 769, articulated 929
+//   udot             741 (312 add, 410 mul, 11 div, 8 func) -- composite form; composite 741, articulated 865
 //   energy           217 (76 add, 124 mul, 9 div, 8 func)
 //   momentum         520 (209 add, 301 mul, 1 div, 9 func)
 //   reactions        485 (212 add, 265 mul, 0 div, 8 func)
@@ -111,16 +111,19 @@ inline constexpr double bus_J0_zz = 0.0397678;  // inertia about O (undeformed) 
 
 // derived: constant subexpressions, evaluated here exactly
 inline constexpr double k01983bd6 = 0.010453365000000003;  // = ant1_J0_xx + ant1_J0_yy + ant1_J0_zz
+inline constexpr double k0796b03a = 0.005226645000000001;  // = -ant2_J0_xx + ant2_J0_yy
 inline constexpr double k0a0d0185 = 0.012500023915801071;  // = -ant2_S0_x*kcc6cb094 + ant2_mass
-inline constexpr double k0db3b1c0 = 0.00028879999999999997;  // = ant3_p_J_x*k5ebff7ff
 inline constexpr double k120a1de7 = 0.0002888;  // = ant4_mass*ant4_p_J_x*ant4_p_J_x
 inline constexpr double k17c33d87 = 13.870000000000001;  // = ant3_mass + k4a18a489
+inline constexpr double k18b5b6fd = 0.03749997608419893;  // = ant4_mass - kf403a077
 inline constexpr double k210dde67 = 13.920000000000002;  // = ant2_mass + k17c33d87
 inline constexpr double k27aefc3f = 191.32640859285164;  // = 1.0/ant1_J0_zz
+inline constexpr double k27f0a6c9 = 0.005226645000000001;  // = -ant1_J0_xx + ant1_J0_yy
 inline constexpr double k30f1a2bf = 0.0002888;  // = ant3_mass*ant3_p_J_x*ant3_p_J_x
+inline constexpr double k349cc8b8 = 0.03749997608419893;  // = ant3_mass - kf60b70e0
 inline constexpr double k436c28d2 = 0.0002888;  // = ant2_mass*ant2_p_J_x*ant2_p_J_x
+inline constexpr double k4811ff8f = 0.03749997608419893;  // = ant2_mass - k0a0d0185
 inline constexpr double k4a18a489 = 13.82;  // = ant4_mass + bus_mass
-inline constexpr double k4bb7cc2c = 0.00028879999999999997;  // = ant2_p_J_x*ka477f534
 inline constexpr double k4fd48471 = 0.0038;  // = ant1_mass*ant1_p_J_x
 inline constexpr double k58048099 = 0.010453365000000003;  // = ant2_J0_xx + ant2_J0_yy + ant2_J0_zz
 inline constexpr double k5ebff7ff = 0.0038;  // = ant3_mass*ant3_p_J_x
@@ -131,18 +134,19 @@ inline constexpr double k71ea316f = 0.010453365000000003;  // = ant3_J0_xx + ant
 inline constexpr double k76fc5947 = 191.32640859285164;  // = 1.0/ant3_J0_zz
 inline constexpr double k831f4c64 = 0.012500023915801071;  // = -ant1_S0_x*kd4ea43be + ant1_mass
 inline constexpr double k87fb8c2e = 0.005515470000000001;  // = ant3_J0_zz + k30f1a2bf
-inline constexpr double k8f00d060 = 0.00028879999999999997;  // = ant1_p_J_x*k4fd48471
+inline constexpr double k9cafa986 = 0.005226645000000001;  // = -ant3_J0_xx + ant3_J0_yy
 inline constexpr double ka12c911f = 0.010453365000000003;  // = ant4_J0_xx + ant4_J0_yy + ant4_J0_zz
 inline constexpr double ka477f534 = 0.0038;  // = ant2_mass*ant2_p_J_x
 inline constexpr double ka76cdd21 = 0.005515470000000001;  // = ant1_J0_zz + k6dac2802
+inline constexpr double ka8269305 = 0.005226645000000001;  // = -ant4_J0_xx + ant4_J0_yy
 inline constexpr double kb4598452 = 0.0038;  // = ant4_mass*ant4_p_J_x
-inline constexpr double kc75ca83b = 0.00028879999999999997;  // = ant4_p_J_x*kb4598452
 inline constexpr double kc81f9097 = 0.005515470000000001;  // = ant4_J0_zz + k120a1de7
 inline constexpr double kcc6cb094 = 2.6785697202999232;  // = ant2_S0_x*kfb86315a
 inline constexpr double kcf35cde3 = 2.6785697202999232;  // = ant3_S0_x*k76fc5947
 inline constexpr double kd4ea43be = 2.6785697202999232;  // = ant1_S0_x*k27aefc3f
 inline constexpr double ke0717566 = 13.970000000000002;  // = ant1_mass + k210dde67
 inline constexpr double ke25b6aa2 = 2.6785697202999232;  // = ant4_S0_x*k6a61888a
+inline constexpr double ked4677d0 = 0.03749997608419893;  // = ant1_mass - k831f4c64
 inline constexpr double kf403a077 = 0.012500023915801071;  // = -ant4_S0_x*ke25b6aa2 + ant4_mass
 inline constexpr double kf60b70e0 = 0.012500023915801071;  // = -ant3_S0_x*kcf35cde3 + ant3_mass
 inline constexpr double kfb86315a = 191.32640859285164;  // = 1.0/ant2_J0_zz
@@ -231,15 +235,14 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant4: composite inertia (inward)
   const T t79 = ant4_S0_x*t65;
   const T t80 = ant4_S0_x*t66;
-  const T t81 = ant4_J0_xx*t65;
-  const T t82 = -ant4_J0_yy*t66;
-  const T t83 = ant4_J0_xx*t66;
-  const T t84 = ant4_J0_yy*t65;
-  const T t85 = t65*t81 - t66*t82;
-  const T t86 = t65*t82 + t66*t81;
-  const T t87 = t65*t84 + t66*t83;
-  const T t88 = -ant4_p_J_x*t80 + t86;
-  const T t89 = 2.0*ant4_p_J_x*t79 + k120a1de7 + t87;
+  const T t81 = t66*t66;
+  const T t82 = t65*t66;
+  const T t84 = -ka8269305*t81;
+  const T t85 = ant4_J0_xx - t84;
+  const T t86 = ant4_J0_yy + t84;
+  const T t87 = -ka8269305*t82;
+  const T t88 = -ant4_p_J_x*t80 + t87;
+  const T t89 = 2.0*ant4_p_J_x*t79 + k120a1de7 + t86;
   const T t90 = 2.0*ant4_p_J_x*t79 + kc81f9097;
   const T t91 = kb4598452 + t79;
   const T t92 = bus_J0_xx + t90;
@@ -248,15 +251,14 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant3: composite inertia (inward)
   const T t95 = ant3_S0_x*t51;
   const T t96 = ant3_S0_x*t52;
-  const T t97 = ant3_J0_xx*t51;
-  const T t98 = -ant3_J0_yy*t52;
-  const T t99 = ant3_J0_xx*t52;
-  const T t100 = ant3_J0_yy*t51;
-  const T t101 = t51*t97 - t52*t98;
-  const T t102 = t51*t98 + t52*t97;
-  const T t103 = t100*t51 + t52*t99;
-  const T t104 = -ant3_p_J_x*t96 + t102;
-  const T t105 = 2.0*ant3_p_J_x*t95 + k30f1a2bf + t103;
+  const T t97 = t52*t52;
+  const T t98 = t51*t52;
+  const T t100 = -k9cafa986*t97;
+  const T t101 = ant3_J0_xx - t100;
+  const T t102 = ant3_J0_yy + t100;
+  const T t103 = -k9cafa986*t98;
+  const T t104 = -ant3_p_J_x*t96 + t103;
+  const T t105 = 2.0*ant3_p_J_x*t95 + k30f1a2bf + t102;
   const T t106 = 2.0*ant3_p_J_x*t95 + k87fb8c2e;
   const T t107 = k5ebff7ff + t95;
   const T t108 = t101 + t92;
@@ -267,15 +269,14 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant2: composite inertia (inward)
   const T t113 = ant2_S0_x*t37;
   const T t114 = ant2_S0_x*t38;
-  const T t115 = ant2_J0_xx*t37;
-  const T t116 = -ant2_J0_yy*t38;
-  const T t117 = ant2_J0_xx*t38;
-  const T t118 = ant2_J0_yy*t37;
-  const T t119 = t115*t37 - t116*t38;
-  const T t120 = t115*t38 + t116*t37;
-  const T t121 = t117*t38 + t118*t37;
-  const T t122 = -ant2_p_J_x*t114 + t120;
-  const T t123 = 2.0*ant2_p_J_x*t113 + k436c28d2 + t121;
+  const T t115 = t38*t38;
+  const T t116 = t37*t38;
+  const T t118 = -k0796b03a*t115;
+  const T t119 = ant2_J0_xx - t118;
+  const T t120 = ant2_J0_yy + t118;
+  const T t121 = -k0796b03a*t116;
+  const T t122 = -ant2_p_J_x*t114 + t121;
+  const T t123 = 2.0*ant2_p_J_x*t113 + k436c28d2 + t120;
   const T t124 = 2.0*ant2_p_J_x*t113 + k6dcb7660;
   const T t125 = ka477f534 + t113;
   const T t126 = t108 + t124;
@@ -289,15 +290,14 @@ void mass_matrix(const T* q, T* M) {
   // ---- body ant1: composite inertia (inward)
   const T t134 = ant1_S0_x*t23;
   const T t135 = ant1_S0_x*t24;
-  const T t136 = ant1_J0_xx*t23;
-  const T t137 = -ant1_J0_yy*t24;
-  const T t138 = ant1_J0_xx*t24;
-  const T t139 = ant1_J0_yy*t23;
-  const T t140 = t136*t23 - t137*t24;
-  const T t141 = t136*t24 + t137*t23;
-  const T t142 = t138*t24 + t139*t23;
-  const T t143 = -ant1_p_J_x*t135 + t141;
-  const T t144 = 2.0*ant1_p_J_x*t134 + k6dac2802 + t142;
+  const T t136 = t24*t24;
+  const T t137 = t23*t24;
+  const T t139 = -k27f0a6c9*t136;
+  const T t140 = ant1_J0_xx - t139;
+  const T t141 = ant1_J0_yy + t139;
+  const T t142 = -k27f0a6c9*t137;
+  const T t143 = -ant1_p_J_x*t135 + t142;
+  const T t144 = 2.0*ant1_p_J_x*t134 + k6dac2802 + t141;
   const T t145 = 2.0*ant1_p_J_x*t134 + ka76cdd21;
   const T t146 = k4fd48471 + t134;
   const T t147 = t126 + t140;
@@ -821,15 +821,14 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant4: composite inertia (inward)
   const T t212 = ant4_S0_x*t128;
   const T t213 = ant4_S0_x*t129;
-  const T t214 = ant4_J0_xx*t128;
-  const T t215 = -ant4_J0_yy*t129;
-  const T t216 = ant4_J0_xx*t129;
-  const T t217 = ant4_J0_yy*t128;
-  const T t218 = t128*t214 - t129*t215;
-  const T t219 = t128*t215 + t129*t214;
-  const T t220 = t128*t217 + t129*t216;
-  const T t221 = -ant4_p_J_x*t213 + t219;
-  const T t222 = 2.0*ant4_p_J_x*t212 + k120a1de7 + t220;
+  const T t214 = t129*t129;
+  const T t215 = t128*t129;
+  const T t217 = -ka8269305*t214;
+  const T t218 = ant4_J0_xx - t217;
+  const T t219 = ant4_J0_yy + t217;
+  const T t220 = -ka8269305*t215;
+  const T t221 = -ant4_p_J_x*t213 + t220;
+  const T t222 = 2.0*ant4_p_J_x*t212 + k120a1de7 + t219;
   const T t223 = 2.0*ant4_p_J_x*t212 + kc81f9097;
   const T t224 = kb4598452 + t212;
   const T t225 = bus_J0_xx + t223;
@@ -838,15 +837,14 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant3: composite inertia (inward)
   const T t228 = ant3_S0_x*t94;
   const T t229 = ant3_S0_x*t95;
-  const T t230 = ant3_J0_xx*t94;
-  const T t231 = -ant3_J0_yy*t95;
-  const T t232 = ant3_J0_xx*t95;
-  const T t233 = ant3_J0_yy*t94;
-  const T t234 = t230*t94 - t231*t95;
-  const T t235 = t230*t95 + t231*t94;
-  const T t236 = t232*t95 + t233*t94;
-  const T t237 = -ant3_p_J_x*t229 + t235;
-  const T t238 = 2.0*ant3_p_J_x*t228 + k30f1a2bf + t236;
+  const T t230 = t95*t95;
+  const T t231 = t94*t95;
+  const T t233 = -k9cafa986*t230;
+  const T t234 = ant3_J0_xx - t233;
+  const T t235 = ant3_J0_yy + t233;
+  const T t236 = -k9cafa986*t231;
+  const T t237 = -ant3_p_J_x*t229 + t236;
+  const T t238 = 2.0*ant3_p_J_x*t228 + k30f1a2bf + t235;
   const T t239 = 2.0*ant3_p_J_x*t228 + k87fb8c2e;
   const T t240 = k5ebff7ff + t228;
   const T t241 = t225 + t234;
@@ -857,15 +855,14 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant2: composite inertia (inward)
   const T t246 = ant2_S0_x*t60;
   const T t247 = ant2_S0_x*t61;
-  const T t248 = ant2_J0_xx*t60;
-  const T t249 = -ant2_J0_yy*t61;
-  const T t250 = ant2_J0_xx*t61;
-  const T t251 = ant2_J0_yy*t60;
-  const T t252 = t248*t60 - t249*t61;
-  const T t253 = t248*t61 + t249*t60;
-  const T t254 = t250*t61 + t251*t60;
-  const T t255 = -ant2_p_J_x*t247 + t253;
-  const T t256 = 2.0*ant2_p_J_x*t246 + k436c28d2 + t254;
+  const T t248 = t61*t61;
+  const T t249 = t60*t61;
+  const T t251 = -k0796b03a*t248;
+  const T t252 = ant2_J0_xx - t251;
+  const T t253 = ant2_J0_yy + t251;
+  const T t254 = -k0796b03a*t249;
+  const T t255 = -ant2_p_J_x*t247 + t254;
+  const T t256 = 2.0*ant2_p_J_x*t246 + k436c28d2 + t253;
   const T t257 = 2.0*ant2_p_J_x*t246 + k6dcb7660;
   const T t258 = ka477f534 + t246;
   const T t259 = t241 + t257;
@@ -879,15 +876,14 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body ant1: composite inertia (inward)
   const T t267 = ant1_S0_x*t26;
   const T t268 = ant1_S0_x*t27;
-  const T t269 = ant1_J0_xx*t26;
-  const T t270 = -ant1_J0_yy*t27;
-  const T t271 = ant1_J0_xx*t27;
-  const T t272 = ant1_J0_yy*t26;
-  const T t273 = t26*t269 - t27*t270;
-  const T t274 = t26*t270 + t269*t27;
-  const T t275 = t26*t272 + t27*t271;
-  const T t276 = -ant1_p_J_x*t268 + t274;
-  const T t277 = 2.0*ant1_p_J_x*t267 + k6dac2802 + t275;
+  const T t269 = t27*t27;
+  const T t270 = t26*t27;
+  const T t272 = -k27f0a6c9*t269;
+  const T t273 = ant1_J0_xx - t272;
+  const T t274 = ant1_J0_yy + t272;
+  const T t275 = -k27f0a6c9*t270;
+  const T t276 = -ant1_p_J_x*t268 + t275;
+  const T t277 = 2.0*ant1_p_J_x*t267 + k6dac2802 + t274;
   const T t278 = 2.0*ant1_p_J_x*t267 + ka76cdd21;
   const T t279 = k4fd48471 + t267;
   const T t280 = t259 + t273;

@@ -20,7 +20,7 @@
 //   qdot             141 (40 add, 76 mul, 25 div, 0 func)
 //   mass_matrix     3592 (1465 add, 2033 mul, 81 div, 13 func)
 //   forcing         4435 (1776 add, 2565 mul, 81 div, 13 func)
-//   udot            8488 (3547 add, 4818 mul, 110 div, 13 func) -- composite form; composite 8488, articulated 9321
+//   udot            8488 (3547 add, 4818 mul, 110 div, 13 func) -- composite form; composite 8488, articulated 9300
 //   momentum        4349 (1722 add, 2531 mul, 82 div, 14 func)
 //   input_jacobian  152784 (0 add, 152784 mul, 0 div, 0 func)
 //   outputs           52 (15 add, 35 mul, 1 div, 1 func)

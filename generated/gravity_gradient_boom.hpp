@@ -19,7 +19,7 @@
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
 //   mass_matrix     1158 (445 add, 687 mul, 26 div, 0 func)
 //   forcing         2498 (941 add, 1475 mul, 68 div, 14 func)
-//   udot            3777 (1474 add, 2206 mul, 83 div, 14 func) -- composite form; composite 3777, articulated 4200
+//   udot            3777 (1474 add, 2206 mul, 83 div, 14 func) -- composite form; composite 3777, articulated 4196
 //   energy          2035 (785 add, 1163 mul, 73 div, 14 func)
 //   momentum        1403 (544 add, 831 mul, 27 div, 1 func)
 //   outputs          779 (311 add, 441 mul, 26 div, 1 func)

@@ -16,9 +16,9 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
-//   mass_matrix       76 (34 add, 38 mul, 0 div, 4 func)
+//   mass_matrix       62 (32 add, 26 mul, 0 div, 4 func)
 //   forcing          233 (95 add, 134 mul, 0 div, 4 func)
-//   udot             416 (172 add, 230 mul, 10 div, 4 func) -- composite form; composite 416, articulated 462
+//   udot             402 (170 add, 218 mul, 10 div, 4 func) -- composite form; composite 402, articulated 430
 //   energy           137 (50 add, 78 mul, 5 div, 4 func)
 //   momentum         330 (131 add, 193 mul, 1 div, 5 func)
 
@@ -88,6 +88,7 @@ inline constexpr double drum_J0_yy = 1.8258699999999999;  // inertia about O (un
 inline constexpr double drum_J0_zz = 2.40075;  // inertia about O (undeformed) [kg m^2]
 
 // derived: constant subexpressions, evaluated here exactly
+inline constexpr double k045960e5 = 0.16660000000000003;  // = -boom_b_J0_xx + boom_b_J0_yy
 inline constexpr double k1e2590b3 = 30.5;  // = boom_b_mass + drum_mass
 inline constexpr double k1ee5eefe = 0.2;  // = boom_b_mass*boom_b_p_J_x
 inline constexpr double k23ec43b2 = 0.1250749850029994;  // = -boom_b_S0_x*k32a03d25 + boom_b_mass
@@ -104,9 +105,10 @@ inline constexpr double k843d8d08 = 0.2;  // = boom_a_mass*boom_a_p_J_x
 inline constexpr double k8601161c = 31;  // = boom_a_mass + k1e2590b3
 inline constexpr double k86563293 = 0.08000000000000002;  // = boom_b_mass*boom_b_p_J_x*boom_b_p_J_x
 inline constexpr double k9ea44c44 = 0.08000000000000002;  // = boom_a_mass*boom_a_p_J_x*boom_a_p_J_x
-inline constexpr double kbedbf0bd = 0.08000000000000002;  // = boom_a_p_J_x*k843d8d08
+inline constexpr double kc10e8868 = 0.3749250149970006;  // = boom_b_mass - k23ec43b2
+inline constexpr double kc1ee7fa7 = 0.3749250149970006;  // = boom_a_mass - k561e5ab5
+inline constexpr double kcabccadd = 0.16660000000000003;  // = -boom_a_J0_xx + boom_a_J0_yy
 inline constexpr double kd72e89ac = 0.24670000000000003;  // = boom_a_J0_zz + k9ea44c44
-inline constexpr double ke296b5d9 = 0.08000000000000002;  // = boom_b_p_J_x*k1ee5eefe
 
 
 // ---- dual numbers for jacobian() ---------------------------------------------
@@ -184,15 +186,14 @@ void mass_matrix(const T* q, T* M) {
   // ---- body boom_b: composite inertia (inward)
   const T t51 = boom_b_S0_x*t37;
   const T t52 = boom_b_S0_x*t38;
-  const T t53 = boom_b_J0_xx*t37;
-  const T t54 = -boom_b_J0_yy*t38;
-  const T t55 = boom_b_J0_xx*t38;
-  const T t56 = boom_b_J0_yy*t37;
-  const T t57 = t37*t53 - t38*t54;
-  const T t58 = t37*t54 + t38*t53;
-  const T t59 = t37*t56 + t38*t55;
-  const T t60 = -boom_b_p_J_x*t52 + t58;
-  const T t61 = 2.0*boom_b_p_J_x*t51 + k86563293 + t59;
+  const T t53 = t38*t38;
+  const T t54 = t37*t38;
+  const T t56 = -k045960e5*t53;
+  const T t57 = boom_b_J0_xx - t56;
+  const T t58 = boom_b_J0_yy + t56;
+  const T t59 = -k045960e5*t54;
+  const T t60 = -boom_b_p_J_x*t52 + t59;
+  const T t61 = 2.0*boom_b_p_J_x*t51 + k86563293 + t58;
   const T t62 = 2.0*boom_b_p_J_x*t51 + k6a252898;
   const T t63 = k1ee5eefe + t51;
   const T t64 = drum_J0_xx + t57;
@@ -206,15 +207,14 @@ void mass_matrix(const T* q, T* M) {
   // ---- body boom_a: composite inertia (inward)
   const T t72 = boom_a_S0_x*t23;
   const T t73 = boom_a_S0_x*t24;
-  const T t74 = boom_a_J0_xx*t23;
-  const T t75 = -boom_a_J0_yy*t24;
-  const T t76 = boom_a_J0_xx*t24;
-  const T t77 = boom_a_J0_yy*t23;
-  const T t78 = t23*t74 - t24*t75;
-  const T t79 = t23*t75 + t24*t74;
-  const T t80 = t23*t77 + t24*t76;
-  const T t81 = -boom_a_p_J_x*t73 + t79;
-  const T t82 = 2.0*boom_a_p_J_x*t72 + k9ea44c44 + t80;
+  const T t74 = t24*t24;
+  const T t75 = t23*t24;
+  const T t77 = -kcabccadd*t74;
+  const T t78 = boom_a_J0_xx - t77;
+  const T t79 = boom_a_J0_yy + t77;
+  const T t80 = -kcabccadd*t75;
+  const T t81 = -boom_a_p_J_x*t73 + t80;
+  const T t82 = 2.0*boom_a_p_J_x*t72 + k9ea44c44 + t79;
   const T t83 = 2.0*boom_a_p_J_x*t72 + kd72e89ac;
   const T t84 = k843d8d08 + t72;
   const T t85 = t64 + t78;
@@ -539,15 +539,14 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body boom_b: composite inertia (inward)
   const T t128 = boom_b_S0_x*t60;
   const T t129 = boom_b_S0_x*t61;
-  const T t130 = boom_b_J0_xx*t60;
-  const T t131 = -boom_b_J0_yy*t61;
-  const T t132 = boom_b_J0_xx*t61;
-  const T t133 = boom_b_J0_yy*t60;
-  const T t134 = t130*t60 - t131*t61;
-  const T t135 = t130*t61 + t131*t60;
-  const T t136 = t132*t61 + t133*t60;
-  const T t137 = -boom_b_p_J_x*t129 + t135;
-  const T t138 = 2.0*boom_b_p_J_x*t128 + k86563293 + t136;
+  const T t130 = t61*t61;
+  const T t131 = t60*t61;
+  const T t133 = -k045960e5*t130;
+  const T t134 = boom_b_J0_xx - t133;
+  const T t135 = boom_b_J0_yy + t133;
+  const T t136 = -k045960e5*t131;
+  const T t137 = -boom_b_p_J_x*t129 + t136;
+  const T t138 = 2.0*boom_b_p_J_x*t128 + k86563293 + t135;
   const T t139 = 2.0*boom_b_p_J_x*t128 + k6a252898;
   const T t140 = k1ee5eefe + t128;
   const T t141 = drum_J0_xx + t134;
@@ -561,15 +560,14 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body boom_a: composite inertia (inward)
   const T t149 = boom_a_S0_x*t26;
   const T t150 = boom_a_S0_x*t27;
-  const T t151 = boom_a_J0_xx*t26;
-  const T t152 = -boom_a_J0_yy*t27;
-  const T t153 = boom_a_J0_xx*t27;
-  const T t154 = boom_a_J0_yy*t26;
-  const T t155 = t151*t26 - t152*t27;
-  const T t156 = t151*t27 + t152*t26;
-  const T t157 = t153*t27 + t154*t26;
-  const T t158 = -boom_a_p_J_x*t150 + t156;
-  const T t159 = 2.0*boom_a_p_J_x*t149 + k9ea44c44 + t157;
+  const T t151 = t27*t27;
+  const T t152 = t26*t27;
+  const T t154 = -kcabccadd*t151;
+  const T t155 = boom_a_J0_xx - t154;
+  const T t156 = boom_a_J0_yy + t154;
+  const T t157 = -kcabccadd*t152;
+  const T t158 = -boom_a_p_J_x*t150 + t157;
+  const T t159 = 2.0*boom_a_p_J_x*t149 + k9ea44c44 + t156;
   const T t160 = 2.0*boom_a_p_J_x*t149 + kd72e89ac;
   const T t161 = k843d8d08 + t149;
   const T t162 = t141 + t155;

@@ -16,9 +16,9 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
-//   mass_matrix       58 (25 add, 29 mul, 0 div, 4 func)
+//   mass_matrix       44 (23 add, 17 mul, 0 div, 4 func)
 //   forcing          247 (104 add, 139 mul, 0 div, 4 func)
-//   udot             464 (197 add, 252 mul, 11 div, 4 func) -- composite form; composite 464, articulated 701
+//   udot             450 (195 add, 240 mul, 11 div, 4 func) -- composite form; composite 450, articulated 582
 //   energy           149 (58 add, 82 mul, 5 div, 4 func)
 //   momentum         342 (139 add, 197 mul, 1 div, 5 func)
 
@@ -90,16 +90,19 @@ inline constexpr double hub_J0_yz = 0.13;  // inertia about O (undeformed) [kg m
 inline constexpr double hub_J0_zz = 8.05;  // inertia about O (undeformed) [kg m^2]
 
 // derived: constant subexpressions, evaluated here exactly
+inline constexpr double k03e810aa = 3.75;  // = -ke287f7f5 + panel_a_mass
 inline constexpr double k07e40866 = 1.5;  // = panel_b_S0_z*panel_b_p_J_z
+inline constexpr double k0c067288 = 2.75;  // = k17f04895*panel_b_p_J_z
 inline constexpr double k17f04895 = 5.5;  // = kdc82b262 + panel_b_S0_z
 inline constexpr double k18dc2502 = 5.1;  // = panel_b_J0_xx + panel_b_J0_yy + panel_b_J0_zz
 inline constexpr double k1fb67d07 = 1.25;  // = kce8776b3*panel_a_S0_x
 inline constexpr double k257d0e65 = 4.25;  // = 2.0*k07e40866 + kfedc5b9b
+inline constexpr double k32ed8d95 = 0.1499999999999999;  // = panel_b_J0_xx - panel_b_J0_yy
+inline constexpr double k3ee71b9a = 4.25;  // = k07e40866 + k0c067288
 inline constexpr double k49580a9d = 6.666666666666667;  // = 1.0/panel_b_J0_zz
 inline constexpr double k4fb1083a = 1.25;  // = panel_a_mass*panel_a_p_J_x*panel_a_p_J_x
 inline constexpr double k55ca917c = 3.5;  // = -hub_S0_x + k17f04895
 inline constexpr double k58539d89 = 3.65;  // = k4fb1083a + panel_a_J0_zz
-inline constexpr double k5994e191 = 1.25;  // = kd17a335d*panel_a_p_J_x
 inline constexpr double ka18995c0 = 5.1;  // = panel_a_J0_xx + panel_a_J0_yy + panel_a_J0_zz
 inline constexpr double ka33caaa5 = 105;  // = hub_mass + panel_b_mass
 inline constexpr double ka56682f0 = 110;  // = ka33caaa5 + panel_a_mass
@@ -108,6 +111,8 @@ inline constexpr double kce8776b3 = 0.4166666666666667;  // = 1.0/panel_a_J0_zz
 inline constexpr double kd17a335d = 2.5;  // = panel_a_mass*panel_a_p_J_x
 inline constexpr double kdc82b262 = 2.5;  // = panel_b_mass*panel_b_p_J_z
 inline constexpr double ke287f7f5 = 1.25;  // = -k1fb67d07*panel_a_S0_x + panel_a_mass
+inline constexpr double ke2fc8cb0 = 0.00909090909090909;  // = 1.0/ka56682f0
+inline constexpr double ke6ae794a = 2.4;  // = -panel_a_J0_xx + panel_a_J0_yy
 inline constexpr double kfedc5b9b = 1.25;  // = panel_b_mass*panel_b_p_J_z*panel_b_p_J_z
 
 
@@ -184,30 +189,28 @@ void mass_matrix(const T* q, T* M) {
   const T t37 = cos(q[8]);
   const T t38 = sin(q[8]);
   // ---- body panel_b: composite inertia (inward)
-  const T t51 = panel_b_J0_xx*t37;
-  const T t52 = -panel_b_J0_yy*t38;
-  const T t53 = panel_b_J0_xx*t38;
-  const T t54 = panel_b_J0_yy*t37;
-  const T t55 = t37*t51 - t38*t52;
-  const T t56 = t37*t52 + t38*t51;
-  const T t57 = t37*t54 + t38*t53;
+  const T t51 = t38*t38;
+  const T t52 = t37*t38;
+  const T t54 = k32ed8d95*t51;
+  const T t55 = panel_b_J0_xx - t54;
+  const T t56 = panel_b_J0_yy + t54;
+  const T t57 = k32ed8d95*t52;
   const T t58 = k257d0e65 + t55;
-  const T t59 = k257d0e65 + t57;
+  const T t59 = k257d0e65 + t56;
   const T t60 = hub_J0_yy + t59;
-  const T t61 = hub_J0_yz + t56;
+  const T t61 = hub_J0_yz + t57;
   const T t62 = hub_J0_zz + t58;
   // ---- body panel_a: composite inertia (inward)
   const T t63 = panel_a_S0_x*t23;
   const T t64 = panel_a_S0_x*t24;
-  const T t65 = panel_a_J0_xx*t23;
-  const T t66 = -panel_a_J0_yy*t24;
-  const T t67 = panel_a_J0_xx*t24;
-  const T t68 = panel_a_J0_yy*t23;
-  const T t69 = t23*t65 - t24*t66;
-  const T t70 = t23*t66 + t24*t65;
-  const T t71 = t23*t68 + t24*t67;
-  const T t72 = -panel_a_p_J_x*t64 + t70;
-  const T t73 = 2.0*panel_a_p_J_x*t63 + k4fb1083a + t71;
+  const T t65 = t24*t24;
+  const T t66 = t23*t24;
+  const T t68 = -ke6ae794a*t65;
+  const T t69 = panel_a_J0_xx - t68;
+  const T t70 = panel_a_J0_yy + t68;
+  const T t71 = -ke6ae794a*t66;
+  const T t72 = -panel_a_p_J_x*t64 + t71;
+  const T t73 = 2.0*panel_a_p_J_x*t63 + k4fb1083a + t70;
   const T t74 = 2.0*panel_a_p_J_x*t63 + k58539d89;
   const T t75 = kd17a335d + t63;
   const T t76 = kc7bdeba1 + t69;
@@ -525,30 +528,28 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t126 = t122*w_B_panel_b_z - t124*t84;
   const T t127 = -t122*t85 + t123*t84;
   // ---- body panel_b: composite inertia (inward)
-  const T t128 = panel_b_J0_xx*t60;
-  const T t129 = -panel_b_J0_yy*t61;
-  const T t130 = panel_b_J0_xx*t61;
-  const T t131 = panel_b_J0_yy*t60;
-  const T t132 = t128*t60 - t129*t61;
-  const T t133 = t128*t61 + t129*t60;
-  const T t134 = t130*t61 + t131*t60;
+  const T t128 = t61*t61;
+  const T t129 = t60*t61;
+  const T t131 = k32ed8d95*t128;
+  const T t132 = panel_b_J0_xx - t131;
+  const T t133 = panel_b_J0_yy + t131;
+  const T t134 = k32ed8d95*t129;
   const T t135 = k257d0e65 + t132;
-  const T t136 = k257d0e65 + t134;
+  const T t136 = k257d0e65 + t133;
   const T t137 = hub_J0_yy + t136;
-  const T t138 = hub_J0_yz + t133;
+  const T t138 = hub_J0_yz + t134;
   const T t139 = hub_J0_zz + t135;
   // ---- body panel_a: composite inertia (inward)
   const T t140 = panel_a_S0_x*t26;
   const T t141 = panel_a_S0_x*t27;
-  const T t142 = panel_a_J0_xx*t26;
-  const T t143 = -panel_a_J0_yy*t27;
-  const T t144 = panel_a_J0_xx*t27;
-  const T t145 = panel_a_J0_yy*t26;
-  const T t146 = t142*t26 - t143*t27;
-  const T t147 = t142*t27 + t143*t26;
-  const T t148 = t144*t27 + t145*t26;
-  const T t149 = -panel_a_p_J_x*t141 + t147;
-  const T t150 = 2.0*panel_a_p_J_x*t140 + k4fb1083a + t148;
+  const T t142 = t27*t27;
+  const T t143 = t26*t27;
+  const T t145 = -ke6ae794a*t142;
+  const T t146 = panel_a_J0_xx - t145;
+  const T t147 = panel_a_J0_yy + t145;
+  const T t148 = -ke6ae794a*t143;
+  const T t149 = -panel_a_p_J_x*t141 + t148;
+  const T t150 = 2.0*panel_a_p_J_x*t140 + k4fb1083a + t147;
   const T t151 = 2.0*panel_a_p_J_x*t140 + k58539d89;
   const T t152 = kd17a335d + t140;
   const T t153 = kc7bdeba1 + t146;

@@ -16,9 +16,9 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
-//   mass_matrix       35 (16 add, 17 mul, 0 div, 2 func)
+//   mass_matrix        0 (0 add, 0 mul, 0 div, 0 func)
 //   forcing          199 (82 add, 115 mul, 0 div, 2 func)
-//   udot             380 (158 add, 209 mul, 11 div, 2 func) -- composite form; composite 380, articulated 720
+//   udot             270 (114 add, 154 mul, 0 div, 2 func) -- composite form; composite 270, articulated 273
 //   energy           119 (46 add, 68 mul, 3 div, 2 func)
 //   momentum         288 (113 add, 171 mul, 1 div, 3 func)
 
@@ -87,46 +87,173 @@ inline constexpr double bus_J0_yz = 0.014;  // inertia about O (undeformed) [kg 
 inline constexpr double bus_J0_zz = 0.81;  // inertia about O (undeformed) [kg m^2]
 
 // derived: constant subexpressions, evaluated here exactly
-inline constexpr double k05f44240 = 9.12667807454839e-10;  // = k4ab06a8f*k80dbd051
+inline constexpr double k0117888d = 19.771880540290038;  // = -k2d383c28*k42c83df6 + k55910245
+inline constexpr double k05032069 = 0.00999950002499875;  // = k144a06fa*k2e47b47e - k184a4b98*kbe764671 - kfb5c4d30
+inline constexpr double k0878fe78 = 0.8336207829891898;  // = 1.0/k50c55f5e + k8b22619e*k8b22619e/k402b2dd7
+inline constexpr double k09c7e7cd = 0.2003477668244563;  // = bus_S0_x + k4923f8de
 inline constexpr double k0adc6025 = 4.730120176180773e-08;  // = k539cd6f4*probe_p_J_y
+inline constexpr double k0adc6090 = -2.174369511488942e-06;  // = k539cd6f4*probe_p_J_z
+inline constexpr double k0bc33935 = 4.014933294251415e-05;  // = -k879742ae*probe_R_PJ_yy - ka1e1120f*probe_R_PJ_yz
+inline constexpr double k0df84bc1 = 1.7910450766180863e-20;  // = k25819bb6*probe_R_PJ_yz + kea2434dd*probe_R_PJ_yy
 inline constexpr double k0e90f1e0 = 0.00011477601033306699;  // = k14056fb0*probe_R_PJ_yz + k539cd6f4*probe_R_PJ_yy
 inline constexpr double k10555159 = 1.5807648370190785e-05;  // = probe_S0_z*probe_p_J_z
-inline constexpr double k12a41664 = 9.995269879823815e-05;  // = probe_mass*probe_p_J_z*probe_p_J_z
+inline constexpr double k10557130 = -3.438793457079377e-07;  // = probe_S0_z*probe_p_J_y
+inline constexpr double k12632d37 = 0.020004738563588472;  // = ka08e2ce9*kf5761fb9
+inline constexpr double k13526884 = 0.010016887496847971;  // = (k09c7e7cd + k184a4b98*k5b21c82d*kb8b53809)*k6072e698
 inline constexpr double k14056fb0 = 0.00036615296740381576;  // = k539cd341 + probe_S0_z
-inline constexpr double k15d08898 = 4.730120176180773e-08;  // = probe_mass*probe_p_J_y*probe_p_J_y
+inline constexpr double k144a06fa = -8.954329927711833e-24;  // = k184a4b98*k98ea08ea
+inline constexpr double k14fbf280 = 0.1664184188235314;  // = k4a3c96b2*kfe1ec95e
+inline constexpr double k184a4b98 = 8.95477764420822e-22;  // = k0df84bc1*k1e3e25bc
+inline constexpr double k19bebda5 = 0.0013691812141387143;  // = -k4ecd60cb*kec9ce579 - kc107fcce
+inline constexpr double k1bdc33d2 = -0.009874898060433276;  // = bus_J0_xz*k9e4c8ac7
+inline constexpr double k1d77e7da = 0.16038610634955258;  // = k4a3c96b2*k4ecd60cb
+inline constexpr double k1dd8b291 = 0.00159473141880304;  // = k82242927*kf1b96bf6
+inline constexpr double k1e3e25bc = 0.049997500124993745;  // = 1.0/k5b21c82d
+inline constexpr double k20463360 = 0.010131412944381388;  // = k2e47b47e*kfb8b7a25/k50c55f5e + k78782cea*kf23f55b5/k402b2dd7 - k98ea08ea/kafe9d580
+inline constexpr double k20a2e8a0 = 1.0100132469309355;  // = bus_J0_xx + k352074fc
 inline constexpr double k213c322b = 6.661000000000001e-06;  // = probe_J0_xx + probe_J0_yy + probe_J0_zz
+inline constexpr double k219f08e1 = 0.20202471011349726;  // = k889332d2 + ka6e1530f*kec9ce579
+inline constexpr double k2372934e = 0.00013494529674038154;  // = (2.0*probe_S0_z*probe_p_J_z + probe_J0_xx) + (probe_mass*probe_p_J_y*probe_p_J_y + probe_mass*pro...
 inline constexpr double k25819bb6 = 0.000955336489125606;  // = probe_R_PJ_xz*probe_mass
+inline constexpr double k25891712 = 1.2041216993658048;  // = bus_J0_yy + k50841abc
+inline constexpr double k2659c3fe = 0.8101349452967405;  // = bus_J0_zz + kb9dd3689
+inline constexpr double k296c18b0 = 0.010016887496847971;  // = k09c7e7cd*ka08e2ce9
+inline constexpr double k2bb5e4c1 = 19.772420436753904;  // = -k1d77e7da*k4ecd60cb + k5375f7d1
+inline constexpr double k2d383c28 = 0.09853828641655699;  // = -k4d1afa91*k82242927 + kc58fc45f
+inline constexpr double k2e47b47e = 0.019967572288243488;  // = (k12632d37*k296c18b0*kfd32cd94 - k98ea08ea*kbe764671*kc613cfee + k9fa281b7)*kb0a02a3e
+inline constexpr double k2eba675b = 0.09894907300631943;  // = k4799cce7*kda3b4caa
+inline constexpr double k352074fc = 1.3246930935596236e-05;  // = k879742ae*probe_R_PJ_xy + ka1e1120f*probe_R_PJ_xz
+inline constexpr double k3688a0d6 = 1.203879764275992;  // = -bus_J0_yz*kbdb64d6e + k9b27a3cf
 inline constexpr double k39abfd5e = 2.5182488571968797e-06;  // = -probe_S0_z*probe_p_J_y - probe_mass*probe_p_J_y*probe_p_J_z
+inline constexpr double k3b8c946c = 0.09839378036288154;  // = k2eba675b - k4ecd60cb*k7a50ebb4
+inline constexpr double k402b2dd7 = 0.799937126095155;  // = k2659c3fe - ((k13526884*k13526884*kc613cfee + k50c55f5e*k8b22619e*k8b22619e) + (k5b21c82d*kb8b538...
+inline constexpr double k41521e70 = 1.0099342468337844;  // = -bus_J0_xz*k1bdc33d2 + k9320e1d4
+inline constexpr double k42c83df6 = 0.00494901415634242;  // = k2d383c28*k531ff1b5
+inline constexpr double k45aaab02 = 1.0100132460182678;  // = bus_J0_xx + k73670a3b
+inline constexpr double k4799cce7 = 0.2473017217533702;  // = k9e4c8ac7*kfe1ec95e
+inline constexpr double k4923f8de = 0.00034776682445628027;  // = -k14056fb0*probe_R_PJ_yy + k539cd6f4*probe_R_PJ_yz
+inline constexpr double k4a3c96b2 = 0.8306477354915884;  // = 1.0/k3688a0d6
+inline constexpr double k4a879de0 = 19.96765844143025;  // = -k14fbf280*kfe1ec95e + kfd32cd94
 inline constexpr double k4ab06a8f = 0.9553364891256059;  // = k70ce114d*k80dbd051
+inline constexpr double k4b382fce = 0.010416333560223836;  // = k12632d37*k2e47b47e + k296c18b0
+inline constexpr double k4d1afa91 = 0.004097910226294751;  // = kb87e8e62*kf1b96bf6
+inline constexpr double k4e6825fc = 3.0242698905934806;  // = k2659c3fe + k45aaab02 + k7a44b90c
+inline constexpr double k4ecd60cb = 0.19308558790524352;  // = -bus_S0_z - kbdb64d6e*kda3b4caa
+inline constexpr double k50841abc = 0.00012169936580478528;  // = -k5bb69828*probe_R_PJ_yy - k79d8f120*probe_R_PJ_yz
+inline constexpr double k50c55f5e = 1.1997162306399165;  // = k7a44b90c - ((k296c18b0*k296c18b0*kfd32cd94 + k2e47b47e*k2e47b47e*kafe9d580) + (k5b21c82d*kfb5c4d...
+inline constexpr double k51c731a0 = 0.01595985038473625;  // = -k80dbd051*kcf881ceb + kbe3314ec
+inline constexpr double k531ff1b5 = 0.05022427663721639;  // = 1.0/k5579ef2f
+inline constexpr double k5375f7d1 = 19.803388682390242;  // = -kd447e126*kda3b4caa + kfd32cd94
 inline constexpr double k539cd341 = 0.00031615296740381574;  // = probe_mass*probe_p_J_z
 inline constexpr double k539cd6f4 = -6.877586914158754e-06;  // = probe_mass*probe_p_J_y
-inline constexpr double k6f6401e7 = 7.067368818235087e-07;  // = k79d8f120*probe_R_PJ_yz
+inline constexpr double k5579ef2f = 19.910689948274854;  // = -k4d1afa91*kb87e8e62 + kb3b1c3c4
+inline constexpr double k55910245 = 19.772368207664456;  // = -k1dd8b291*k82242927 + kdc3c5a3d
+inline constexpr double k5b21c82d = 20.001;  // = bus_mass + ka7239acb
+inline constexpr double k5b847224 = 0.00036085640903815795;  // = kc99a359a/k402b2dd7
+inline constexpr double k5bb69828 = 0.00012812878402524312;  // = -k39abfd5e*probe_R_PJ_yz - k8d95fafd*probe_R_PJ_yy
+inline constexpr double k5eb42b89 = 0.00012169927847259276;  // = -k5fd87caa*probe_R_PJ_yz - k9bae49ed*probe_R_PJ_yy
+inline constexpr double k5fd87caa = 2.3917965610590575e-06;  // = -k0adc6025*probe_R_PJ_yz - kec373ccc*probe_R_PJ_yy
+inline constexpr double k6072e698 = 0.049997500124993745;  // = 1.0/kc613cfee
+inline constexpr double k672a5b3b = 0.019919732749080894;  // = (k13526884*k184a4b98 + kb8b53809) - (k05032069*k8b22619e + k144a06fa*k743ab252)
+inline constexpr double k67b4344c = 0.012717287463727148;  // = k78782cea/k402b2dd7
+inline constexpr double k697d935b = 0.016751689098223825;  // = k2e47b47e/k50c55f5e + k78782cea*k8b22619e/k402b2dd7
+inline constexpr double k6e38b76b = 4.0149615263750854e-05;  // = -k8502c437*probe_R_PJ_yz - kb6c51f26*probe_R_PJ_yy
 inline constexpr double k70ce114d = 999999999.9999999;  // = 1.0/probe_J0_zz
+inline constexpr double k71c4f190 = 0.9903745639945821;  // = 1.0/kaca03149
+inline constexpr double k722e46c4 = 0.012649260028516355;  // = kf23f55b5/k402b2dd7
+inline constexpr double k73670a3b = 1.3246018267788783e-05;  // = k8502c437*probe_R_PJ_xz + kb6c51f26*probe_R_PJ_xy
+inline constexpr double k743ab252 = 0.010003285924050998;  // = -(bus_J0_xz + k13526884*k98ea08ea*kc613cfee)*kb0a02a3e
+inline constexpr double k760c4453 = 0.050488228249160515;  // = (1.0/kfd32cd94 + k12632d37*k12632d37/kafe9d580) + (k4b382fce*k4b382fce/k50c55f5e + kc99a359a*kc99...
+inline constexpr double k78782cea = 0.010173030385459837;  // = k2e47b47e*k8b22619e + k743ab252
 inline constexpr double k79d8f120 = 2.391501040852396e-06;  // = -k39abfd5e*probe_R_PJ_yy - kbcb0f926*probe_R_PJ_yz
-inline constexpr double k7edb958f = 2.4057750219790365e-06;  // = k39abfd5e*probe_R_PJ_xz
-inline constexpr double k7edee362 = 7.44193422703504e-07;  // = k39abfd5e*probe_R_PJ_yz
+inline constexpr double k7a44b90c = 1.2041216992784725;  // = bus_J0_yy + k5eb42b89
+inline constexpr double k7a50ebb4 = 0.0028758886122065104;  // = k4a3c96b2*ka6e1530f
+inline constexpr double k7b565e6b = 0.0005761778610914591;  // = k14fbf280*ka6e1530f
+inline constexpr double k7bea668d = -0.000955336489125606;  // = probe_R_PJ_yy*probe_mass
+inline constexpr double k8094571d = 0.010627093308354731;  // = k8b22619e/k402b2dd7
 inline constexpr double k80dbd051 = 9.55336489125606e-10;  // = probe_J0_zz*probe_R_PJ_xz
 inline constexpr double k80dcbd64 = 2.9552020666133954e-10;  // = probe_J0_zz*probe_R_PJ_yz
-inline constexpr double k85239292 = 0.00013156799553861972;  // = 2.0*k10555159 + k12a41664
-inline constexpr double k87659ac3 = 8.733219254516083e-05;  // = kb2a327ab*probe_R_PJ_yz
+inline constexpr double k82242927 = 0.03158680894370257;  // = -k19bebda5*kd3e4ee15 + kdbc276db
+inline constexpr double k8502c437 = 7.893819867260513e-07;  // = k0adc6025*probe_R_PJ_xz + kec373ccc*probe_R_PJ_xy
+inline constexpr double k879742ae = 4.22708585417524e-05;  // = k39abfd5e*probe_R_PJ_xz + k8d95fafd*probe_R_PJ_xy
+inline constexpr double k87e33c47 = 0.8335304420001137;  // = 1.0/k50c55f5e
+inline constexpr double k889332d2 = 0.20197841377402698;  // = -bus_S0_z - k1bdc33d2*kfe1ec95e
+inline constexpr double k896c0661 = 19.95145365231487;  // = -k4799cce7*kfe1ec95e + kfd32cd94
+inline constexpr double k8a1d27a2 = 0.0013560022479822016;  // = k19bebda5*k71c4f190
+inline constexpr double k8b22619e = 0.008501006479830337;  // = ((bus_J0_yz + k13526884*kbe764671*kc613cfee) + (k2e47b47e*k743ab252*kafe9d580 + k5b21c82d*kb8b538...
+inline constexpr double k8d95fafd = 0.00013489799553861973;  // = 2.0*probe_S0_z*probe_p_J_z + probe_J0_yy + probe_mass*probe_p_J_z*probe_p_J_z
+inline constexpr double k920f6e7a = 0.0002739589136447557;  // = k8b22619e*kf23f55b5/k402b2dd7 + kfb8b7a25/k50c55f5e
+inline constexpr double k9320e1d4 = 1.0100132460182678;  // = k20a2e8a0 - k4ab06a8f*k80dbd051
+inline constexpr double k93a540d0 = 0.016098098957582317;  // = -bus_J0_xz*kbdb64d6e + k51c731a0
+inline constexpr double k95368a4e = 20.001;  // = bus_mass + kdb7db7cd
 inline constexpr double k954b958c = 0.9999999999999999;  // = k70ce114d*probe_J0_zz
+inline constexpr double k96d9dd7c = 0.00011576034716842896;  // = k14056fb0*probe_p_J_z
+inline constexpr double k98ea08ea = -0.00999950002499875;  // = bus_S0_z*k6072e698
+inline constexpr double k9b27a3cf = 1.2041216992784727;  // = k25891712 - k80dcbd64*kcf881ceb
+inline constexpr double k9bae49ed = 0.00012812878402524314;  // = -kb7969180*probe_R_PJ_yy - kec373ccc*probe_R_PJ_yz
+inline constexpr double k9e4c8ac7 = 1.2343622575541595;  // = 1.0/kc929d4ee
+inline constexpr double k9fa281b7 = 0.01595985038473625;  // = bus_J0_xy - k6e38b76b
+inline constexpr double ka08e2ce9 = 0.049997500124993745;  // = 1.0/kfd32cd94
+inline constexpr double ka16c5185 = 19.951443695343997;  // = -k7a50ebb4*ka6e1530f + k896c0661
 inline constexpr double ka1e1120f = 7.903373232151769e-07;  // = k39abfd5e*probe_R_PJ_xy + kbcb0f926*probe_R_PJ_xz
-inline constexpr double ka35c9b67 = 0.00013161529674038153;  // = 2.0*k10555159 + k12a41664 + k15d08898
+inline constexpr double ka6e1530f = 0.0034622241045471833;  // = kbdb64d6e*kfe1ec95e
+inline constexpr double ka6f48908 = 0.008123198817015384;  // = k05032069/k50c55f5e - k672a5b3b*k8b22619e/k402b2dd7
+inline constexpr double ka7239acb = 0.001;  // = k25819bb6*probe_R_PJ_xz + kea2434dd*probe_R_PJ_xy
+inline constexpr double kaca03149 = 1.0097189854781756;  // = k41521e70 - k93a540d0*kec9ce579
+inline constexpr double kaee7bae0 = 0.00011580764837019077;  // = k14056fb0*probe_p_J_z + k539cd6f4*probe_p_J_y
+inline constexpr double kafe9d580 = 1.0000091545237526;  // = -k12632d37*k12632d37*kfd32cd94 + k45aaab02 - k98ea08ea*k98ea08ea*kc613cfee
+inline constexpr double kb0a02a3e = 0.9999908455600519;  // = 1.0/kafe9d580
 inline constexpr double kb2a327ab = 0.00029552020666133953;  // = probe_R_PJ_yz*probe_mass
+inline constexpr double kb3b1c3c4 = 19.911022564233825;  // = -k219f08e1*kc2a315ce + ka16c5185
+inline constexpr double kb4c53bab = 0.4027937961849187;  // = kda3b4caa + kec9ce579*kfe1ec95e
+inline constexpr double kb6c51f26 = 4.227085854175241e-05;  // = kb7969180*probe_R_PJ_xy + kec373ccc*probe_R_PJ_xz
+inline constexpr double kb7969180 = 0.00013489799553861976;  // = k10555159 + k96d9dd7c + probe_J0_yy
+inline constexpr double kb87e8e62 = 0.08116721465459756;  // = k219f08e1*kd3e4ee15 + k7b565e6b
+inline constexpr double kb8b53809 = 0.020004738563588472;  // = k1e3e25bc*kf5761fb9
+inline constexpr double kb9dd3689 = 0.00013494529674038156;  // = k10555159 + kaee7bae0 + probe_J0_xx
 inline constexpr double kbcb0f926 = 4.8301201761807726e-08;  // = probe_J0_zz + probe_mass*probe_p_J_y*probe_p_J_y
+inline constexpr double kbdb64d6e = 0.017281071605758234;  // = bus_J0_yz*k9e4c8ac7
+inline constexpr double kbe3314ec = 0.015959850667057487;  // = bus_J0_xy - k0bc33935
+inline constexpr double kbe42abe4 = 0.008685398759145514;  // = k4b382fce/k50c55f5e + k8b22619e*kc99a359a/k402b2dd7
+inline constexpr double kbe764671 = -8.954329927711833e-24;  // = (k184a4b98*k5b21c82d)*(k6072e698*kfb5c4d30)
+inline constexpr double kbff310c2 = 1.2500982481978802;  // = 1.0/k402b2dd7
+inline constexpr double kc107fcce = -0.003951092625575133;  // = k1bdc33d2*kda3b4caa
+inline constexpr double kc2a315ce = 0.2000801341947867;  // = k219f08e1*k71c4f190
+inline constexpr double kc58fc45f = 0.0986677263239434;  // = k19bebda5*kc2a315ce + k3b8c946c
+inline constexpr double kc613cfee = 20.001;  // = -k184a4b98*k184a4b98*k5b21c82d + k95368a4e
+inline constexpr double kc929d4ee = 0.8101349452967405;  // = bus_J0_zz + k2372934e
+inline constexpr double kc99a359a = 0.00028866243877900176;  // = k12632d37*k743ab252 + k4b382fce*k8b22619e
+inline constexpr double kc99adbfc = 8.689749539340228e-05;  // = -k05032069*k2e47b47e/k50c55f5e - k144a06fa/kafe9d580 + k672a5b3b*k78782cea/k402b2dd7
+inline constexpr double kcc1935bb = 0.020181591508823208;  // = k12632d37/kafe9d580 + k2e47b47e*k4b382fce/k50c55f5e + k78782cea*kc99a359a/k402b2dd7
+inline constexpr double kce57d488 = 0.05022551540360839;  // = (1.0/kc613cfee + k98ea08ea*k98ea08ea/kafe9d580) + (kf23f55b5*kf23f55b5/k402b2dd7 + kfb8b7a25*kfb8...
 inline constexpr double kcf881ceb = 0.2955202066613395;  // = k70ce114d*k80dcbd64
-inline constexpr double kd0817db4 = 8.733219254516081e-11;  // = k80dcbd64*kcf881ceb
-inline constexpr double kd9d9df32 = 7.550380835853164e-07;  // = ka1e1120f*probe_R_PJ_xz
-inline constexpr double kd9e71277 = 2.3356064908871898e-07;  // = ka1e1120f*probe_R_PJ_yz
+inline constexpr double kd3553756 = 19.806977257280558;  // = k4a879de0 - kb4c53bab*kd3e4ee15
+inline constexpr double kd3e4ee15 = 0.39891673027636143;  // = k71c4f190*kb4c53bab
+inline constexpr double kd447e126 = 0.4938865781968916;  // = k9e4c8ac7*kda3b4caa
 inline constexpr double kda3b4caa = 0.4001147760103331;  // = bus_S0_y + k0e90f1e0
 inline constexpr double kdb08d67b = 0.00034776682445628027;  // = k14056fb0*probe_R_PJ_xz + k539cd6f4*probe_R_PJ_xy
-inline constexpr double ke2477e11 = 2.823212366975176e-10;  // = k80dbd051*kcf881ceb
-inline constexpr double ke2d2f207 = 0.0009126678074548391;  // = k25819bb6*probe_R_PJ_xz
-inline constexpr double ke2d2fbca = 0.00028232123669751763;  // = k25819bb6*probe_R_PJ_yz
-inline constexpr double kfc617620 = -6.570409736228635e-06;  // = k539cd6f4*probe_R_PJ_xz
+inline constexpr double kdb7db7cd = 0.001;  // = k7bea668d*probe_R_PJ_yy + kb2a327ab*probe_R_PJ_yz
+inline constexpr double kdbc276db = 0.0321329982368026;  // = k14fbf280*k4ecd60cb
+inline constexpr double kdc3c5a3d = 19.7724185801411;  // = -k19bebda5*k8a1d27a2 + k2bb5e4c1
+inline constexpr double kdfe11949 = 60.003;  // = k5b21c82d + k95368a4e + kfd32cd94
+inline constexpr double ke781aae0 = 0.000205420482848844;  // = -k12632d37*k98ea08ea/kafe9d580 + k4b382fce*kfb8b7a25/k50c55f5e + kc99a359a*kf23f55b5/k402b2dd7
+inline constexpr double ke8516e6d = 1.000452550785749;  // = 1.0/kafe9d580 + k2e47b47e*k2e47b47e/k50c55f5e + k78782cea*k78782cea/k402b2dd7
+inline constexpr double kea2434dd = 0.00029552020666133953;  // = probe_R_PJ_xy*probe_mass
+inline constexpr double kec373ccc = 2.5182488571968797e-06;  // = -k0adc6090 - k10557130
+inline constexpr double kec9ce579 = 0.013371849444835252;  // = k4a3c96b2*k93a540d0
+inline constexpr double kee5d4586 = 7.963080698739598e-05;  // = k05032069*k4b382fce/k50c55f5e + k12632d37*k144a06fa/kafe9d580 - k672a5b3b*kc99a359a/k402b2dd7
+inline constexpr double kf00a5655 = 0.0505768785099756;  // = 1.0/k0117888d
+inline constexpr double kf1b96bf6 = 0.05048725946471336;  // = 1.0/kd3553756
+inline constexpr double kf23f55b5 = 0.01011861271444169;  // = k13526884 - k743ab252*k98ea08ea + k8b22619e*kfb8b7a25
+inline constexpr double kf5761fb9 = 0.4001147760103331;  // = bus_S0_y + kfeed872f
+inline constexpr double kf905b68b = 0.02490162301419597;  // = k672a5b3b/k402b2dd7
+inline constexpr double kf9f5609b = 0.00025030568772947996;  // = ((k144a06fa*k98ea08ea/kafe9d580 + k184a4b98/kc613cfee) + k672a5b3b*kf23f55b5/k402b2dd7) - k050320...
+inline constexpr double kfb5c4d30 = -0.00999950002499875;  // = bus_S0_z*k1e3e25bc
+inline constexpr double kfb84ce57 = 0.05057687850997559;  // = ((1.0/k5b21c82d + k05032069*k05032069/k50c55f5e) + k144a06fa*k144a06fa/kafe9d580) + (k184a4b98*k1...
+inline constexpr double kfb8b7a25 = 0.00019966573959545508;  // = -k2e47b47e*k98ea08ea + kbe764671
 inline constexpr double kfd32cd94 = 20.001;  // = bus_mass + probe_mass
 inline constexpr double kfe1ec95e = 0.2003477668244563;  // = bus_S0_x + kdb08d67b
-inline constexpr double kffa187dd = -2.0324659062035194e-06;  // = k539cd6f4*probe_R_PJ_yz
+inline constexpr double kfeed872f = 0.00011477601033306699;  // = k14056fb0*probe_R_PJ_xy - k539cd6f4*probe_R_PJ_xz
 
 
 // ---- dual numbers for jacobian() ---------------------------------------------
@@ -194,32 +321,6 @@ template <class T>
 void mass_matrix(const T* q, T* M) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q;
-  // ---- body probe: outward pass (positions)
-  const T t23 = cos(q[7]);
-  const T t24 = sin(q[7]);
-  // ---- body probe: composite inertia (inward)
-  const T t44 = probe_J0_xx*t23;
-  const T t45 = -probe_J0_yy*t24;
-  const T t46 = probe_J0_xx*t24;
-  const T t47 = probe_J0_yy*t23;
-  const T t48 = t23*t44 - t24*t45;
-  const T t49 = t23*t45 + t24*t44;
-  const T t50 = t23*t47 + t24*t46;
-  const T t51 = ka35c9b67 + t48;
-  const T t52 = k85239292 + t50;
-  const T t53 = probe_R_PJ_xy*t49;
-  const T t54 = k7edb958f + probe_R_PJ_xy*t52;
-  const T t55 = probe_R_PJ_yy*t49;
-  const T t56 = k7edee362 + probe_R_PJ_yy*t52;
-  const T t57 = kd9d9df32 + probe_R_PJ_xy*t54;
-  const T t58 = kd9e71277 + probe_R_PJ_yy*t54;
-  const T t59 = -k6f6401e7 + probe_R_PJ_yy*t56;
-  const T t60 = bus_J0_xx + t57;
-  const T t61 = bus_J0_xy + t58;
-  const T t62 = bus_J0_xz + t53;
-  const T t63 = bus_J0_yy + t59;
-  const T t64 = bus_J0_yz + t55;
-  const T t65 = bus_J0_zz + t51;
   M[0] = kfd32cd94;
   M[1] = 0.0;
   M[2] = 0.0;
@@ -244,23 +345,23 @@ void mass_matrix(const T* q, T* M) {
   M[21] = 0.0;
   M[22] = -bus_S0_z;
   M[23] = kda3b4caa;
-  M[24] = t60;
-  M[25] = t61;
-  M[26] = t62;
+  M[24] = k20a2e8a0;
+  M[25] = kbe3314ec;
+  M[26] = bus_J0_xz;
   M[27] = k80dbd051;
   M[28] = bus_S0_z;
   M[29] = 0.0;
   M[30] = -kfe1ec95e;
-  M[31] = t61;
-  M[32] = t63;
-  M[33] = t64;
+  M[31] = kbe3314ec;
+  M[32] = k25891712;
+  M[33] = bus_J0_yz;
   M[34] = k80dcbd64;
   M[35] = -kda3b4caa;
   M[36] = kfe1ec95e;
   M[37] = 0.0;
-  M[38] = t62;
-  M[39] = t64;
-  M[40] = t65;
+  M[38] = bus_J0_xz;
+  M[39] = bus_J0_yz;
+  M[40] = kc929d4ee;
   M[41] = 0.0;
   M[42] = 0.0;
   M[43] = 0.0;
@@ -438,178 +539,103 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t95 = t66*t94 - t93*w_B_probe_z;
   const T t96 = -t65*t94 + t92*w_B_probe_z;
   const T t97 = t65*t93 - t66*t92;
-  // ---- body probe: composite inertia (inward)
-  const T t98 = probe_J0_xx*t26;
-  const T t99 = -probe_J0_yy*t27;
-  const T t100 = probe_J0_xx*t27;
-  const T t101 = probe_J0_yy*t26;
-  const T t102 = t26*t98 - t27*t99;
-  const T t103 = t26*t99 + t27*t98;
-  const T t104 = t100*t27 + t101*t26;
-  const T t105 = ka35c9b67 + t102;
-  const T t106 = k85239292 + t104;
-  const T t107 = probe_R_PJ_xy*t103;
-  const T t108 = k7edb958f + probe_R_PJ_xy*t106;
-  const T t109 = probe_R_PJ_yy*t103;
-  const T t110 = k7edee362 + probe_R_PJ_yy*t106;
-  const T t111 = kd9d9df32 + probe_R_PJ_xy*t108;
-  const T t112 = kd9e71277 + probe_R_PJ_yy*t108;
-  const T t113 = -k6f6401e7 + probe_R_PJ_yy*t110;
-  const T t114 = bus_J0_xx + t111;
-  const T t115 = bus_J0_xy + t112;
-  const T t116 = bus_J0_xz + t107;
-  const T t117 = bus_J0_yy + t113;
-  const T t118 = bus_J0_yz + t109;
-  const T t119 = bus_J0_zz + t105;
   // ---- body bus: bias force
-  const T t120 = -bus_mass*t23 - t78;
-  const T t121 = -bus_mass*t24 - t79;
-  const T t122 = -bus_mass*t25 - t80;
-  const T t123 = -bus_S0_y*t25 + bus_S0_z*t24 - t84;
-  const T t124 = bus_S0_x*t25 - bus_S0_z*t23 - t85;
-  const T t125 = -bus_S0_x*t24 + bus_S0_y*t23 - t86;
+  const T t101 = -bus_mass*t23 - t78;
+  const T t102 = -bus_mass*t24 - t79;
+  const T t103 = -bus_mass*t25 - t80;
+  const T t104 = -bus_S0_y*t25 + bus_S0_z*t24 - t84;
+  const T t105 = bus_S0_x*t25 - bus_S0_z*t23 - t85;
+  const T t106 = -bus_S0_x*t24 + bus_S0_y*t23 - t86;
   // ---- body probe: bias force
-  const T t126 = -probe_S0_z*t71 - probe_mass*t73 - t89;
-  const T t127 = probe_S0_z*t70 - probe_mass*t74 - t90;
-  const T t128 = -probe_mass*t64 - t91;
-  const T t129 = -probe_J0_xx*t70 + probe_S0_z*t74 - t95;
-  const T t130 = -probe_J0_yy*t71 - probe_S0_z*t73 - t96;
+  const T t107 = -probe_S0_z*t71 - probe_mass*t73 - t89;
+  const T t108 = probe_S0_z*t70 - probe_mass*t74 - t90;
+  const T t109 = -probe_mass*t64 - t91;
+  const T t110 = -probe_J0_xx*t70 + probe_S0_z*t74 - t95;
+  const T t111 = -probe_J0_yy*t71 - probe_S0_z*t73 - t96;
   // ---- body probe: generalized forces (inward)
-  const T t131 = -probe_k*q[7] + tau[6];
-  const T t132 = t131 - t97;
-  const T t133 = t126*t26 - t127*t27;
-  const T t134 = t126*t27 + t127*t26;
-  const T t135 = probe_p_J_y*t128 - probe_p_J_z*t134;
-  const T t136 = probe_p_J_z*t133;
-  const T t137 = -probe_p_J_y*t133;
-  const T t138 = t129*t26 - t130*t27;
-  const T t139 = t129*t27 + t130*t26;
-  const T t140 = t135 + t138;
-  const T t141 = t136 + t139;
-  const T t142 = t137 - t97;
-  const T t143 = probe_R_PJ_xy*t134 + probe_R_PJ_xz*t128;
-  const T t144 = probe_R_PJ_yy*t134 + probe_R_PJ_yz*t128;
-  const T t145 = probe_R_PJ_xy*t141 + probe_R_PJ_xz*t142;
-  const T t146 = probe_R_PJ_yy*t141 + probe_R_PJ_yz*t142;
-  const T t147 = t120 + t143;
-  const T t148 = t121 + t144;
-  const T t149 = t122 + t133;
-  const T t150 = t123 + t145;
-  const T t151 = t124 + t146;
-  const T t152 = t125 + t140;
+  const T t112 = -probe_k*q[7] + tau[6];
+  const T t113 = t112 - t97;
+  const T t114 = t107*t26 - t108*t27;
+  const T t115 = t107*t27 + t108*t26;
+  const T t116 = probe_p_J_y*t109 - probe_p_J_z*t115;
+  const T t117 = probe_p_J_z*t114;
+  const T t118 = -probe_p_J_y*t114;
+  const T t119 = t110*t26 - t111*t27;
+  const T t120 = t110*t27 + t111*t26;
+  const T t121 = t116 + t119;
+  const T t122 = t117 + t120;
+  const T t123 = t118 - t97;
+  const T t124 = probe_R_PJ_xy*t115 + probe_R_PJ_xz*t109;
+  const T t125 = probe_R_PJ_yy*t115 + probe_R_PJ_yz*t109;
+  const T t126 = probe_R_PJ_xy*t122 + probe_R_PJ_xz*t123;
+  const T t127 = probe_R_PJ_yy*t122 + probe_R_PJ_yz*t123;
+  const T t128 = t101 + t124;
+  const T t129 = t102 + t125;
+  const T t130 = t103 + t114;
+  const T t131 = t104 + t126;
+  const T t132 = t105 + t127;
+  const T t133 = t106 + t121;
   // ---- body bus: generalized forces (inward)
-  const T t153 = t147 + tau[0];
-  const T t154 = t148 + tau[1];
-  const T t155 = t149 + tau[2];
-  const T t156 = t150 + tau[3];
-  const T t157 = t151 + tau[4];
-  const T t158 = t152 + tau[5];
+  const T t134 = t128 + tau[0];
+  const T t135 = t129 + tau[1];
+  const T t136 = t130 + tau[2];
+  const T t137 = t131 + tau[3];
+  const T t138 = t132 + tau[4];
+  const T t139 = t133 + tau[5];
   // ---- M u_dot = F: L^T D L along the dof tree
-  const T t159 = -kd0817db4 + t117;
-  const T t160 = -ke2477e11 + t115;
-  const T t161 = -k05f44240 + t114;
-  const T t162 = 1.0/t119;
-  const T t163 = t118*t162;
-  const T t164 = -t118*t163 + t159;
-  const T t165 = -t116*t163 + t160;
-  const T t166 = -kfe1ec95e*t163;
-  const T t167 = bus_S0_z + kda3b4caa*t163;
-  const T t168 = t116*t162;
-  const T t169 = -t116*t168 + t161;
-  const T t170 = -bus_S0_z - kfe1ec95e*t168;
-  const T t171 = kda3b4caa*t168;
-  const T t172 = kfe1ec95e*t162;
-  const T t173 = kfd32cd94 - kfe1ec95e*t172;
-  const T t174 = kda3b4caa*t172;
-  const T t175 = -kda3b4caa*t162;
-  const T t176 = kda3b4caa*t175 + kfd32cd94;
-  const T t177 = 1.0/t164;
-  const T t178 = t165*t177;
-  const T t179 = -t165*t178 + t169;
-  const T t180 = kda3b4caa + kfe1ec95e*t178;
-  const T t181 = -t166*t178 + t170;
-  const T t182 = -t167*t178 + t171;
-  const T t183 = -kfe1ec95e*t177;
-  const T t184 = kfd32cd94 + kfe1ec95e*t183;
-  const T t185 = -t166*t183;
-  const T t186 = -t167*t183;
-  const T t187 = t166*t177;
-  const T t188 = -t166*t187 + t173;
-  const T t189 = -t167*t187 + t174;
-  const T t190 = t167*t177;
-  const T t191 = -t167*t190 + t176;
-  const T t192 = 1.0/t179;
-  const T t193 = t180*t192;
-  const T t194 = -t180*t193 + t184;
-  const T t195 = -t181*t193 + t185;
-  const T t196 = -t182*t193 + t186;
-  const T t197 = t181*t192;
-  const T t198 = -t181*t197 + t188;
-  const T t199 = -t182*t197 + t189;
-  const T t200 = t182*t192;
-  const T t201 = -t182*t200 + t191;
-  const T t202 = 1.0/t194;
-  const T t203 = t195*t202;
-  const T t204 = -t195*t203 + t198;
-  const T t205 = -t196*t203 + t199;
-  const T t206 = t196*t202;
-  const T t207 = -t196*t206 + t201;
-  const T t208 = 1.0/t204;
-  const T t209 = t205*t208;
-  const T t210 = -t205*t209 + t207;
-  const T t212 = -kcf881ceb*t132 + t157;
-  const T t213 = -k4ab06a8f*t132 + t156;
-  const T t214 = -t158*t163 + t212;
-  const T t215 = -t158*t168 + t213;
-  const T t216 = t154 - t158*t172;
-  const T t217 = t153 - t158*t175;
-  const T t218 = -t178*t214 + t215;
-  const T t219 = t155 - t183*t214;
-  const T t220 = -t187*t214 + t216;
-  const T t221 = -t190*t214 + t217;
-  const T t222 = -t193*t218 + t219;
-  const T t223 = -t197*t218 + t220;
-  const T t224 = -t200*t218 + t221;
-  const T t225 = -t203*t222 + t223;
-  const T t226 = -t206*t222 + t224;
-  const T t227 = -t209*t225 + t226;
-  const T t228 = t227/t210;
-  const T t229 = t225/t204;
-  const T t230 = t222/t194;
-  const T t231 = t218/t179;
-  const T t232 = t214/t164;
-  const T t233 = t158/t119;
-  const T t234 = k70ce114d*t132;
-  const T t235 = -t209*t228 + t229;
-  const T t236 = -t203*t235 + t230;
-  const T t237 = -t206*t228 + t236;
-  const T t238 = -t193*t237 + t231;
-  const T t239 = -t197*t235 + t238;
-  const T t240 = -t200*t228 + t239;
-  const T t241 = -t178*t240 + t232;
-  const T t242 = -t183*t237 + t241;
-  const T t243 = -t187*t235 + t242;
-  const T t244 = -t190*t228 + t243;
-  const T t245 = -t163*t244 + t233;
-  const T t246 = -t168*t240 + t245;
-  const T t247 = -t172*t235 + t246;
-  const T t248 = -t175*t228 + t247;
-  const T t249 = -kcf881ceb*t244 + t234;
-  const T t250 = -k4ab06a8f*t240 + t249;
-  if (!(t210 > 1e-14*kfd32cd94)) return 1;
-  if (!(t204 > 1e-14*kfd32cd94)) return 2;
-  if (!(t194 > 1e-14*kfd32cd94)) return 3;
-  if (!(t179 > 1e-14*t114)) return 4;
-  if (!(t164 > 1e-14*t117)) return 5;
-  if (!(t119 > 0.0)) return 6;
+  const T t140 = -kcf881ceb*t113 + t138;
+  const T t141 = -k4ab06a8f*t113 + t137;
+  const T t142 = -kbdb64d6e*t139 + t140;
+  const T t143 = -k1bdc33d2*t139 + t141;
+  const T t144 = -k4799cce7*t139 + t135;
+  const T t145 = kd447e126*t139 + t134;
+  const T t146 = -kec9ce579*t142 + t143;
+  const T t147 = k14fbf280*t142 + t136;
+  const T t148 = k7a50ebb4*t142 + t144;
+  const T t149 = k1d77e7da*t142 + t145;
+  const T t150 = -kd3e4ee15*t146 + t147;
+  const T t151 = -kc2a315ce*t146 + t148;
+  const T t152 = k8a1d27a2*t146 + t149;
+  const T t153 = k4d1afa91*t150 + t151;
+  const T t154 = k1dd8b291*t150 + t152;
+  const T t155 = -k42c83df6*t153 + t154;
+  const T t156 = kf00a5655*t155;
+  const T t157 = k531ff1b5*t153;
+  const T t158 = kf1b96bf6*t150;
+  const T t159 = k71c4f190*t146;
+  const T t160 = k4a3c96b2*t142;
+  const T t161 = k9e4c8ac7*t139;
+  const T t162 = k70ce114d*t113;
+  const T t163 = -k42c83df6*t156 + t157;
+  const T t164 = k4d1afa91*t163 + t158;
+  const T t165 = k1dd8b291*t156 + t164;
+  const T t166 = -kd3e4ee15*t165 + t159;
+  const T t167 = -kc2a315ce*t163 + t166;
+  const T t168 = k8a1d27a2*t156 + t167;
+  const T t169 = -kec9ce579*t168 + t160;
+  const T t170 = k14fbf280*t165 + t169;
+  const T t171 = k7a50ebb4*t163 + t170;
+  const T t172 = k1d77e7da*t156 + t171;
+  const T t173 = -kbdb64d6e*t172 + t161;
+  const T t174 = -k1bdc33d2*t168 + t173;
+  const T t175 = -k4799cce7*t163 + t174;
+  const T t176 = kd447e126*t156 + t175;
+  const T t177 = -kcf881ceb*t172 + t162;
+  const T t178 = -k4ab06a8f*t168 + t177;
+  if (!(k0117888d > 1e-14*kfd32cd94)) return 1;
+  if (!(k5579ef2f > 1e-14*kfd32cd94)) return 2;
+  if (!(kd3553756 > 1e-14*kfd32cd94)) return 3;
+  if (!(kaca03149 > 1e-14*k20a2e8a0)) return 4;
+  if (!(k3688a0d6 > 1e-14*k25891712)) return 5;
+  if (!(kc929d4ee > 0.0)) return 6;
   if (!(probe_J0_zz > 0.0)) return 7;
-  udot[0] = t228;
-  udot[1] = t235;
-  udot[2] = t237;
-  udot[3] = t240;
-  udot[4] = t244;
-  udot[5] = t248;
-  udot[6] = t250;
+  udot[0] = t156;
+  udot[1] = t163;
+  udot[2] = t165;
+  udot[3] = t168;
+  udot[4] = t172;
+  udot[5] = t176;
+  udot[6] = t178;
   return 0;
 }
 

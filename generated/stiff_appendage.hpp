@@ -18,7 +18,7 @@
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
 //   mass_matrix     1517 (601 add, 876 mul, 40 div, 0 func)
 //   forcing         1710 (679 add, 991 mul, 40 div, 0 func)
-//   udot            3469 (1415 add, 1995 mul, 59 div, 0 func) -- composite form; composite 3469, articulated 3864
+//   udot            3469 (1415 add, 1995 mul, 59 div, 0 func) -- composite form; composite 3469, articulated 3853
 //   energy          2389 (981 add, 1362 mul, 46 div, 0 func)
 //   momentum        1659 (646 add, 971 mul, 41 div, 1 func)
 
