@@ -1,8 +1,8 @@
 // Compact u-dot code (codegen/outlined_code.hpp, issue 38): kernels shared by
 // the bodies whose code has the same shape. The same operations as the
 // straight-line code, so the same u-dot to rounding, on chains, trees,
-// flexible bodies and free roots in orbit; the kernels do not grow with the
-// chain; the cost model's choice ("auto") is what docs/speed.md measured.
+// flexible bodies, free roots in orbit and prescribed motion; the kernels do
+// not grow with the chain; the cost model's choice ("auto") is what docs/speed.md measured.
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
 
@@ -109,6 +109,8 @@ TEST_CASE("compact u-dot code computes the straight-line code's u-dot and Jacobi
       {"branched tree", test::source_path("models/branched_tree.yaml"), "articulated"},
       {"flexible spacecraft (modes, wheels, a gimbal)", test::source_path("models/flexible_spacecraft.yaml"), "auto"},
       {"Explorer I in orbit (central gravity, free root)", test::source_path("models/explorer1_orbit.yaml"), "auto"},
+      {"prescribed motion (a polynomial and a sine: time-dependent code and its preludes)",
+       test::source_path("tests/reference/v_prescribed_mix/v_prescribed_mix.yaml"), "composite"},
   };
   for (const Case& c : cases) {
     INFO(c.name);
