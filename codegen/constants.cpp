@@ -204,13 +204,20 @@ std::string Constants::role(const std::string& name) const {
 }
 
 std::string Constants::role_of(const GiNaC::ex& e) const {
+  // blind to signs, as GiNaC may hold -(a - b) c as (b - a) c in another run (roles only order operands)
   if (GiNaC::is_a<GiNaC::symbol>(e)) return role(GiNaC::ex_to<GiNaC::symbol>(e).get_name());
   if (GiNaC::is_a<GiNaC::numeric>(e)) {
     OpCount unused;
-    return print_cpp(e, unused);
+    return print_cpp(GiNaC::abs(GiNaC::ex_to<GiNaC::numeric>(e)), unused);
   }
   std::vector<std::string> operands;
-  for (std::size_t i = 0; i < e.nops(); ++i) operands.push_back(role_of(e.op(i)));
+  for (std::size_t i = 0; i < e.nops(); ++i) {
+    if (GiNaC::is_a<GiNaC::mul>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(i)) &&
+        GiNaC::abs(GiNaC::ex_to<GiNaC::numeric>(e.op(i))) == 1)
+      continue;
+    operands.push_back(role_of(e.op(i)));
+  }
+  if (GiNaC::is_a<GiNaC::mul>(e) && operands.size() == 1) return operands[0];
   const bool commutative = GiNaC::is_a<GiNaC::add>(e) || GiNaC::is_a<GiNaC::mul>(e);
   if (commutative) std::sort(operands.begin(), operands.end());
   const std::string head = GiNaC::is_a<GiNaC::add>(e) ? "+" : GiNaC::is_a<GiNaC::mul>(e) ? "*" : GiNaC::is_a<GiNaC::power>(e) ? "^" : "f";

@@ -91,7 +91,9 @@ class Canonical {
     std::vector<std::tuple<std::string, std::string, std::size_t>> operands;
     for (std::size_t i = 0; i < e.nops(); ++i) {
       OpCount unused;
-      operands.emplace_back(shape(e.op(i)), print_cpp(e.op(i), unused), i);
+      std::string text = print_cpp(e.op(i), unused);  // canonical, signs of sums normalized; its own sign dropped
+      if (!text.empty() && text[0] == '-') text.erase(0, 1);
+      operands.emplace_back(shape(e.op(i)), std::move(text), i);
     }
     if (is_a<add>(e) || is_a<mul>(e))
       std::sort(operands.begin(), operands.end(), [](const auto& a, const auto& b) {
@@ -104,6 +106,9 @@ class Canonical {
   std::vector<std::string> input_order, constant_order;
 
  private:
+  /// The shape, blind to signs: GiNaC keeps a sum inside a product with the sign that makes its hash-first
+  /// term positive, so -(p - q) r in one run is (q - p) r in the next; a numeric factor's sign and a factor
+  /// -1 are left out (a -x is shaped as x).
   std::string shape(const ex& e) const {
     if (is_a<symbol>(e)) {
       const std::string& n = ex_to<symbol>(e).get_name();
@@ -112,11 +117,15 @@ class Canonical {
     }
     if (is_a<numeric>(e)) {
       std::ostringstream s;
-      s << e;
+      s << abs(ex_to<numeric>(e));
       return s.str();
     }
     std::vector<std::string> operands;
-    for (std::size_t i = 0; i < e.nops(); ++i) operands.push_back(shape(e.op(i)));
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      if (is_a<mul>(e) && is_a<numeric>(e.op(i)) && abs(ex_to<numeric>(e.op(i))) == 1) continue;
+      operands.push_back(shape(e.op(i)));
+    }
+    if (is_a<mul>(e) && operands.size() == 1) return operands[0];
     if (is_a<add>(e) || is_a<mul>(e)) std::sort(operands.begin(), operands.end());
     const std::string head = is_a<add>(e)        ? "+"
                              : is_a<mul>(e)      ? "*"

@@ -123,6 +123,9 @@ std::optional<AxisTurn> axis_turn(KaneContext& ctx, const SM3& R) {
     if (!same(R(j, j), R(i, i)) || !same(R(i, j), -R(j, i))) continue;
     AxisTurn t{i, j, k, R(i, i), R(j, i), 0, 0, 0, 0};
     const auto vc = ctx.C.numeric_value(t.c), vs = ctx.C.numeric_value(t.s);
+    // the formulas take c^2 = 1 - s^2: a constant turn must be a rotation to rounding (the loader accepts a
+    // user's matrix orthonormal to 1e-9, and that one is turned as given)
+    if (vc && vs && std::abs(*vc * *vc + *vs * *vs - 1.0) > 4 * std::numeric_limits<double>::epsilon()) continue;
     if (vc && vs && is_a<symbol>(t.c)) {
       t.ss = ctx.C.companion(t.c, "ss", *vs * *vs, "a turn's sin^2");
       t.cs = ctx.C.companion(t.c, "cs", *vc * *vs, "a turn's cos sin");

@@ -9732,20 +9732,20 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel0(T* w, const int* x, const do
   const double C7 = c[7];
   const double C8 = c[8];
   const T a0 = -X0*X1 + X2*X3;
-  const T a1 = X1*X5 - X2*X4;
-  const T a2 = X0*X4 - X3*X5;
+  const T a1 = X1*X4 - X2*X5;
+  const T a2 = X0*X5 - X3*X4;
   const T a3 = C0*X3;
-  const T a4 = -C0*X4 + C1*X1;
+  const T a4 = -C0*X5 + C1*X1;
   const T a5 = -C1*X3;
   const T a6 = -X1*a4 + X3*a5;
-  const T a7 = X1*a3 - X4*a5;
-  const T a8 = -X3*a3 + X4*a4;
-  const T a9 = C2*X4 + C3*X3 + C4*X1;
-  const T a10 = C3*X4 + C5*X3 + C6*X1;
-  const T a11 = C4*X4 + C6*X3 + C7*X1;
+  const T a7 = X1*a3 - X5*a5;
+  const T a8 = -X3*a3 + X5*a4;
+  const T a9 = C2*X5 + C3*X3 + C4*X1;
+  const T a10 = C3*X5 + C5*X3 + C6*X1;
+  const T a11 = C4*X5 + C6*X3 + C7*X1;
   const T a12 = -X1*a10 + X3*a11;
-  const T a13 = X1*a9 - X4*a11;
-  const T a14 = -X3*a9 + X4*a10;
+  const T a13 = X1*a9 - X5*a11;
+  const T a14 = -X3*a9 + X5*a10;
   const T a15 = -C8*a0 - a6;
   const T a16 = -C8*a1 - a7;
   const T a17 = -C8*a2 - a8;
@@ -10028,8 +10028,8 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel4(T* w, const int* x, const do
   const T a1 = sin(C0 + X0);
   const T a2 = C1*X1 + C2*X2;
   const T a3 = C3*X1 + C4*X2;
-  const T a4 = C1*X4 - C2*X3;
-  const T a5 = C3*X4 - C4*X3;
+  const T a4 = C1*X3 - C2*X4;
+  const T a5 = C3*X3 - C4*X4;
   const T a6 = C5*a3;
   const T a7 = -C5*a2;
   const T a8 = a2*a7 - a3*a6;
@@ -10224,8 +10224,8 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel6(T* w, const int* x, const do
   const T a1 = sin(X0);
   const T a2 = C0*X1 + C1*X2;
   const T a3 = C2*X1 + C3*X2;
-  const T a4 = C0*X4 - C1*X3;
-  const T a5 = C2*X4 - C3*X3;
+  const T a4 = C0*X3 - C1*X4;
+  const T a5 = C2*X3 - C3*X4;
   const T a6 = C4*a3;
   const T a7 = -C4*a2;
   const T a8 = a2*a7 - a3*a6;
@@ -10863,8 +10863,8 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel9(T* w, const int* x, const do
   const T a77 = a37 - a76;
   const T a78 = a21 + a76;
   const T a79 = C4*a40 + C5*a75;
-  const T a80 = -C6*a39 + C7*a38;
-  const T a81 = C6*a38 + C7*a39;
+  const T a80 = C6*a38 - C7*a39;
+  const T a81 = C6*a39 + C7*a38;
   const T a82 = a61 + a63;
   const T a83 = -a59 + a64;
   const T a84 = C3*a82 + C5*a83;
@@ -10873,17 +10873,17 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel9(T* w, const int* x, const do
   const T a87 = -a61 + a84;
   const T a88 = -a59 + a85;
   const T a89 = a64 + a85;
-  const T a90 = -C6*a49 + C7*a48;
-  const T a91 = C6*a48 + C7*a49;
-  const T a92 = C6*a57 + C7*a62;
-  const T a93 = C6*a62 - C7*a57;
+  const T a90 = C6*a48 - C7*a49;
+  const T a91 = C6*a49 + C7*a48;
+  const T a92 = C6*a62 + C7*a57;
+  const T a93 = -C6*a57 + C7*a62;
   const T a94 = a70 - a74;
   const T a95 = C2*a73 + C3*a94;
   const T a96 = a70 - a95;
   const T a97 = a74 + a95;
   const T a98 = C4*a73 + C5*a94;
-  const T a99 = -C6*a67 + C7*a66;
-  const T a100 = C6*a66 + C7*a67;
+  const T a99 = C6*a66 - C7*a67;
+  const T a100 = C6*a67 + C7*a66;
   const T a101 = C8 + a36;
   const T a102 = C8 + a77;
   const T a103 = C9 + a88;
@@ -10900,10 +10900,10 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel9(T* w, const int* x, const do
   const T a114 = X29*a27 + X30*a29;
   const T a115 = a111 + a114;
   const T a116 = a112 + a30;
-  const T a117 = C13*a24 + C7*a110;
-  const T a118 = C14*a24 + C6*a110;
-  const T a119 = C13*a116 + C7*a115;
-  const T a120 = C14*a116 + C6*a115;
+  const T a117 = C13*a24 + C6*a110;
+  const T a118 = C14*a24 + C7*a110;
+  const T a119 = C13*a116 + C6*a115;
+  const T a120 = C14*a116 + C7*a115;
   const T a121 = -X31 + a109;
   const T a122 = -X32 + a117;
   const T a123 = -X33 + a118;
@@ -11460,7 +11460,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel13(T* w, const int* x, const d
   const T a5 = -X4*X6 + X5*a2;
   const T a6 = -X1*X6 + X5*X7;
   const T a7 = -X1*X5 - X6*X7;
-  const T a8 = (X13*a7 + X14) - (((X0*X11 + X10*a6) + X12*a5) + (X8*a4 + X9*a3));
+  const T a8 = (X12*a7 + X14) - (((X0*X11 + X10*a6) + X13*a5) + (X8*a4 + X9*a3));
   const T a9 = X15*a8;
   const T a10 = X0 + a9;
   w[x[16]] = a3;
@@ -11502,7 +11502,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel14(T* w, const int* x, const d
   const T a5 = -X4*X6 + X5*a2;
   const T a6 = X1*X6 + X5*X7;
   const T a7 = X1*X5 - X6*X7;
-  const T a8 = ((X0*X12 + X13*a7) + X14) - ((X10*a6 + X11*a5) + (X8*a4 + X9*a3));
+  const T a8 = ((X0*X8 + X12*a7) + X14) - ((X10*a3 + X11*a6) + (X13*a5 + X9*a4));
   const T a9 = X15*a8;
   const T a10 = -X0 + a9;
   w[x[16]] = a3;
@@ -11544,7 +11544,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel15(T* w, const int* x, const d
   const T a5 = -X4*X6 + X5*a2;
   const T a6 = X1*X6 + X5*X7;
   const T a7 = X1*X5 - X6*X7;
-  const T a8 = (X0*X13 + X14) - (((X10*a3 + X11*a4) + X12*a7) + (X8*a6 + X9*a5));
+  const T a8 = (X0*X8 + X14) - (((X10*a5 + X11*a3) + X12*a4) + (X13*a7 + X9*a6));
   const T a9 = X15*a8;
   const T a10 = -X0 + a9;
   w[x[16]] = a3;
@@ -11594,7 +11594,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel16(T* w, const int* x, const d
   const T a9 = -X4*X6 + X5*a6;
   const T a10 = X5*X7 + X6*a0;
   const T a11 = X5*a0 - X6*X7;
-  const T a12 = (X13*a11 + X14) - (((X10*a10 + X11*a9) + X12*a1) + (X8*a8 + X9*a7));
+  const T a12 = (X11*a11 + X14) - (((X10*a10 + X12*a9) + X13*a1) + (X8*a8 + X9*a7));
   const T a13 = X15*a12;
   const T a14 = a1 + a13;
   w[x[16]] = a7;
@@ -11636,7 +11636,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel17(T* w, const int* x, const d
   const T a5 = -X4*X6 + X5*a2;
   const T a6 = X1*X6 + X5*X7;
   const T a7 = X1*X5 - X6*X7;
-  const T a8 = (X0*X13 + X14) - (((X10*a7 + X11*a6) + X12*a5) + (X8*a3 + X9*a4));
+  const T a8 = (X0*X8 + X14) - (((X10*a4 + X11*a7) + X12*a6) + (X13*a5 + X9*a3));
   const T a9 = X15*a8;
   const T a10 = -X0 + a9;
   w[x[16]] = a3;
@@ -11679,7 +11679,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel18(T* w, const int* x, const d
 }
 
 // body base: outward pass (velocities)
-static constexpr int udot_x0[] = {0, 3, 1, 2, 5, 4, 7, 9, 8, 1443, 1444, 1445, 1446, 1447, 1448};
+static constexpr int udot_x0[] = {0, 3, 1, 2, 4, 5, 7, 9, 8, 1443, 1444, 1445, 1446, 1447, 1448};
 static constexpr double udot_c0[] = {base_S0_z, base_S0_x, base_J0_xx, base_J0_xy, base_J0_xz, base_J0_yy, base_J0_yz, base_J0_zz, base_mass};
 // body link1: outward pass (velocities)
 static constexpr int udot_x1[] = {6, 2, 3, 5, 7, 8, 9, 10, 1442, 1441, 16, 14, 12, 13, 20, 15, 17, 18, 1407, 1408, 1409, 1410, 1411, 1412};
@@ -11691,7 +11691,7 @@ static constexpr double udot_c2[] = {link2_angle_offset, link2_p_J_x, link2_S0_x
 static constexpr int udot_x3[] = {21, 22, 23, 24, 25, 15, 26, 27, 28, 29, 30, 1370, 1369, 36, 35, 32, 33, 40, 34, 38, 37, 1335, 1336, 1337, 1338, 1339, 1340};
 static constexpr double udot_c3[] = {link3_angle_offset, link3_p_J_x, link3_S0_x, link3_J0_xx, link3_J0_yy, link3_J0_zz, link3_mass};
 // body link4: outward pass (velocities)
-static constexpr int udot_x4[] = {31, 32, 33, 25, 34, 35, 37, 36, 38, 39, 40, 1334, 1333, 46, 47, 44, 42, 43, 51, 45, 49, 48, 1299, 1300, 1301, 1302, 1303, 1304};
+static constexpr int udot_x4[] = {31, 32, 33, 34, 25, 35, 37, 36, 38, 39, 40, 1334, 1333, 46, 47, 44, 42, 43, 51, 45, 49, 48, 1299, 1300, 1301, 1302, 1303, 1304};
 static constexpr double udot_c4[] = {link4_angle_offset, link4_R_PJ_yy, link4_R_PJ_zy, link4_R_PJ_yz, link4_R_PJ_zz, link4_p_J_x, link4_S0_x, link4_J0_xx, link4_J0_yy, link4_J0_zz, link4_mass};
 // body link5: outward pass (velocities)
 static constexpr int udot_x5[] = {41, 42, 43, 44, 45, 46, 47, 48, 49, 50, 51, 1298, 1297, 57, 55, 53, 54, 61, 56, 59, 58, 1263, 1264, 1265, 1266, 1267, 1268};
@@ -11703,7 +11703,7 @@ static constexpr double udot_c6[] = {link6_angle_offset, link6_p_J_x, link6_S0_x
 static constexpr int udot_x7[] = {62, 63, 64, 65, 66, 56, 67, 68, 69, 70, 71, 1226, 1225, 77, 76, 73, 74, 81, 75, 79, 78, 1191, 1192, 1193, 1194, 1195, 1196};
 static constexpr double udot_c7[] = {link7_angle_offset, link7_p_J_x, link7_S0_x, link7_J0_xx, link7_J0_yy, link7_J0_zz, link7_mass};
 // body link8: outward pass (velocities)
-static constexpr int udot_x8[] = {72, 73, 74, 66, 75, 76, 78, 77, 79, 80, 81, 1190, 1189, 87, 88, 85, 83, 84, 92, 86, 90, 89, 1155, 1156, 1157, 1158, 1159, 1160};
+static constexpr int udot_x8[] = {72, 73, 74, 75, 66, 76, 78, 77, 79, 80, 81, 1190, 1189, 87, 88, 85, 83, 84, 92, 86, 90, 89, 1155, 1156, 1157, 1158, 1159, 1160};
 static constexpr double udot_c8[] = {link8_angle_offset, link8_R_PJ_yy, link8_R_PJ_zy, link8_R_PJ_yz, link8_R_PJ_zz, link8_p_J_x, link8_S0_x, link8_J0_xx, link8_J0_yy, link8_J0_zz, link8_mass};
 // body link9: outward pass (velocities)
 static constexpr int udot_x9[] = {82, 83, 84, 85, 86, 87, 88, 89, 90, 91, 92, 1154, 1153, 98, 96, 94, 95, 102, 97, 100, 99, 1119, 1120, 1121, 1122, 1123, 1124};
@@ -11715,7 +11715,7 @@ static constexpr double udot_c10[] = {link10_angle_offset, link10_p_J_x, link10_
 static constexpr int udot_x11[] = {103, 104, 105, 106, 107, 97, 108, 109, 110, 111, 112, 1082, 1081, 118, 117, 114, 115, 122, 116, 120, 119, 1047, 1048, 1049, 1050, 1051, 1052};
 static constexpr double udot_c11[] = {link11_angle_offset, link11_p_J_x, link11_S0_x, link11_J0_xx, link11_J0_yy, link11_J0_zz, link11_mass};
 // body link12: outward pass (velocities)
-static constexpr int udot_x12[] = {113, 114, 115, 107, 116, 117, 119, 118, 120, 121, 122, 1046, 1045, 128, 129, 126, 124, 125, 133, 127, 131, 130, 1011, 1012, 1013, 1014, 1015, 1016};
+static constexpr int udot_x12[] = {113, 114, 115, 116, 107, 117, 119, 118, 120, 121, 122, 1046, 1045, 128, 129, 126, 124, 125, 133, 127, 131, 130, 1011, 1012, 1013, 1014, 1015, 1016};
 static constexpr double udot_c12[] = {link12_angle_offset, link12_R_PJ_yy, link12_R_PJ_zy, link12_R_PJ_yz, link12_R_PJ_zz, link12_p_J_x, link12_S0_x, link12_J0_xx, link12_J0_yy, link12_J0_zz, link12_mass};
 // body link13: outward pass (velocities)
 static constexpr int udot_x13[] = {123, 124, 125, 126, 127, 128, 129, 130, 131, 132, 133, 1010, 1009, 139, 137, 135, 136, 143, 138, 141, 140, 975, 976, 977, 978, 979, 980};
@@ -11727,7 +11727,7 @@ static constexpr double udot_c14[] = {link14_angle_offset, link14_p_J_x, link14_
 static constexpr int udot_x15[] = {144, 145, 146, 147, 148, 138, 149, 150, 151, 152, 153, 938, 937, 159, 158, 155, 156, 163, 157, 161, 160, 903, 904, 905, 906, 907, 908};
 static constexpr double udot_c15[] = {link15_angle_offset, link15_p_J_x, link15_S0_x, link15_J0_xx, link15_J0_yy, link15_J0_zz, link15_mass};
 // body link16: outward pass (velocities)
-static constexpr int udot_x16[] = {154, 155, 156, 148, 157, 158, 160, 159, 161, 162, 163, 902, 901, 169, 170, 167, 165, 166, 174, 168, 172, 171, 867, 868, 869, 870, 871, 872};
+static constexpr int udot_x16[] = {154, 155, 156, 157, 148, 158, 160, 159, 161, 162, 163, 902, 901, 169, 170, 167, 165, 166, 174, 168, 172, 171, 867, 868, 869, 870, 871, 872};
 static constexpr double udot_c16[] = {link16_angle_offset, link16_R_PJ_yy, link16_R_PJ_zy, link16_R_PJ_yz, link16_R_PJ_zz, link16_p_J_x, link16_S0_x, link16_J0_xx, link16_J0_yy, link16_J0_zz, link16_mass};
 // body link17: outward pass (velocities)
 static constexpr int udot_x17[] = {164, 165, 166, 167, 168, 169, 170, 171, 172, 173, 174, 866, 865, 180, 178, 176, 177, 184, 179, 182, 181, 831, 832, 833, 834, 835, 836};
@@ -11739,7 +11739,7 @@ static constexpr double udot_c18[] = {link18_angle_offset, link18_p_J_x, link18_
 static constexpr int udot_x19[] = {185, 186, 187, 188, 189, 179, 190, 191, 192, 193, 194, 794, 793, 200, 199, 196, 197, 204, 198, 202, 201, 759, 760, 761, 762, 763, 764};
 static constexpr double udot_c19[] = {link19_angle_offset, link19_p_J_x, link19_S0_x, link19_J0_xx, link19_J0_yy, link19_J0_zz, link19_mass};
 // body link20: outward pass (velocities)
-static constexpr int udot_x20[] = {195, 196, 197, 189, 198, 199, 201, 200, 202, 203, 204, 758, 757, 210, 211, 208, 206, 207, 215, 209, 213, 212, 723, 724, 725, 726, 727, 728};
+static constexpr int udot_x20[] = {195, 196, 197, 198, 189, 199, 201, 200, 202, 203, 204, 758, 757, 210, 211, 208, 206, 207, 215, 209, 213, 212, 723, 724, 725, 726, 727, 728};
 static constexpr double udot_c20[] = {link20_angle_offset, link20_R_PJ_yy, link20_R_PJ_zy, link20_R_PJ_yz, link20_R_PJ_zz, link20_p_J_x, link20_S0_x, link20_J0_xx, link20_J0_yy, link20_J0_zz, link20_mass};
 // body link21: outward pass (velocities)
 static constexpr int udot_x21[] = {205, 206, 207, 208, 209, 210, 211, 212, 213, 214, 215, 722, 721, 221, 219, 217, 218, 225, 220, 223, 222, 687, 688, 689, 690, 691, 692};
@@ -11751,7 +11751,7 @@ static constexpr double udot_c22[] = {link22_angle_offset, link22_p_J_x, link22_
 static constexpr int udot_x23[] = {226, 227, 228, 229, 230, 220, 231, 232, 233, 234, 235, 650, 649, 241, 240, 237, 238, 245, 239, 243, 242, 615, 616, 617, 618, 619, 620};
 static constexpr double udot_c23[] = {link23_angle_offset, link23_p_J_x, link23_S0_x, link23_J0_xx, link23_J0_yy, link23_J0_zz, link23_mass};
 // body link24: outward pass (velocities)
-static constexpr int udot_x24[] = {236, 237, 238, 230, 239, 240, 242, 241, 243, 244, 245, 614, 613, 251, 252, 249, 247, 248, 256, 250, 254, 253, 579, 580, 581, 582, 583, 584};
+static constexpr int udot_x24[] = {236, 237, 238, 239, 230, 240, 242, 241, 243, 244, 245, 614, 613, 251, 252, 249, 247, 248, 256, 250, 254, 253, 579, 580, 581, 582, 583, 584};
 static constexpr double udot_c24[] = {link24_angle_offset, link24_R_PJ_yy, link24_R_PJ_zy, link24_R_PJ_yz, link24_R_PJ_zz, link24_p_J_x, link24_S0_x, link24_J0_xx, link24_J0_yy, link24_J0_zz, link24_mass};
 // body link25: outward pass (velocities)
 static constexpr int udot_x25[] = {246, 247, 248, 249, 250, 251, 252, 253, 254, 255, 256, 578, 577, 262, 260, 258, 259, 266, 261, 264, 263, 543, 544, 545, 546, 547, 548};
@@ -11763,7 +11763,7 @@ static constexpr double udot_c26[] = {link26_angle_offset, link26_p_J_x, link26_
 static constexpr int udot_x27[] = {267, 268, 269, 270, 271, 261, 272, 273, 274, 275, 276, 506, 505, 282, 281, 278, 279, 286, 280, 284, 283, 471, 472, 473, 474, 475, 476};
 static constexpr double udot_c27[] = {link27_angle_offset, link27_p_J_x, link27_S0_x, link27_J0_xx, link27_J0_yy, link27_J0_zz, link27_mass};
 // body link28: outward pass (velocities)
-static constexpr int udot_x28[] = {277, 278, 279, 271, 280, 281, 283, 282, 284, 285, 286, 470, 469, 292, 293, 290, 288, 289, 297, 291, 295, 294, 435, 436, 437, 438, 439, 440};
+static constexpr int udot_x28[] = {277, 278, 279, 280, 271, 281, 283, 282, 284, 285, 286, 470, 469, 292, 293, 290, 288, 289, 297, 291, 295, 294, 435, 436, 437, 438, 439, 440};
 static constexpr double udot_c28[] = {link28_angle_offset, link28_R_PJ_yy, link28_R_PJ_zy, link28_R_PJ_yz, link28_R_PJ_zz, link28_p_J_x, link28_S0_x, link28_J0_xx, link28_J0_yy, link28_J0_zz, link28_mass};
 // body link29: outward pass (velocities)
 static constexpr int udot_x29[] = {287, 288, 289, 290, 291, 292, 293, 294, 295, 296, 297, 434, 433, 303, 301, 299, 300, 307, 302, 305, 304, 399, 400, 401, 402, 403, 404};
@@ -11775,7 +11775,7 @@ static constexpr double udot_c30[] = {link30_angle_offset, link30_p_J_x, link30_
 static constexpr int udot_x31[] = {308, 309, 310, 311, 312, 302, 313, 314, 315, 316, 317, 362, 361, 323, 322, 319, 320, 327, 321, 325, 324, 329, 330, 331, 332, 333, 334};
 static constexpr double udot_c31[] = {link31_angle_offset, link31_p_J_x, link31_S0_x, link31_J0_xx, link31_J0_yy, link31_J0_zz, link31_mass};
 // body link32: outward pass (velocities)
-static constexpr int udot_x32[] = {318, 319, 320, 312, 321, 322, 324, 323, 325, 326, 327, 328, 329, 330, 331, 332, 333, 334, 1734, 1735, 1737, 351, 346, 347, 342, 352, 355, 348, 340, 344, 358, 343, 345, 350, 341, 354, 356, 338, 339, 337, 349, 353, 357, 359, 360, 336};
+static constexpr int udot_x32[] = {318, 319, 320, 321, 312, 322, 324, 323, 325, 326, 327, 328, 329, 330, 331, 332, 333, 334, 1734, 1735, 1737, 351, 346, 347, 342, 352, 355, 348, 340, 344, 358, 343, 345, 350, 341, 354, 356, 338, 339, 337, 349, 353, 357, 359, 360, 336};
 static constexpr double udot_c32[] = {link32_R_PJ_yy, link32_R_PJ_zy, link32_R_PJ_yz, link32_R_PJ_zz, link32_p_J_x, link32_S0_x, link32_J0_xx, link32_J0_yy, link32_J0_zz, link32_mass, link32_k, k3ff32523, kc10ef88f, ked851ae2, k8b7360bd, kb606456b, link32_R_PJ_yy_ss, link32_R_PJ_yy_cs, link31_mass, link31_S0_x, link31_J0_xx, link31_J0_yy, link31_J0_zz};
 // body link31: articulated inertia and bias force (inward)
 static constexpr int udot_x33[] = {308, 335, 336, 337, 338, 339, 340, 341, 342, 343, 344, 345, 346, 347, 348, 349, 350, 351, 352, 353, 354, 355, 356, 357, 358, 359, 360, 361, 362, 363, 364, 365, 366, 367, 368, 1728, 1729, 1775, 381, 380, 386, 382, 391, 387, 383, 388, 374, 376, 377, 394, 378, 379, 385, 375, 390, 392, 372, 373, 371, 384, 389, 393, 395, 396, 370};
@@ -11788,7 +11788,7 @@ static constexpr int udot_x35[] = {287, 405, 406, 407, 408, 409, 410, 411, 412, 
 static constexpr double udot_c35[] = {link29_k, link29_p_J_x, link28_mass, link28_S0_x, link28_J0_xx, link28_J0_yy, link28_J0_zz};
 // body link28: articulated inertia and bias force (inward)
 static constexpr int udot_x36[] = {277, 441, 442, 443, 444, 445, 446, 447, 448, 449, 450, 451, 452, 453, 454, 455, 456, 457, 458, 459, 460, 461, 462, 463, 464, 465, 466, 467, 468, 469, 470, 471, 472, 473, 474, 475, 476, 1704, 1705, 1772, 490, 494, 488, 489, 496, 484, 495, 499, 491, 482, 486, 502, 485, 487, 493, 483, 498, 500, 480, 481, 479, 492, 497, 501, 503, 504, 478};
-static constexpr double udot_c36[] = {link28_k, link28_p_J_x, link28_R_PJ_yy_S2, link28_R_PJ_yy_ss, link28_R_PJ_yy_C2, link28_R_PJ_yy_cs, link28_R_PJ_zy, link28_R_PJ_yy, link27_mass, link27_S0_x, link27_J0_xx, link27_J0_yy, link27_J0_zz, link28_R_PJ_yz, link28_R_PJ_zz};
+static constexpr double udot_c36[] = {link28_k, link28_p_J_x, link28_R_PJ_yy_S2, link28_R_PJ_yy_ss, link28_R_PJ_yy_C2, link28_R_PJ_yy_cs, link28_R_PJ_yy, link28_R_PJ_zy, link27_mass, link27_S0_x, link27_J0_xx, link27_J0_yy, link27_J0_zz, link28_R_PJ_yz, link28_R_PJ_zz};
 // body link27: articulated inertia and bias force (inward)
 static constexpr int udot_x37[] = {267, 477, 478, 479, 480, 481, 482, 483, 484, 485, 486, 487, 488, 489, 490, 491, 492, 493, 494, 495, 496, 497, 498, 499, 500, 501, 502, 503, 504, 505, 506, 507, 508, 509, 510, 511, 512, 1696, 1697, 1771, 525, 524, 530, 526, 535, 531, 527, 532, 518, 520, 521, 538, 522, 523, 529, 519, 534, 536, 516, 517, 515, 528, 533, 537, 539, 540, 514};
 static constexpr double udot_c37[] = {link27_k, link27_p_J_x, link26_mass, link26_S0_x, link26_J0_xx, link26_J0_yy, link26_J0_zz};
@@ -11800,7 +11800,7 @@ static constexpr int udot_x39[] = {246, 549, 550, 551, 552, 553, 554, 555, 556, 
 static constexpr double udot_c39[] = {link25_k, link25_p_J_x, link24_mass, link24_S0_x, link24_J0_xx, link24_J0_yy, link24_J0_zz};
 // body link24: articulated inertia and bias force (inward)
 static constexpr int udot_x40[] = {236, 585, 586, 587, 588, 589, 590, 591, 592, 593, 594, 595, 596, 597, 598, 599, 600, 601, 602, 603, 604, 605, 606, 607, 608, 609, 610, 611, 612, 613, 614, 615, 616, 617, 618, 619, 620, 1672, 1673, 1768, 634, 638, 632, 633, 640, 628, 639, 643, 635, 626, 630, 646, 629, 631, 637, 627, 642, 644, 624, 625, 623, 636, 641, 645, 647, 648, 622};
-static constexpr double udot_c40[] = {link24_k, link24_p_J_x, link24_R_PJ_yy_S2, link24_R_PJ_yy_ss, link24_R_PJ_yy_C2, link24_R_PJ_yy_cs, link24_R_PJ_zy, link24_R_PJ_yy, link23_mass, link23_S0_x, link23_J0_xx, link23_J0_yy, link23_J0_zz, link24_R_PJ_yz, link24_R_PJ_zz};
+static constexpr double udot_c40[] = {link24_k, link24_p_J_x, link24_R_PJ_yy_S2, link24_R_PJ_yy_ss, link24_R_PJ_yy_C2, link24_R_PJ_yy_cs, link24_R_PJ_yy, link24_R_PJ_zy, link23_mass, link23_S0_x, link23_J0_xx, link23_J0_yy, link23_J0_zz, link24_R_PJ_yz, link24_R_PJ_zz};
 // body link23: articulated inertia and bias force (inward)
 static constexpr int udot_x41[] = {226, 621, 622, 623, 624, 625, 626, 627, 628, 629, 630, 631, 632, 633, 634, 635, 636, 637, 638, 639, 640, 641, 642, 643, 644, 645, 646, 647, 648, 649, 650, 651, 652, 653, 654, 655, 656, 1664, 1665, 1767, 669, 668, 674, 670, 679, 675, 671, 676, 662, 664, 665, 682, 666, 667, 673, 663, 678, 680, 660, 661, 659, 672, 677, 681, 683, 684, 658};
 static constexpr double udot_c41[] = {link23_k, link23_p_J_x, link22_mass, link22_S0_x, link22_J0_xx, link22_J0_yy, link22_J0_zz};
@@ -11812,7 +11812,7 @@ static constexpr int udot_x43[] = {205, 693, 694, 695, 696, 697, 698, 699, 700, 
 static constexpr double udot_c43[] = {link21_k, link21_p_J_x, link20_mass, link20_S0_x, link20_J0_xx, link20_J0_yy, link20_J0_zz};
 // body link20: articulated inertia and bias force (inward)
 static constexpr int udot_x44[] = {195, 729, 730, 731, 732, 733, 734, 735, 736, 737, 738, 739, 740, 741, 742, 743, 744, 745, 746, 747, 748, 749, 750, 751, 752, 753, 754, 755, 756, 757, 758, 759, 760, 761, 762, 763, 764, 1640, 1641, 1764, 778, 782, 776, 777, 784, 772, 783, 787, 779, 770, 774, 790, 773, 775, 781, 771, 786, 788, 768, 769, 767, 780, 785, 789, 791, 792, 766};
-static constexpr double udot_c44[] = {link20_k, link20_p_J_x, link20_R_PJ_yy_S2, link20_R_PJ_yy_ss, link20_R_PJ_yy_C2, link20_R_PJ_yy_cs, link20_R_PJ_zy, link20_R_PJ_yy, link19_mass, link19_S0_x, link19_J0_xx, link19_J0_yy, link19_J0_zz, link20_R_PJ_yz, link20_R_PJ_zz};
+static constexpr double udot_c44[] = {link20_k, link20_p_J_x, link20_R_PJ_yy_S2, link20_R_PJ_yy_ss, link20_R_PJ_yy_C2, link20_R_PJ_yy_cs, link20_R_PJ_yy, link20_R_PJ_zy, link19_mass, link19_S0_x, link19_J0_xx, link19_J0_yy, link19_J0_zz, link20_R_PJ_yz, link20_R_PJ_zz};
 // body link19: articulated inertia and bias force (inward)
 static constexpr int udot_x45[] = {185, 765, 766, 767, 768, 769, 770, 771, 772, 773, 774, 775, 776, 777, 778, 779, 780, 781, 782, 783, 784, 785, 786, 787, 788, 789, 790, 791, 792, 793, 794, 795, 796, 797, 798, 799, 800, 1632, 1633, 1763, 813, 812, 818, 814, 823, 819, 815, 820, 806, 808, 809, 826, 810, 811, 817, 807, 822, 824, 804, 805, 803, 816, 821, 825, 827, 828, 802};
 static constexpr double udot_c45[] = {link19_k, link19_p_J_x, link18_mass, link18_S0_x, link18_J0_xx, link18_J0_yy, link18_J0_zz};
@@ -11824,7 +11824,7 @@ static constexpr int udot_x47[] = {164, 837, 838, 839, 840, 841, 842, 843, 844, 
 static constexpr double udot_c47[] = {link17_k, link17_p_J_x, link16_mass, link16_S0_x, link16_J0_xx, link16_J0_yy, link16_J0_zz};
 // body link16: articulated inertia and bias force (inward)
 static constexpr int udot_x48[] = {154, 873, 874, 875, 876, 877, 878, 879, 880, 881, 882, 883, 884, 885, 886, 887, 888, 889, 890, 891, 892, 893, 894, 895, 896, 897, 898, 899, 900, 901, 902, 903, 904, 905, 906, 907, 908, 1608, 1609, 1760, 922, 926, 920, 921, 928, 916, 927, 931, 923, 914, 918, 934, 917, 919, 925, 915, 930, 932, 912, 913, 911, 924, 929, 933, 935, 936, 910};
-static constexpr double udot_c48[] = {link16_k, link16_p_J_x, link16_R_PJ_yy_S2, link16_R_PJ_yy_ss, link16_R_PJ_yy_C2, link16_R_PJ_yy_cs, link16_R_PJ_zy, link16_R_PJ_yy, link15_mass, link15_S0_x, link15_J0_xx, link15_J0_yy, link15_J0_zz, link16_R_PJ_yz, link16_R_PJ_zz};
+static constexpr double udot_c48[] = {link16_k, link16_p_J_x, link16_R_PJ_yy_S2, link16_R_PJ_yy_ss, link16_R_PJ_yy_C2, link16_R_PJ_yy_cs, link16_R_PJ_yy, link16_R_PJ_zy, link15_mass, link15_S0_x, link15_J0_xx, link15_J0_yy, link15_J0_zz, link16_R_PJ_yz, link16_R_PJ_zz};
 // body link15: articulated inertia and bias force (inward)
 static constexpr int udot_x49[] = {144, 909, 910, 911, 912, 913, 914, 915, 916, 917, 918, 919, 920, 921, 922, 923, 924, 925, 926, 927, 928, 929, 930, 931, 932, 933, 934, 935, 936, 937, 938, 939, 940, 941, 942, 943, 944, 1600, 1601, 1759, 957, 956, 962, 958, 967, 963, 959, 964, 950, 952, 953, 970, 954, 955, 961, 951, 966, 968, 948, 949, 947, 960, 965, 969, 971, 972, 946};
 static constexpr double udot_c49[] = {link15_k, link15_p_J_x, link14_mass, link14_S0_x, link14_J0_xx, link14_J0_yy, link14_J0_zz};
@@ -11836,7 +11836,7 @@ static constexpr int udot_x51[] = {123, 981, 982, 983, 984, 985, 986, 987, 988, 
 static constexpr double udot_c51[] = {link13_k, link13_p_J_x, link12_mass, link12_S0_x, link12_J0_xx, link12_J0_yy, link12_J0_zz};
 // body link12: articulated inertia and bias force (inward)
 static constexpr int udot_x52[] = {113, 1017, 1018, 1019, 1020, 1021, 1022, 1023, 1024, 1025, 1026, 1027, 1028, 1029, 1030, 1031, 1032, 1033, 1034, 1035, 1036, 1037, 1038, 1039, 1040, 1041, 1042, 1043, 1044, 1045, 1046, 1047, 1048, 1049, 1050, 1051, 1052, 1576, 1577, 1756, 1066, 1070, 1064, 1065, 1072, 1060, 1071, 1075, 1067, 1058, 1062, 1078, 1061, 1063, 1069, 1059, 1074, 1076, 1056, 1057, 1055, 1068, 1073, 1077, 1079, 1080, 1054};
-static constexpr double udot_c52[] = {link12_k, link12_p_J_x, link12_R_PJ_yy_S2, link12_R_PJ_yy_ss, link12_R_PJ_yy_C2, link12_R_PJ_yy_cs, link12_R_PJ_zy, link12_R_PJ_yy, link11_mass, link11_S0_x, link11_J0_xx, link11_J0_yy, link11_J0_zz, link12_R_PJ_yz, link12_R_PJ_zz};
+static constexpr double udot_c52[] = {link12_k, link12_p_J_x, link12_R_PJ_yy_S2, link12_R_PJ_yy_ss, link12_R_PJ_yy_C2, link12_R_PJ_yy_cs, link12_R_PJ_yy, link12_R_PJ_zy, link11_mass, link11_S0_x, link11_J0_xx, link11_J0_yy, link11_J0_zz, link12_R_PJ_yz, link12_R_PJ_zz};
 // body link11: articulated inertia and bias force (inward)
 static constexpr int udot_x53[] = {103, 1053, 1054, 1055, 1056, 1057, 1058, 1059, 1060, 1061, 1062, 1063, 1064, 1065, 1066, 1067, 1068, 1069, 1070, 1071, 1072, 1073, 1074, 1075, 1076, 1077, 1078, 1079, 1080, 1081, 1082, 1083, 1084, 1085, 1086, 1087, 1088, 1568, 1569, 1755, 1101, 1100, 1106, 1102, 1111, 1107, 1103, 1108, 1094, 1096, 1097, 1114, 1098, 1099, 1105, 1095, 1110, 1112, 1092, 1093, 1091, 1104, 1109, 1113, 1115, 1116, 1090};
 static constexpr double udot_c53[] = {link11_k, link11_p_J_x, link10_mass, link10_S0_x, link10_J0_xx, link10_J0_yy, link10_J0_zz};
@@ -11848,7 +11848,7 @@ static constexpr int udot_x55[] = {82, 1125, 1126, 1127, 1128, 1129, 1130, 1131,
 static constexpr double udot_c55[] = {link9_k, link9_p_J_x, link8_mass, link8_S0_x, link8_J0_xx, link8_J0_yy, link8_J0_zz};
 // body link8: articulated inertia and bias force (inward)
 static constexpr int udot_x56[] = {72, 1161, 1162, 1163, 1164, 1165, 1166, 1167, 1168, 1169, 1170, 1171, 1172, 1173, 1174, 1175, 1176, 1177, 1178, 1179, 1180, 1181, 1182, 1183, 1184, 1185, 1186, 1187, 1188, 1189, 1190, 1191, 1192, 1193, 1194, 1195, 1196, 1544, 1545, 1752, 1210, 1214, 1208, 1209, 1216, 1204, 1215, 1219, 1211, 1202, 1206, 1222, 1205, 1207, 1213, 1203, 1218, 1220, 1200, 1201, 1199, 1212, 1217, 1221, 1223, 1224, 1198};
-static constexpr double udot_c56[] = {link8_k, link8_p_J_x, link8_R_PJ_yy_S2, link8_R_PJ_yy_ss, link8_R_PJ_yy_C2, link8_R_PJ_yy_cs, link8_R_PJ_zy, link8_R_PJ_yy, link7_mass, link7_S0_x, link7_J0_xx, link7_J0_yy, link7_J0_zz, link8_R_PJ_yz, link8_R_PJ_zz};
+static constexpr double udot_c56[] = {link8_k, link8_p_J_x, link8_R_PJ_yy_S2, link8_R_PJ_yy_ss, link8_R_PJ_yy_C2, link8_R_PJ_yy_cs, link8_R_PJ_yy, link8_R_PJ_zy, link7_mass, link7_S0_x, link7_J0_xx, link7_J0_yy, link7_J0_zz, link8_R_PJ_yz, link8_R_PJ_zz};
 // body link7: articulated inertia and bias force (inward)
 static constexpr int udot_x57[] = {62, 1197, 1198, 1199, 1200, 1201, 1202, 1203, 1204, 1205, 1206, 1207, 1208, 1209, 1210, 1211, 1212, 1213, 1214, 1215, 1216, 1217, 1218, 1219, 1220, 1221, 1222, 1223, 1224, 1225, 1226, 1227, 1228, 1229, 1230, 1231, 1232, 1536, 1537, 1751, 1245, 1244, 1250, 1246, 1255, 1251, 1247, 1252, 1238, 1240, 1241, 1258, 1242, 1243, 1249, 1239, 1254, 1256, 1236, 1237, 1235, 1248, 1253, 1257, 1259, 1260, 1234};
 static constexpr double udot_c57[] = {link7_k, link7_p_J_x, link6_mass, link6_S0_x, link6_J0_xx, link6_J0_yy, link6_J0_zz};
@@ -11860,7 +11860,7 @@ static constexpr int udot_x59[] = {41, 1269, 1270, 1271, 1272, 1273, 1274, 1275,
 static constexpr double udot_c59[] = {link5_k, link5_p_J_x, link4_mass, link4_S0_x, link4_J0_xx, link4_J0_yy, link4_J0_zz};
 // body link4: articulated inertia and bias force (inward)
 static constexpr int udot_x60[] = {31, 1305, 1306, 1307, 1308, 1309, 1310, 1311, 1312, 1313, 1314, 1315, 1316, 1317, 1318, 1319, 1320, 1321, 1322, 1323, 1324, 1325, 1326, 1327, 1328, 1329, 1330, 1331, 1332, 1333, 1334, 1335, 1336, 1337, 1338, 1339, 1340, 1512, 1513, 1748, 1354, 1358, 1352, 1353, 1360, 1348, 1359, 1363, 1355, 1346, 1350, 1366, 1349, 1351, 1357, 1347, 1362, 1364, 1344, 1345, 1343, 1356, 1361, 1365, 1367, 1368, 1342};
-static constexpr double udot_c60[] = {link4_k, link4_p_J_x, link4_R_PJ_yy_S2, link4_R_PJ_yy_ss, link4_R_PJ_yy_C2, link4_R_PJ_yy_cs, link4_R_PJ_zy, link4_R_PJ_yy, link3_mass, link3_S0_x, link3_J0_xx, link3_J0_yy, link3_J0_zz, link4_R_PJ_yz, link4_R_PJ_zz};
+static constexpr double udot_c60[] = {link4_k, link4_p_J_x, link4_R_PJ_yy_S2, link4_R_PJ_yy_ss, link4_R_PJ_yy_C2, link4_R_PJ_yy_cs, link4_R_PJ_yy, link4_R_PJ_zy, link3_mass, link3_S0_x, link3_J0_xx, link3_J0_yy, link3_J0_zz, link4_R_PJ_yz, link4_R_PJ_zz};
 // body link3: articulated inertia and bias force (inward)
 static constexpr int udot_x61[] = {21, 1341, 1342, 1343, 1344, 1345, 1346, 1347, 1348, 1349, 1350, 1351, 1352, 1353, 1354, 1355, 1356, 1357, 1358, 1359, 1360, 1361, 1362, 1363, 1364, 1365, 1366, 1367, 1368, 1369, 1370, 1371, 1372, 1373, 1374, 1375, 1376, 1504, 1505, 1747, 1389, 1388, 1394, 1390, 1399, 1395, 1391, 1396, 1382, 1384, 1385, 1402, 1386, 1387, 1393, 1383, 1398, 1400, 1380, 1381, 1379, 1392, 1397, 1401, 1403, 1404, 1378};
 static constexpr double udot_c61[] = {link3_k, link3_p_J_x, link2_mass, link2_S0_x, link2_J0_xx, link2_J0_yy, link2_J0_zz};
@@ -11873,97 +11873,97 @@ static constexpr double udot_c63[] = {link1_k, link1_p_J_x, base_mass, base_S0_z
 // body base: articulated inertia and bias force (inward)
 static constexpr int udot_x64[] = {1449, 1450, 1451, 1452, 1453, 1454, 1455, 1456, 1457, 1458, 1459, 1460, 1461, 1462, 1463, 1464, 1465, 1466, 1467, 1468, 1469, 1470, 1471, 1472, 1473, 1474, 1475, 1476, 1477, 1478, 1479, 1480, 1481, 1739, 1740, 1741, 1743, 1744, 1738, 1742, 1486, 1485, 1484, 1487, 1482, 1483};
 // body link1: accelerations (outward)
-static constexpr int udot_x65[] = {1482, 1483, 1484, 1485, 1486, 1442, 1441, 1487, 1418, 1420, 1421, 1415, 1419, 1422, 1488, 1489, 1492, 1494, 1493, 1495, 1490, 1776, 1491};
+static constexpr int udot_x65[] = {1482, 1483, 1484, 1485, 1486, 1442, 1441, 1487, 1418, 1420, 1421, 1415, 1422, 1419, 1488, 1489, 1492, 1494, 1493, 1495, 1490, 1776, 1491};
 static constexpr double udot_c65[] = {link1_p_J_x};
 // body link2: accelerations (outward)
-static constexpr int udot_x66[] = {1490, 1491, 1492, 1493, 1494, 1406, 1405, 1495, 1382, 1384, 1385, 1383, 1379, 1386, 1496, 1497, 1500, 1502, 1501, 1503, 1498, 1777, 1499};
+static constexpr int udot_x66[] = {1490, 1491, 1492, 1493, 1494, 1406, 1405, 1495, 1379, 1382, 1384, 1385, 1386, 1383, 1496, 1497, 1500, 1502, 1501, 1503, 1498, 1777, 1499};
 static constexpr double udot_c66[] = {link2_p_J_x};
 // body link3: accelerations (outward)
-static constexpr int udot_x67[] = {1498, 1499, 1500, 1501, 1502, 1370, 1369, 1503, 1349, 1347, 1348, 1346, 1350, 1343, 1504, 1505, 1508, 1510, 1509, 1511, 1506, 1778, 1507};
+static constexpr int udot_x67[] = {1498, 1499, 1500, 1501, 1502, 1370, 1369, 1503, 1343, 1349, 1347, 1348, 1346, 1350, 1504, 1505, 1508, 1510, 1509, 1511, 1506, 1778, 1507};
 static constexpr double udot_c67[] = {link3_p_J_x};
 // body link4: accelerations (outward)
-static constexpr int udot_x68[] = {1506, 1507, 1509, 1508, 1510, 1334, 1333, 1511, 1310, 1312, 1313, 1311, 1307, 1314, 1512, 1513, 1516, 1518, 1517, 1519, 1514, 1779, 1515};
+static constexpr int udot_x68[] = {1506, 1507, 1509, 1508, 1510, 1334, 1333, 1511, 1310, 1312, 1313, 1314, 1311, 1307, 1512, 1513, 1516, 1518, 1517, 1519, 1514, 1779, 1515};
 static constexpr double udot_c68[] = {link4_R_PJ_yy, link4_R_PJ_zy, link4_R_PJ_yz, link4_R_PJ_zz, link4_p_J_x};
 // body link5: accelerations (outward)
-static constexpr int udot_x69[] = {1514, 1515, 1516, 1517, 1518, 1298, 1297, 1519, 1274, 1276, 1277, 1275, 1271, 1278, 1520, 1521, 1524, 1526, 1525, 1527, 1522, 1780, 1523};
+static constexpr int udot_x69[] = {1514, 1515, 1516, 1517, 1518, 1298, 1297, 1519, 1271, 1274, 1276, 1277, 1278, 1275, 1520, 1521, 1524, 1526, 1525, 1527, 1522, 1780, 1523};
 static constexpr double udot_c69[] = {link5_p_J_x};
 // body link6: accelerations (outward)
-static constexpr int udot_x70[] = {1522, 1523, 1524, 1525, 1526, 1262, 1261, 1527, 1238, 1240, 1241, 1239, 1235, 1242, 1528, 1529, 1532, 1534, 1533, 1535, 1530, 1781, 1531};
+static constexpr int udot_x70[] = {1522, 1523, 1524, 1525, 1526, 1262, 1261, 1527, 1235, 1238, 1240, 1241, 1242, 1239, 1528, 1529, 1532, 1534, 1533, 1535, 1530, 1781, 1531};
 static constexpr double udot_c70[] = {link6_p_J_x};
 // body link7: accelerations (outward)
-static constexpr int udot_x71[] = {1530, 1531, 1532, 1533, 1534, 1226, 1225, 1535, 1205, 1203, 1204, 1202, 1206, 1199, 1536, 1537, 1540, 1542, 1541, 1543, 1538, 1782, 1539};
+static constexpr int udot_x71[] = {1530, 1531, 1532, 1533, 1534, 1226, 1225, 1535, 1199, 1205, 1203, 1204, 1202, 1206, 1536, 1537, 1540, 1542, 1541, 1543, 1538, 1782, 1539};
 static constexpr double udot_c71[] = {link7_p_J_x};
 // body link8: accelerations (outward)
-static constexpr int udot_x72[] = {1538, 1539, 1541, 1540, 1542, 1190, 1189, 1543, 1166, 1168, 1169, 1167, 1163, 1170, 1544, 1545, 1548, 1550, 1549, 1551, 1546, 1783, 1547};
+static constexpr int udot_x72[] = {1538, 1539, 1541, 1540, 1542, 1190, 1189, 1543, 1166, 1168, 1169, 1170, 1167, 1163, 1544, 1545, 1548, 1550, 1549, 1551, 1546, 1783, 1547};
 static constexpr double udot_c72[] = {link8_R_PJ_yy, link8_R_PJ_zy, link8_R_PJ_yz, link8_R_PJ_zz, link8_p_J_x};
 // body link9: accelerations (outward)
-static constexpr int udot_x73[] = {1546, 1547, 1548, 1549, 1550, 1154, 1153, 1551, 1130, 1132, 1133, 1131, 1127, 1134, 1552, 1553, 1556, 1558, 1557, 1559, 1554, 1784, 1555};
+static constexpr int udot_x73[] = {1546, 1547, 1548, 1549, 1550, 1154, 1153, 1551, 1127, 1130, 1132, 1133, 1134, 1131, 1552, 1553, 1556, 1558, 1557, 1559, 1554, 1784, 1555};
 static constexpr double udot_c73[] = {link9_p_J_x};
 // body link10: accelerations (outward)
-static constexpr int udot_x74[] = {1554, 1555, 1556, 1557, 1558, 1118, 1117, 1559, 1094, 1096, 1097, 1095, 1091, 1098, 1560, 1561, 1564, 1566, 1565, 1567, 1562, 1785, 1563};
+static constexpr int udot_x74[] = {1554, 1555, 1556, 1557, 1558, 1118, 1117, 1559, 1091, 1094, 1096, 1097, 1098, 1095, 1560, 1561, 1564, 1566, 1565, 1567, 1562, 1785, 1563};
 static constexpr double udot_c74[] = {link10_p_J_x};
 // body link11: accelerations (outward)
-static constexpr int udot_x75[] = {1562, 1563, 1564, 1565, 1566, 1082, 1081, 1567, 1061, 1059, 1060, 1058, 1062, 1055, 1568, 1569, 1572, 1574, 1573, 1575, 1570, 1786, 1571};
+static constexpr int udot_x75[] = {1562, 1563, 1564, 1565, 1566, 1082, 1081, 1567, 1055, 1061, 1059, 1060, 1058, 1062, 1568, 1569, 1572, 1574, 1573, 1575, 1570, 1786, 1571};
 static constexpr double udot_c75[] = {link11_p_J_x};
 // body link12: accelerations (outward)
-static constexpr int udot_x76[] = {1570, 1571, 1573, 1572, 1574, 1046, 1045, 1575, 1022, 1024, 1025, 1023, 1019, 1026, 1576, 1577, 1580, 1582, 1581, 1583, 1578, 1787, 1579};
+static constexpr int udot_x76[] = {1570, 1571, 1573, 1572, 1574, 1046, 1045, 1575, 1022, 1024, 1025, 1026, 1023, 1019, 1576, 1577, 1580, 1582, 1581, 1583, 1578, 1787, 1579};
 static constexpr double udot_c76[] = {link12_R_PJ_yy, link12_R_PJ_zy, link12_R_PJ_yz, link12_R_PJ_zz, link12_p_J_x};
 // body link13: accelerations (outward)
-static constexpr int udot_x77[] = {1578, 1579, 1580, 1581, 1582, 1010, 1009, 1583, 986, 988, 989, 987, 983, 990, 1584, 1585, 1588, 1590, 1589, 1591, 1586, 1788, 1587};
+static constexpr int udot_x77[] = {1578, 1579, 1580, 1581, 1582, 1010, 1009, 1583, 983, 986, 988, 989, 990, 987, 1584, 1585, 1588, 1590, 1589, 1591, 1586, 1788, 1587};
 static constexpr double udot_c77[] = {link13_p_J_x};
 // body link14: accelerations (outward)
-static constexpr int udot_x78[] = {1586, 1587, 1588, 1589, 1590, 974, 973, 1591, 950, 952, 953, 951, 947, 954, 1592, 1593, 1596, 1598, 1597, 1599, 1594, 1789, 1595};
+static constexpr int udot_x78[] = {1586, 1587, 1588, 1589, 1590, 974, 973, 1591, 947, 950, 952, 953, 954, 951, 1592, 1593, 1596, 1598, 1597, 1599, 1594, 1789, 1595};
 static constexpr double udot_c78[] = {link14_p_J_x};
 // body link15: accelerations (outward)
-static constexpr int udot_x79[] = {1594, 1595, 1596, 1597, 1598, 938, 937, 1599, 917, 915, 916, 914, 918, 911, 1600, 1601, 1604, 1606, 1605, 1607, 1602, 1790, 1603};
+static constexpr int udot_x79[] = {1594, 1595, 1596, 1597, 1598, 938, 937, 1599, 911, 917, 915, 916, 914, 918, 1600, 1601, 1604, 1606, 1605, 1607, 1602, 1790, 1603};
 static constexpr double udot_c79[] = {link15_p_J_x};
 // body link16: accelerations (outward)
-static constexpr int udot_x80[] = {1602, 1603, 1605, 1604, 1606, 902, 901, 1607, 878, 880, 881, 879, 875, 882, 1608, 1609, 1612, 1614, 1613, 1615, 1610, 1791, 1611};
+static constexpr int udot_x80[] = {1602, 1603, 1605, 1604, 1606, 902, 901, 1607, 878, 880, 881, 882, 879, 875, 1608, 1609, 1612, 1614, 1613, 1615, 1610, 1791, 1611};
 static constexpr double udot_c80[] = {link16_R_PJ_yy, link16_R_PJ_zy, link16_R_PJ_yz, link16_R_PJ_zz, link16_p_J_x};
 // body link17: accelerations (outward)
-static constexpr int udot_x81[] = {1610, 1611, 1612, 1613, 1614, 866, 865, 1615, 842, 844, 845, 843, 839, 846, 1616, 1617, 1620, 1622, 1621, 1623, 1618, 1792, 1619};
+static constexpr int udot_x81[] = {1610, 1611, 1612, 1613, 1614, 866, 865, 1615, 839, 842, 844, 845, 846, 843, 1616, 1617, 1620, 1622, 1621, 1623, 1618, 1792, 1619};
 static constexpr double udot_c81[] = {link17_p_J_x};
 // body link18: accelerations (outward)
-static constexpr int udot_x82[] = {1618, 1619, 1620, 1621, 1622, 830, 829, 1623, 806, 808, 809, 807, 803, 810, 1624, 1625, 1628, 1630, 1629, 1631, 1626, 1793, 1627};
+static constexpr int udot_x82[] = {1618, 1619, 1620, 1621, 1622, 830, 829, 1623, 803, 806, 808, 809, 810, 807, 1624, 1625, 1628, 1630, 1629, 1631, 1626, 1793, 1627};
 static constexpr double udot_c82[] = {link18_p_J_x};
 // body link19: accelerations (outward)
-static constexpr int udot_x83[] = {1626, 1627, 1628, 1629, 1630, 794, 793, 1631, 773, 771, 772, 770, 774, 767, 1632, 1633, 1636, 1638, 1637, 1639, 1634, 1794, 1635};
+static constexpr int udot_x83[] = {1626, 1627, 1628, 1629, 1630, 794, 793, 1631, 767, 773, 771, 772, 770, 774, 1632, 1633, 1636, 1638, 1637, 1639, 1634, 1794, 1635};
 static constexpr double udot_c83[] = {link19_p_J_x};
 // body link20: accelerations (outward)
-static constexpr int udot_x84[] = {1634, 1635, 1637, 1636, 1638, 758, 757, 1639, 734, 736, 737, 735, 731, 738, 1640, 1641, 1644, 1646, 1645, 1647, 1642, 1795, 1643};
+static constexpr int udot_x84[] = {1634, 1635, 1637, 1636, 1638, 758, 757, 1639, 734, 736, 737, 738, 735, 731, 1640, 1641, 1644, 1646, 1645, 1647, 1642, 1795, 1643};
 static constexpr double udot_c84[] = {link20_R_PJ_yy, link20_R_PJ_zy, link20_R_PJ_yz, link20_R_PJ_zz, link20_p_J_x};
 // body link21: accelerations (outward)
-static constexpr int udot_x85[] = {1642, 1643, 1644, 1645, 1646, 722, 721, 1647, 698, 700, 701, 699, 695, 702, 1648, 1649, 1652, 1654, 1653, 1655, 1650, 1796, 1651};
+static constexpr int udot_x85[] = {1642, 1643, 1644, 1645, 1646, 722, 721, 1647, 695, 698, 700, 701, 702, 699, 1648, 1649, 1652, 1654, 1653, 1655, 1650, 1796, 1651};
 static constexpr double udot_c85[] = {link21_p_J_x};
 // body link22: accelerations (outward)
-static constexpr int udot_x86[] = {1650, 1651, 1652, 1653, 1654, 686, 685, 1655, 662, 664, 665, 663, 659, 666, 1656, 1657, 1660, 1662, 1661, 1663, 1658, 1797, 1659};
+static constexpr int udot_x86[] = {1650, 1651, 1652, 1653, 1654, 686, 685, 1655, 659, 662, 664, 665, 666, 663, 1656, 1657, 1660, 1662, 1661, 1663, 1658, 1797, 1659};
 static constexpr double udot_c86[] = {link22_p_J_x};
 // body link23: accelerations (outward)
-static constexpr int udot_x87[] = {1658, 1659, 1660, 1661, 1662, 650, 649, 1663, 629, 627, 628, 626, 630, 623, 1664, 1665, 1668, 1670, 1669, 1671, 1666, 1798, 1667};
+static constexpr int udot_x87[] = {1658, 1659, 1660, 1661, 1662, 650, 649, 1663, 623, 629, 627, 628, 626, 630, 1664, 1665, 1668, 1670, 1669, 1671, 1666, 1798, 1667};
 static constexpr double udot_c87[] = {link23_p_J_x};
 // body link24: accelerations (outward)
-static constexpr int udot_x88[] = {1666, 1667, 1669, 1668, 1670, 614, 613, 1671, 590, 592, 593, 591, 587, 594, 1672, 1673, 1676, 1678, 1677, 1679, 1674, 1799, 1675};
+static constexpr int udot_x88[] = {1666, 1667, 1669, 1668, 1670, 614, 613, 1671, 590, 592, 593, 594, 591, 587, 1672, 1673, 1676, 1678, 1677, 1679, 1674, 1799, 1675};
 static constexpr double udot_c88[] = {link24_R_PJ_yy, link24_R_PJ_zy, link24_R_PJ_yz, link24_R_PJ_zz, link24_p_J_x};
 // body link25: accelerations (outward)
-static constexpr int udot_x89[] = {1674, 1675, 1676, 1677, 1678, 578, 577, 1679, 554, 556, 557, 555, 551, 558, 1680, 1681, 1684, 1686, 1685, 1687, 1682, 1800, 1683};
+static constexpr int udot_x89[] = {1674, 1675, 1676, 1677, 1678, 578, 577, 1679, 551, 554, 556, 557, 558, 555, 1680, 1681, 1684, 1686, 1685, 1687, 1682, 1800, 1683};
 static constexpr double udot_c89[] = {link25_p_J_x};
 // body link26: accelerations (outward)
-static constexpr int udot_x90[] = {1682, 1683, 1684, 1685, 1686, 542, 541, 1687, 518, 520, 521, 519, 515, 522, 1688, 1689, 1692, 1694, 1693, 1695, 1690, 1801, 1691};
+static constexpr int udot_x90[] = {1682, 1683, 1684, 1685, 1686, 542, 541, 1687, 515, 518, 520, 521, 522, 519, 1688, 1689, 1692, 1694, 1693, 1695, 1690, 1801, 1691};
 static constexpr double udot_c90[] = {link26_p_J_x};
 // body link27: accelerations (outward)
-static constexpr int udot_x91[] = {1690, 1691, 1692, 1693, 1694, 506, 505, 1695, 485, 483, 484, 482, 486, 479, 1696, 1697, 1700, 1702, 1701, 1703, 1698, 1802, 1699};
+static constexpr int udot_x91[] = {1690, 1691, 1692, 1693, 1694, 506, 505, 1695, 479, 485, 483, 484, 482, 486, 1696, 1697, 1700, 1702, 1701, 1703, 1698, 1802, 1699};
 static constexpr double udot_c91[] = {link27_p_J_x};
 // body link28: accelerations (outward)
-static constexpr int udot_x92[] = {1698, 1699, 1701, 1700, 1702, 470, 469, 1703, 446, 448, 449, 447, 443, 450, 1704, 1705, 1708, 1710, 1709, 1711, 1706, 1803, 1707};
+static constexpr int udot_x92[] = {1698, 1699, 1701, 1700, 1702, 470, 469, 1703, 446, 448, 449, 450, 447, 443, 1704, 1705, 1708, 1710, 1709, 1711, 1706, 1803, 1707};
 static constexpr double udot_c92[] = {link28_R_PJ_yy, link28_R_PJ_zy, link28_R_PJ_yz, link28_R_PJ_zz, link28_p_J_x};
 // body link29: accelerations (outward)
-static constexpr int udot_x93[] = {1706, 1707, 1708, 1709, 1710, 434, 433, 1711, 410, 412, 413, 411, 407, 414, 1712, 1713, 1716, 1718, 1717, 1719, 1714, 1804, 1715};
+static constexpr int udot_x93[] = {1706, 1707, 1708, 1709, 1710, 434, 433, 1711, 407, 410, 412, 413, 414, 411, 1712, 1713, 1716, 1718, 1717, 1719, 1714, 1804, 1715};
 static constexpr double udot_c93[] = {link29_p_J_x};
 // body link30: accelerations (outward)
-static constexpr int udot_x94[] = {1714, 1715, 1716, 1717, 1718, 398, 397, 1719, 374, 376, 377, 375, 371, 378, 1720, 1721, 1724, 1726, 1725, 1727, 1722, 1805, 1723};
+static constexpr int udot_x94[] = {1714, 1715, 1716, 1717, 1718, 398, 397, 1719, 371, 374, 376, 377, 378, 375, 1720, 1721, 1724, 1726, 1725, 1727, 1722, 1805, 1723};
 static constexpr double udot_c94[] = {link30_p_J_x};
 // body link31: accelerations (outward)
-static constexpr int udot_x95[] = {1722, 1723, 1724, 1725, 1726, 362, 361, 1727, 342, 340, 344, 343, 341, 337, 1728, 1729, 1732, 1736, 1733, 1730, 1806, 1731};
+static constexpr int udot_x95[] = {1722, 1723, 1724, 1725, 1726, 362, 361, 1727, 337, 342, 340, 344, 343, 341, 1728, 1729, 1732, 1736, 1733, 1730, 1806, 1731};
 static constexpr double udot_c95[] = {link31_p_J_x};
 // body link32: accelerations (outward)
 static constexpr int udot_x96[] = {1730, 1731, 1733, 1732, 1736, 1735, 1734, 1737, 1807};
