@@ -171,6 +171,11 @@ std::string op_counts(const EmittedModel& m) {
     if (!f.kernels.empty())
       s += fmt::format("; compact code: {} kernels ({} operations of code), {} calls", f.kernels.size(),
                        f.kernel_ops.total(), f.kernel_calls);
+    if (!f.ops_by_pass.empty()) {
+      std::vector<std::string> parts;
+      for (const auto& [pass, n] : f.ops_by_pass) parts.push_back(fmt::format("{} {}", pass, n));
+      s += fmt::format("\n//     {} by pass: {}", f.name, join(parts, "; "));
+    }
     s += "\n";
   }
   return s;

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "codegen/printer.hpp"
@@ -54,6 +55,7 @@ struct EmittedFunction {
   OpCount kernel_ops;  ///< the kernels' own code (each once); `ops` counts every call's
   int workspace = 0;
   OpCount ops;
+  std::vector<std::pair<std::string, long>> ops_by_pass;  ///< u-dot: its operations by pass (Program::ops_by_pass)
   std::string note;             ///< extra comment lines for the header section (may be empty)
 };
 

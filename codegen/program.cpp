@@ -125,6 +125,36 @@ Program::Listing Program::listing(const std::string& indent) const {
   return out;
 }
 
+std::vector<std::pair<std::string, long>> Program::ops_by_pass() const {
+  const Listing l = listing("");
+  std::vector<std::pair<std::string, long>> out;
+  auto add = [&](const std::string& pass, long ops) {
+    for (auto& [p, n] : out)
+      if (p == pass) {
+        n += ops;
+        return;
+      }
+    out.emplace_back(pass, ops);
+  };
+  std::string pass = "(first values)";
+  for (const LiveTemp& t : l.temps) {
+    if (!t.section.empty()) {
+      const auto colon = t.section.find(": ");
+      pass = t.section.rfind("body ", 0) == 0 && colon != std::string::npos ? t.section.substr(colon + 2) : t.section;
+    }
+    OpCount c;
+    print_cpp(t.value, c);
+    add(pass, c.total());
+  }
+  for (const Statement& st : l.statements) {
+    if (st.lhs.empty()) continue;
+    OpCount c;
+    print_cpp(st.value, c);
+    if (c.total()) add("outputs", c.total());
+  }
+  return out;
+}
+
 ChunkedBody Program::emit_chunked(const std::string& indent, OpCount& ops, long max_chunk_ops) const {
   std::set<std::string> needed;
   const std::vector<bool> live = liveness(needed);

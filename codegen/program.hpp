@@ -85,6 +85,10 @@ class Program {
     std::string preludes;  ///< the preludes some live expression needs, indented, one per line
   };
   Listing listing(const std::string& indent) const;
+  /// The operations of the live code by pass: the sections' titles without their body ("body link3: outward
+  /// pass (velocities)" counts as "outward pass (velocities)"), in order of first appearance; the outputs'
+  /// own operations as "outputs".
+  std::vector<std::pair<std::string, long>> ops_by_pass() const;
 
  private:
   /// Which temporaries some statement needs; `needed` gets their symbols.

@@ -19,6 +19,7 @@
 //   mass_matrix     2006 (790 add, 1164 mul, 48 div, 4 func)
 //   forcing         3162 (1226 add, 1884 mul, 48 div, 4 func)
 //   udot            5572 (2285 add, 3208 mul, 75 div, 4 func) -- composite form; composite 5572, articulated 6091
+//     udot by pass: outward pass (velocities) 73; mass and velocity terms 22; node 2 (rotary inertia, foreshortening) 246; node 3 (rotary inertia, foreshortening) 246; node 4 (rotary inertia, foreshortening) 246; node 5 (rotary inertia, foreshortening) 246; node 6 (rotary inertia, foreshortening) 246; node 7 (rotary inertia, foreshortening) 246; node 8 (rotary inertia, foreshortening) 246; node 9 (rotary inertia, foreshortening) 246; composite inertia (inward) 1098; its columns of M (walked to the root) 104; bias force 1275; generalized forces (inward) 96; M u_dot = F: L^T D L along the dof tree 936
 //   energy          2987 (1208 add, 1716 mul, 59 div, 4 func)
 //   momentum        2268 (881 add, 1333 mul, 49 div, 5 func)
 //   reactions       3423 (1348 add, 2023 mul, 48 div, 4 func)

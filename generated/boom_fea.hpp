@@ -19,6 +19,7 @@
 //   mass_matrix      801 (297 add, 472 mul, 30 div, 2 func)
 //   forcing         1039 (352 add, 653 mul, 32 div, 2 func)
 //   udot            1664 (613 add, 1012 mul, 37 div, 2 func) -- composite form; composite 1664, articulated 2227
+//     udot by pass: outward pass (velocities) 300; node 2 (rotary inertia, foreshortening) 51; node 3 (rotary inertia, foreshortening) 51; node 4 (rotary inertia, foreshortening) 51; node 5 (rotary inertia, foreshortening) 51; node 6 (rotary inertia, foreshortening) 51; node 7 (rotary inertia, foreshortening) 51; node 8 (rotary inertia, foreshortening) 51; node 9 (rotary inertia, foreshortening) 51; node 10 (rotary inertia, foreshortening) 51; node 11 (rotary inertia, foreshortening) 51; node 12 (rotary inertia, foreshortening) 51; node 13 (rotary inertia, foreshortening) 51; mass and velocity terms 38; composite inertia (inward) 377; its columns of M (walked to the root) 12; bias force 207; generalized forces (inward) 62; M u_dot = F: L^T D L along the dof tree 56
 //   energy           799 (298 add, 463 mul, 36 div, 2 func)
 //   momentum        1015 (369 add, 612 mul, 30 div, 4 func)
 //   reactions       1688 (613 add, 1041 mul, 32 div, 2 func)

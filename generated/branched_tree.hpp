@@ -19,6 +19,7 @@
 //   mass_matrix      261 (127 add, 122 mul, 0 div, 12 func)
 //   forcing          624 (265 add, 347 mul, 0 div, 12 func)
 //   udot            1421 (625 add, 767 mul, 17 div, 12 func) -- composite form; composite 1421, articulated 1501
+//     udot by pass: outward pass (velocities) 190; mass and velocity terms 160; composite inertia (inward) 192; its columns of M (walked to the root) 51; bias force 128; generalized forces (inward) 146; M u_dot = F: L^T D L along the dof tree 554
 //   energy           342 (136 add, 184 mul, 10 div, 12 func)
 //   momentum         728 (305 add, 409 mul, 1 div, 13 func)
 //   reactions        885 (414 add, 459 mul, 0 div, 12 func)

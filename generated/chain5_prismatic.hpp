@@ -19,6 +19,7 @@
 //   mass_matrix      338 (149 add, 183 mul, 0 div, 6 func)
 //   forcing          523 (217 add, 298 mul, 0 div, 8 func)
 //   udot             946 (399 add, 532 mul, 7 div, 8 func) -- composite form; composite 946, articulated 1164
+//     udot by pass: outward pass (velocities) 214; mass and velocity terms 94; composite inertia (inward) 212; its columns of M (walked to the root) 113; bias force 94; generalized forces (inward) 121; M u_dot = F: L^T D L along the dof tree 98
 //   energy           309 (117 add, 176 mul, 8 div, 8 func)
 //   reactions        700 (309 add, 383 mul, 0 div, 8 func)
 

@@ -19,6 +19,7 @@
 //   mass_matrix        0 (0 add, 0 mul, 0 div, 0 func)
 //   forcing            8 (4 add, 4 mul, 0 div, 0 func)
 //   udot              20 (8 add, 12 mul, 0 div, 0 func) -- composite form; composite 20, articulated 20
+//     udot by pass: generalized forces (inward) 8; M u_dot = F: L^T D L along the dof tree 12
 //   energy            35 (10 add, 20 mul, 5 div, 0 func)
 //   momentum          31 (11 add, 20 mul, 0 div, 0 func)
 //   reactions         31 (11 add, 20 mul, 0 div, 0 func)

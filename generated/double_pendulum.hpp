@@ -19,6 +19,7 @@
 //   mass_matrix       45 (19 add, 24 mul, 0 div, 2 func)
 //   forcing          136 (53 add, 79 mul, 0 div, 4 func)
 //   udot             186 (73 add, 108 mul, 1 div, 4 func) -- composite form; composite 186, articulated 235
+//     udot by pass: outward pass (velocities) 40; mass and velocity terms 38; composite inertia (inward) 31; its columns of M (walked to the root) 10; bias force 35; generalized forces (inward) 23; M u_dot = F: L^T D L along the dof tree 9
 //   energy            97 (34 add, 57 mul, 2 div, 4 func)
 //   momentum         156 (57 add, 95 mul, 0 div, 4 func)
 //   reactions        256 (108 add, 144 mul, 0 div, 4 func)

@@ -19,6 +19,7 @@
 //   mass_matrix     2619 (1027 add, 1528 mul, 64 div, 0 func)
 //   forcing         3466 (1308 add, 2094 mul, 64 div, 0 func)
 //   udot            6503 (2590 add, 3822 mul, 91 div, 0 func) -- composite form; composite 6503, articulated 7088
+//     udot by pass: outward pass (velocities) 77; mass and velocity terms 12; node 2 (rotary inertia, foreshortening) 356; node 3 (rotary inertia, foreshortening) 356; node 4 (rotary inertia, foreshortening) 356; node 5 (rotary inertia, foreshortening) 356; node 6 (rotary inertia, foreshortening) 356; node 7 (rotary inertia, foreshortening) 356; node 8 (rotary inertia, foreshortening) 356; node 9 (rotary inertia, foreshortening) 356; composite inertia (inward) 1631; its columns of M (walked to the root) 28; bias force 1067; generalized forces (inward) 102; M u_dot = F: L^T D L along the dof tree 738
 //   energy          4305 (1720 add, 2508 mul, 77 div, 0 func)
 //   momentum        3544 (1381 add, 2097 mul, 65 div, 1 func)
 

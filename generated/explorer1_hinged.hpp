@@ -19,6 +19,7 @@
 //   mass_matrix      168 (84 add, 76 mul, 0 div, 8 func)
 //   forcing          430 (176 add, 246 mul, 0 div, 8 func)
 //   udot             837 (360 add, 458 mul, 11 div, 8 func) -- composite form; composite 837, articulated 969
+//     udot by pass: outward pass (velocities) 145; mass and velocity terms 88; composite inertia (inward) 140; its columns of M (walked to the root) 20; bias force 67; generalized forces (inward) 130; M u_dot = F: L^T D L along the dof tree 247
 //   energy           233 (84 add, 132 mul, 9 div, 8 func)
 //   momentum         560 (229 add, 321 mul, 1 div, 9 func)
 

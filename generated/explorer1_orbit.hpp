@@ -20,6 +20,7 @@
 //   mass_matrix      116 (56 add, 52 mul, 0 div, 8 func)
 //   forcing         1084 (394 add, 660 mul, 16 div, 14 func)
 //   udot            1439 (550 add, 848 mul, 27 div, 14 func) -- composite form; composite 1439, articulated 1563
+//     udot by pass: outward pass (velocities) 265; mass and velocity terms 88; central gravity on 1 mass elements 520; composite inertia (inward) 96; its columns of M (walked to the root) 12; bias force 97; generalized forces (inward) 114; M u_dot = F: L^T D L along the dof tree 247
 //   energy           639 (216 add, 379 mul, 30 div, 14 func)
 //   momentum         520 (209 add, 301 mul, 1 div, 9 func)
 //   outputs          387 (149 add, 228 mul, 1 div, 9 func)

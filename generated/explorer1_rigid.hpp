@@ -19,6 +19,7 @@
 //   mass_matrix      116 (56 add, 52 mul, 0 div, 8 func)
 //   forcing          386 (156 add, 222 mul, 0 div, 8 func)
 //   udot             741 (312 add, 410 mul, 11 div, 8 func) -- composite form; composite 741, articulated 865
+//     udot by pass: outward pass (velocities) 117; mass and velocity terms 88; composite inertia (inward) 96; its columns of M (walked to the root) 12; bias force 67; generalized forces (inward) 114; M u_dot = F: L^T D L along the dof tree 247
 //   energy           217 (76 add, 124 mul, 9 div, 8 func)
 //   momentum         520 (209 add, 301 mul, 1 div, 9 func)
 //   reactions        485 (212 add, 265 mul, 0 div, 8 func)

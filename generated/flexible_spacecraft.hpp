@@ -21,6 +21,7 @@
 //   mass_matrix     3592 (1465 add, 2033 mul, 81 div, 13 func)
 //   forcing         4435 (1776 add, 2565 mul, 81 div, 13 func)
 //   udot            8488 (3547 add, 4818 mul, 110 div, 13 func) -- composite form; composite 8488, articulated 9300
+//     udot by pass: outward pass (velocities) 523; mass and velocity terms 128; node 2 (rotary inertia, foreshortening) 334; node 3 (rotary inertia, foreshortening) 334; node 4 (rotary inertia, foreshortening) 334; node 5 (rotary inertia, foreshortening) 334; node 6 (rotary inertia, foreshortening) 334; node 7 (rotary inertia, foreshortening) 334; node 8 (rotary inertia, foreshortening) 334; node 9 (rotary inertia, foreshortening) 334; node 10 (rotary inertia, foreshortening) 334; node 11 (rotary inertia, foreshortening) 334; composite inertia (inward) 1892; its columns of M (walked to the root) 47; bias force 914; generalized forces (inward) 370; M u_dot = F: L^T D L along the dof tree 1274
 //   momentum        4349 (1722 add, 2531 mul, 82 div, 14 func)
 //   input_jacobian  152784 (0 add, 152784 mul, 0 div, 0 func)
 //   outputs           52 (15 add, 35 mul, 1 div, 1 func)

@@ -21,6 +21,7 @@
 //   mass_matrix      266 (107 add, 153 mul, 1 div, 5 func)
 //   forcing          550 (227 add, 315 mul, 1 div, 7 func)
 //   udot            1219 (527 add, 671 mul, 14 div, 7 func) -- composite form; composite 1219, articulated 1333
+//     udot by pass: outward pass (velocities) 244; mass and velocity terms 88; composite inertia (inward) 160; its columns of M (walked to the root) 36; bias force 71; generalized forces (inward) 147; M u_dot = F: L^T D L along the dof tree 473
 //   energy           306 (111 add, 180 mul, 8 div, 7 func)
 //   momentum         617 (248 add, 359 mul, 2 div, 8 func)
 //   reactions        669 (292 add, 369 mul, 1 div, 7 func)

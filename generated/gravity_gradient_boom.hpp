@@ -20,6 +20,7 @@
 //   mass_matrix     1158 (445 add, 687 mul, 26 div, 0 func)
 //   forcing         2498 (941 add, 1475 mul, 68 div, 14 func)
 //   udot            3777 (1474 add, 2206 mul, 83 div, 14 func) -- composite form; composite 3777, articulated 4196
+//     udot by pass: outward pass (velocities) 395; mass and velocity terms 24; central gravity on 1 mass elements 200; node 2 (rotary inertia, foreshortening) 89; node 3 (rotary inertia, foreshortening) 89; node 4 (rotary inertia, foreshortening) 89; node 5 (rotary inertia, foreshortening) 89; node 6 (rotary inertia, foreshortening) 89; node 7 (rotary inertia, foreshortening) 89; node 8 (rotary inertia, foreshortening) 89; node 9 (rotary inertia, foreshortening) 89; node 10 (rotary inertia, foreshortening) 89; node 11 (rotary inertia, foreshortening) 89; central gravity on 11 mass elements 732; composite inertia (inward) 754; its columns of M (walked to the root) 8; bias force 359; generalized forces (inward) 98; M u_dot = F: L^T D L along the dof tree 317
 //   energy          2035 (785 add, 1163 mul, 73 div, 14 func)
 //   momentum        1403 (544 add, 831 mul, 27 div, 1 func)
 //   outputs          779 (311 add, 441 mul, 26 div, 1 func)

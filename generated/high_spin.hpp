@@ -19,6 +19,7 @@
 //   mass_matrix       62 (32 add, 26 mul, 0 div, 4 func)
 //   forcing          233 (95 add, 134 mul, 0 div, 4 func)
 //   udot             402 (170 add, 218 mul, 10 div, 4 func) -- composite form; composite 402, articulated 430
+//     udot by pass: outward pass (velocities) 63; mass and velocity terms 68; composite inertia (inward) 52; its columns of M (walked to the root) 6; bias force 46; generalized forces (inward) 56; M u_dot = F: L^T D L along the dof tree 111
 //   energy           137 (50 add, 78 mul, 5 div, 4 func)
 //   momentum         330 (131 add, 193 mul, 1 div, 5 func)
 

@@ -19,6 +19,7 @@
 //   mass_matrix       44 (23 add, 17 mul, 0 div, 4 func)
 //   forcing          247 (104 add, 139 mul, 0 div, 4 func)
 //   udot             450 (195 add, 240 mul, 11 div, 4 func) -- composite form; composite 450, articulated 582
+//     udot by pass: outward pass (velocities) 63; mass and velocity terms 78; composite inertia (inward) 37; its columns of M (walked to the root) 3; bias force 50; generalized forces (inward) 56; M u_dot = F: L^T D L along the dof tree 163
 //   energy           149 (58 add, 82 mul, 5 div, 4 func)
 //   momentum         342 (139 add, 197 mul, 1 div, 5 func)
 

@@ -19,6 +19,7 @@
 //   mass_matrix       98 (49 add, 45 mul, 0 div, 4 func)
 //   forcing          272 (115 add, 153 mul, 0 div, 4 func)
 //   udot             644 (279 add, 348 mul, 13 div, 4 func) -- composite form; composite 644, articulated 804
+//     udot by pass: outward pass (velocities) 78; mass and velocity terms 80; composite inertia (inward) 71; its columns of M (walked to the root) 21; bias force 54; generalized forces (inward) 60; M u_dot = F: L^T D L along the dof tree 280
 //   energy           159 (62 add, 88 mul, 5 div, 4 func)
 //   momentum         358 (146 add, 206 mul, 1 div, 5 func)
 

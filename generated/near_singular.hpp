@@ -19,6 +19,7 @@
 //   mass_matrix       98 (44 add, 48 mul, 0 div, 6 func)
 //   forcing          280 (116 add, 158 mul, 0 div, 6 func)
 //   udot             718 (305 add, 392 mul, 15 div, 6 func) -- composite form; composite 718, articulated 820
+//     udot by pass: outward pass (velocities) 86; mass and velocity terms 77; composite inertia (inward) 66; its columns of M (walked to the root) 22; bias force 50; generalized forces (inward) 67; M u_dot = F: L^T D L along the dof tree 350
 //   energy           160 (60 add, 90 mul, 4 div, 6 func)
 //   momentum         407 (163 add, 236 mul, 1 div, 7 func)
 

@@ -19,6 +19,7 @@
 //   mass_matrix        0 (0 add, 0 mul, 0 div, 0 func)
 //   forcing          199 (82 add, 115 mul, 0 div, 2 func)
 //   udot             270 (114 add, 154 mul, 0 div, 2 func) -- composite form; composite 270, articulated 273
+//     udot by pass: outward pass (velocities) 55; mass and velocity terms 61; bias force 36; generalized forces (inward) 47; M u_dot = F: L^T D L along the dof tree 71
 //   energy           119 (46 add, 68 mul, 3 div, 2 func)
 //   momentum         288 (113 add, 171 mul, 1 div, 3 func)
 

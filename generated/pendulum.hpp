@@ -19,6 +19,7 @@
 //   mass_matrix        0 (0 add, 0 mul, 0 div, 0 func)
 //   forcing            3 (1 add, 1 mul, 0 div, 1 func)
 //   udot               3 (1 add, 1 mul, 0 div, 1 func) -- composite form; composite 3, articulated 3
+//     udot by pass: outward pass (velocities) 2; generalized forces (inward) 1
 //   energy             4 (0 add, 2 mul, 1 div, 1 func)
 //   momentum           4 (0 add, 2 mul, 0 div, 2 func)
 //   reactions          7 (2 add, 3 mul, 0 div, 2 func)

@@ -19,6 +19,7 @@
 //   mass_matrix      283 (105 add, 176 mul, 1 div, 1 func)
 //   forcing          337 (143 add, 192 mul, 1 div, 1 func)
 //   udot             915 (377 add, 496 mul, 41 div, 1 func) -- articulated form; composite 1274, articulated 915
+//     udot by pass: outward pass (velocities) 180; mass and velocity terms 50; bias force 33; articulated inertia and bias force (inward) 512; accelerations (outward) 140
 //   energy           189 (72 add, 111 mul, 5 div, 1 func)
 //   momentum         408 (167 add, 237 mul, 2 div, 2 func)
 //   reactions        408 (181 add, 225 mul, 1 div, 1 func)

@@ -21,6 +21,7 @@
 //   mass_matrix     2217 (907 add, 1250 mul, 60 div, 0 func)
 //   forcing         2919 (1152 add, 1701 mul, 60 div, 6 func)
 //   udot            5410 (2233 add, 3088 mul, 83 div, 6 func) -- composite form; composite 5410, articulated 5839
+//     udot by pass: outward pass (velocities) 102; mass and velocity terms 78; node 2 (rotary inertia, foreshortening) 246; node 3 (rotary inertia, foreshortening) 246; node 4 (rotary inertia, foreshortening) 246; node 5 (rotary inertia, foreshortening) 246; node 6 (rotary inertia, foreshortening) 246; node 7 (rotary inertia, foreshortening) 246; node 8 (rotary inertia, foreshortening) 246; node 9 (rotary inertia, foreshortening) 246; node 10 (rotary inertia, foreshortening) 246; node 11 (rotary inertia, foreshortening) 246; composite inertia (inward) 1207; its columns of M (walked to the root) 6; bias force 743; generalized forces (inward) 136; M u_dot = F: L^T D L along the dof tree 678
 //   momentum        2901 (1169 add, 1664 mul, 61 div, 7 func)
 //   input_jacobian   48690 (0 add, 48690 mul, 0 div, 0 func)
 //   outputs           88 (25 add, 61 mul, 1 div, 1 func)

@@ -19,6 +19,7 @@
 //   mass_matrix     6611 (2649 add, 3802 mul, 154 div, 6 func)
 //   forcing         8456 (3351 add, 4941 mul, 158 div, 6 func)
 //   udot           15019 (6222 add, 8594 mul, 197 div, 6 func) -- composite form; composite 15019, articulated 15954
+//     udot by pass: outward pass (velocities) 540; mass and velocity terms 118; node 2 (rotary inertia, foreshortening) 492; node 3 (rotary inertia, foreshortening) 492; node 4 (rotary inertia, foreshortening) 492; node 5 (rotary inertia, foreshortening) 492; node 6 (rotary inertia, foreshortening) 492; node 7 (rotary inertia, foreshortening) 492; node 8 (rotary inertia, foreshortening) 492; node 9 (rotary inertia, foreshortening) 492; node 10 (rotary inertia, foreshortening) 492; node 11 (rotary inertia, foreshortening) 492; node 12 (rotary inertia, foreshortening) 492; node 13 (rotary inertia, foreshortening) 492; composite inertia (inward) 3533; its columns of M (walked to the root) 171; bias force 2656; generalized forces (inward) 234; M u_dot = F: L^T D L along the dof tree 1863
 //   energy          8823 (3657 add, 4986 mul, 174 div, 6 func)
 //   momentum        6091 (2396 add, 3533 mul, 155 div, 7 func)
 //   reactions       9622 (3826 add, 5632 mul, 158 div, 6 func)

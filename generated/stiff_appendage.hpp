@@ -19,6 +19,7 @@
 //   mass_matrix     1517 (601 add, 876 mul, 40 div, 0 func)
 //   forcing         1710 (679 add, 991 mul, 40 div, 0 func)
 //   udot            3469 (1415 add, 1995 mul, 59 div, 0 func) -- composite form; composite 3469, articulated 3853
+//     udot by pass: outward pass (velocities) 26; mass and velocity terms 42; node 2 (rotary inertia, foreshortening) 158; node 3 (rotary inertia, foreshortening) 158; node 4 (rotary inertia, foreshortening) 158; node 5 (rotary inertia, foreshortening) 158; node 6 (rotary inertia, foreshortening) 158; node 7 (rotary inertia, foreshortening) 158; node 8 (rotary inertia, foreshortening) 158; node 9 (rotary inertia, foreshortening) 158; node 10 (rotary inertia, foreshortening) 158; node 11 (rotary inertia, foreshortening) 158; composite inertia (inward) 793; its columns of M (walked to the root) 14; bias force 432; generalized forces (inward) 40; M u_dot = F: L^T D L along the dof tree 542
 //   energy          2389 (981 add, 1362 mul, 46 div, 0 func)
 //   momentum        1659 (646 add, 971 mul, 41 div, 1 func)
 

@@ -19,6 +19,7 @@
 //   mass_matrix     1290 (612 add, 646 mul, 0 div, 32 func)
 //   forcing         2119 (863 add, 1224 mul, 0 div, 32 func)
 //   udot            4503 (1972 add, 2488 mul, 11 div, 32 func) -- composite form; composite 4503, articulated 4772
+//     udot by pass: outward pass (velocities) 745; mass and velocity terms 397; composite inertia (inward) 1032; its columns of M (walked to the root) 226; bias force 320; generalized forces (inward) 657; M u_dot = F: L^T D L along the dof tree 1126
 //   energy          1156 (440 add, 651 mul, 33 div, 32 func)
 //   momentum        2540 (1057 add, 1449 mul, 1 div, 33 func)
 
