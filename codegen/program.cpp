@@ -81,23 +81,13 @@ std::string Program::used_preludes(const std::set<std::string>& needed, const st
 }
 
 std::string Program::emit(const std::string& indent, OpCount& ops) const {
-  std::set<std::string> needed;
-  const std::vector<bool> live = liveness(needed);
-  std::string out = used_preludes(needed, indent);
-  const std::string* pending = nullptr;  // a section marker not yet printed
-  for (std::size_t k = 0; k < temps_.size(); ++k) {
-    if (!temps_[k].section.empty()) {
-      pending = &temps_[k].section;
-      continue;
-    }
-    if (!live[k]) continue;
-    if (pending) {
-      out += fmt::format("{}// ---- {}\n", indent, *pending);
-      pending = nullptr;
-    }
-    out += fmt::format("{}const T {} = {};\n", indent, temps_[k].sym.get_name(), print_cpp(temps_[k].value, ops));
+  const Listing l = listing(indent);
+  std::string out = l.preludes;
+  for (const LiveTemp& t : l.temps) {
+    if (!t.section.empty()) out += fmt::format("{}// ---- {}\n", indent, t.section);
+    out += fmt::format("{}const T {} = {};\n", indent, t.sym.get_name(), print_cpp(t.value, ops));
   }
-  for (const Stmt& s : stmts_) {
+  for (const Statement& s : l.statements) {
     if (s.lhs.empty())
       out += indent + s.text + "\n";
     else
@@ -156,46 +146,37 @@ std::vector<std::pair<std::string, long>> Program::ops_by_pass() const {
 }
 
 ChunkedBody Program::emit_chunked(const std::string& indent, OpCount& ops, long max_chunk_ops) const {
-  std::set<std::string> needed;
-  const std::vector<bool> live = liveness(needed);
+  const Listing listed = listing(indent);
   // 1. the live temporaries in order, their text, cost and chunk
   struct Line {
-    std::size_t k;
+    const LiveTemp* temp;       ///< a temporary, or nullptr for an output assignment
+    const Statement* output;
     std::string text;
     int chunk;
-    const std::string* section;
-    const Stmt* output;  ///< an output assignment, or nullptr for temporary k
   };
   std::vector<Line> lines;
   std::map<std::string, int> chunk_of;  // temporary -> chunk that defines it
   int chunk = 0;
   long in_chunk = 0;
-  const std::string* pending = nullptr;
-  for (std::size_t k = 0; k < temps_.size(); ++k) {
-    if (!temps_[k].section.empty()) {
-      pending = &temps_[k].section;
-      continue;
-    }
-    if (!live[k]) continue;
+  for (const LiveTemp& t : listed.temps) {
     OpCount c;
-    std::string text = print_cpp(temps_[k].value, c);
+    std::string text = print_cpp(t.value, c);
     ops += c;
     if (in_chunk > 0 && in_chunk + c.total() > max_chunk_ops) ++chunk, in_chunk = 0;
     in_chunk += c.total();
-    lines.push_back({k, std::move(text), chunk, pending, nullptr});
-    pending = nullptr;
-    chunk_of[temps_[k].sym.get_name()] = chunk;
+    lines.push_back({&t, nullptr, std::move(text), chunk});
+    chunk_of[t.sym.get_name()] = chunk;
   }
   // the outputs, in the same sequence of parts (the verbatim statements, which
   // may return, stay in the function itself)
-  for (const Stmt& st : stmts_) {
+  for (const Statement& st : listed.statements) {
     if (st.lhs.empty()) continue;
     OpCount c;
     std::string text = print_cpp(st.value, c);
     ops += c;
     if (in_chunk > 0 && in_chunk + c.total() + 1 > max_chunk_ops) ++chunk, in_chunk = 0;
     in_chunk += c.total() + 1;
-    lines.push_back({0, std::move(text), chunk, nullptr, &st});
+    lines.push_back({nullptr, &st, std::move(text), chunk});
   }
   const int last = chunk + 1;  // the verbatim statements form the last part (the function itself)
   // 2. which temporaries cross a part boundary: they go through the workspace
@@ -211,14 +192,13 @@ ChunkedBody Program::emit_chunked(const std::string& indent, OpCount& ops, long 
       loads[part].insert(n);
     }
   };
-  for (const Line& l : lines) uses(l.output ? l.output->value : temps_[l.k].value, l.chunk);
-  for (const Stmt& s : stmts_)
+  for (const Line& l : lines) uses(l.output ? l.output->value : l.temp->value, l.chunk);
+  for (const Statement& s : listed.statements)
     if (s.lhs.empty()) uses(s.value, last);
   // 3. the parts
-  const std::string prelude = used_preludes(needed, indent);
   ChunkedBody out;
-  out.parts.assign(last, prelude);
-  std::string main = prelude;
+  out.parts.assign(last, listed.preludes);
+  std::string main = listed.preludes;
   auto load_text = [&](int part) {
     std::string t;
     for (const auto& n : loads[part]) t += fmt::format("{}const T {} = w[{}];\n", indent, n, slot.at(n));
@@ -232,12 +212,12 @@ ChunkedBody Program::emit_chunked(const std::string& indent, OpCount& ops, long 
       dst += fmt::format("{}{} = {};\n", indent, l.output->lhs, l.text);
       continue;
     }
-    if (l.section) dst += fmt::format("{}// ---- {}\n", indent, *l.section);
-    const std::string& n = temps_[l.k].sym.get_name();
+    if (!l.temp->section.empty()) dst += fmt::format("{}// ---- {}\n", indent, l.temp->section);
+    const std::string& n = l.temp->sym.get_name();
     dst += fmt::format("{}const T {} = {};\n", indent, n, l.text);
     if (auto it = slot.find(n); it != slot.end()) dst += fmt::format("{}w[{}] = {};\n", indent, it->second, n);
   }
-  for (const Stmt& s : stmts_)
+  for (const Statement& s : listed.statements)
     if (s.lhs.empty()) main += indent + s.text + "\n";
   out.main = std::move(main);
   out.workspace = static_cast<int>(slot.size());
