@@ -14,14 +14,6 @@ using namespace GiNaC;
 
 namespace {
 
-void symbol_names(const ex& e, std::set<std::string>& names) {
-  if (is_a<symbol>(e)) {
-    names.insert(ex_to<symbol>(e).get_name());
-    return;
-  }
-  for (std::size_t i = 0; i < e.nops(); ++i) symbol_names(e.op(i), names);
-}
-
 /// The body a section's title names ("body link3: outward pass" -> "link3"), or "".
 std::string body_of(const std::string& title) {
   if (title.rfind("body ", 0) != 0) return {};
@@ -150,7 +142,7 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
   std::map<std::string, int> index_of;  // temporary -> its index in the listing
   for (int k = 0; k < nt; ++k) index_of[temps[k].sym.get_name()] = k;
   std::vector<std::set<std::string>> reads(nt);
-  for (int k = 0; k < nt; ++k) symbol_names(temps[k].value, reads[k]);
+  for (int k = 0; k < nt; ++k) collect_symbols(temps[k].value, reads[k]);
 
   // 1. groups: the sections, a body's later section fused into its last group when every temporary it reads
   // is computed by then
@@ -211,7 +203,7 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
       }
   std::vector<std::set<std::string>> statement_reads(listing.statements.size());
   for (std::size_t i = 0; i < listing.statements.size(); ++i) {
-    symbol_names(listing.statements[i].value, statement_reads[i]);
+    collect_symbols(listing.statements[i].value, statement_reads[i]);
     for (const std::string& n : statement_reads[i])
       if (index_of.count(n)) slot_of(n);
   }

@@ -49,7 +49,7 @@ void Program::prelude(const std::string& text, const std::vector<std::string>& d
   preludes_.push_back({text, defines});
 }
 
-static void collect_symbols(const ex& e, std::set<std::string>& names) {
+void collect_symbols(const ex& e, std::set<std::string>& names) {
   if (is_a<symbol>(e)) {
     names.insert(ex_to<symbol>(e).get_name());
     return;

@@ -35,6 +35,9 @@ struct ChunkedBody {
   int workspace = 0;  ///< number of workspace entries
 };
 
+/// The names of the symbols in e (temporaries, state, constants).
+void collect_symbols(const ex& e, std::set<std::string>& names);
+
 class Program {
  public:
   /// Applied to every expression before it is bound or assigned (e.g. the

@@ -449,7 +449,11 @@ LinearModel linearize(Engine& engine, const State& state, const LinearizeOptions
     VecX x0(nx);
     x0 << q0, u0;
     auto step = [](double v) { return 1e-6 * std::max(1.0, std::abs(v)); };
-    for (int c = 0; c < nq + 2 * nu + model.nw; ++c) {
+    // in the orbit frame A and C are differenced in the chart's own coordinates (to_orbit_frame): only the
+    // input columns are needed here
+    const int first = orbit_chart ? nx : 0;
+    if (orbit_chart) J.setZero(), CD.leftCols(nx).setZero();
+    for (int c = first; c < nq + 2 * nu + model.nw; ++c) {
       VecX q = q0, u = u0, tau = tau0, w = w0;
       double* v = c < nq ? &q(c) : c < nx ? &u(c - nq) : c < nx + model.nw ? &w(c - nx) : &tau(c - nx - model.nw);
       const double v0 = *v, h = step(v0);
