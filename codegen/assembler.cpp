@@ -291,6 +291,9 @@ AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, 
   j["np"] = m.np;
   j["parameters"] = m.parameter_names;
   j["udot_form"] = m.udot_form;
+  for (const auto& f : m.functions)
+    if (f.name == "udot")
+      j["udot_code"] = !f.kernels.empty() ? "compact" : !f.parts.empty() ? "straight-line in parts" : "straight-line";
   j["takes_time"] = std::any_of(m.functions.begin(), m.functions.end(), [](const EmittedFunction& f) {
     return std::find(f.args.begin(), f.args.end(), Arg::t) != f.args.end();
   });

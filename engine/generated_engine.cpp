@@ -104,6 +104,19 @@ void GeneratedEngine::do_forcing(double t, const VecX& q, const VecX& u, const V
   forcing_(&a, F.data());
 }
 
+void GeneratedEngine::use_udot(KanegenFunctionPtr fn, std::shared_ptr<void> library, std::string compiler) {
+  if (!fn) throw std::logic_error("GeneratedEngine::use_udot: no function");
+  udot_ = fn;
+  udot_library_ = std::move(library);
+  udot_compiler_ = std::move(compiler);
+}
+
+int GeneratedEngine::call_udot(KanegenFunctionPtr fn, double t, const VecX& q, const VecX& u, const VecX& tau,
+                               double* out) const {
+  const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs(), code_parameters_);
+  return fn(&a, out);
+}
+
 void GeneratedEngine::do_udot(double t, const VecX& q, const VecX& u, const VecX& tau, VecX& ud) {
   const KanegenArgs a = args(t, &q, &u, &tau, nullptr, inputs(), code_parameters_);
   if (const int pivot = udot_(&a, ud.data()); pivot != 0) singular(pivot);

@@ -40,6 +40,16 @@ class GeneratedEngine final : public Engine {
   const std::string& udot_form() const { return udot_form_; }
   void set_udot_form(std::string form) { udot_form_ = std::move(form); }
 
+  /// u-dot (and state_derivative) from `fn` instead: the same function built otherwise, in `library` (kept
+  /// loaded), e.g. by a second compiler (jit.cpp). `compiler` names it for reports.
+  void use_udot(KanegenFunctionPtr fn, std::shared_ptr<void> library, std::string compiler);
+  /// The compiler of the u-dot in use when use_udot() replaced it; empty: the library's own.
+  const std::string& udot_compiler() const { return udot_compiler_; }
+  KanegenFunctionPtr udot_function() const { return udot_; }
+  /// Calls `fn` (a u-dot of this model's table, or of another build of it) at (t, q, u, tau) with this
+  /// engine's inputs and parameters, writing nu doubles to `out`; returns its status.
+  int call_udot(KanegenFunctionPtr fn, double t, const VecX& q, const VecX& u, const VecX& tau, double* out) const;
+
   /// x_dot = [q_dot; u_dot] straight from x = [q; u] (nq + nu doubles, tau nu
   /// doubles): no copies, no size checks, for an integrator's right-hand
   /// side. Returns 0, or the 1-based speed of a non-positive pivot (udot()
@@ -75,6 +85,8 @@ class GeneratedEngine final : public Engine {
   std::shared_ptr<void> library_;
   std::string library_path_;
   std::string udot_form_;
+  std::shared_ptr<void> udot_library_;
+  std::string udot_compiler_;
   KanegenFunctionPtr qdot_ = nullptr, mass_matrix_ = nullptr, forcing_ = nullptr, udot_ = nullptr,
                      jacobian_ = nullptr, energy_ = nullptr, momentum_ = nullptr, reactions_ = nullptr,
                      outputs_ = nullptr, input_jacobian_ = nullptr, output_jacobian_ = nullptr;

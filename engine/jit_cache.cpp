@@ -63,6 +63,10 @@ std::optional<LibraryRecord> verified_record(const std::string& so_path) {
     r.checksum = j.at("fnv1a64").get<std::string>();
     r.jacobian_for_integration = j.value("jacobian_for_integration", true);
     r.udot_form = j.value("udot_form", "");
+    r.compiler = j.value("compiler", "");
+    r.preferred = j.value("preferred", false);
+    r.udot_ns = j.value("udot_ns", 0.0);
+    r.main_udot_ns = j.value("main_udot_ns", 0.0);
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;
   }
@@ -90,6 +94,12 @@ void write_record(const std::string& so_path, const LibraryRecord& r) {
   j["fnv1a64"] = r.checksum;
   j["jacobian_for_integration"] = r.jacobian_for_integration;
   j["udot_form"] = r.udot_form;
+  if (!r.compiler.empty()) {
+    j["compiler"] = r.compiler;
+    j["preferred"] = r.preferred;
+    j["udot_ns"] = r.udot_ns;
+    j["main_udot_ns"] = r.main_udot_ns;
+  }
   {
     std::ofstream out(tmp, std::ios::binary);
     out << j.dump() << "\n";

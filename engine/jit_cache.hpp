@@ -22,6 +22,11 @@ struct LibraryRecord {
   bool jacobian_for_integration = true;
   /// The u-dot form the generator chose or was told ("composite", "articulated"; empty in older records).
   std::string udot_form;
+  /// A library of u-dot alone built by a second compiler (jit.cpp, "A second compiler for u-dot"): its
+  /// compiler, whether it was measured faster than the main library's u-dot, and the two least times (ns).
+  std::string compiler;
+  bool preferred = false;
+  double udot_ns = 0, main_udot_ns = 0;
 };
 
 /// <dir>/<stem>-<key>.json for a library path <dir>/<stem>-<key>.so.

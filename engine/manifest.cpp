@@ -38,6 +38,7 @@ Manifest parse_manifest(const std::string& text, const std::string& what) {
     m.ny = j.value("ny", 0);
     m.np = j.value("np", 0);
     m.udot_form = j.value("udot_form", "");
+    m.udot_code = j.value("udot_code", "");
     for (const auto& f : j.at("functions"))
       m.functions.push_back({f.at("name").get<std::string>(), f.at("ops").get<long>(), f.at("out_size").get<int>()});
   } catch (const nlohmann::json::exception& e) {

@@ -21,6 +21,9 @@ struct Manifest {
   int nw = 0, ny = 0;  ///< named inputs and outputs
   int np = 0;          ///< runtime parameters
   std::string udot_form;
+  /// How u-dot is emitted: "straight-line" (one function), "straight-line in parts" or "compact"
+  /// (outlined_code.hpp); empty in older manifests.
+  std::string udot_code;
   std::vector<ManifestFunction> functions;
   const ManifestFunction* find(const std::string& name) const;
 };

@@ -7,7 +7,8 @@
 #                                three.js: libjs-three)
 #   install_deps.sh demo         both
 #   install_deps.sh              all of it: also the tests, benchmarks, peers
-#                                (MuJoCo, Simbody), the Python module, Open MPI and the
+#                                (MuJoCo, Simbody), the Python module, Open MPI, clang (the
+#                                JIT's second compiler for u-dot, engine/jit.cpp) and the
 #                                browser the 3D view's test opens (chromium)
 set -euo pipefail
 build_packages=(
@@ -26,6 +27,7 @@ case "${1:-all}" in
       python3-scipy python3-dev pybind11-dev python3-pybind11
       libopenmpi-dev openmpi-bin
       libmujoco-dev libsimbody-dev
+      clang
       chromium)
     ;;
   *) echo "install_deps.sh: unknown set '$1' (expected demo-build, demo-plot, demo or nothing)" >&2; exit 2 ;;

@@ -68,6 +68,9 @@ def peer_udot(bindir, model, quick, rows):
                                                "min_ns_mujoco", "min_ns_generated", "min_ns_generated_native",
                                                "min_ns_generated_baseline", "min_ns_generic",
                                                "max_rel_diff_generated", "kanegen_jit_seconds",
+                                               "udot_compiler_generated", "udot_compiler_generated_baseline",
+                                               "ns_generated_baseline_main_compiler",
+                                               "min_ns_generated_baseline_main_compiler",
                                                "backward_error_mujoco", "cond_M")})
             row["nu"] = len(j["u_names"])
         else:
@@ -137,7 +140,11 @@ def udot_section(rows, provenance):
           "-O2 gets; the headline ratio), at the JIT's default flags (*dispatched*: an AVX2 clone picked at load "
           "time on this CPU) and with `--native` (`-march=native`), kanegen's generic engine and MuJoCo 2.2's "
           "`mj_forward` interleaved in one process; Simbody 3.7 (`realize` to Acceleration) in its own process "
-          "right after (its median). *code*: straight-line, or compact (kernels shared by bodies of one shape, "
+          "right after (its median). *baseline* and *dispatched* name the compiler of the u-dot served where it "
+          "is not the JIT's main one (g++): where clang++ is installed, the JIT builds a long straight-line u-dot "
+          "with it too and serves it only when measured 5 % faster at the initial state (engine/jit.cpp, "
+          "docs/decisions.md); *g++ baseline* is then g++'s own u-dot, timed in the same slices. "
+          "*code*: straight-line, or compact (kernels shared by bodies of one shape, "
           "docs/decisions.md); *floor*: for one-degree-of-freedom joints, the cheaper of Featherstone's articulated-body count "
           "in joint-local frames, 429 n − 348, and the composite route for a chain (RNEA + CRBA + dense LTDL; a tree's is cheaper), "
           "plus 6 n for sin/cos and springs (`../shared/perf/udot-floor-analysis.md`), and the operations "
@@ -145,22 +152,28 @@ def udot_section(rows, provenance):
           "largest relative difference (last columns), accepted up to 1e-12, or, where M is ill-conditioned (two "
           "correct solvers then differ by up to cond(M)·1e-16), a normwise backward error of the peer's u-dot in "
           "kanegen's M u-dot = F below 1e-14 (given in brackets with cond(M)).", "",
-          "| model | nu | u-dot ops (form, code) | floor (ops / floor) | baseline | ns/op | dispatched | native | "
+          "| model | nu | u-dot ops (form, code) | floor (ops / floor) | baseline | ns/op | g++ baseline | dispatched | native | "
           "generic | MuJoCo | **MuJoCo / baseline** | MuJoCo / dispatched | MuJoCo / native | Simbody | "
           "Simbody / baseline | diff MuJoCo | diff Simbody |",
-          "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+          "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         fl = r.get("floor")
         fl_txt = "—" if not fl or not r.get("ops") else f"{fl:,} ({r['ops'] / fl:.2f})"
         if "mujoco_error" in r:
             L.append(f"| {r['model']} | | {r['ops']} ({r['form']}) | {fl_txt} | MuJoCo run failed: "
-                     f"{r['mujoco_error']} | | | | | | | | | | | | |")
+                     f"{r['mujoco_error']} | | | | | | | | | | | | | |")
             continue
         sd = r.get("simbody_diff")
         base = t(r, "ns_generated_baseline")
         per_op = "—" if base is None or not r.get("ops") else f"{base / r['ops']:.3f}"
+
+        def served(k):  # the compiler of the u-dot served, where not the main one
+            c = r.get("udot_compiler_" + k)
+            return "" if c in (None, "main") else f" ({c})"
         L.append(f"| {r['model']} | {r.get('nu', '')} | {r['ops']:,} ({r['form']}) | {fl_txt} | "
-                 f"{fmt_ns(base)} | {per_op} | {fmt_ns(t(r, 'ns_generated'))} | "
+                 f"{fmt_ns(base)}{served('generated_baseline')} | {per_op} | "
+                 f"{fmt_ns(t(r, 'ns_generated_baseline_main_compiler')) if served('generated_baseline') else '='} | "
+                 f"{fmt_ns(t(r, 'ns_generated'))}{served('generated')} | "
                  f"{fmt_ns(t(r, 'ns_generated_native'))} | {fmt_ns(t(r, 'ns_generic'))} | "
                  f"{fmt_ns(t(r, 'ns_mujoco'))} | **{ratio(t(r, 'ns_mujoco'), base)}** | "
                  f"{ratio(t(r, 'ns_mujoco'), t(r, 'ns_generated'))} | "

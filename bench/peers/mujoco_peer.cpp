@@ -440,6 +440,7 @@ int main(int argc, char** argv) {
       std::vector<std::function<void()>> engines{[&] { peer.forward(); },
                                                  [&] { generated->udot(q, u, tau, ud_gen); },
                                                  [&] { generic.udot(q, u, tau, ud_gen2); }};
+      std::vector<std::string> names{"mujoco", "generated", "generic"};
       kanegen::VecX ud_base, ud_nat;
       generated_baseline->udot(q, u, tau, ud_base);
       j["max_rel_diff_generated_baseline"] = max_rel(ud_base, ud);
@@ -448,6 +449,20 @@ int main(int argc, char** argv) {
         status = 1;
       }
       engines.push_back([&] { generated_baseline->udot(q, u, tau, ud_base); });
+      names.push_back("generated_baseline");
+      // which compiler built the u-dot served (the JIT's second compiler when it was measured faster,
+      // engine/jit.cpp), and the main compiler's u-dot timed beside it then
+      j["udot_compiler_generated"] = generated->udot_compiler().empty() ? "main" : generated->udot_compiler();
+      j["udot_compiler_generated_baseline"] =
+          generated_baseline->udot_compiler().empty() ? "main" : generated_baseline->udot_compiler();
+      kanegen::VecX ud_main(km.nu);
+      const KanegenFunctionPtr main_udot = generated_baseline->function("udot");
+      if (!generated_baseline->udot_compiler().empty()) {
+        generated_baseline->call_udot(main_udot, 0.0, q, u, tau, ud_main.data());
+        j["max_rel_diff_generated_baseline_main_compiler"] = max_rel(ud_main, ud);
+        engines.push_back([&] { generated_baseline->call_udot(main_udot, 0.0, q, u, tau, ud_main.data()); });
+        names.push_back("generated_baseline_main_compiler");
+      }
       kanegen::VecX ud_compact;
       if (generated_compact) {
         generated_compact->udot(q, u, tau, ud_compact);
@@ -458,6 +473,7 @@ int main(int argc, char** argv) {
           status = 1;
         } else {
           engines.push_back([&] { generated_compact->udot(q, u, tau, ud_compact); });
+          names.push_back("generated_compact_baseline");
         }
       }
       if (generated_native) {
@@ -468,12 +484,10 @@ int main(int argc, char** argv) {
           status = 1;
         } else {
           engines.push_back([&] { generated_native->udot(q, u, tau, ud_nat); });
+          names.push_back("generated_native");
         }
       }
       const auto times = kanegen::bench::interleaved_times(engines, rounds, 1e-3);
-      std::vector<std::string> names{"mujoco", "generated", "generic", "generated_baseline"};
-      if (generated_compact && names.size() < engines.size()) names.push_back("generated_compact_baseline");
-      if (generated_native && names.size() < engines.size()) names.push_back("generated_native");
       for (std::size_t k = 0; k < names.size(); ++k) {
         j["ns_" + names[k]] = times.median[k];      // median of the slices
         j["min_ns_" + names[k]] = times.min[k];     // the least slice
