@@ -399,14 +399,17 @@ EmittedModel generate(const Model& model_in, const GeneratorOptions& options) {
     KaneContext ctx(fr, p, C, xr);
     prepare(ctx, true);
     const auto W = compute_reactions(ctx, xr.udot);
-    // back to the model's body axes: [R_BB' f; R_BB' t]
+    // back to the model's body axes and origin: [R_BB' f; R_BB' t + o_B x R_BB' f]
     for (int j = 0; j < out.nbodies; ++j) {
-      const SM3 Q = ctx.cmat(fr.R_BBp[j], fr.model.bodies[j].name + "_R_BBp", "",
-                             "the model's body axes from the generator's (joint_frames.hpp)");
-      for (int half = 0; half < 2; ++half) {
-        const SV3 w{{W[6 * j + 3 * half], W[6 * j + 3 * half + 1], W[6 * j + 3 * half + 2]}};
-        const SV3 wB = ctx.A.mul(Q, w);
-        for (int a = 0; a < 3; ++a) p.assign(fmt::format("wrenches[{}]", 6 * j + 3 * half + a), wB[a]);
+      const std::string& n = fr.model.bodies[j].name;
+      const SM3 Q = ctx.cmat(fr.R_BBp[j], n + "_R_BBp", "", "the model's body axes from the generator's (joint_frames.hpp)");
+      const SV3 f = ctx.A.mul(Q, SV3{{W[6 * j], W[6 * j + 1], W[6 * j + 2]}});
+      SV3 t = ctx.A.mul(Q, SV3{{W[6 * j + 3], W[6 * j + 4], W[6 * j + 5]}});
+      if (!fr.o_B[j].isZero(0.0))
+        t = ctx.A.add(t, ctx.A.cross(ctx.cvec(fr.o_B[j], n + "_o_B", "m", "the generator's origin from the model's"), f));
+      for (int a = 0; a < 3; ++a) {
+        p.assign(fmt::format("wrenches[{}]", 6 * j + a), f[a]);
+        p.assign(fmt::format("wrenches[{}]", 6 * j + 3 + a), t[a]);
       }
     }
     EmittedFunction f =

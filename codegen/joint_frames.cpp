@@ -30,11 +30,34 @@ Mat3 rot_x(double a) {
   return R;
 }
 
+/// Where along its axis z (through the origin) body j's frame origin goes: the foot of the common normal
+/// to the child's axis, through p with direction a (unit vectors); for parallel axes, the foot of the
+/// perpendicular from p (the offset is then across the axis alone).
+double common_normal_foot(const Vec3& z, const Vec3& p, const Vec3& a) {
+  const double b = z.dot(a), denom = 1.0 - b * b;
+  if (denom < 1e-12) return z.dot(p);
+  // closest points O + t z and p + s a: (t z - p - s a) . z = 0 and . a = 0
+  return (z.dot(p) - b * a.dot(p)) / denom;
+}
+
+/// Whether body j's origin stays where the model puts it: its joint at a flexible parent's node, or
+/// parameters that fix it: its centre of mass, its joint's position or misalignment
+/// (given in the model's frames at run time), or a child joint's position (given from O_B).
+bool origin_pinned(const Model& m, int j) {
+  if (m.bodies[j].joint.node >= 0) return true;  // a joint at a flexible parent's node turns with the node
+  return std::any_of(m.parameters.begin(), m.parameters.end(), [&](const RuntimeParameter& p) {
+    if (p.body == j)
+      return p.kind == ParameterKind::com || p.kind == ParameterKind::position ||
+             p.kind == ParameterKind::misalignment;
+    return p.body >= 0 && m.bodies[p.body].parent == j && p.kind == ParameterKind::position;
+  });
+}
+
 }  // namespace
 
 FramedModel keep_joint_frames(const Model& model) {
   FramedModel f{model, std::vector<Mat3>(model.bodies.size(), Mat3::Identity()),
-                std::vector<double>(model.bodies.size(), 0.0)};
+                std::vector<double>(model.bodies.size(), 0.0), std::vector<Vec3>(model.bodies.size(), Vec3::Zero())};
   return f;
 }
 
@@ -61,9 +84,10 @@ FramedModel choose_joint_frames(const Model& in) {
     Vec3 x;
     if (const int c = main_child[j]; c >= 0) {
       const Body& cb = in.bodies[c];
-      const Vec3 a_c = cb.joint.R_PJ * cb.joint.axis_J;  // the child's axis in B
+      const Vec3 a_c = (cb.joint.R_PJ * cb.joint.axis_J).normalized();  // the child's axis in B
       const Vec3 n = z.cross(a_c);
       x = n.norm() > 1e-9 ? Vec3(n.normalized()) : perpendicular(z, cb.joint.p_PJ);
+      if (!origin_pinned(in, j)) out.o_B[j] = z * common_normal_foot(z, cb.joint.p_PJ, a_c);
     } else {
       x = perpendicular(z, b.rigid.com_B);
     }
@@ -80,11 +104,13 @@ FramedModel choose_joint_frames(const Model& in) {
     Body& o = out.model.bodies[j];
     const Mat3& Q = out.R_BBp[j];
     const Mat3 Qp = b.parent >= 0 ? out.R_BBp[b.parent] : Mat3::Identity();
+    const Vec3 o_P = b.parent >= 0 ? out.o_B[b.parent] : Vec3::Zero();
     o.joint.R_PJ = Qp.transpose() * b.joint.R_PJ * Q;
-    o.joint.p_PJ = Qp.transpose() * b.joint.p_PJ;
+    // O_B' = O_B + o_B (o_B along the joint axis: the same point for every q), from O_P' = O_P + o_P
+    o.joint.p_PJ = Qp.transpose() * (b.joint.p_PJ + b.joint.R_PJ * out.o_B[j] - o_P);
     if (reframable(b)) o.joint.axis_J = Vec3::UnitZ();
-    move_ports(out.model.inputs, out.model.sensors, j, j, Vec3::Zero(), Q.transpose());
-    o.rigid.com_B = Q.transpose() * b.rigid.com_B;
+    move_ports(out.model.inputs, out.model.sensors, j, j, -(Q.transpose() * out.o_B[j]), Q.transpose());
+    o.rigid.com_B = Q.transpose() * (b.rigid.com_B - out.o_B[j]);
     o.rigid.I_c_B = Q.transpose() * b.rigid.I_c_B * Q;
     o.rigid.I_c_B = 0.5 * (o.rigid.I_c_B + o.rigid.I_c_B.transpose()).eval();
     // Denavit-Hartenberg: when the parent's x axis is normal to this revolute

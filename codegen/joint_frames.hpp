@@ -11,10 +11,17 @@
 //   - B''s x axis lies along the common normal of its axis and its main
 //     child's axis (Denavit-Hartenberg), so that the constant rotation to that
 //     child is a rotation about x alone, Rx(alpha), once a constant offset
-//     delta is added to the child's joint angle (Rx(alpha) Rz(q + delta)).
+//     delta is added to the child's joint angle (Rx(alpha) Rz(q + delta));
+//   - B''s origin slides along its joint axis (which leaves the joint's motion
+//     unchanged) to the foot of that common normal: the offset from B' to its
+//     main child's frame is then a along the common normal plus d along the
+//     child's axis, (a, 0, d) in the child's joint axes (McMillan and Orin's
+//     axial screws), so that moving an articulated inertia, a wrench or a
+//     motion to the parent costs fewer products.
 //
 // Only the generator's internal quantities change; reactions, reported in the
-// model's body axes, are rotated back by the constant R_BB'.
+// model's body axes about the model's origin O_B, are turned back by the
+// constant R_BB' and moved back by the constant o_B.
 #pragma once
 
 #include <vector>
@@ -27,6 +34,7 @@ struct FramedModel {
   Model model;                       ///< same bodies, q and u; re-chosen body frames
   std::vector<Mat3> R_BBp;           ///< per body: axes of the new frame B' in the model's frame B
   std::vector<double> angle_offset;  ///< per body: revolute joint rotation Rz(q + offset) (0 otherwise)
+  std::vector<Vec3> o_B;             ///< per body: the origin of B' from O_B, the model's body axes (along the axis)
 };
 
 /// The model with re-chosen body frames (see the header comment).

@@ -36,6 +36,13 @@ SM3 misalignment_rotation(KaneContext& ctx, int j) {
   return A.mul(Qs.transpose(), A.mul(R, Qs));
 }
 
+/// v with round-off residues (entries below 1e-15 of its largest) set to 0: the joint-local offset of
+/// joint_frames.hpp, (a, 0, d), keeps its zero
+Vec3 snapped(Vec3 v) {
+  snap_roundoff_residues(v);
+  return v;
+}
+
 /// Qp^T p: body j's joint origin (runtime parameters, the parent's model axes) in the parent's frame P'.
 SV3 joint_position(KaneContext& ctx, int j) {
   const Body& b = ctx.model.bodies[j];
@@ -363,7 +370,7 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     const SM3 R_JP = R_PJ.transpose(), R_BJ = R_JB.transpose();
     // O_J from O_P in J components: a model constant unless O_J is a node of a flexible parent
     const SV3 p_J = b.joint.node >= 0 || misaligned || moved ? A.mul(R_JP, p_PJ)
-                                      : ctx.cvec(b.joint.R_PJ.transpose() * b.joint.p_PJ, n + "_p_J", "m",
+                                      : ctx.cvec(snapped(Vec3(b.joint.R_PJ.transpose() * b.joint.p_PJ)), n + "_p_J", "m",
                                                  "joint origin from the parent's origin, joint axes");
     s.p_BP_J = A.add(p_J, e_J);
     s.R_PB = A.mul(R_PJ, R_JB, ctx.name("R_PB", j));

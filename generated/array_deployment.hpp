@@ -5180,22 +5180,22 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t938 = t923 + t933;
   const T t939 = t924 - t932;
   wrenches[0] = t934;
-  wrenches[1] = t935;
-  wrenches[2] = t936;
   wrenches[3] = t937;
+  wrenches[1] = t935;
   wrenches[4] = t938;
+  wrenches[2] = t936;
   wrenches[5] = t939;
   wrenches[6] = t888;
-  wrenches[7] = t889;
-  wrenches[8] = t890;
   wrenches[9] = t891;
+  wrenches[7] = t889;
   wrenches[10] = t892;
+  wrenches[8] = t890;
   wrenches[11] = t893;
   wrenches[12] = t904;
-  wrenches[13] = t905;
-  wrenches[14] = t906;
   wrenches[15] = t907;
+  wrenches[13] = t905;
   wrenches[16] = t908;
+  wrenches[14] = t906;
   wrenches[17] = t909;
 }
 

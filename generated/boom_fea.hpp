@@ -2745,22 +2745,22 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t640 = t636 + t638;
   const T t641 = t588 + t640;
   wrenches[0] = t631;
-  wrenches[1] = t632;
-  wrenches[2] = t633;
   wrenches[3] = t634;
+  wrenches[1] = t632;
   wrenches[4] = t639;
+  wrenches[2] = t633;
   wrenches[5] = t641;
   wrenches[6] = t631;
-  wrenches[7] = t632;
-  wrenches[8] = t633;
   wrenches[9] = t634;
+  wrenches[7] = t632;
   wrenches[10] = t635;
+  wrenches[8] = t633;
   wrenches[11] = t636;
   wrenches[12] = t613;
-  wrenches[13] = -t612;
-  wrenches[14] = t611;
   wrenches[15] = t616;
+  wrenches[13] = -t612;
   wrenches[16] = -t615;
+  wrenches[14] = t611;
   wrenches[17] = t614;
 }
 

@@ -287,10 +287,10 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t31 = -beam_Prf_xz_1*udot_in[0] - beam_Prf_xz_3*udot_in[2];
   const T t32 = beam_Prf_xy_2*udot_in[1] + beam_Prf_xy_4*udot_in[3];
   wrenches[0] = 0.0;
-  wrenches[1] = t28;
-  wrenches[2] = t29;
   wrenches[3] = t30;
+  wrenches[1] = t28;
   wrenches[4] = t31;
+  wrenches[2] = t29;
   wrenches[5] = t32;
 }
 

@@ -16,13 +16,13 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot               0 (0 add, 0 mul, 0 div, 0 func)
-//   mass_matrix       45 (19 add, 24 mul, 0 div, 2 func)
-//   forcing          136 (53 add, 79 mul, 0 div, 4 func)
-//   udot             186 (73 add, 108 mul, 1 div, 4 func) -- composite form; composite 186, articulated 235
-//     udot by pass: outward pass (velocities) 40; mass and velocity terms 38; composite inertia (inward) 31; its columns of M (walked to the root) 10; bias force 35; generalized forces (inward) 23; M u_dot = F: L^T D L along the dof tree 9
-//   energy            97 (34 add, 57 mul, 2 div, 4 func)
-//   momentum         156 (57 add, 95 mul, 0 div, 4 func)
-//   reactions        256 (108 add, 144 mul, 0 div, 4 func)
+//   mass_matrix       39 (16 add, 21 mul, 0 div, 2 func)
+//   forcing          132 (51 add, 77 mul, 0 div, 4 func)
+//   udot             176 (68 add, 103 mul, 1 div, 4 func) -- composite form; composite 176, articulated 215
+//     udot by pass: outward pass (velocities) 38; mass and velocity terms 38; composite inertia (inward) 27; its columns of M (walked to the root) 8; bias force 35; generalized forces (inward) 21; M u_dot = F: L^T D L along the dof tree 9
+//   energy            95 (33 add, 56 mul, 2 div, 4 func)
+//   momentum         158 (58 add, 96 mul, 0 div, 4 func)
+//   reactions        252 (106 add, 142 mul, 0 div, 4 func)
 
 #pragma once
 
@@ -65,14 +65,16 @@ inline constexpr double link1_R_PJ_xx = 0.8692335601383587;  // joint frame orie
 inline constexpr double link1_R_PJ_xy = -0.49440167670548435;  // joint frame orientation in the parent
 inline constexpr double link1_R_PJ_zx = -0.49440167670548435;  // joint frame orientation in the parent
 inline constexpr double link1_R_PJ_zy = -0.8692335601383587;  // joint frame orientation in the parent
+inline constexpr double link1_p_PJ_y = 0.0737032113948051;  // joint frame origin in the parent y [m]
+inline constexpr double link1_p_J_z = 0.0737032113948051;  // joint origin from the parent's origin, joint axes z [m]
 inline constexpr double link1_S0_x = 0.44450481360328903;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link1_S0_y = -0.229816167149975;  // first mass moment about O (undeformed) y [kg m]
-inline constexpr double link1_S0_z = 0.03;  // first mass moment about O (undeformed) z [kg m]
-inline constexpr double link1_J0_xx = 0.0868708832236105;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link1_S0_z = -0.0437032113948051;  // first mass moment about O (undeformed) z [kg m]
+inline constexpr double link1_J0_xx = 0.0878808539098295;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link1_J0_xy = 0.136348834682609;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link1_J0_xz = -0.010847013520956204;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link1_J0_yy = 0.2653291167763895;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link1_J0_yz = 0.0031784111874005945;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link1_J0_xz = 0.02191441872205544;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link1_J0_yy = 0.2663390874626085;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link1_J0_yz = -0.013759778361997875;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link1_J0_zz = 0.3354;  // inertia about O (undeformed) [kg m^2]
 
 // body link2: revolute joint to link1, mass 0.6 kg
@@ -82,11 +84,10 @@ inline constexpr double link2_R_PJ_zy = 0.9988527010004034;  // joint frame orie
 inline constexpr double link2_R_PJ_zz = -0.04788822093374167;  // joint frame orientation in the parent
 inline constexpr double link2_p_PJ_x = 0.8692335601383587;  // joint frame origin in the parent x [m]
 inline constexpr double link2_p_PJ_y = -0.49440167670548435;  // joint frame origin in the parent y [m]
-inline constexpr double link2_p_PJ_z = 0.05;  // joint frame origin in the parent z [m]
+inline constexpr double link2_p_PJ_z = -0.023703211394805093;  // joint frame origin in the parent z [m]
 inline constexpr double link2_angle_offset = 0.4704898923184695;  // joint angle offset of the generator's body frame (joint_frames.hpp) [rad]
 inline constexpr double link2_p_J_x = 0.8692335601383587;  // joint origin from the parent's origin, joint axes x [m]
-inline constexpr double link2_p_J_y = 0.07361865177410473;  // joint origin from the parent's origin, joint axes y [m]
-inline constexpr double link2_p_J_z = 0.4914400391097142;  // joint origin from the parent's origin, joint axes z [m]
+inline constexpr double link2_p_J_z = 0.49496955478051485;  // joint origin from the parent's origin, joint axes z [m]
 inline constexpr double link2_mass = 0.6;  // mass (rigid part and plain nodes) [kg]
 inline constexpr double link2_S0_x = 0.17441330224498364;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double link2_S0_z = 0.168;  // first mass moment about O (undeformed) z [kg m]
@@ -104,6 +105,7 @@ inline constexpr double link1_R_BBp_xx = 0.8692335601383587;  // the model's bod
 inline constexpr double link1_R_BBp_xy = -0.49440167670548435;  // the model's body axes from the generator's (joint_frames.hpp)
 inline constexpr double link1_R_BBp_zx = -0.49440167670548435;  // the model's body axes from the generator's (joint_frames.hpp)
 inline constexpr double link1_R_BBp_zy = -0.8692335601383587;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link1_o_B_y = 0.0737032113948051;  // the generator's origin from the model's y [m]
 inline constexpr double link2_R_BBp_xx = 0.7981042627383865;  // the model's body axes from the generator's (joint_frames.hpp)
 inline constexpr double link2_R_BBp_xy = 0.05504167329230252;  // the model's body axes from the generator's (joint_frames.hpp)
 inline constexpr double link2_R_BBp_xz = 0.6;  // the model's body axes from the generator's (joint_frames.hpp)
@@ -118,45 +120,40 @@ inline constexpr double gravity_z = -9.81;  // gravity in N z [m/s^2]
 inline constexpr double minus_gravity_z = 9.81;  // -gravity in N: the ground's fictitious acceleration z [m/s^2]
 
 // derived: constant subexpressions, evaluated here exactly
-inline constexpr double k006006a7 = 0.5384120127759056;  // = k1835183a + kcd353d42 + link2_J0_zz
 inline constexpr double k1190128e = 0.22820826203862124;  // = -k59499beb*link2_S0_x + link2_mass
-inline constexpr double k1835183a = 0.0032518235334221364;  // = link2_mass*link2_p_J_y*link2_p_J_y
-inline constexpr double k18351ad3 = 0.021707491864242274;  // = link2_mass*link2_p_J_y*link2_p_J_z
+inline constexpr double k154fd1a6 = 0.05;  // = link1_p_PJ_y + link2_p_PJ_z
 inline constexpr double k1adb1eba = 0.02708139819115127;  // = k59499beb*link2_J0_xz + link2_S0_z
 inline constexpr double k20edf4c2 = 0.00505244041256677;  // = ka903064d*link2_J0_yz - link2_J0_xy
 inline constexpr double k2d09fd55 = 0.28548000000000007;  // = link2_J0_xx + link2_J0_yy + link2_J0_zz
 inline constexpr double k359ff293 = -4.850080448480802;  // = link1_R_PJ_zx*minus_gravity_z
-inline constexpr double k3a62d85f = 0.14490798722409443;  // = link2_mass*link2_p_J_z*link2_p_J_z
+inline constexpr double k3a62d85f = 0.14699691609577265;  // = link2_mass*link2_p_J_z*link2_p_J_z
 inline constexpr double k3e46bb28 = 0.1263778729177485;  // = -k912e4bf7 + k9938a779
-inline constexpr double k56a6b3da = -0.022165734618012186;  // = k97f57875*link2_R_PJ_zz
-inline constexpr double k56b964fd = -0.4623329800347569;  // = k97f57875*link2_R_PJ_yz
+inline constexpr double k56a6b3da = -0.022267147953751627;  // = k97f57875*link2_R_PJ_zz
+inline constexpr double k56b964fd = -0.4644482597913584;  // = k97f57875*link2_R_PJ_yz
 inline constexpr double k59499beb = 2.1316707680882865;  // = kb7e5959a*link2_S0_x
-inline constexpr double k59fbd54e = 0.08256192657043199;  // = link2_S0_z*link2_p_J_z
-inline constexpr double k59fbd957 = 0.012367933498049596;  // = link2_S0_z*link2_p_J_y
+inline constexpr double k59fbd54e = 0.0831548852031265;  // = link2_S0_z*link2_p_J_z
 inline constexpr double k59fbda24 = 0.14603123810324428;  // = link2_S0_z*link2_p_J_x
 inline constexpr double k5bfb74db = -8.5271812249573;  // = link1_R_PJ_zy*minus_gravity_z
 inline constexpr double k61224f02 = 0.37179173796137877;  // = -k1190128e + link2_mass
 inline constexpr double k7584c250 = -0.008045221116868602;  // = link2_R_PJ_zz*link2_S0_z
-inline constexpr double k778d903d = 0.2948640234658285;  // = link2_mass*link2_p_J_z
-inline constexpr double k778d9160 = 0.044171191064462836;  // = link2_mass*link2_p_J_y
+inline constexpr double k778d903d = 0.2969817328683089;  // = link2_mass*link2_p_J_z
 inline constexpr double k778d9397 = 0.5215401360830152;  // = link2_mass*link2_p_J_x
-inline constexpr double k872e6b78 = 0.03407542536229187;  // = k18351ad3 + k59fbd957
 inline constexpr double k912e4bf7 = 0.011919692238265832;  // = -ka903064d*link2_J0_xz + link2_J0_xx
-inline constexpr double k97f57875 = 0.46286402346582856;  // = k778d903d + link2_S0_z
+inline constexpr double k97f57875 = 0.4649817328683089;  // = k778d903d + link2_S0_z
 inline constexpr double k98569865 = 1.6;  // = 1.0 + link2_mass
 inline constexpr double k9938a779 = 0.13829756515601432;  // = -ka904c900*link2_J0_yz + link2_J0_yy
-inline constexpr double ka6ba76ae = 0.7633720296074418;  // = 2.0*k59fbd54e + k3a62d85f + kcd353d42
+inline constexpr double ka6ba76ae = 0.7666468757445091;  // = 2.0*k59fbd54e + k3a62d85f + kcd353d42
 inline constexpr double ka7b3ad17 = 0.07299708875739648;  // = -link2_J0_xx + link2_J0_yy
 inline constexpr double ka903064d = -0.8079578793302834;  // = kb7e5959a*link2_J0_xz
 inline constexpr double ka904c900 = -0.019458328036908456;  // = kb7e5959a*link2_J0_yz
 inline constexpr double kb7e5959a = 12.22195062331948;  // = 1.0/link2_J0_zz
-inline constexpr double kc16c934c = 0.3132836638983805;  // = 2.0*k59fbd54e + k1835183a + k3a62d85f
-inline constexpr double kc3b8c593 = 0.40233694297716693;  // = k59fbda24 + kcd3534fc
+inline constexpr double kbe5816c7 = 0.5351601892424834;  // = kcd353d42 + link2_J0_zz
+inline constexpr double kc3b8c593 = 0.40417772706042343;  // = k59fbda24 + kcd3534fc
 inline constexpr double kc435ddc0 = -0.0033937912490833535;  // = k59499beb*link2_J0_yz
 inline constexpr double kc7236622 = 0.14091860180884874;  // = -k1adb1eba + link2_S0_z
-inline constexpr double kcd3534fc = 0.2563057048739227;  // = link2_mass*link2_p_J_x*link2_p_J_z
-inline constexpr double kcd353bb1 = 0.03839508166451469;  // = link2_mass*link2_p_J_x*link2_p_J_y
+inline constexpr double kcd3534fc = 0.2581464889571792;  // = link2_mass*link2_p_J_x*link2_p_J_z
 inline constexpr double kcd353d42 = 0.4533401892424834;  // = link2_mass*link2_p_J_x*link2_p_J_x
+inline constexpr double kd79b540e = 0.31330668650202564;  // = 2.0*k59fbd54e + k3a62d85f
 
 
 // ---- dual numbers for jacobian() ---------------------------------------------
@@ -213,22 +210,22 @@ void mass_matrix(const T* q, T* M) {
   const T t41 = link2_J0_yy + t39;
   const T t44 = link2_J0_xz*t7 + link2_J0_yz*t6;
   const T t48 = 2.0*link2_p_J_x*t34 + ka6ba76ae + t41;
-  const T t49 = -k872e6b78 - link2_p_J_z*t35 + t44;
-  const T t50 = 2.0*link2_p_J_x*t34 + 2.0*link2_p_J_y*t35 + k006006a7;
-  const T t55 = t48 - t50;
-  const T t56 = link2_R_PJ_yy_S2*t49 + link2_R_PJ_yy_ss*t55;
-  const T t58 = t50 + t56;
-  const T t67 = link1_J0_zz + t58;
+  const T t49 = -link2_p_J_z*t35 + t44;
+  const T t50 = 2.0*link2_p_J_x*t34 + kbe5816c7;
+  const T t54 = t48 - t50;
+  const T t55 = link2_R_PJ_yy_S2*t49 + link2_R_PJ_yy_ss*t54;
+  const T t57 = t50 + t55;
+  const T t66 = link1_J0_zz + t57;
   // ---- body link2: its columns of M (walked to the root)
-  const T t74 = -link2_S0_x*t7;
-  const T t76 = link2_p_J_z*t74;
-  const T t77 = link2_p_J_x*t34 - link2_p_J_y*t74;
-  const T t79 = t44 + t76;
-  const T t80 = link2_J0_zz + t77;
-  const T t84 = link2_R_PJ_zy*t79 + link2_R_PJ_zz*t80;
-  M[0] = t67;
-  M[1] = t84;
-  M[2] = t84;
+  const T t73 = -link2_S0_x*t7;
+  const T t75 = link2_p_J_z*t73;
+  const T t76 = link2_p_J_x*t34;
+  const T t78 = t44 + t75;
+  const T t79 = link2_J0_zz + t76;
+  const T t83 = link2_R_PJ_zy*t78 + link2_R_PJ_zz*t79;
+  M[0] = t66;
+  M[1] = t83;
+  M[2] = t83;
   M[3] = link2_J0_zz;
 }
 
@@ -247,7 +244,7 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t9 = sin(link2_angle_offset + q[1]);
   const T t22 = link2_R_PJ_zy*u[0];
   const T t23 = link2_R_PJ_zz*u[0];
-  const T t24 = -link2_p_J_y*t23 + link2_p_J_z*t22;
+  const T t24 = link2_p_J_z*t22;
   const T t25 = link2_p_J_x*t23;
   const T t26 = -link2_p_J_x*t22;
   const T t27 = t22*t26 - t23*t25;
@@ -292,7 +289,7 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   const T t78 = t71*t8 - t72*t9;
   const T t79 = t71*t9 + t72*t8;
   const T t81 = -link2_p_J_x*t73 + link2_p_J_z*t78;
-  const T t82 = link2_p_J_x*t79 - link2_p_J_y*t78;
+  const T t82 = link2_p_J_x*t79;
   const T t84 = t74*t9 + t75*t8;
   const T t86 = t81 + t84;
   const T t87 = t76 + t82;
@@ -320,7 +317,7 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t9 = sin(link2_angle_offset + q[1]);
   const T t22 = link2_R_PJ_zy*u[0];
   const T t23 = link2_R_PJ_zz*u[0];
-  const T t24 = -link2_p_J_y*t23 + link2_p_J_z*t22;
+  const T t24 = link2_p_J_z*t22;
   const T t25 = link2_p_J_x*t23;
   const T t26 = -link2_p_J_x*t22;
   const T t27 = t22*t26 - t23*t25;
@@ -360,52 +357,52 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   const T t73 = link2_J0_yy + t71;
   const T t76 = link2_J0_xz*t9 + link2_J0_yz*t8;
   const T t80 = 2.0*link2_p_J_x*t66 + ka6ba76ae + t73;
-  const T t81 = -k872e6b78 - link2_p_J_z*t67 + t76;
-  const T t82 = 2.0*link2_p_J_x*t66 + 2.0*link2_p_J_y*t67 + k006006a7;
-  const T t87 = t80 - t82;
-  const T t88 = link2_R_PJ_yy_S2*t81 + link2_R_PJ_yy_ss*t87;
-  const T t90 = t82 + t88;
-  const T t99 = link1_J0_zz + t90;
+  const T t81 = -link2_p_J_z*t67 + t76;
+  const T t82 = 2.0*link2_p_J_x*t66 + kbe5816c7;
+  const T t86 = t80 - t82;
+  const T t87 = link2_R_PJ_yy_S2*t81 + link2_R_PJ_yy_ss*t86;
+  const T t89 = t82 + t87;
+  const T t98 = link1_J0_zz + t89;
   // ---- body link2: its columns of M (walked to the root)
-  const T t106 = -link2_S0_x*t9;
-  const T t108 = link2_p_J_z*t106;
-  const T t109 = link2_p_J_x*t66 - link2_p_J_y*t106;
-  const T t111 = t108 + t76;
-  const T t112 = link2_J0_zz + t109;
-  const T t116 = link2_R_PJ_zy*t111 + link2_R_PJ_zz*t112;
+  const T t105 = -link2_S0_x*t9;
+  const T t107 = link2_p_J_z*t105;
+  const T t108 = link2_p_J_x*t66;
+  const T t110 = t107 + t76;
+  const T t111 = link2_J0_zz + t108;
+  const T t115 = link2_R_PJ_zy*t110 + link2_R_PJ_zz*t111;
   // ---- body link1: bias force
-  const T t121 = -link1_S0_x*t7 + link1_S0_y*t6;
+  const T t120 = -link1_S0_x*t7 + link1_S0_y*t6;
   // ---- body link2: bias force
-  const T t122 = -link2_S0_z*t41 - link2_mass*t43 - t57;
-  const T t123 = link2_S0_z*t40 - link2_mass*t44 - t58;
-  const T t124 = link2_S0_x*t41 - link2_mass*t34 - t59;
-  const T t125 = link2_S0_z*t44 - ((link2_J0_xx*t40 + link2_J0_xy*t41) + t63);
-  const T t126 = link2_S0_x*t34 - ((link2_J0_xy*t40 + link2_J0_yy*t41) + (link2_S0_z*t43 + t64));
-  const T t127 = -((link2_J0_xz*t40 + link2_J0_yz*t41) + (link2_S0_x*t44 + t65));
+  const T t121 = -link2_S0_z*t41 - link2_mass*t43 - t57;
+  const T t122 = link2_S0_z*t40 - link2_mass*t44 - t58;
+  const T t123 = link2_S0_x*t41 - link2_mass*t34 - t59;
+  const T t124 = link2_S0_z*t44 - ((link2_J0_xx*t40 + link2_J0_xy*t41) + t63);
+  const T t125 = link2_S0_x*t34 - ((link2_J0_xy*t40 + link2_J0_yy*t41) + (link2_S0_z*t43 + t64));
+  const T t126 = -((link2_J0_xz*t40 + link2_J0_yz*t41) + (link2_S0_x*t44 + t65));
   // ---- body link2: generalized forces (inward)
-  const T t128 = t127 + tau[1];
-  const T t129 = t122*t8 - t123*t9;
-  const T t130 = t122*t9 + t123*t8;
-  const T t132 = -link2_p_J_x*t124 + link2_p_J_z*t129;
-  const T t133 = link2_p_J_x*t130 - link2_p_J_y*t129;
-  const T t135 = t125*t9 + t126*t8;
-  const T t137 = t132 + t135;
-  const T t138 = t127 + t133;
-  const T t142 = link2_R_PJ_zy*t137 + link2_R_PJ_zz*t138;
-  const T t147 = t121 + t142;
+  const T t127 = t126 + tau[1];
+  const T t128 = t121*t8 - t122*t9;
+  const T t129 = t121*t9 + t122*t8;
+  const T t131 = -link2_p_J_x*t123 + link2_p_J_z*t128;
+  const T t132 = link2_p_J_x*t129;
+  const T t134 = t124*t9 + t125*t8;
+  const T t136 = t131 + t134;
+  const T t137 = t126 + t132;
+  const T t141 = link2_R_PJ_zy*t136 + link2_R_PJ_zz*t137;
+  const T t146 = t120 + t141;
   // ---- body link1: generalized forces (inward)
-  const T t148 = t147 + tau[0];
+  const T t147 = t146 + tau[0];
   // ---- M u_dot = F: L^T D L along the dof tree
-  const T t149 = kb7e5959a*t116;
-  const T t150 = -t116*t149 + t99;
-  const T t152 = -t128*t149 + t148;
-  const T t153 = t152/t150;
-  const T t154 = kb7e5959a*t128;
-  const T t155 = -t149*t153 + t154;
-  if (!(t150 > 1e-14*t99)) return 1;
+  const T t148 = kb7e5959a*t115;
+  const T t149 = -t115*t148 + t98;
+  const T t151 = -t127*t148 + t147;
+  const T t152 = t151/t149;
+  const T t153 = kb7e5959a*t127;
+  const T t154 = -t148*t152 + t153;
+  if (!(t149 > 1e-14*t98)) return 1;
   if (!(link2_J0_zz > 0.0)) return 2;
-  udot[0] = t153;
-  udot[1] = t155;
+  udot[0] = t152;
+  udot[1] = t154;
   return 0;
 }
 
@@ -428,7 +425,7 @@ void energy(const T* q, const T* u, T* TV) {
   const T t21 = R_PB_link1_zx*link2_p_PJ_x + R_PB_link1_zy*link2_p_PJ_y;
   const T t22 = link2_R_PJ_zy*u[0];
   const T t23 = link2_R_PJ_zz*u[0];
-  const T t24 = -link2_p_J_y*t23 + link2_p_J_z*t22;
+  const T t24 = link2_p_J_z*t22;
   const T t25 = link2_p_J_x*t23;
   const T t26 = -link2_p_J_x*t22;
   const T t35 = t22*t9;
@@ -485,7 +482,7 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t21 = R_PB_link1_zx*link2_p_PJ_x + R_PB_link1_zy*link2_p_PJ_y;
   const T t22 = link2_R_PJ_zy*u[0];
   const T t23 = link2_R_PJ_zz*u[0];
-  const T t24 = -link2_p_J_y*t23 + link2_p_J_z*t22;
+  const T t24 = link2_p_J_z*t22;
   const T t25 = link2_p_J_x*t23;
   const T t26 = -link2_p_J_x*t22;
   const T t35 = t22*t9;
@@ -504,35 +501,39 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t67 = R_PB_link1_zx*t45 + R_PB_link1_zy*t46;
   const T t68 = R_PB_link1_xx*t49 + R_PB_link1_xy*t50;
   const T t69 = R_PB_link1_zx*t49 + R_PB_link1_zy*t50;
-  const T t70 = link2_S0_z*t36 + link2_mass*t38;
-  const T t71 = link2_S0_x*w_B_link2_z - link2_S0_z*t35 + link2_mass*t39;
-  const T t72 = -link2_S0_x*t36 + link2_mass*t26;
-  const T t73 = ((link2_J0_xx*t35 + link2_J0_xy*t36) + link2_J0_xz*w_B_link2_z) - link2_S0_z*t39;
-  const T t74 = ((link2_J0_xy*t35 + link2_J0_yy*t36) + (link2_J0_yz*w_B_link2_z + link2_S0_z*t38)) - link2_S0_x*t26;
-  const T t75 = (link2_J0_xz*t35 + link2_J0_yz*t36) + (link2_J0_zz*w_B_link2_z + link2_S0_x*t39);
-  const T t76 = R_NB_link2_xx*t70 + R_NB_link2_xy*t71 + R_NB_link2_xz*t72;
-  const T t77 = R_PB_link2_zx*t70 + R_PB_link2_zy*t71 + link2_R_PJ_zz*t72;
-  const T t78 = R_NB_link2_zx*t70 + R_NB_link2_zy*t71 + R_NB_link2_zz*t72;
-  const T t79 = R_NB_link2_xx*t73 + R_NB_link2_xy*t74 + R_NB_link2_xz*t75;
-  const T t80 = R_PB_link2_zx*t73 + R_PB_link2_zy*t74 + link2_R_PJ_zz*t75;
-  const T t81 = R_NB_link2_zx*t73 + R_NB_link2_zy*t74 + R_NB_link2_zz*t75;
-  const T t82 = link2_p_PJ_z*t78 - t21*t77;
-  const T t83 = -t20*t78 + t21*t76;
-  const T t84 = -link2_p_PJ_z*t76 + t20*t77;
-  const T t85 = t79 + t82;
-  const T t86 = t80 + t83;
-  const T t87 = t81 + t84;
-  const T t88 = t66 + t76;
-  const T t89 = t67 + t78;
-  const T t90 = t68 + t85;
-  const T t91 = t51 + t86;
-  const T t92 = t69 + t87;
-  pH[0] = t88;
-  pH[1] = t77;
-  pH[2] = t89;
-  pH[3] = t90;
-  pH[4] = t91;
-  pH[5] = t92;
+  const T t70 = link1_p_PJ_y*t67;
+  const T t71 = -link1_p_PJ_y*t66;
+  const T t72 = t68 + t70;
+  const T t73 = t69 + t71;
+  const T t74 = link2_S0_z*t36 + link2_mass*t38;
+  const T t75 = link2_S0_x*w_B_link2_z - link2_S0_z*t35 + link2_mass*t39;
+  const T t76 = -link2_S0_x*t36 + link2_mass*t26;
+  const T t77 = ((link2_J0_xx*t35 + link2_J0_xy*t36) + link2_J0_xz*w_B_link2_z) - link2_S0_z*t39;
+  const T t78 = ((link2_J0_xy*t35 + link2_J0_yy*t36) + (link2_J0_yz*w_B_link2_z + link2_S0_z*t38)) - link2_S0_x*t26;
+  const T t79 = (link2_J0_xz*t35 + link2_J0_yz*t36) + (link2_J0_zz*w_B_link2_z + link2_S0_x*t39);
+  const T t80 = R_NB_link2_xx*t74 + R_NB_link2_xy*t75 + R_NB_link2_xz*t76;
+  const T t81 = R_PB_link2_zx*t74 + R_PB_link2_zy*t75 + link2_R_PJ_zz*t76;
+  const T t82 = R_NB_link2_zx*t74 + R_NB_link2_zy*t75 + R_NB_link2_zz*t76;
+  const T t83 = R_NB_link2_xx*t77 + R_NB_link2_xy*t78 + R_NB_link2_xz*t79;
+  const T t84 = R_PB_link2_zx*t77 + R_PB_link2_zy*t78 + link2_R_PJ_zz*t79;
+  const T t85 = R_NB_link2_zx*t77 + R_NB_link2_zy*t78 + R_NB_link2_zz*t79;
+  const T t86 = k154fd1a6*t82 - t21*t81;
+  const T t87 = -t20*t82 + t21*t80;
+  const T t88 = -k154fd1a6*t80 + t20*t81;
+  const T t89 = t83 + t86;
+  const T t90 = t84 + t87;
+  const T t91 = t85 + t88;
+  const T t92 = t66 + t80;
+  const T t93 = t67 + t82;
+  const T t94 = t72 + t89;
+  const T t95 = t51 + t90;
+  const T t96 = t73 + t91;
+  pH[0] = t92;
+  pH[1] = t81;
+  pH[2] = t93;
+  pH[3] = t94;
+  pH[4] = t95;
+  pH[5] = t96;
 }
 
 // ---- reactions on each body from its parent: [force; torque about O_B], body axes ---
@@ -550,7 +551,7 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t9 = sin(link2_angle_offset + q[1]);
   const T t22 = link2_R_PJ_zy*u[0];
   const T t23 = link2_R_PJ_zz*u[0];
-  const T t24 = -link2_p_J_y*t23 + link2_p_J_z*t22;
+  const T t24 = link2_p_J_z*t22;
   const T t25 = link2_p_J_x*t23;
   const T t26 = -link2_p_J_x*t22;
   const T t27 = t22*t26 - t23*t25;
@@ -597,7 +598,7 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t70 = link1_J0_zz*udot_in[0] + link1_S0_x*t7 - link1_S0_y*t6;
   const T t71 = link2_R_PJ_zy*udot_in[0];
   const T t72 = link2_R_PJ_zz*udot_in[0];
-  const T t73 = -link2_p_J_y*t72 + link2_p_J_z*t71;
+  const T t73 = link2_p_J_z*t71;
   const T t74 = link2_p_J_x*t72;
   const T t75 = -link2_p_J_x*t71;
   const T t76 = t73*t8 + t74*t9;
@@ -613,9 +614,9 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t86 = (((t40 + t78)*link2_J0_xz + (t41 + t79)*link2_J0_yz) + (t44 + t77)*link2_S0_x) + (link2_J0_zz*t80 + t65);
   const T t87 = t8*t81 - t82*t9;
   const T t88 = t8*t82 + t81*t9;
-  const T t89 = link2_p_J_y*t83 - link2_p_J_z*t88;
+  const T t89 = -link2_p_J_z*t88;
   const T t90 = -link2_p_J_x*t83 + link2_p_J_z*t87;
-  const T t91 = link2_p_J_x*t88 - link2_p_J_y*t87;
+  const T t91 = link2_p_J_x*t88;
   const T t92 = t8*t84 - t85*t9;
   const T t93 = t8*t85 + t84*t9;
   const T t94 = t89 + t92;
@@ -634,24 +635,28 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t107 = link1_R_BBp_zx*t101 + link1_R_BBp_zy*t102;
   const T t108 = link1_R_BBp_xx*t103 + link1_R_BBp_xy*t104;
   const T t109 = link1_R_BBp_zx*t103 + link1_R_BBp_zy*t104;
-  const T t110 = link2_R_BBp_xx*t81 + link2_R_BBp_xy*t82 + link2_R_BBp_xz*t83;
-  const T t111 = link2_R_BBp_yx*t81 + link2_R_BBp_yy*t82;
-  const T t112 = link2_R_BBp_zx*t81 + link2_R_BBp_zy*t82 + link2_R_BBp_zz*t83;
-  const T t113 = link2_R_BBp_xx*t84 + link2_R_BBp_xy*t85 + link2_R_BBp_xz*t86;
-  const T t114 = link2_R_BBp_yx*t84 + link2_R_BBp_yy*t85;
-  const T t115 = link2_R_BBp_zx*t84 + link2_R_BBp_zy*t85 + link2_R_BBp_zz*t86;
+  const T t110 = link1_o_B_y*t107;
+  const T t111 = -link1_o_B_y*t106;
+  const T t112 = t108 + t110;
+  const T t113 = t109 + t111;
+  const T t114 = link2_R_BBp_xx*t81 + link2_R_BBp_xy*t82 + link2_R_BBp_xz*t83;
+  const T t115 = link2_R_BBp_yx*t81 + link2_R_BBp_yy*t82;
+  const T t116 = link2_R_BBp_zx*t81 + link2_R_BBp_zy*t82 + link2_R_BBp_zz*t83;
+  const T t117 = link2_R_BBp_xx*t84 + link2_R_BBp_xy*t85 + link2_R_BBp_xz*t86;
+  const T t118 = link2_R_BBp_yx*t84 + link2_R_BBp_yy*t85;
+  const T t119 = link2_R_BBp_zx*t84 + link2_R_BBp_zy*t85 + link2_R_BBp_zz*t86;
   wrenches[0] = t106;
+  wrenches[3] = t112;
   wrenches[1] = t98;
-  wrenches[2] = t107;
-  wrenches[3] = t108;
   wrenches[4] = t105;
-  wrenches[5] = t109;
-  wrenches[6] = t110;
-  wrenches[7] = t111;
-  wrenches[8] = t112;
-  wrenches[9] = t113;
-  wrenches[10] = t114;
-  wrenches[11] = t115;
+  wrenches[2] = t107;
+  wrenches[5] = t113;
+  wrenches[6] = t114;
+  wrenches[9] = t117;
+  wrenches[7] = t115;
+  wrenches[10] = t118;
+  wrenches[8] = t116;
+  wrenches[11] = t119;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

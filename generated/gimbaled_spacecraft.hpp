@@ -2158,28 +2158,28 @@ void reactions(const T* q, const T* u, const T* udot_in, const T* inputs, T* wre
   const T t349 = t332 + t343;
   const T t350 = t333 + t344;
   wrenches[0] = t345;
-  wrenches[1] = t346;
-  wrenches[2] = t347;
   wrenches[3] = t348;
+  wrenches[1] = t346;
   wrenches[4] = t349;
+  wrenches[2] = t347;
   wrenches[5] = t350;
   wrenches[6] = t259;
-  wrenches[7] = t260;
-  wrenches[8] = t261;
   wrenches[9] = t262;
+  wrenches[7] = t260;
   wrenches[10] = t263;
+  wrenches[8] = t261;
   wrenches[11] = t264;
   wrenches[12] = t278;
-  wrenches[13] = t279;
-  wrenches[14] = t280;
   wrenches[15] = t281;
+  wrenches[13] = t279;
   wrenches[16] = t282;
+  wrenches[14] = t280;
   wrenches[17] = t283;
   wrenches[18] = t296;
-  wrenches[19] = t297;
-  wrenches[20] = t298;
   wrenches[21] = t299;
+  wrenches[19] = t297;
   wrenches[22] = t300;
+  wrenches[20] = t298;
   wrenches[23] = t301;
 }
 

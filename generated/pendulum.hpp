@@ -185,10 +185,10 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t5 = t2 + t4;
   const T t6 = t3 + udot_in[0];
   wrenches[0] = t5;
-  wrenches[1] = 0.0;
-  wrenches[2] = -t6;
   wrenches[3] = 0.0;
+  wrenches[1] = 0.0;
   wrenches[4] = t6;
+  wrenches[2] = -t6;
   wrenches[5] = 0.0;
 }
 

@@ -1640,22 +1640,22 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   const T t243 = t180 + t237;
   const T t244 = t181 + t234;
   wrenches[0] = t239;
-  wrenches[1] = t240;
-  wrenches[2] = t241;
   wrenches[3] = t242;
+  wrenches[1] = t240;
   wrenches[4] = t243;
+  wrenches[2] = t241;
   wrenches[5] = t244;
   wrenches[6] = -t230;
-  wrenches[7] = t229;
-  wrenches[8] = t231;
   wrenches[9] = -t233;
+  wrenches[7] = t229;
   wrenches[10] = t232;
+  wrenches[8] = t231;
   wrenches[11] = t234;
   wrenches[12] = t211;
-  wrenches[13] = t212;
-  wrenches[14] = t213;
   wrenches[15] = t214;
+  wrenches[13] = t212;
   wrenches[16] = t215;
+  wrenches[14] = t213;
   wrenches[17] = t216;
 }
 

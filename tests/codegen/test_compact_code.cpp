@@ -15,36 +15,12 @@
 #include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "sim/crosscheck.hpp"
+#include "tests/support/random_chain.hpp"
 #include "tests/support/test_support.hpp"
 
 using namespace kanegen;
 
 namespace {
-
-/// An n-link chain of revolute joints, random axes, frames, inertias, springs and dampers, under gravity:
-/// the bench models' kind (../shared/bench-models/chain_*.yaml), generated here with a fixed seed.
-std::string random_chain(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> U(-1.0, 1.0);
-  std::string s = fmt::format("name: chain{}\ngravity: [0, 0, -9.81]\nbodies:\n", n);
-  for (int i = 1; i <= n; ++i) {
-    double ax = U(rng), ay = U(rng), az = U(rng);
-    const double norm = std::sqrt(ax * ax + ay * ay + az * az);
-    ax /= norm, ay /= norm, az /= norm;
-    const double a = 0.02 + 0.01 * std::abs(U(rng)), b = 0.02 + 0.01 * std::abs(U(rng)), c = 0.03 + 0.01 * std::abs(U(rng));
-    s += fmt::format(
-        "  - name: link{}\n    parent: {}\n"
-        "    joint: {{type: revolute, axis: [{:.17g}, {:.17g}, {:.17g}], position: [{}, {}, {}], rotation: {{rpy: [{}, {}, {}]}}, "
-        "stiffness: {}, damping: {}, rest: {}}}\n"
-        "    mass: {}\n    com: [{}, {}, {}]\n    inertia: [{}, {}, {}, {}, {}, {}]\n",
-        i, i == 1 ? "ground" : fmt::format("link{}", i - 1), ax, ay, az, i == 1 ? 0.0 : 0.3 * U(rng),
-        i == 1 ? 0.0 : 0.3 * U(rng), i == 1 ? 0.0 : 0.3 * U(rng), 3 * U(rng), 1.5 * U(rng), 3 * U(rng),
-        0.5 + 0.5 * std::abs(U(rng)), 0.05 + 0.1 * std::abs(U(rng)), 0.2 * U(rng), 0.5 + 1.5 * std::abs(U(rng)),
-        0.15 * U(rng), 0.15 * U(rng), 0.15 * U(rng), b + c, a + c, a + b, 0.1 * a * U(rng), 0.1 * b * U(rng),
-        0.1 * c * U(rng));
-  }
-  return s;
-}
 
 std::unique_ptr<GeneratedEngine> engine_with(const Model& model, const std::string& code, const std::string& form) {
   codegen::GeneratorOptions g;
@@ -69,7 +45,7 @@ TEST_CASE("compact u-dot code: a chain's middle links share kernels, which do no
   std::vector<long> kernel_ops;
   for (int n : {8, 16, 24}) {
     INFO(n << " links");
-    const Model model = load_model(test::write_temp(fmt::format("compact_chain{}.yaml", n), random_chain(n, 7)));
+    const Model model = load_model(test::write_temp(fmt::format("compact_chain{}.yaml", n), test::random_chain(n, 7)));
     const codegen::EmittedModel straight_model = codegen::generate(model, [] {
       codegen::GeneratorOptions o;
       o.udot_code = "straight-line";
@@ -102,7 +78,7 @@ TEST_CASE("compact u-dot code computes the straight-line code's u-dot and Jacobi
   struct Case {
     std::string name, path, form;
   };
-  const std::string chain = test::write_temp("compact_chain12.yaml", random_chain(12, 11));
+  const std::string chain = test::write_temp("compact_chain12.yaml", test::random_chain(12, 11));
   const std::vector<Case> cases = {
       {"random 12-link chain, articulated", chain, "articulated"},
       {"random 12-link chain, composite", chain, "composite"},
@@ -147,8 +123,8 @@ TEST_CASE("compact u-dot code computes the straight-line code's u-dot and Jacobi
 TEST_CASE("compact u-dot code: the cost model's choice", "[generator][compact]") {
   // auto: compact for a long chain (beyond the instruction cache, its bodies share kernels), straight-line for
   // a short one and for the flexible spacecraft (its bodies share nothing)
-  const Model long_chain = load_model(test::write_temp("compact_chain20.yaml", random_chain(20, 5)));
-  const Model short_chain = load_model(test::write_temp("compact_chain4.yaml", random_chain(4, 5)));
+  const Model long_chain = load_model(test::write_temp("compact_chain20.yaml", test::random_chain(20, 5)));
+  const Model short_chain = load_model(test::write_temp("compact_chain4.yaml", test::random_chain(4, 5)));
   const Model flexible = load_model(test::source_path("models/flexible_spacecraft.yaml"));
   CHECK_FALSE(udot_of(codegen::generate(long_chain)).kernels.empty());
   CHECK(udot_of(codegen::generate(short_chain)).kernels.empty());

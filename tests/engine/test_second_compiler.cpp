@@ -54,10 +54,11 @@ struct SecondCompilerCache {
     std::error_code ec;
     fs::remove_all(dir, ec);
   }
-  /// u-dot at the baseline ISA, the four functions every engine needs (a quicker build)
+  /// g++'s u-dot at the baseline ISA, the four functions every engine needs (a quicker build)
   JitOptions options() const {
     JitOptions o;
     o.cache_dir = dir.string();
+    o.compiler = "g++";  // the main compiler (with $CXX=clang++ there would be no second one)
     o.dispatch = false;
     o.derivatives = false;
     o.only_set = true;

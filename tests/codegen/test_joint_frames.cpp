@@ -1,0 +1,93 @@
+// The generator's body frames (codegen/joint_frames.hpp) are a convention:
+// the framed model, evaluated by the generic engine at q + angle_offset,
+// has the model's M, F and reactions (these turned and moved back by R_BB'
+// and o_B). And the frames are the ones promised: the offset from a body to
+// its main child, in the child's joint axes, is (a, 0, d) (origins at the
+// feet of the common normals), the turn between them about x alone.
+#include <catch2/catch.hpp>
+
+#include <random>
+
+#include "codegen/joint_frames.hpp"
+#include "engine/generic_engine.hpp"
+#include "engine/load_model.hpp"
+#include "tests/support/random_chain.hpp"
+#include "tests/support/test_support.hpp"
+
+using namespace kanegen;
+
+namespace {
+
+/// The model without joint springs and dampers: the framed model's joint angles are shifted by the
+/// offsets, its springs' rest angles are not (the generator applies the offsets inside the joint rotation).
+Model without_springs(Model m) {
+  for (Body& b : m.bodies) b.joint.stiffness.fill(0.0), b.joint.damping.fill(0.0);
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("joint frames: the offset to a main child is (a, 0, d) in its joint axes, the turn about x",
+          "[generator][joint-frames]") {
+  const Model model = load_model(test::write_temp("frames_chain8.yaml", test::random_chain(8, 5)));
+  const codegen::FramedModel fr = codegen::choose_joint_frames(model);
+  int shifted = 0;
+  for (std::size_t c = 1; c < fr.model.bodies.size(); ++c) {
+    const Joint& jc = fr.model.bodies[c].joint;
+    const Vec3 p_J = jc.R_PJ.transpose() * jc.p_PJ;
+    INFO("body " << fr.model.bodies[c].name << ": p_J = " << p_J.transpose());
+    CHECK(std::abs(p_J.y()) <= 1e-13 * p_J.norm());
+    CHECK(jc.R_PJ(0, 0) == 1.0);  // Rx(alpha)
+    CHECK(jc.R_PJ(0, 1) == 0.0);
+    CHECK(jc.R_PJ(0, 2) == 0.0);
+    // the origin slid along the joint axis (z of B' in the model's axes)
+    const int p = fr.model.bodies[c].parent;
+    CHECK((fr.o_B[p] - fr.R_BBp[p].col(2) * fr.R_BBp[p].col(2).dot(fr.o_B[p])).norm() <= 1e-15);
+    shifted += fr.o_B[p].norm() > 0 ? 1 : 0;
+  }
+  CHECK(shifted == 7);  // every body with a child: random axes are skew
+}
+
+TEST_CASE("joint frames: the framed model at q + offset has the model's M, F and reactions",
+          "[generator][joint-frames]") {
+  const std::string chain = test::write_temp("frames_chain6.yaml", test::random_chain(6, 9));
+  for (const std::string& file : {chain, test::source_path("models/extreme/wide_tree.yaml"),
+                                  test::source_path("models/gimbaled_spacecraft.yaml")}) {
+    INFO(file);
+    const Model model = without_springs(load_model(file));
+    const codegen::FramedModel fr = codegen::choose_joint_frames(model);
+    GenericEngine g(model), gf(fr.model);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> d(-1.0, 1.0);
+    for (int k = 0; k < 3; ++k) {
+      VecX q = model.q0, u(model.nu), tau(model.nu);
+      for (const Body& b : model.bodies)
+        if (b.joint.type == JointType::revolute || b.joint.type == JointType::prismatic) q(b.q_joint) = d(rng);
+      for (int i = 0; i < model.nu; ++i) u(i) = d(rng), tau(i) = d(rng);
+      VecX qf = q;
+      for (std::size_t j = 0; j < model.bodies.size(); ++j)
+        if (fr.angle_offset[j] != 0.0) qf(model.bodies[j].q_joint) += fr.angle_offset[j];
+      MatX M, Mf;
+      VecX F, Ff, ud, udf;
+      g.mass_matrix(q, M);
+      gf.mass_matrix(qf, Mf);
+      g.forcing(q, u, tau, F);
+      gf.forcing(qf, u, tau, Ff);
+      CHECK(test::rel_err(Mf, M) < 1e-13);
+      CHECK(test::rel_err(Ff, F) < 1e-13);
+      g.udot(q, u, tau, ud);
+      std::vector<Reaction> R, Rf;
+      g.reactions(q, u, ud, R);
+      gf.reactions(qf, u, ud, Rf);
+      REQUIRE(R.size() == Rf.size());
+      double scale = 0, err = 0;
+      for (std::size_t j = 0; j < R.size(); ++j) {
+        const Mat3& Q = fr.R_BBp[j];
+        const Vec3 f = Q * Rf[j].force_B, t = Q * Rf[j].torque_B + fr.o_B[j].cross(f);
+        scale = std::max({scale, R[j].force_B.norm(), R[j].torque_B.norm()});
+        err = std::max({err, (f - R[j].force_B).norm(), (t - R[j].torque_B).norm()});
+      }
+      CHECK(err <= 1e-12 * scale);
+    }
+  }
+}
