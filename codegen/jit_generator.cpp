@@ -12,6 +12,16 @@ CodeGenerator jit_code_generator(const GeneratorOptions& options) {
     const AssembledFiles f = assemble(generate(model, options), template_dir(), "model.hpp");
     return GeneratedSources{f.header, f.entry, f.manifest};
   };
+  if (options.udot_code == "auto") {
+    // compact code shares kernels along chains: the articulated form's bodies have one shape
+    GeneratorOptions compact = options;
+    compact.udot_code = "compact";
+    if (compact.udot_form == "auto") compact.udot_form = "articulated";
+    g.generate_compact_udot = [compact](const Model& model) {
+      const AssembledFiles f = assemble(generate(model, compact), template_dir(), "model.hpp");
+      return GeneratedSources{f.header, f.entry, f.manifest};
+    };
+  }
   return g;
 }
 

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <optional>
 #include <thread>
@@ -25,7 +26,7 @@
 #include "engine/jit_cache.hpp"
 #include "engine/manifest.hpp"
 #include "engine/resources.hpp"
-#include "engine/udot_race.hpp"
+#include "engine/udot_candidates.hpp"
 #include "model/model_hash.hpp"
 #include "model/parameters.hpp"
 #include "model/signal_cleanup.hpp"
@@ -145,7 +146,7 @@ constexpr long kMaxJacobianUdotOps = 6000;
 
 /// Changes whenever plan_compile() chooses differently or the record holds more (part of the cache key).
 /// 5: the record names the u-dot form (LibraryRecord::udot_form).
-/// 6: a second compiler's u-dot may be built beside the library (second_compiler()).
+/// 6: u-dot candidates may be built beside the library (udot_candidates.hpp).
 constexpr int kCompilePlanVersion = 6;
 
 /// The generated functions are compiled one per translation unit, in
@@ -294,84 +295,12 @@ int run_steps(const std::vector<CompileStep>& steps, const std::string& log_path
 }
 
 
-// ---- A second compiler for u-dot -------------------------------------------
-// GCC and clang differ most on long straight-line u-dot code: clang packs
-// pairs of like operations into SSE2 instructions and its code is smaller (it
-// fits the instruction cache sooner); at the baseline ISA clang's u-dot ran
-// 1.13x faster on chain_8 and 1.3-1.5x on tree_15, but 1.5x slower on
-// gravity_gradient_boom, and no faster in compact code or below ~2,000
-// operations (docs/speed.md, "Compilers"). No rule of thumb predicts it, so
-// where clang++ is installed the JIT builds u-dot with it too, beside the
-// library, and keeps it only when it is measured faster on this machine
-// (udot_race.hpp), recorded in its cache record (docs/decisions.md).
-
-/// Straight-line u-dot below this many operations fits the instruction cache; GCC's code is then as fast.
-constexpr long kSecondCompilerMinOps = 2000;
-
-/// The executable `name` on $PATH, or empty.
-std::string on_path(const std::string& name) {
-  const std::string path = env("PATH");
-  std::istringstream dirs(path);
-  for (std::string d; std::getline(dirs, d, ':');) {
-    if (d.empty()) continue;
-    const fs::path p = fs::path(d) / name;
-    if (access(p.c_str(), X_OK) == 0) return p.string();
-  }
-  return {};
-}
-
-/// The second compiler u-dot is built with, or empty: $KANEGEN_SECOND_CXX ("none": none), else clang++
-/// when it is on the PATH; only for optimized builds at the default flags by a compiler that is not clang.
-std::string second_compiler(const JitOptions& o) {
-  if (o.quick || o.flags != default_jit_flags()) return {};
-  for (const std::string& w : split_words(o.compiler))
-    if (fs::path(w).filename().string().find("clang") != std::string::npos) return {};
-  const std::string chosen = env("KANEGEN_SECOND_CXX");
-  if (chosen == "none") return {};
-  if (!chosen.empty()) return chosen;
-  return on_path("clang++").empty() ? std::string() : std::string("clang++");
-}
-
-/// Whether the manifest's u-dot is code a second compiler may build faster: one straight-line function.
-bool second_compiler_pays(const Manifest& manifest) {
-  const ManifestFunction* udot = manifest.find("udot");
-  return udot && manifest.udot_code == "straight-line" && udot->ops >= kSecondCompilerMinOps;
-}
-
-/// Where the second compiler's u-dot of the library `so_path` is kept (with its record beside it).
-std::string second_udot_path(const std::string& so_path) {
-  fs::path p(so_path);
-  p.replace_extension(".udot2.so");
-  return p.string();
-}
-
-/// One command that builds a library of u-dot alone (its table lists only u-dot) with `compiler`, for the
-/// instruction set the main library's u-dot runs at on this CPU (its AVX2 clone where the CPU has AVX2 and
-/// the build dispatches; clang cannot clone templates).
-std::vector<std::string> plan_second(const std::string& compiler, const fs::path& entry, const fs::path& out,
-                                     const Manifest& manifest, const JitOptions& o) {
-  std::vector<std::string> argv = split_words(compiler);
-  for (const char* f : {"-O2", "-std=c++20", "-fPIC", "-shared", "-fno-math-errno"}) argv.emplace_back(f);
-  if (o.native) {
-    argv.emplace_back("-march=native");
-  } else if (o.dispatch) {
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("x86-64-v3")) argv.emplace_back("-march=x86-64-v3");
-#endif
-  }
-  argv.insert(argv.end(), {"-DKANEGEN_NO_DISPATCH", "-DKANEGEN_PART_udot", "-DKANEGEN_PART_table"});
-  for (const ManifestFunction& f : manifest.functions)
-    if (f.name != "udot") argv.push_back("-DKANEGEN_OMIT_" + f.name);
-  argv.insert(argv.end(), {"-I" + o.include_dir, entry.string(), "-o", out.string()});
-  return argv;
-}
-
 /// Compiles `sources` in a private temp dir beside so_path and publishes the
-/// library and its record (jit_cache.hpp), and the second compiler's u-dot
-/// beside it when one applies and builds.
+/// library and its record (jit_cache.hpp), and the u-dot candidates beside
+/// it (udot_candidates.hpp; `compact`: the sources with compact u-dot, if any)
+/// that build.
 void build_library(const GeneratedSources& sources, const Manifest& manifest, const fs::path& so_path,
-                   const JitOptions& o) {
+                   const JitOptions& o, const std::optional<GeneratedSources>& compact = std::nullopt) {
   const fs::path dir = so_path.parent_path().empty() ? fs::path(".") : so_path.parent_path();
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -412,22 +341,29 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
     std::fflush(stderr);
   }
   const auto t0 = std::chrono::steady_clock::now();
-  // the second compiler's u-dot is built alongside; if it fails, the library goes without it
-  const std::string second = second_compiler(o);
-  const fs::path second_out = tmp / "udot2.so";
-  int second_status = -1;
-  std::string second_error;
-  std::thread second_build;
-  if (!second.empty() && second_compiler_pays(manifest)) {
-    const std::vector<std::string> argv = plan_second(second, entry_path, second_out, manifest, o);
-    if (o.verbose) fmt::print(stderr, "  {}\n", join_quoted(argv));
-    second_build = std::thread(
-        [&, argv] { second_status = run_logged(argv, (tmp / "second_compiler.log").string(), second_error); });
+  // the u-dot candidates are built alongside; one that fails is left out
+  fs::path compact_entry;
+  if (compact) {
+    fs::create_directories(tmp / "compact");
+    write_file(tmp / "compact" / "model.hpp", compact->header);
+    write_file(tmp / "compact" / "entry.cpp", compact->entry);
+    compact_entry = tmp / "compact" / "entry.cpp";
+  }
+  const std::vector<UdotCandidate> candidates = plan_udot_candidates(manifest, o, tmp, entry_path, compact_entry);
+  std::vector<int> candidate_status(candidates.size(), -1);
+  std::vector<std::string> candidate_error(candidates.size());
+  std::vector<std::thread> candidate_builds;
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    if (o.verbose) fmt::print(stderr, "  {}\n", join_quoted(candidates[k].argv));
+    candidate_builds.emplace_back([&, k] {
+      candidate_status[k] = run_logged(candidates[k].argv, (tmp / ("udot-" + candidates[k].tag + ".log")).string(),
+                                       candidate_error[k]);
+    });
   }
   std::string run_error;
   std::size_t failed_step = steps.size() - 1;
   const int status = run_steps(steps, log_path.string(), run_error, failed_step);
-  if (second_build.joinable()) second_build.join();
+  for (auto& t : candidate_builds) t.join();
   const std::string command = join_quoted(steps[failed_step].argv);  // for messages
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -472,15 +408,17 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
                                          ec.message()));
   jit_cache::write_record(so_path.string(), record);
   if (talk) fmt::print(stderr, "kanegen: compiled {} in {:.1f} s; cached as {}\n", label, seconds, fs::path(so_path).string());
-  if (second_status == 0 && fs::exists(second_out)) {
-    jit_cache::LibraryRecord r2 = jit_cache::make_record(second_out.string(), manifest.api_symbol);
-    r2.compiler = second;
-    const std::string path2 = second_udot_path(so_path.string());
-    fs::rename(second_out, path2, ec);
-    if (!ec) jit_cache::write_record(path2, r2);
-  } else if (!second.empty() && second_compiler_pays(manifest) && o.verbose) {
-    fmt::print(stderr, "kanegen: {} did not build u-dot ({}); the main compiler's is used\n", second,
-               second_error.empty() ? fmt::format("exit status {}", second_status) : second_error);
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    if (candidate_status[k] == 0 && fs::exists(candidates[k].out)) {
+      jit_cache::LibraryRecord r = jit_cache::make_record(candidates[k].out.string(), manifest.api_symbol);
+      r.compiler = candidates[k].name;
+      const std::string path = udot_candidate_path(so_path.string(), candidates[k].tag);
+      fs::rename(candidates[k].out, path, ec);
+      if (!ec) jit_cache::write_record(path, r);
+    } else if (o.verbose) {
+      fmt::print(stderr, "kanegen: the u-dot candidate {} did not build ({}); left out\n", candidates[k].name,
+                 candidate_error[k].empty() ? fmt::format("exit status {}", candidate_status[k]) : candidate_error[k]);
+    }
   }
 }
 
@@ -506,53 +444,19 @@ std::unique_ptr<GeneratedEngine> open_library(const Model& model, const std::str
   return e;
 }
 
-/// Serves `e`'s u-dot from the second compiler's build beside `so_path` when that one is measured faster:
-/// raced now when `fresh` (just built; the outcome goes into its record), else as its record says.
-void attach_second_udot(GeneratedEngine& e, const Model& model, const std::string& so_path, const JitOptions& o,
-                        bool fresh) {
-  const std::string second = second_compiler(o);
-  if (second.empty()) return;
-  const std::string path = second_udot_path(so_path);
-  auto record = jit_cache::verified_record(path);
-  if (!record || record->compiler != second || (!fresh && !record->preferred)) return;
-  void* h = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (!h) return;  // the library's own u-dot serves
-  std::shared_ptr<void> handle(h, [](void* p) { dlclose(p); });
-  auto api_fn = reinterpret_cast<KanegenGeneratedApiFn>(dlsym(h, record->api_symbol.c_str()));
-  const KanegenGeneratedApi* api = api_fn ? api_fn() : nullptr;
-  if (!api || api->api_version != e.api().api_version || std::string(api->model_hash) != e.api().model_hash ||
-      api->nq != e.api().nq || api->nu != e.api().nu || api->np != e.api().np)
-    return;
-  KanegenFunctionPtr fn = nullptr;
-  for (int i = 0; i < api->n_functions; ++i)
-    if (api->functions[i].name && std::string(api->functions[i].name) == "udot") fn = api->functions[i].fn;
-  if (!fn) return;
-  if (fresh) {
-    const UdotRace r = race_udot(e, e.udot_function(), fn, initial_state(model));
-    record->preferred = second_wins(r);
-    record->udot_ns = r.second_ns;
-    record->main_udot_ns = r.first_ns;
-    jit_cache::write_record(path, *record);
-    if (announce(o))
-      fmt::print(stderr, "kanegen: u-dot of {} built by {} runs {:.0f} ns, by the main compiler {:.0f} ns{}: {}'s is used\n",
-                 model.name, second, r.second_ns, r.first_ns,
-                 r.max_rel_diff > 1e-9 ? fmt::format(" (they differ by {:.1e})", r.max_rel_diff) : std::string(),
-                 record->preferred ? second : std::string("the main compiler"));
-  }
-  if (record->preferred) e.use_udot(fn, std::move(handle), second);
-}
-
 /// Loads so_path when its record verifies; otherwise builds it from the sources
-/// `make_sources()` gives (called only then) and loads the result.
+/// `make_sources()` gives (called only then), with the u-dot candidates
+/// (`make_compact()`: the sources with compact u-dot, or null), and loads the result.
 template <class MakeSources>
 std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::string& so_path,
                                                const std::string& generator_hash, const JitOptions& o,
                                                MakeSources make_sources,
-                                               const std::vector<RuntimeParameter>& implicit = {}) {
+                                               const std::vector<RuntimeParameter>& implicit = {},
+                                               const std::function<GeneratedSources()>& make_compact = {}) {
   if (const auto record = jit_cache::verified_record(so_path)) {
     if (announce(o)) fmt::print(stderr, "kanegen: generated code for {} from the cache ({})\n", model.name, so_path);
     auto e = open_library(model, so_path, *record, generator_hash, implicit);
-    attach_second_udot(*e, model, so_path, o, false);
+    attach_udot_candidates(*e, model, so_path, o, false, announce(o));
     return e;
   }
   const auto t_gen = std::chrono::steady_clock::now();
@@ -561,11 +465,19 @@ std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::st
     fmt::print(stderr, "kanegen: generated the equations of {} in {:.1f} s\n", model.name,
                std::chrono::duration<double>(std::chrono::steady_clock::now() - t_gen).count());
   const Manifest manifest = parse_manifest(sources.manifest, "generated manifest of " + model.name);
-  build_library(sources, manifest, so_path, o);
+  std::optional<GeneratedSources> compact;
+  if (make_compact && compact_candidate_wanted(manifest, o)) {
+    const auto t_compact = std::chrono::steady_clock::now();
+    compact = make_compact();
+    if (announce(o))
+      fmt::print(stderr, "kanegen: generated {}'s u-dot as compact code too, to race it, in {:.1f} s\n", model.name,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t_compact).count());
+  }
+  build_library(sources, manifest, so_path, o, compact);
   const auto record = jit_cache::verified_record(so_path);
   if (!record) throw std::runtime_error(fmt::format("kanegen: the library just built at {} does not verify", so_path));
   auto e = open_library(model, so_path, *record, generator_hash, implicit);
-  attach_second_udot(*e, model, so_path, o, true);
+  attach_udot_candidates(*e, model, so_path, o, true, announce(o));
   return e;
 }
 
@@ -661,9 +573,10 @@ std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerato
   // (a value edited in the model file then reuses the cached library)
   const std::vector<RuntimeParameter> implicit =
       o.implicit_parameters ? implicit_parameters(model) : std::vector<RuntimeParameter>{};
-  return load_or_build(
-      model, so_path, generator.hash, o,
-      [&] { return generator.generate(implicit.empty() ? model : with_parameters(model, implicit)); }, implicit);
+  const Model& m = implicit.empty() ? model : with_parameters(model, implicit);
+  std::function<GeneratedSources()> compact;
+  if (generator.generate_compact_udot) compact = [&] { return generator.generate_compact_udot(m); };
+  return load_or_build(model, so_path, generator.hash, o, [&] { return generator.generate(m); }, implicit, compact);
 }
 
 }  // namespace kanegen

@@ -27,6 +27,9 @@ struct GeneratedSources {
 struct CodeGenerator {
   std::function<GeneratedSources(const Model&)> generate;
   std::string hash;  ///< identifies the generator (its sources and templates)
+  /// The model's code with u-dot as compact code, which the JIT races against a straight-line u-dot
+  /// (udot_candidates.hpp); empty: none.
+  std::function<GeneratedSources(const Model&)> generate_compact_udot;
 };
 
 struct JitOptions {

@@ -55,15 +55,45 @@ def udot_ops(kanegen, model):
         return int(m.group(1)), f"{m.group(2)}, {code}"
 
 
+PEER_PROCESSES = 3
+
+
+def least_of_runs(runs):
+    """One peer result from several processes: each time the least over them (ns_* the median of the medians),
+    the rest from the first."""
+    j = dict(runs[0])
+    for k in j:
+        vals = [r[k] for r in runs if isinstance(r.get(k), (int, float))]
+        if k.startswith("min_ns_") and vals:
+            j[k] = min(vals)
+        elif k.startswith("ns_") and vals:
+            j[k] = sorted(vals)[len(vals) // 2]
+    # the compiler served: the one of the process whose baseline was fastest
+    best = min(runs, key=lambda r: r.get("min_ns_generated_baseline") or float("inf"))
+    for k in ("udot_compiler_generated", "udot_compiler_generated_baseline"):
+        j[k] = best.get(k)
+    return j
+
+
 def peer_udot(bindir, model, quick, rows):
     name = os.path.splitext(os.path.basename(model))[0]
     ops, form = udot_ops(os.path.join(bindir, "kanegen"), model)
     row = dict(model=name, ops=ops, form=form, floor=floor_ops(model))
     mj = os.path.join(bindir, "kanegen_peer_mujoco")
     if os.path.exists(mj):
-        code, out, err = run([mj, model, "--kanegen", "--native", "--rounds", "11" if quick else "31"])
-        if code == 0:
-            j = json.loads(out)
+        # PEER_PROCESSES processes: MuJoCo's time (and ours) moves between processes by up to 1.5x (code and
+        # data placement), more than within one; the least of each engine over all of them is what a rerun can
+        # reproduce, and the ratio of each process is kept to show the spread
+        runs = []
+        for _ in range(1 if quick else PEER_PROCESSES):
+            code, out, err = run([mj, model, "--kanegen", "--native", "--rounds", "11" if quick else "31"])
+            if code != 0:
+                break
+            runs.append(json.loads(out))
+        if runs:
+            j = least_of_runs(runs)
+            row["process_ratios"] = [r["min_ns_mujoco"] / r["min_ns_generated_baseline"] for r in runs
+                                     if r.get("min_ns_mujoco") and r.get("min_ns_generated_baseline")]
             row.update({k: j.get(k) for k in ("ns_mujoco", "ns_generated", "ns_generated_native", "ns_generated_baseline", "ns_generic",
                                                "min_ns_mujoco", "min_ns_generated", "min_ns_generated_native",
                                                "min_ns_generated_baseline", "min_ns_generic",
@@ -73,7 +103,7 @@ def peer_udot(bindir, model, quick, rows):
                                                "min_ns_generated_baseline_main_compiler",
                                                "backward_error_mujoco", "cond_M")})
             row["nu"] = len(j["u_names"])
-        else:
+        if not runs or len(runs) < (1 if quick else PEER_PROCESSES):
             row["mujoco_error"] = (err.strip().splitlines() or ["?"])[-1]
     sb = os.path.join(bindir, "kanegen_peer_simbody")
     if os.path.exists(sb):
@@ -108,6 +138,12 @@ def ratio(a, b):
     return "—" if a is None or b is None or b == 0 else f"{a / b:.1f}×"
 
 
+def spread(r):
+    """The range of the headline ratio over the peer's processes."""
+    pr = r.get("process_ratios") or []
+    return "—" if len(pr) < 2 else f"{min(pr):.1f}–{max(pr):.1f}×"
+
+
 def floor_ops(model_path):
     """The operation floor of ../shared/perf/udot-floor-analysis.md for a model of revolute joints only (None
     for others, e.g. a free base): the cheaper of Featherstone's articulated-body count in joint-local frames,
@@ -140,10 +176,14 @@ def udot_section(rows, provenance):
           "-O2 gets; the headline ratio), at the JIT's default flags (*dispatched*: an AVX2 clone picked at load "
           "time on this CPU) and with `--native` (`-march=native`), kanegen's generic engine and MuJoCo 2.2's "
           "`mj_forward` interleaved in one process; Simbody 3.7 (`realize` to Acceleration) in its own process "
-          "right after (its median). *baseline* and *dispatched* name the compiler of the u-dot served where it "
-          "is not the JIT's main one (g++): where clang++ is installed, the JIT builds a long straight-line u-dot "
-          "with it too and serves it only when measured 5 % faster at the initial state (engine/jit.cpp, "
-          "docs/decisions.md); *g++ baseline* is then g++'s own u-dot, timed in the same slices. "
+          "right after (its median). Each model's peer runs in 3 processes (1 with --quick): MuJoCo's time and ours "
+          "move between processes by up to 1.5x (code and data placement), more than within one; the times are the "
+          "least over the processes, the ratio their quotient, *per process* the range of the processes' own "
+          "ratios. *baseline* and *dispatched* name the u-dot served where it is not the library's own (g++'s "
+          "straight-line code): the JIT builds a long straight-line u-dot also with clang++ and as compact code, "
+          "races them at the initial state and serves the fastest only when measured 5 % faster "
+          "(engine/udot_candidates.hpp, docs/decisions.md); *own baseline* is then the library's own u-dot, timed "
+          "in the same slices. "
           "*code*: straight-line, or compact (kernels shared by bodies of one shape, "
           "docs/decisions.md); *floor*: for one-degree-of-freedom joints, the cheaper of Featherstone's articulated-body count "
           "in joint-local frames, 429 n − 348, and the composite route for a chain (RNEA + CRBA + dense LTDL; a tree's is cheaper), "
@@ -152,16 +192,16 @@ def udot_section(rows, provenance):
           "largest relative difference (last columns), accepted up to 1e-12, or, where M is ill-conditioned (two "
           "correct solvers then differ by up to cond(M)·1e-16), a normwise backward error of the peer's u-dot in "
           "kanegen's M u-dot = F below 1e-14 (given in brackets with cond(M)).", "",
-          "| model | nu | u-dot ops (form, code) | floor (ops / floor) | baseline | ns/op | g++ baseline | dispatched | native | "
-          "generic | MuJoCo | **MuJoCo / baseline** | MuJoCo / dispatched | MuJoCo / native | Simbody | "
+          "| model | nu | u-dot ops (form, code) | floor (ops / floor) | baseline | ns/op | own baseline | dispatched | native | "
+          "generic | MuJoCo | **MuJoCo / baseline** | per process | MuJoCo / dispatched | MuJoCo / native | Simbody | "
           "Simbody / baseline | diff MuJoCo | diff Simbody |",
-          "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+          "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         fl = r.get("floor")
         fl_txt = "—" if not fl or not r.get("ops") else f"{fl:,} ({r['ops'] / fl:.2f})"
         if "mujoco_error" in r:
             L.append(f"| {r['model']} | | {r['ops']} ({r['form']}) | {fl_txt} | MuJoCo run failed: "
-                     f"{r['mujoco_error']} | | | | | | | | | | | | | |")
+                     f"{r['mujoco_error']} | | | | | | | | | | | | | | |")
             continue
         sd = r.get("simbody_diff")
         base = t(r, "ns_generated_baseline")
@@ -175,7 +215,7 @@ def udot_section(rows, provenance):
                  f"{fmt_ns(t(r, 'ns_generated_baseline_main_compiler')) if served('generated_baseline') else '='} | "
                  f"{fmt_ns(t(r, 'ns_generated'))}{served('generated')} | "
                  f"{fmt_ns(t(r, 'ns_generated_native'))} | {fmt_ns(t(r, 'ns_generic'))} | "
-                 f"{fmt_ns(t(r, 'ns_mujoco'))} | **{ratio(t(r, 'ns_mujoco'), base)}** | "
+                 f"{fmt_ns(t(r, 'ns_mujoco'))} | **{ratio(t(r, 'ns_mujoco'), base)}** | {spread(r)} | "
                  f"{ratio(t(r, 'ns_mujoco'), t(r, 'ns_generated'))} | "
                  f"{ratio(t(r, 'ns_mujoco'), t(r, 'ns_generated_native'))} | {fmt_ns(r.get('ns_simbody'))} | "
                  f"{ratio(r.get('ns_simbody'), base)} | "

@@ -450,8 +450,8 @@ int main(int argc, char** argv) {
       }
       engines.push_back([&] { generated_baseline->udot(q, u, tau, ud_base); });
       names.push_back("generated_baseline");
-      // which compiler built the u-dot served (the JIT's second compiler when it was measured faster,
-      // engine/jit.cpp), and the main compiler's u-dot timed beside it then
+      // which u-dot is served (a candidate of engine/udot_candidates.hpp when it was measured faster:
+      // clang++'s or compact code), and the library's own u-dot timed beside it then
       j["udot_compiler_generated"] = generated->udot_compiler().empty() ? "main" : generated->udot_compiler();
       j["udot_compiler_generated_baseline"] =
           generated_baseline->udot_compiler().empty() ? "main" : generated_baseline->udot_compiler();

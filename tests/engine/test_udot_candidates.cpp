@@ -1,7 +1,7 @@
-// The JIT's second compiler for u-dot (engine/jit.cpp, "A second compiler for
-// u-dot"): where clang++ is installed, a long straight-line u-dot is built by
-// it too, raced against the main compiler's at the initial state
-// (engine/udot_race.hpp) and served only when measured faster. Both builds
+// The JIT's u-dot candidates (engine/udot_candidates.hpp): a long
+// straight-line u-dot is also built by a second compiler (clang++) and as
+// compact code, each raced against the library's own at the initial state
+// (engine/udot_race.hpp) and served only when measured faster. Every build
 // must compute the same u-dot as the generic engine, whichever is served; the
 // choice is recorded and reused from the cache.
 #include <catch2/catch.hpp>
@@ -18,6 +18,7 @@
 #include "engine/jit.hpp"
 #include "engine/jit_cache.hpp"
 #include "engine/load_model.hpp"
+#include "engine/udot_candidates.hpp"
 #include "engine/udot_race.hpp"
 #include "model/state_io.hpp"
 #include "tests/support/test_support.hpp"
@@ -66,11 +67,6 @@ struct SecondCompilerCache {
   }
 };
 
-std::string second_path_of(const std::string& so_path) {
-  fs::path p(so_path);
-  p.replace_extension(".udot2.so");
-  return p.string();
-}
 
 /// The u-dot of the library at `path` (its table's "udot"), the library kept open by `handle`.
 KanegenFunctionPtr udot_of_library(const std::string& path, const std::string& api_symbol,
@@ -88,72 +84,85 @@ KanegenFunctionPtr udot_of_library(const std::string& path, const std::string& a
 
 }  // namespace
 
-TEST_CASE("a second compiler's u-dot is built, raced, served only when faster, and recorded", "[jit][second-compiler]") {
+TEST_CASE("u-dot candidates are built, raced, the fastest served only when faster, and recorded",
+          "[jit][udot-candidates]") {
   REQUIRE(std::system("command -v clang++ > /dev/null 2>&1") == 0);  // scripts/install_deps.sh installs clang
   const SecondCompilerEnv env("clang++");
   const SecondCompilerCache cache;
   // 3,777 operations of straight-line u-dot, a free base and flexible modes
   const Model model = load_model(test::source_path("models/gravity_gradient_boom.yaml"));
   auto e = jit_load(model, codegen::jit_code_generator(), cache.options());
-  const std::string second = second_path_of(e->library_path());
-  const auto record = jit_cache::verified_record(second);
-  REQUIRE(record);
-  CHECK(record->compiler == "clang++");
-  CHECK(record->udot_ns > 0);
-  CHECK(record->main_udot_ns > 0);
-  // served exactly when measured 5 % faster (second_wins)
-  CHECK(record->preferred == (record->udot_ns < 0.95 * record->main_udot_ns));
-  CHECK(e->udot_compiler() == (record->preferred ? "clang++" : ""));
-
-  // Both builds against the generic engine, at the initial attitude with random speeds and inputs.
-  std::shared_ptr<void> handle;
-  const KanegenFunctionPtr clang_udot = udot_of_library(second, record->api_symbol, handle);
-  const KanegenFunctionPtr main_udot = e->function("udot");
-  REQUIRE(clang_udot != main_udot);
   GenericEngine g(model);
-  State s = initial_state(model);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> d(-0.5, 0.5);
-  for (int k = 0; k < 4; ++k) {
-    for (int i = 0; i < model.nu; ++i) s.u(i) = d(rng), s.tau(i) = d(rng);
-    VecX expected, by_main(model.nu), by_clang(model.nu), served;
-    g.udot(s.q, s.u, s.tau, expected);
-    REQUIRE(e->call_udot(main_udot, s.t, s.q, s.u, s.tau, by_main.data()) == 0);
-    REQUIRE(e->call_udot(clang_udot, s.t, s.q, s.u, s.tau, by_clang.data()) == 0);
-    e->udot(s.q, s.u, s.tau, served);
-    CHECK(test::rel_err(by_main, expected) < 1e-12);
-    CHECK(test::rel_err(by_clang, expected) < 1e-12);
-    CHECK(test::rel_err(served, expected) < 1e-12);
+  const KanegenFunctionPtr own = e->function("udot");
+  int preferred = 0;
+  std::string served;
+  for (const auto& [tag, name] : {std::pair<std::string, std::string>{"second", "clang++"}, {"compact", "compact"}}) {
+    INFO(tag);
+    const std::string path = udot_candidate_path(e->library_path(), tag);
+    const auto record = jit_cache::verified_record(path);
+    REQUIRE(record);
+    CHECK(record->compiler == name);
+    CHECK(record->udot_ns > 0);
+    CHECK(record->main_udot_ns > 0);
+    // served only when measured 5 % faster (second_wins), and then the fastest of them
+    if (record->preferred) {
+      CHECK(record->udot_ns < 0.95 * record->main_udot_ns);
+      ++preferred;
+      served = name;
+    }
+    // the candidate against the generic engine, at the initial attitude with random speeds and inputs
+    std::shared_ptr<void> handle;
+    const KanegenFunctionPtr fn = udot_of_library(path, record->api_symbol, handle);
+    REQUIRE(fn != own);
+    State s = initial_state(model);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> d(-0.5, 0.5);
+    for (int k = 0; k < 4; ++k) {
+      for (int i = 0; i < model.nu; ++i) s.u(i) = d(rng), s.tau(i) = d(rng);
+      VecX expected, by_own(model.nu), by_candidate(model.nu), by_engine;
+      g.udot(s.q, s.u, s.tau, expected);
+      REQUIRE(e->call_udot(own, s.t, s.q, s.u, s.tau, by_own.data()) == 0);
+      REQUIRE(e->call_udot(fn, s.t, s.q, s.u, s.tau, by_candidate.data()) == 0);
+      e->udot(s.q, s.u, s.tau, by_engine);
+      CHECK(test::rel_err(by_own, expected) < 1e-12);
+      CHECK(test::rel_err(by_candidate, expected) < 1e-12);
+      CHECK(test::rel_err(by_engine, expected) < 1e-12);
+    }
   }
+  CHECK(preferred <= 1);
+  CHECK(e->udot_compiler() == served);
 
-  // From the cache: the recorded choice, no second race (the record is unchanged).
+  // From the cache: the recorded choice, no second race (the records are unchanged).
+  const auto before = jit_cache::verified_record(udot_candidate_path(e->library_path(), "compact"));
   auto e2 = jit_load(model, codegen::jit_code_generator(), cache.options());
   CHECK(e2->udot_compiler() == e->udot_compiler());
-  const auto again = jit_cache::verified_record(second);
-  REQUIRE(again);
-  CHECK(again->udot_ns == record->udot_ns);
+  const auto after = jit_cache::verified_record(udot_candidate_path(e->library_path(), "compact"));
+  REQUIRE(after);
+  CHECK(after->udot_ns == before->udot_ns);
 }
 
-TEST_CASE("no second compiler for short or compact u-dot, nor when told none", "[jit][second-compiler]") {
+TEST_CASE("no u-dot candidates for short u-dot, no second compiler when told none", "[jit][udot-candidates]") {
   const SecondCompilerCache cache;
   {
     const SecondCompilerEnv env("clang++");
     // 186 operations: fits the instruction cache, the main compiler's code is as fast
     const Model small = load_model(test::source_path("models/double_pendulum.yaml"));
     auto e = jit_load(small, codegen::jit_code_generator(), cache.options());
-    CHECK_FALSE(fs::exists(second_path_of(e->library_path())));
+    CHECK_FALSE(fs::exists(udot_candidate_path(e->library_path(), "second")));
+    CHECK_FALSE(fs::exists(udot_candidate_path(e->library_path(), "compact")));
     CHECK(e->udot_compiler().empty());
   }
   {
     const SecondCompilerEnv env("none");
     const Model model = load_model(test::source_path("models/gravity_gradient_boom.yaml"));
     auto e = jit_load(model, codegen::jit_code_generator(), cache.options());
-    CHECK_FALSE(fs::exists(second_path_of(e->library_path())));
-    CHECK(e->udot_compiler().empty());
+    CHECK_FALSE(fs::exists(udot_candidate_path(e->library_path(), "second")));
+    CHECK(fs::exists(udot_candidate_path(e->library_path(), "compact")));
+    CHECK(e->udot_compiler() != "clang++");
   }
 }
 
-TEST_CASE("second_wins: agreeing outputs and a clear margin", "[jit][second-compiler]") {
+TEST_CASE("second_wins: agreeing outputs and a clear margin", "[jit][udot-candidates]") {
   UdotRace r;
   r.first_ns = 1000;
   r.second_ns = 900;

@@ -1,0 +1,185 @@
+#include "engine/udot_candidates.hpp"
+
+#include <dlfcn.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+#include <sstream>
+
+#include "engine/jit_cache.hpp"
+#include "engine/udot_race.hpp"
+#include "model/state_io.hpp"
+
+namespace kanegen {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Straight-line u-dot below this many operations fits the instruction cache: GCC's code is then as fast as
+/// clang's (chain_4: faster) and as compact code (docs/decisions.md).
+constexpr long kCandidateMinOps = 2000;
+
+std::vector<std::string> words(const std::string& s) {
+  std::vector<std::string> out;
+  std::istringstream in(s);
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
+
+/// The executable `name` on $PATH, or empty.
+std::string on_path(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::istringstream dirs(path ? path : "");
+  for (std::string d; std::getline(dirs, d, ':');) {
+    if (d.empty()) continue;
+    const fs::path p = fs::path(d) / name;
+    if (access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return {};
+}
+
+bool optimized_default_build(const JitOptions& o) { return !o.quick && o.flags == default_jit_flags(); }
+
+bool long_straight_line(const Manifest& manifest) {
+  const ManifestFunction* udot = manifest.find("udot");
+  return udot && manifest.udot_code == "straight-line" && udot->ops >= kCandidateMinOps;
+}
+
+/// The command's tail that builds a library of u-dot alone from `entry` (its table lists only u-dot).
+void udot_alone(std::vector<std::string>& argv, const Manifest& manifest, const JitOptions& o, const fs::path& entry,
+                const fs::path& out) {
+  argv.insert(argv.end(), {"-DKANEGEN_PART_udot", "-DKANEGEN_PART_table"});
+  for (const ManifestFunction& f : manifest.functions)
+    if (f.name != "udot") argv.push_back("-DKANEGEN_OMIT_" + f.name);
+  argv.insert(argv.end(), {"-I" + o.include_dir, entry.string(), "-o", out.string()});
+}
+
+/// A candidate's library loaded, checked against the engine's table, and its u-dot.
+struct LoadedCandidate {
+  std::shared_ptr<void> handle;
+  KanegenFunctionPtr udot = nullptr;
+};
+
+std::optional<LoadedCandidate> load_candidate(const GeneratedEngine& e, const std::string& path,
+                                              const std::string& api_symbol) {
+  void* h = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!h) return std::nullopt;  // the library's own u-dot serves
+  LoadedCandidate c{std::shared_ptr<void>(h, [](void* p) { dlclose(p); }), nullptr};
+  auto api_fn = reinterpret_cast<KanegenGeneratedApiFn>(dlsym(h, api_symbol.c_str()));
+  const KanegenGeneratedApi* api = api_fn ? api_fn() : nullptr;
+  if (!api || api->api_version != e.api().api_version || std::string(api->model_hash) != e.api().model_hash ||
+      api->nq != e.api().nq || api->nu != e.api().nu || api->np != e.api().np)
+    return std::nullopt;
+  for (int i = 0; i < api->n_functions; ++i)
+    if (api->functions[i].name && std::string(api->functions[i].name) == "udot") c.udot = api->functions[i].fn;
+  if (!c.udot) return std::nullopt;
+  return c;
+}
+
+}  // namespace
+
+std::string second_compiler(const JitOptions& o) {
+  if (!optimized_default_build(o)) return {};
+  for (const std::string& w : words(o.compiler))
+    if (fs::path(w).filename().string().find("clang") != std::string::npos) return {};
+  const char* chosen = std::getenv("KANEGEN_SECOND_CXX");
+  if (chosen && std::string(chosen) == "none") return {};
+  if (chosen && *chosen) return chosen;
+  return on_path("clang++").empty() ? std::string() : std::string("clang++");
+}
+
+bool compact_candidate_wanted(const Manifest& manifest, const JitOptions& o) {
+  return optimized_default_build(o) && long_straight_line(manifest);
+}
+
+std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const JitOptions& o, const fs::path& tmp,
+                                                const fs::path& entry, const fs::path& compact_entry) {
+  std::vector<UdotCandidate> out;
+  if (!optimized_default_build(o) || !long_straight_line(manifest)) return out;
+  if (const std::string second = second_compiler(o); !second.empty()) {
+    // for the instruction set the main library's u-dot runs at on this CPU: its AVX2 clone where the CPU
+    // has AVX2 and the build dispatches (clang 14 cannot clone templates), else the baseline
+    UdotCandidate c{second, "second", words(second), tmp / "udot-second.so"};
+    for (const char* f : {"-O2", "-std=c++20", "-fPIC", "-shared", "-fno-math-errno"}) c.argv.emplace_back(f);
+    if (o.native) {
+      c.argv.emplace_back("-march=native");
+    } else if (o.dispatch) {
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+      __builtin_cpu_init();
+      if (__builtin_cpu_supports("x86-64-v3")) c.argv.emplace_back("-march=x86-64-v3");
+#endif
+    }
+    c.argv.emplace_back("-DKANEGEN_NO_DISPATCH");
+    udot_alone(c.argv, manifest, o, entry, c.out);
+    out.push_back(std::move(c));
+  }
+  if (!compact_entry.empty()) {
+    // the main compiler at the main library's flags (its AVX2 clone too)
+    UdotCandidate c{"compact", "compact", words(o.compiler), tmp / "udot-compact.so"};
+    for (const std::string& f : words(o.flags)) c.argv.push_back(f);
+    if (o.native) c.argv.emplace_back("-march=native");
+    if (!o.dispatch) c.argv.emplace_back("-DKANEGEN_NO_DISPATCH");
+    udot_alone(c.argv, manifest, o, compact_entry, c.out);
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+std::string udot_candidate_path(const std::string& so_path, const std::string& tag) {
+  fs::path p(so_path);
+  p.replace_extension(".udot-" + tag + ".so");
+  return p.string();
+}
+
+void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::string& so_path, const JitOptions& o,
+                            bool fresh, bool talk) {
+  struct Entry {
+    std::string path;
+    jit_cache::LibraryRecord record;
+    LoadedCandidate loaded;
+    UdotRace race;
+  };
+  std::vector<Entry> entries;
+  const std::string second = second_compiler(o);
+  for (const auto& [tag, name] : {std::pair<std::string, std::string>{"second", second}, {"compact", "compact"}}) {
+    if (name.empty()) continue;
+    const std::string path = udot_candidate_path(so_path, tag);
+    auto record = jit_cache::verified_record(path);
+    if (!record || record->compiler != name || (!fresh && !record->preferred)) continue;
+    auto loaded = load_candidate(e, path, record->api_symbol);
+    if (!loaded) continue;
+    entries.push_back({path, *record, std::move(*loaded), {}});
+  }
+  if (entries.empty()) return;
+  Entry* served = nullptr;
+  if (fresh) {
+    const State s = initial_state(model);
+    for (Entry& en : entries) {
+      en.race = race_udot(e, e.udot_function(), en.loaded.udot, s);
+      if (second_wins(en.race) && (!served || en.race.second_ns < served->race.second_ns)) served = &en;
+    }
+    std::string said;
+    for (Entry& en : entries) {
+      en.record.preferred = &en == served;
+      en.record.udot_ns = en.race.second_ns;
+      en.record.main_udot_ns = en.race.first_ns;
+      jit_cache::write_record(en.path, en.record);
+      said += fmt::format("{} {:.0f} ns{}, ", en.record.compiler, en.race.second_ns,
+                          en.race.max_rel_diff > 1e-9 ? fmt::format(" (differs by {:.1e})", en.race.max_rel_diff)
+                                                      : std::string());
+    }
+    if (talk)
+      fmt::print(stderr, "kanegen: u-dot of {} at the initial state: {}the library's own {:.0f} ns: {} is used\n",
+                 model.name, said, entries.front().race.first_ns,
+                 served ? served->record.compiler + "'s" : std::string("the library's own"));
+  } else {
+    served = &entries.front();  // only preferred ones were loaded
+  }
+  if (served) e.use_udot(served->loaded.udot, served->loaded.handle, served->record.compiler);
+}
+
+}  // namespace kanegen

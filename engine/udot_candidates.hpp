@@ -1,0 +1,55 @@
+// The u-dot candidates the JIT builds beside a model's library, races
+// against the library's own u-dot at the initial state (udot_race.hpp) and
+// serves when measured faster (docs/decisions.md, "u-dot candidates"):
+//   - u-dot by a second compiler (clang++ where installed): GCC and clang
+//     differ most on long straight-line code (clang packs pairs of like
+//     operations into SSE2 instructions, its code is smaller), and which is
+//     faster varies by model;
+//   - u-dot as compact code (kernels shared by bodies of one shape,
+//     codegen/outlined_code.hpp), where the generator's cost model chose
+//     straight-line code near the instruction cache's size.
+// Each is a library of u-dot alone, <stem>-<key>.udot-<tag>.so, with a cache
+// record that keeps the race's outcome; a later load serves what it says.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "engine/generated_engine.hpp"
+#include "engine/jit.hpp"
+#include "engine/manifest.hpp"
+
+namespace kanegen {
+
+struct UdotCandidate {
+  std::string name;                ///< what it is, for reports and its record: the compiler, or "compact"
+  std::string tag;                 ///< its file: <stem>-<key>.udot-<tag>.so ("second", "compact")
+  std::vector<std::string> argv;   ///< one command that compiles and links it
+  std::filesystem::path out;       ///< where that command writes it
+};
+
+/// The second compiler u-dot is built with, or empty: $KANEGEN_SECOND_CXX ("none": none), else clang++
+/// when it is on the PATH; only for optimized builds at the default flags by a main compiler not clang.
+std::string second_compiler(const JitOptions& o);
+
+/// Whether the JIT should generate the model's code with compact u-dot to race it: the library's u-dot is one
+/// straight-line function of at least 2,000 operations, the build is optimized at the default flags.
+bool compact_candidate_wanted(const Manifest& manifest, const JitOptions& o);
+
+/// The candidates of a library of `manifest` built from `entry`, in the temporary directory `tmp`;
+/// `compact_entry`: the entry file of the compact code's sources (empty: no compact candidate).
+std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const JitOptions& o,
+                                                const std::filesystem::path& tmp, const std::filesystem::path& entry,
+                                                const std::filesystem::path& compact_entry);
+
+/// Where the candidate `tag` of the library `so_path` is kept (its record beside it).
+std::string udot_candidate_path(const std::string& so_path, const std::string& tag);
+
+/// Serves `e`'s u-dot from the fastest candidate beside `so_path` measured faster than its own: raced now when
+/// `fresh` (just built; the outcome goes into the records, and is said on stderr when `talk`), else as the
+/// records say.
+void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::string& so_path, const JitOptions& o,
+                            bool fresh, bool talk);
+
+}  // namespace kanegen
