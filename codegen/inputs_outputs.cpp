@@ -226,7 +226,9 @@ void assign_sensor_outputs(KaneContext& ctx, const std::vector<ex>& wrenches,
       }
       case SensorType::reaction: {
         const SV3 f{{wrenches[6 * j], wrenches[6 * j + 1], wrenches[6 * j + 2]}};
-        const SV3 t{{wrenches[6 * j + 3], wrenches[6 * j + 4], wrenches[6 * j + 5]}};
+        // torque about the sensor's point: the model's O_B, which the generator's frame may have moved from
+        // (codegen/joint_frames.hpp: the point is then -o_B in B' components; 0 otherwise)
+        const SV3 t = ctx.A.sub(SV3{{wrenches[6 * j + 3], wrenches[6 * j + 4], wrenches[6 * j + 5]}}, ctx.A.cross(p, f));
         put(f, sn.offset);
         put(t, sn.offset + 3);
         break;

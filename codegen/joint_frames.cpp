@@ -33,11 +33,15 @@ Mat3 rot_x(double a) {
 /// Where along its axis z (through the origin) body j's frame origin goes: the foot of the common normal
 /// to the child's axis, through p with direction a (unit vectors); for parallel axes, the foot of the
 /// perpendicular from p (the offset is then across the axis alone).
+/// Nearly parallel axes put that foot far away (r / theta for axes theta apart): there, and wherever it lies
+/// more than 4 |p| along the axis from the perpendicular's foot, the latter is taken (the offset then has three
+/// components, as before; the origin stays near the body).
 double common_normal_foot(const Vec3& z, const Vec3& p, const Vec3& a) {
-  const double b = z.dot(a), denom = 1.0 - b * b;
-  if (denom < 1e-12) return z.dot(p);
+  const double b = z.dot(a), denom = 1.0 - b * b, perpendicular = z.dot(p);
+  if (denom < 1e-12) return perpendicular;
   // closest points O + t z and p + s a: (t z - p - s a) . z = 0 and . a = 0
-  return (z.dot(p) - b * a.dot(p)) / denom;
+  const double t = (z.dot(p) - b * a.dot(p)) / denom;
+  return std::abs(t - perpendicular) <= 4.0 * p.norm() ? t : perpendicular;
 }
 
 /// Whether body j's origin stays where the model puts it: its joint at a flexible parent's node, or

@@ -349,10 +349,12 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
     write_file(tmp / "compact" / "entry.cpp", compact->entry);
     compact_entry = tmp / "compact" / "entry.cpp";
   }
-  const std::vector<UdotCandidate> candidates = plan_udot_candidates(manifest, o, tmp, entry_path, compact_entry);
+  const std::vector<UdotCandidate> candidates = plan_udot_candidates(
+      manifest, o, tmp, entry_path, compact_entry,
+      compact ? parse_manifest(compact->manifest, "compact manifest of " + manifest.model).udot_form : std::string());
   std::vector<int> candidate_status(candidates.size(), -1);
   std::vector<std::string> candidate_error(candidates.size());
-  std::vector<std::thread> candidate_builds;
+  std::vector<std::jthread> candidate_builds;  // joined on every way out, before `cleanup` removes tmp
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     if (o.verbose) fmt::print(stderr, "  {}\n", join_quoted(candidates[k].argv));
     candidate_builds.emplace_back([&, k] {
@@ -402,6 +404,7 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
   const ManifestFunction* udot_fn = manifest.find("udot");
   record.jacobian_for_integration = !(udot_fn && udot_fn->ops > kMaxJacobianUdotOps);
   record.udot_form = manifest.udot_form;
+  remove_udot_candidates(so_path.string());  // those of a library this one replaces
   fs::rename(out_path, so_path, ec);
   if (ec)
     throw std::runtime_error(fmt::format("kanegen: cannot move the compiled library to {}: {}", so_path.string(),
@@ -412,6 +415,8 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
     if (candidate_status[k] == 0 && fs::exists(candidates[k].out)) {
       jit_cache::LibraryRecord r = jit_cache::make_record(candidates[k].out.string(), manifest.api_symbol);
       r.compiler = candidates[k].name;
+      r.udot_form = candidates[k].udot_form;
+      r.main_checksum = record.checksum;
       const std::string path = udot_candidate_path(so_path.string(), candidates[k].tag);
       fs::rename(candidates[k].out, path, ec);
       if (!ec) jit_cache::write_record(path, r);
@@ -456,7 +461,7 @@ std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::st
   if (const auto record = jit_cache::verified_record(so_path)) {
     if (announce(o)) fmt::print(stderr, "kanegen: generated code for {} from the cache ({})\n", model.name, so_path);
     auto e = open_library(model, so_path, *record, generator_hash, implicit);
-    attach_udot_candidates(*e, model, so_path, o, false, announce(o));
+    attach_udot_candidates(*e, model, so_path, record->checksum, o, false, announce(o));
     return e;
   }
   const auto t_gen = std::chrono::steady_clock::now();
@@ -468,8 +473,12 @@ std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::st
   std::optional<GeneratedSources> compact;
   if (make_compact && compact_candidate_wanted(manifest, o)) {
     const auto t_compact = std::chrono::steady_clock::now();
-    compact = make_compact();
-    if (announce(o))
+    try {
+      compact = make_compact();
+    } catch (const std::exception& ex) {  // a candidate, not the library: left out
+      if (o.verbose) fmt::print(stderr, "kanegen: compact u-dot of {} not generated ({}); left out\n", model.name, ex.what());
+    }
+    if (compact && announce(o))
       fmt::print(stderr, "kanegen: generated {}'s u-dot as compact code too, to race it, in {:.1f} s\n", model.name,
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t_compact).count());
   }
@@ -477,7 +486,7 @@ std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::st
   const auto record = jit_cache::verified_record(so_path);
   if (!record) throw std::runtime_error(fmt::format("kanegen: the library just built at {} does not verify", so_path));
   auto e = open_library(model, so_path, *record, generator_hash, implicit);
-  attach_udot_candidates(*e, model, so_path, o, true, announce(o));
+  attach_udot_candidates(*e, model, so_path, record->checksum, o, true, announce(o));
   return e;
 }
 

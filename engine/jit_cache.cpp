@@ -67,6 +67,7 @@ std::optional<LibraryRecord> verified_record(const std::string& so_path) {
     r.preferred = j.value("preferred", false);
     r.udot_ns = j.value("udot_ns", 0.0);
     r.main_udot_ns = j.value("main_udot_ns", 0.0);
+    r.main_checksum = j.value("main_fnv1a64", "");
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;
   }
@@ -99,6 +100,7 @@ void write_record(const std::string& so_path, const LibraryRecord& r) {
     j["preferred"] = r.preferred;
     j["udot_ns"] = r.udot_ns;
     j["main_udot_ns"] = r.main_udot_ns;
+    j["main_fnv1a64"] = r.main_checksum;
   }
   {
     std::ofstream out(tmp, std::ios::binary);

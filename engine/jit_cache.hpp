@@ -27,6 +27,7 @@ struct LibraryRecord {
   std::string compiler;
   bool preferred = false;
   double udot_ns = 0, main_udot_ns = 0;
+  std::string main_checksum;  ///< the checksum of the main library it was built and raced beside
 };
 
 /// <dir>/<stem>-<key>.json for a library path <dir>/<stem>-<key>.so.

@@ -44,6 +44,22 @@ std::string on_path(const std::string& name) {
 
 bool optimized_default_build(const JitOptions& o) { return !o.quick && o.flags == default_jit_flags(); }
 
+/// Whether the second compiler builds for AVX2 (x86-64-v3): where the main library's u-dot runs its AVX2 clone,
+/// i.e. the build dispatches and this CPU has it (clang 14 cannot clone templates).
+bool second_at_v3(const JitOptions& o) {
+  if (o.native || !o.dispatch) return false;
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("x86-64-v3");
+#else
+  return false;
+#endif
+}
+
+/// The file tag of the second compiler's u-dot on this CPU: a library built for AVX2 is never found, and so
+/// never served, on a CPU without it (a cache shared between machines).
+std::string second_tag(const JitOptions& o) { return second_at_v3(o) ? "second-v3" : "second"; }
+
 bool long_straight_line(const Manifest& manifest) {
   const ManifestFunction* udot = manifest.find("udot");
   return udot && manifest.udot_code == "straight-line" && udot->ops >= kCandidateMinOps;
@@ -97,29 +113,23 @@ bool compact_candidate_wanted(const Manifest& manifest, const JitOptions& o) {
 }
 
 std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const JitOptions& o, const fs::path& tmp,
-                                                const fs::path& entry, const fs::path& compact_entry) {
+                                                const fs::path& entry, const fs::path& compact_entry,
+                                                const std::string& compact_form) {
   std::vector<UdotCandidate> out;
   if (!optimized_default_build(o) || !long_straight_line(manifest)) return out;
   if (const std::string second = second_compiler(o); !second.empty()) {
-    // for the instruction set the main library's u-dot runs at on this CPU: its AVX2 clone where the CPU
-    // has AVX2 and the build dispatches (clang 14 cannot clone templates), else the baseline
-    UdotCandidate c{second, "second", words(second), tmp / "udot-second.so"};
+    // for the instruction set the main library's u-dot runs at on this CPU
+    UdotCandidate c{second, second_tag(o), manifest.udot_form, words(second), tmp / "udot-second.so"};
     for (const char* f : {"-O2", "-std=c++20", "-fPIC", "-shared", "-fno-math-errno"}) c.argv.emplace_back(f);
-    if (o.native) {
-      c.argv.emplace_back("-march=native");
-    } else if (o.dispatch) {
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-      __builtin_cpu_init();
-      if (__builtin_cpu_supports("x86-64-v3")) c.argv.emplace_back("-march=x86-64-v3");
-#endif
-    }
+    if (o.native) c.argv.emplace_back("-march=native");
+    if (second_at_v3(o)) c.argv.emplace_back("-march=x86-64-v3");
     c.argv.emplace_back("-DKANEGEN_NO_DISPATCH");
     udot_alone(c.argv, manifest, o, entry, c.out);
     out.push_back(std::move(c));
   }
   if (!compact_entry.empty()) {
     // the main compiler at the main library's flags (its AVX2 clone too)
-    UdotCandidate c{"compact", "compact", words(o.compiler), tmp / "udot-compact.so"};
+    UdotCandidate c{"compact", "compact", compact_form, words(o.compiler), tmp / "udot-compact.so"};
     for (const std::string& f : words(o.flags)) c.argv.push_back(f);
     if (o.native) c.argv.emplace_back("-march=native");
     if (!o.dispatch) c.argv.emplace_back("-DKANEGEN_NO_DISPATCH");
@@ -135,8 +145,17 @@ std::string udot_candidate_path(const std::string& so_path, const std::string& t
   return p.string();
 }
 
-void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::string& so_path, const JitOptions& o,
-                            bool fresh, bool talk) {
+void remove_udot_candidates(const std::string& so_path) {
+  for (const char* tag : {"second", "second-v3", "compact"}) {
+    const std::string path = udot_candidate_path(so_path, tag);
+    std::error_code ec;
+    fs::remove(jit_cache::record_path(path), ec);  // the record first: a library without one is never loaded
+    fs::remove(path, ec);
+  }
+}
+
+void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::string& so_path,
+                            const std::string& main_checksum, const JitOptions& o, bool fresh, bool talk) {
   struct Entry {
     std::string path;
     jit_cache::LibraryRecord record;
@@ -145,11 +164,13 @@ void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::s
   };
   std::vector<Entry> entries;
   const std::string second = second_compiler(o);
-  for (const auto& [tag, name] : {std::pair<std::string, std::string>{"second", second}, {"compact", "compact"}}) {
+  for (const auto& [tag, name] : {std::pair<std::string, std::string>{second_tag(o), second}, {"compact", "compact"}}) {
     if (name.empty()) continue;
     const std::string path = udot_candidate_path(so_path, tag);
     auto record = jit_cache::verified_record(path);
-    if (!record || record->compiler != name || (!fresh && !record->preferred)) continue;
+    if (!record || record->compiler != name || record->main_checksum != main_checksum ||
+        (!fresh && !record->preferred))
+      continue;
     auto loaded = load_candidate(e, path, record->api_symbol);
     if (!loaded) continue;
     entries.push_back({path, *record, std::move(*loaded), {}});
@@ -177,9 +198,13 @@ void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::s
                  model.name, said, entries.front().race.first_ns,
                  served ? served->record.compiler + "'s" : std::string("the library's own"));
   } else {
-    served = &entries.front();  // only preferred ones were loaded
+    // only preferred ones were loaded (two processes racing at once may each have preferred one)
+    for (Entry& en : entries)
+      if (!served || en.record.udot_ns < served->record.udot_ns) served = &en;
   }
-  if (served) e.use_udot(served->loaded.udot, served->loaded.handle, served->record.compiler);
+  if (!served) return;
+  e.use_udot(served->loaded.udot, served->loaded.handle, served->record.compiler);
+  if (!served->record.udot_form.empty()) e.set_udot_form(served->record.udot_form);
 }
 
 }  // namespace kanegen

@@ -24,7 +24,9 @@ namespace kanegen {
 
 struct UdotCandidate {
   std::string name;                ///< what it is, for reports and its record: the compiler, or "compact"
-  std::string tag;                 ///< its file: <stem>-<key>.udot-<tag>.so ("second", "compact")
+  /// its file: <stem>-<key>.udot-<tag>.so ("second", or "second-v3" when built for AVX2; "compact")
+  std::string tag;
+  std::string udot_form;           ///< its u-dot form (the main library's, or the compact code's)
   std::vector<std::string> argv;   ///< one command that compiles and links it
   std::filesystem::path out;       ///< where that command writes it
 };
@@ -41,15 +43,19 @@ bool compact_candidate_wanted(const Manifest& manifest, const JitOptions& o);
 /// `compact_entry`: the entry file of the compact code's sources (empty: no compact candidate).
 std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const JitOptions& o,
                                                 const std::filesystem::path& tmp, const std::filesystem::path& entry,
-                                                const std::filesystem::path& compact_entry);
+                                                const std::filesystem::path& compact_entry,
+                                                const std::string& compact_form);
+
+/// Removes every candidate of the library `so_path` (before a new library is published there).
+void remove_udot_candidates(const std::string& so_path);
 
 /// Where the candidate `tag` of the library `so_path` is kept (its record beside it).
 std::string udot_candidate_path(const std::string& so_path, const std::string& tag);
 
-/// Serves `e`'s u-dot from the fastest candidate beside `so_path` measured faster than its own: raced now when
-/// `fresh` (just built; the outcome goes into the records, and is said on stderr when `talk`), else as the
-/// records say.
-void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::string& so_path, const JitOptions& o,
-                            bool fresh, bool talk);
+/// Serves `e`'s u-dot from the fastest candidate beside `so_path` (built beside the library of checksum
+/// `main_checksum`) measured faster than its own: raced now when `fresh` (just built; the outcome goes into
+/// the records, and is said on stderr when `talk`), else as the records say.
+void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::string& so_path,
+                            const std::string& main_checksum, const JitOptions& o, bool fresh, bool talk);
 
 }  // namespace kanegen

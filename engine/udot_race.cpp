@@ -35,14 +35,25 @@ UdotRace race_udot(const GeneratedEngine& engine, KanegenFunctionPtr first, Kane
   const int nu = engine.model().nu;
   std::vector<double> out1(static_cast<std::size_t>(std::max(nu, 1))), out2(out1.size());
   UdotRace r;
-  r.first_status = engine.call_udot(first, s.t, s.q, s.u, s.tau, out1.data());
-  r.second_status = engine.call_udot(second, s.t, s.q, s.u, s.tau, out2.data());
-  double scale = 1.0;
-  for (int i = 0; i < nu; ++i) scale = std::max(scale, std::abs(out1[static_cast<std::size_t>(i)]));
-  for (int i = 0; i < nu; ++i) {
-    const double d = std::abs(out1[static_cast<std::size_t>(i)] - out2[static_cast<std::size_t>(i)]) / scale;
-    r.max_rel_diff = std::max(r.max_rel_diff, std::isnan(d) ? std::numeric_limits<double>::infinity() : d);
+  // agreement at the state and at one with every speed and input moved (a body at rest with no inputs has
+  // u-dot 0 from nearly any code), relative to the largest entry of either
+  State moved = s;
+  for (int i = 0; i < nu; ++i) moved.u(i) += 0.1 * (1 + i % 3), moved.tau(i) += 0.05 * (1 + i % 2);
+  std::vector<double> a[2], b[2];
+  double scale = 1e-300;
+  for (int k = 0; k < 2; ++k) {
+    const State& at = k == 0 ? s : moved;
+    a[k].resize(out1.size()), b[k].resize(out1.size());
+    const int st1 = engine.call_udot(first, at.t, at.q, at.u, at.tau, a[k].data());
+    const int st2 = engine.call_udot(second, at.t, at.q, at.u, at.tau, b[k].data());
+    if (k == 0) r.first_status = st1, r.second_status = st2;
+    for (int i = 0; i < nu; ++i) scale = std::max(scale, std::abs(a[k][static_cast<std::size_t>(i)]));
   }
+  for (int k = 0; k < 2; ++k)
+    for (int i = 0; i < nu; ++i) {
+      const double d = std::abs(a[k][static_cast<std::size_t>(i)] - b[k][static_cast<std::size_t>(i)]) / scale;
+      r.max_rel_diff = std::max(r.max_rel_diff, std::isnan(d) ? std::numeric_limits<double>::infinity() : d);
+    }
   const std::function<void()> calls[2] = {
       [&] { engine.call_udot(first, s.t, s.q, s.u, s.tau, out1.data()); },
       [&] { engine.call_udot(second, s.t, s.q, s.u, s.tau, out2.data()); }};

@@ -11,7 +11,9 @@ namespace kanegen {
 
 struct UdotRace {
   double first_ns = 0, second_ns = 0;  ///< least time per call of each
-  double max_rel_diff = 0;             ///< largest |difference| of their outputs over max |first's output| (or 1)
+  /// largest |difference| of their outputs over the largest |first's output|, at the state and at one with
+  /// moved speeds and inputs
+  double max_rel_diff = 0;
   int first_status = 0, second_status = 0;
 };
 
