@@ -203,6 +203,9 @@ void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::s
       if (!served || en.record.udot_ns < served->record.udot_ns) served = &en;
   }
   if (!served) return;
+  if (!fresh && talk)
+    fmt::print(stderr, "kanegen: u-dot of {} from {}'s build (raced {:.0f} ns against the library's own {:.0f} ns)\n",
+               model.name, served->record.compiler, served->record.udot_ns, served->record.main_udot_ns);
   e.use_udot(served->loaded.udot, served->loaded.handle, served->record.compiler);
   if (!served->record.udot_form.empty()) e.set_udot_form(served->record.udot_form);
 }
