@@ -70,11 +70,13 @@ GeneratedEngine::GeneratedEngine(const Model& m, const KanegenGeneratedApi* api,
 
 void GeneratedEngine::parameters_changed() { code_parameters_.head(parameters().size()) = parameters(); }
 
-KanegenFunctionPtr GeneratedEngine::function(const std::string& name) const {
-  for (int i = 0; i < api_->n_functions; ++i)
-    if (api_->functions[i].name && name == api_->functions[i].name) return api_->functions[i].fn;
+KanegenFunctionPtr find_function(const KanegenGeneratedApi& api, const std::string& name) {
+  for (int i = 0; i < api.n_functions; ++i)
+    if (api.functions[i].name && name == api.functions[i].name) return api.functions[i].fn;
   return nullptr;
 }
+
+KanegenFunctionPtr GeneratedEngine::function(const std::string& name) const { return find_function(*api_, name); }
 
 void GeneratedEngine::missing_output(const char* what) const {
   throw std::runtime_error(fmt::format("model was generated without '{}' output (add it to `outputs:` in {})", what,

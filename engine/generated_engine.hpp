@@ -14,6 +14,9 @@
 
 namespace kanegen {
 
+/// The function of `api`'s table called `name`, or null.
+KanegenFunctionPtr find_function(const KanegenGeneratedApi& api, const std::string& name);
+
 class GeneratedEngine final : public Engine {
  public:
   /// `library` keeps the shared object holding `api` loaded (may be null when

@@ -294,7 +294,6 @@ int run_steps(const std::vector<CompileStep>& steps, const std::string& log_path
   return s;
 }
 
-
 /// Compiles `sources` in a private temp dir beside so_path and publishes the
 /// library and its record (jit_cache.hpp), and the u-dot candidates beside
 /// it (udot_candidates.hpp; `compact`: the sources with compact u-dot, if any)

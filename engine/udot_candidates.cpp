@@ -90,8 +90,7 @@ std::optional<LoadedCandidate> load_candidate(const GeneratedEngine& e, const st
   if (!api || api->api_version != e.api().api_version || std::string(api->model_hash) != e.api().model_hash ||
       api->nq != e.api().nq || api->nu != e.api().nu || api->np != e.api().np)
     return std::nullopt;
-  for (int i = 0; i < api->n_functions; ++i)
-    if (api->functions[i].name && std::string(api->functions[i].name) == "udot") c.udot = api->functions[i].fn;
+  c.udot = find_function(*api, "udot");
   if (!c.udot) return std::nullopt;
   return c;
 }

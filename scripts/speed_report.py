@@ -99,8 +99,8 @@ def peer_udot(bindir, model, quick, rows):
                                                "min_ns_generated_baseline", "min_ns_generic",
                                                "max_rel_diff_generated", "kanegen_jit_seconds",
                                                "udot_compiler_generated", "udot_compiler_generated_baseline",
-                                               "ns_generated_baseline_main_compiler",
-                                               "min_ns_generated_baseline_main_compiler",
+                                               "ns_generated_baseline_own",
+                                               "min_ns_generated_baseline_own",
                                                "backward_error_mujoco", "cond_M")})
             row["nu"] = len(j["u_names"])
         if not runs or len(runs) < (1 if quick else PEER_PROCESSES):
@@ -212,7 +212,7 @@ def udot_section(rows, provenance):
             return "" if c in (None, "main") else f" ({c})"
         L.append(f"| {r['model']} | {r.get('nu', '')} | {r['ops']:,} ({r['form']}) | {fl_txt} | "
                  f"{fmt_ns(base)}{served('generated_baseline')} | {per_op} | "
-                 f"{fmt_ns(t(r, 'ns_generated_baseline_main_compiler')) if served('generated_baseline') else '='} | "
+                 f"{fmt_ns(t(r, 'ns_generated_baseline_own')) if served('generated_baseline') else '='} | "
                  f"{fmt_ns(t(r, 'ns_generated'))}{served('generated')} | "
                  f"{fmt_ns(t(r, 'ns_generated_native'))} | {fmt_ns(t(r, 'ns_generic'))} | "
                  f"{fmt_ns(t(r, 'ns_mujoco'))} | **{ratio(t(r, 'ns_mujoco'), base)}** | {spread(r)} | "

@@ -455,13 +455,13 @@ int main(int argc, char** argv) {
       j["udot_compiler_generated"] = generated->udot_compiler().empty() ? "main" : generated->udot_compiler();
       j["udot_compiler_generated_baseline"] =
           generated_baseline->udot_compiler().empty() ? "main" : generated_baseline->udot_compiler();
-      kanegen::VecX ud_main(km.nu);
-      const KanegenFunctionPtr main_udot = generated_baseline->function("udot");
+      kanegen::VecX ud_own(km.nu);
+      const KanegenFunctionPtr own_udot = generated_baseline->function("udot");
       if (!generated_baseline->udot_compiler().empty()) {
-        generated_baseline->call_udot(main_udot, 0.0, q, u, tau, ud_main.data());
-        j["max_rel_diff_generated_baseline_main_compiler"] = max_rel(ud_main, ud);
-        engines.push_back([&] { generated_baseline->call_udot(main_udot, 0.0, q, u, tau, ud_main.data()); });
-        names.push_back("generated_baseline_main_compiler");
+        generated_baseline->call_udot(own_udot, 0.0, q, u, tau, ud_own.data());
+        j["max_rel_diff_generated_baseline_own"] = max_rel(ud_own, ud);
+        engines.push_back([&] { generated_baseline->call_udot(own_udot, 0.0, q, u, tau, ud_own.data()); });
+        names.push_back("generated_baseline_own");
       }
       kanegen::VecX ud_compact;
       if (generated_compact) {
