@@ -179,25 +179,19 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
     k = end;
   }
 
-  // 2. the workspace: every temporary read outside its group, and every runtime value a group reads (the state,
-  // inputs, time, the preludes' values), copied in first
-  std::map<std::string, int> slot;
+  // 2. the workspace's entries: every temporary read outside its group or by the statements, and every runtime
+  // value a group reads (the state, inputs, time, the preludes' values; copied in first). Each entry lives in the
+  // region of a group: a temporary in its own group's, a runtime value in that of the first group reading it.
+  const int ng = static_cast<int>(groups.size());
+  std::map<std::string, int> owner;  // entry -> the group whose region holds it
   std::vector<std::string> runtime;  // runtime values, in order of first use
-  auto slot_of = [&](const std::string& n) {
-    auto it = slot.find(n);
-    if (it != slot.end()) return it->second;
-    const int s = static_cast<int>(slot.size());
-    slot.emplace(n, s);
-    return s;
-  };
-  for (const Group& g : groups)
-    for (int k : g.temps)
+  for (int g = 0; g < ng; ++g)
+    for (int k : groups[g].temps)
       for (const std::string& n : reads[k]) {
         auto it = index_of.find(n);
         if (it != index_of.end()) {
-          if (group_of[it->second] != group_of[k]) slot_of(n);
-        } else if (!constants.count(n) && !slot.count(n)) {
-          slot_of(n);
+          if (group_of[it->second] != g) owner.emplace(n, group_of[it->second]);
+        } else if (!constants.count(n) && owner.emplace(n, g).second) {
           runtime.push_back(n);
         }
       }
@@ -205,7 +199,7 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
   for (std::size_t i = 0; i < listing.statements.size(); ++i) {
     collect_symbols(listing.statements[i].value, statement_reads[i]);
     for (const std::string& n : statement_reads[i])
-      if (index_of.count(n)) slot_of(n);
+      if (auto it = index_of.find(n); it != index_of.end()) owner.emplace(n, group_of[it->second]);
   }
 
   // 3. each external's role: a constant's (Constants::role), another group's temporary by its place in that
@@ -220,11 +214,26 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
     return colon == std::string::npos ? title : title.substr(colon);
   };
 
-  // 4. each group's canonical text; equal texts share a kernel
+  // 4. each group's canonical text; equal texts share a kernel. A call's entries: its inputs (in the kernel's
+  // order), then the outputs it keeps in the workspace.
+  struct Call {
+    int kernel = 0;
+    std::vector<std::string> entries;
+    std::vector<int> outputs;  ///< the locals (a<i>) stored, one per output entry
+    std::vector<std::string> constants;
+    std::string section;
+  };
+  struct Kernel {
+    int inputs = 0, constants = 0;
+    std::string locals;  ///< the lines `const T a<i> = ...;`
+    std::vector<int> calls;
+  };
   OutlinedBody out;
+  std::vector<Call> call(ng);
+  std::vector<Kernel> kernels;
   std::map<std::string, int> kernel_of_text;
-  std::string calls;
-  for (const Group& g : groups) {
+  for (int gi = 0; gi < ng; ++gi) {
+    const Group& g = groups[gi];
     std::map<std::string, int> local;
     for (std::size_t i = 0; i < g.temps.size(); ++i) local[temps[g.temps[i]].sym.get_name()] = static_cast<int>(i);
     std::map<std::string, std::string> role;
@@ -232,7 +241,7 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
       for (const std::string& n : reads[k]) {
         if (local.count(n) || role.count(n)) continue;
         if (constants.count(n)) {
-          role[n] = "C" + model_constants.role(n);
+          role[n] = fmt::format("C{}", model_constants.role(n));
         } else if (auto it = index_of.find(n); it != index_of.end()) {
           const int dg = group_of[it->second];
           role[n] = fmt::format("X{}{}{}", groups[dg].body == g.body ? "self" : "other", section_kind(dg),
@@ -243,15 +252,6 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
       }
     Canonical canon(local, role);
     for (int k : g.temps) canon.visit(temps[k].value);
-    std::vector<std::string> x;  // the x table: input slots, then output slots
-    std::string text;
-    for (std::size_t i = 0; i < canon.input_order.size(); ++i) {
-      const std::string& n = canon.input_order[i];
-      x.push_back(std::to_string(slot.at(n)));
-      text += fmt::format("{}const T X{} = w[x[{}]];\n", indent, i, i);
-    }
-    for (std::size_t i = 0; i < canon.constant_order.size(); ++i)
-      text += fmt::format("{}const double C{} = c[{}];\n", indent, i, i);
     // the substitution: locals a<i>, inputs X<i>, constants C<i>
     std::map<std::string, ex> by_name;
     for (const auto& [n, i] : local) by_name[n] = symbol(fmt::format("a{}", i));
@@ -260,40 +260,173 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
       by_name[canon.constant_order[i]] = symbol(fmt::format("C{}", i));
     Rename sub(by_name);
     OpCount group_ops;
+    std::string locals;
     for (std::size_t i = 0; i < g.temps.size(); ++i)
-      text += fmt::format("{}const T a{} = {};\n", indent, i, print_cpp(sub(temps[g.temps[i]].value), group_ops));
+      locals += fmt::format("{}const T a{} = {};\n", indent, i, print_cpp(sub(temps[g.temps[i]].value), group_ops));
     ops += group_ops;
-    for (std::size_t i = 0; i < g.temps.size(); ++i) {
-      const std::string& n = temps[g.temps[i]].sym.get_name();
-      if (auto it = slot.find(n); it != slot.end()) {
-        text += fmt::format("{}w[x[{}]] = a{};\n", indent, x.size(), i);
-        x.push_back(std::to_string(it->second));
+    Call& c = call[gi];
+    c.entries = canon.input_order;
+    for (std::size_t i = 0; i < g.temps.size(); ++i)
+      if (const std::string& n = temps[g.temps[i]].sym.get_name(); owner.count(n)) {
+        c.entries.push_back(n);
+        c.outputs.push_back(static_cast<int>(i));
       }
-    }
-    auto [it, added] = kernel_of_text.emplace(text, static_cast<int>(out.kernels.size()));
+    c.constants = canon.constant_order;
+    c.section = temps[g.temps.front()].section;
+    // the key: the text with every entry read and written through the table
+    std::string key = fmt::format("{} inputs, {} constants\n{}", canon.input_order.size(), canon.constant_order.size(), locals);
+    for (int o : c.outputs) key += fmt::format("w <- a{}\n", o);
+    auto [it, added] = kernel_of_text.emplace(key, static_cast<int>(kernels.size()));
     if (added) {
-      out.kernels.push_back(text);
+      kernels.push_back({static_cast<int>(canon.input_order.size()), static_cast<int>(canon.constant_order.size()),
+                         std::move(locals), {}});
       out.kernel_ops += group_ops;
     }
-    // the call's tables at namespace scope with internal linkage: a function-local static of a template is a
-    // GNU unique symbol, which the dynamic loader binds across libraries (two variants of one model's code
-    // loaded in one process would read each other's tables)
-    const std::string section = temps[g.temps.front()].section;
-    const int call = out.calls++;
-    out.tables += fmt::format("// {}\nstatic constexpr int {}_x{}[] = {{{}}};\n",
-                              section.empty() ? "(the function's first values)" : section, name, call, fmt::join(x, ", "));
-    if (canon.constant_order.empty()) {
-      calls += fmt::format("{}{}_kernel{}(w, {}_x{}, static_cast<const double*>(nullptr));\n", indent, name, it->second,
-                           name, call);
-    } else {
-      out.tables += fmt::format("static constexpr double {}_c{}[] = {{{}}};\n", name, call,
-                                fmt::join(canon.constant_order, ", "));
-      calls += fmt::format("{}{}_kernel{}(w, {}_x{}, {}_c{});\n", indent, name, it->second, name, call, name, call);
-    }
+    c.kernel = it->second;
+    kernels[it->second].calls.push_back(gi);
   }
 
-  // 5. the function's body
-  out.workspace = static_cast<int>(slot.size());
+  // 5. the layout (issue 38): each body's entries in a region of its own, the regions of one stride S, each call
+  // given its region's start. An entry a kernel reads or writes at the same offset from every call's start is
+  // addressed by that constant in the kernel's text; the rest through the call's table. Offsets are classes of
+  // entries: a kernel's entry at one place joins the classes of its calls' entries at that place (when they lie
+  // at one distance of regions from their calls and no two of them share a region), and every class gets one
+  // offset within its regions, so a chain's like bodies put like values at like offsets.
+  std::map<std::string, int> region_index;  // a group's body (or "#g" for a group of no body) -> its region
+  std::vector<int> region(ng);
+  for (int g = 0; g < ng; ++g) {
+    const std::string key = groups[g].body.empty() ? fmt::format("#{}", g) : groups[g].body;
+    region[g] = region_index.emplace(key, static_cast<int>(region_index.size())).first->second;
+  }
+  const int nr = static_cast<int>(region_index.size());
+  std::vector<std::string> entry_name;  // entries by number, in order of first use
+  std::map<std::string, int> entry;
+  auto add_entry = [&](const std::string& n) {
+    if (entry.emplace(n, static_cast<int>(entry_name.size())).second) entry_name.push_back(n);
+  };
+  for (const std::string& n : runtime) add_entry(n);
+  for (const Call& c : call)
+    for (const std::string& n : c.entries) add_entry(n);
+  for (const auto& [n, g] : owner) add_entry(n);
+  const int ne = static_cast<int>(entry_name.size());
+  std::vector<int> entry_region(ne);
+  for (int e = 0; e < ne; ++e) entry_region[e] = region[owner.at(entry_name[e])];
+  // classes: union-find, each class's entries by region
+  std::vector<int> parent(ne);
+  std::vector<std::map<int, int>> members(ne);  // root -> region -> entry
+  for (int e = 0; e < ne; ++e) parent[e] = e, members[e][entry_region[e]] = e;
+  auto find = [&](int e) {
+    while (parent[e] != e) e = parent[e] = parent[parent[e]];
+    return e;
+  };
+  std::vector<int> by_calls(kernels.size());
+  for (std::size_t k = 0; k < kernels.size(); ++k) by_calls[k] = static_cast<int>(k);
+  std::stable_sort(by_calls.begin(), by_calls.end(),
+                   [&](int a, int b) { return kernels[a].calls.size() > kernels[b].calls.size(); });
+  for (int k : by_calls) {
+    const Kernel& K = kernels[k];
+    if (K.calls.size() < 2) continue;
+    for (std::size_t p = 0; p < call[K.calls[0]].entries.size(); ++p) {
+      std::set<int> roots;
+      bool one_distance = true;
+      const int distance = entry_region[entry.at(call[K.calls[0]].entries[p])] - region[K.calls[0]];
+      for (int g : K.calls) {
+        const int e = entry.at(call[g].entries[p]);
+        one_distance = one_distance && entry_region[e] - region[g] == distance;
+        roots.insert(find(e));
+      }
+      if (!one_distance) continue;
+      std::map<int, int> merged;
+      bool apart = true;
+      for (int r : roots)
+        for (const auto& [reg, e] : members[r]) apart = apart && merged.emplace(reg, e).second;
+      if (!apart) continue;
+      const int root = *roots.begin();
+      for (int r : roots) parent[r] = root;
+      members[root] = std::move(merged);
+    }
+  }
+  // each class an offset free in all its regions, the widest classes first
+  std::vector<int> roots;
+  for (int e = 0; e < ne; ++e)
+    if (find(e) == e) roots.push_back(e);
+  std::stable_sort(roots.begin(), roots.end(), [&](int a, int b) { return members[a].size() > members[b].size(); });
+  std::vector<std::vector<bool>> used(nr);
+  std::vector<int> offset_of_root(ne, -1);
+  int stride = 1;
+  for (int r : roots) {
+    auto taken = [&](int o) {
+      for (const auto& [reg, e] : members[r])
+        if (o < static_cast<int>(used[reg].size()) && used[reg][o]) return true;
+      return false;
+    };
+    int o = 0;
+    while (taken(o)) ++o;
+    offset_of_root[r] = o;
+    for (const auto& [reg, e] : members[r]) {
+      if (static_cast<int>(used[reg].size()) <= o) used[reg].resize(o + 1, false);
+      used[reg][o] = true;
+    }
+    stride = std::max(stride, o + 1);
+  }
+  std::map<std::string, int> slot;
+  for (int e = 0; e < ne; ++e) slot[entry_name[e]] = entry_region[e] * stride + offset_of_root[find(e)];
+  auto base = [&](int g) { return region[g] * stride; };
+
+  // 6. the kernels' texts: an entry at one offset from every call's start by that offset, the others through
+  // the call's table x
+  std::vector<std::vector<int>> table_place(kernels.size());  // per kernel, per entry: its place in x, or -1
+  for (std::size_t k = 0; k < kernels.size(); ++k) {
+    const Kernel& K = kernels[k];
+    const Call& first = call[K.calls[0]];
+    std::vector<int>& tp = table_place[k];
+    int next = 0;
+    std::string text;
+    for (std::size_t p = 0; p < first.entries.size(); ++p) {
+      const int d = slot.at(first.entries[p]) - base(K.calls[0]);
+      bool fixed = true;
+      for (int g : K.calls) fixed = fixed && slot.at(call[g].entries[p]) - base(g) == d;
+      tp.push_back(fixed ? -1 : next++);
+      const std::string at = fixed ? fmt::format("w[{}]", d) : fmt::format("w[x[{}]]", tp.back());
+      if (static_cast<int>(p) < K.inputs) text += fmt::format("{}const T X{} = {};\n", indent, p, at);
+    }
+    if (next == 0) text += indent + "(void)x;\n";
+    for (int i = 0; i < K.constants; ++i) text += fmt::format("{}const double C{} = c[{}];\n", indent, i, i);
+    text += K.locals;
+    for (std::size_t j = 0; j < first.outputs.size(); ++j) {
+      const std::size_t p = K.inputs + j;
+      const std::string at = tp[p] < 0 ? fmt::format("w[{}]", slot.at(first.entries[p]) - base(K.calls[0]))
+                                       : fmt::format("w[x[{}]]", tp[p]);
+      text += fmt::format("{}{} = a{};\n", indent, at, first.outputs[j]);
+    }
+    out.kernels.push_back(std::move(text));
+  }
+
+  // 7. the calls and their tables, at namespace scope with internal linkage: a function-local static of a template
+  // is a GNU unique symbol, which the dynamic loader binds across libraries (two variants of one model's code
+  // loaded in one process would read each other's tables)
+  std::string calls;
+  for (int g = 0; g < ng; ++g) {
+    const Call& c = call[g];
+    const int n = out.calls++;
+    std::vector<int> x;
+    for (std::size_t p = 0; p < c.entries.size(); ++p)
+      if (table_place[c.kernel][p] >= 0) x.push_back(slot.at(c.entries[p]) - base(g));
+    out.tables += fmt::format("// {}\n", c.section.empty() ? "(the function's first values)" : c.section);
+    std::string x_arg = "static_cast<const int*>(nullptr)", c_arg = "static_cast<const double*>(nullptr)";
+    if (!x.empty()) {
+      out.tables += fmt::format("static constexpr int {}_x{}[] = {{{}}};\n", name, n, fmt::join(x, ", "));
+      x_arg = fmt::format("{}_x{}", name, n);
+    }
+    if (!c.constants.empty()) {
+      out.tables += fmt::format("static constexpr double {}_c{}[] = {{{}}};\n", name, n, fmt::join(c.constants, ", "));
+      c_arg = fmt::format("{}_c{}", name, n);
+    }
+    calls += fmt::format("{}{}_kernel{}(w + {}, {}, {});\n", indent, name, c.kernel, base(g), x_arg, c_arg);
+  }
+
+  // 8. the function's body
+  out.workspace = nr * stride;
   std::string& m = out.main;
   m = listing.preludes;
   m += fmt::format("{}T w[{}];\n", indent, std::max(1, out.workspace));

@@ -66,6 +66,10 @@ TEST_CASE("compact u-dot code: a chain's middle links share kernels, which do no
     CHECK(f.kernels.size() <= 12);
     kernel_ops.push_back(f.kernel_ops.total());
     CHECK(f.kernel_ops.total() < 0.5 * f.ops.total());
+    // every body's values at like offsets in its region of the workspace: each kernel addresses every value it
+    // reads or writes by a constant offset from its call's region, none through a table
+    for (const std::string& k : f.kernels) CHECK(k.find("w[x[") == std::string::npos);
+    CHECK(f.kernel_tables.find("static constexpr int") == std::string::npos);
   }
   // (a random constant that folds to 0 or 1 may change a kernel by an operation)
   CHECK(std::abs(kernel_ops[1] - kernel_ops[0]) <= 0.01 * kernel_ops[0]);
