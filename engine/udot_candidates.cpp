@@ -60,10 +60,16 @@ bool second_at_v3(const JitOptions& o) {
 /// never served, on a CPU without it (a cache shared between machines).
 std::string second_tag(const JitOptions& o) { return second_at_v3(o) ? "second-v3" : "second"; }
 
-bool long_straight_line(const Manifest& manifest) {
+/// Whether u-dot is long enough to race candidates of it (straight-line or compact code).
+bool long_udot(const Manifest& manifest) {
   const ManifestFunction* udot = manifest.find("udot");
-  return udot && manifest.udot_code == "straight-line" && udot->ops >= kCandidateMinOps;
+  return udot && udot->ops >= kCandidateMinOps;
 }
+
+bool long_straight_line(const Manifest& manifest) { return long_udot(manifest) && manifest.udot_code == "straight-line"; }
+
+/// The file tag of compact code by the second compiler on this CPU (as second_tag).
+std::string compact_second_tag(const JitOptions& o) { return second_at_v3(o) ? "compact-second-v3" : "compact-second"; }
 
 /// The command's tail that builds a library of u-dot alone from `entry` (its table lists only u-dot).
 void udot_alone(std::vector<std::string>& argv, const Manifest& manifest, const JitOptions& o, const fs::path& entry,
@@ -115,18 +121,21 @@ std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const 
                                                 const fs::path& entry, const fs::path& compact_entry,
                                                 const std::string& compact_form) {
   std::vector<UdotCandidate> out;
-  if (!optimized_default_build(o) || !long_straight_line(manifest)) return out;
-  if (const std::string second = second_compiler(o); !second.empty()) {
-    // for the instruction set the main library's u-dot runs at on this CPU
-    UdotCandidate c{second, second_tag(o), manifest.udot_form, words(second), tmp / "udot-second.so"};
+  if (!optimized_default_build(o) || !long_udot(manifest)) return out;
+  const std::string second = second_compiler(o);
+  // the second compiler, for the instruction set the main library's u-dot runs at on this CPU
+  auto by_second = [&](std::string name, std::string tag, const std::string& form, const fs::path& from,
+                       const fs::path& so) {
+    UdotCandidate c{std::move(name), std::move(tag), form, words(second), so};
     for (const char* f : {"-O2", "-std=c++20", "-fPIC", "-shared", "-fno-math-errno"}) c.argv.emplace_back(f);
     if (o.native) c.argv.emplace_back("-march=native");
     if (second_at_v3(o)) c.argv.emplace_back("-march=x86-64-v3");
     c.argv.emplace_back("-DKANEGEN_NO_DISPATCH");
-    udot_alone(c.argv, manifest, o, entry, c.out);
+    udot_alone(c.argv, manifest, o, from, c.out);
     out.push_back(std::move(c));
-  }
-  if (!compact_entry.empty()) {
+  };
+  if (!second.empty()) by_second(second, second_tag(o), manifest.udot_form, entry, tmp / "udot-second.so");
+  if (!compact_entry.empty() && long_straight_line(manifest)) {
     // the main compiler at the main library's flags (its AVX2 clone too)
     UdotCandidate c{"compact", "compact", compact_form, words(o.compiler), tmp / "udot-compact.so"};
     for (const std::string& f : words(o.flags)) c.argv.push_back(f);
@@ -134,6 +143,9 @@ std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const 
     if (!o.dispatch) c.argv.emplace_back("-DKANEGEN_NO_DISPATCH");
     udot_alone(c.argv, manifest, o, compact_entry, c.out);
     out.push_back(std::move(c));
+    if (!second.empty())
+      by_second("compact by " + second, compact_second_tag(o), compact_form, compact_entry,
+                tmp / "udot-compact-second.so");
   }
   return out;
 }
@@ -145,7 +157,7 @@ std::string udot_candidate_path(const std::string& so_path, const std::string& t
 }
 
 void remove_udot_candidates(const std::string& so_path) {
-  for (const char* tag : {"second", "second-v3", "compact"}) {
+  for (const char* tag : {"second", "second-v3", "compact", "compact-second", "compact-second-v3"}) {
     const std::string path = udot_candidate_path(so_path, tag);
     std::error_code ec;
     fs::remove(jit_cache::record_path(path), ec);  // the record first: a library without one is never loaded
@@ -163,7 +175,9 @@ void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::s
   };
   std::vector<Entry> entries;
   const std::string second = second_compiler(o);
-  for (const auto& [tag, name] : {std::pair<std::string, std::string>{second_tag(o), second}, {"compact", "compact"}}) {
+  const std::vector<std::pair<std::string, std::string>> candidates = {
+      {second_tag(o), second}, {"compact", "compact"}, {compact_second_tag(o), second.empty() ? "" : "compact by " + second}};
+  for (const auto& [tag, name] : candidates) {
     if (name.empty()) continue;
     const std::string path = udot_candidate_path(so_path, tag);
     auto record = jit_cache::verified_record(path);
@@ -195,7 +209,7 @@ void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::s
     if (talk)
       fmt::print(stderr, "kanegen: u-dot of {} at the initial state: {}the library's own {:.0f} ns: {} is used\n",
                  model.name, said, entries.front().race.first_ns,
-                 served ? served->record.compiler + "'s" : std::string("the library's own"));
+                 served ? served->record.compiler : std::string("the library's own"));
   } else {
     // only preferred ones were loaded (two processes racing at once may each have preferred one)
     for (Entry& en : entries)
@@ -203,7 +217,7 @@ void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::s
   }
   if (!served) return;
   if (!fresh && talk)
-    fmt::print(stderr, "kanegen: u-dot of {} from {}'s build (raced {:.0f} ns against the library's own {:.0f} ns)\n",
+    fmt::print(stderr, "kanegen: u-dot of {} served by its candidate {} (raced {:.0f} ns against the library's own {:.0f} ns)\n",
                model.name, served->record.compiler, served->record.udot_ns, served->record.main_udot_ns);
   e.use_udot(served->loaded.udot, served->loaded.handle, served->record.compiler);
   if (!served->record.udot_form.empty()) e.set_udot_form(served->record.udot_form);

@@ -1,13 +1,16 @@
 // The u-dot candidates the JIT builds beside a model's library, races
 // against the library's own u-dot at the initial state (udot_race.hpp) and
 // serves when measured faster (docs/decisions.md, "u-dot candidates"):
-//   - u-dot by a second compiler (clang++ where installed): GCC and clang
+//   - u-dot by a second compiler (clang++ where installed), for u-dot of
+//     2,000 operations and more, straight-line or compact: GCC and clang
 //     differ most on long straight-line code (clang packs pairs of like
 //     operations into SSE2 instructions, its code is smaller), and which is
-//     faster varies by model;
+//     faster varies by model (on compact code too: chain_8's ran 5 % faster
+//     by clang++, chain_16's 4 % slower);
 //   - u-dot as compact code (kernels shared by bodies of one shape,
-//     codegen/outlined_code.hpp), where the generator's cost model chose
-//     straight-line code near the instruction cache's size.
+//     codegen/outlined_code.hpp) in the main code's form, by each compiler,
+//     where the generator's cost model chose straight-line code near the
+//     instruction cache's size.
 // Each is a library of u-dot alone, <stem>-<key>.udot-<tag>.so, with a cache
 // record that keeps the race's outcome; a later load serves what it says.
 #pragma once
@@ -23,8 +26,10 @@
 namespace kanegen {
 
 struct UdotCandidate {
-  std::string name;                ///< what it is, for reports and its record: the compiler, or "compact"
-  /// its file: <stem>-<key>.udot-<tag>.so ("second", or "second-v3" when built for AVX2; "compact")
+  /// what it is, for reports and its record: the second compiler, "compact", or "compact by " the second compiler
+  std::string name;
+  /// its file: <stem>-<key>.udot-<tag>.so ("second", or "second-v3" when built for AVX2; "compact";
+  /// "compact-second", or "compact-second-v3")
   std::string tag;
   std::string udot_form;           ///< its u-dot form (the main library's, or the compact code's)
   std::vector<std::string> argv;   ///< one command that compiles and links it

@@ -1,6 +1,6 @@
-// The JIT's u-dot candidates (engine/udot_candidates.hpp): a long
-// straight-line u-dot is also built by a second compiler (clang++) and as
-// compact code, each raced against the library's own at the initial state
+// The JIT's u-dot candidates (engine/udot_candidates.hpp): a long u-dot is
+// also built by a second compiler (clang++), and a long straight-line one as
+// compact code by both compilers, each raced against the library's own at the initial state
 // (engine/udot_race.hpp) and served only when measured faster. Every build
 // must compute the same u-dot as the generic engine, whichever is served; the
 // choice is recorded and reused from the cache.
@@ -21,6 +21,7 @@
 #include "engine/udot_candidates.hpp"
 #include "engine/udot_race.hpp"
 #include "model/state_io.hpp"
+#include "tests/support/random_chain.hpp"
 #include "tests/support/test_support.hpp"
 
 using namespace kanegen;
@@ -96,7 +97,9 @@ TEST_CASE("u-dot candidates are built, raced, the fastest served only when faste
   const KanegenFunctionPtr own = e->function("udot");
   int preferred = 0;
   std::string served;
-  for (const auto& [tag, name] : {std::pair<std::string, std::string>{"second", "clang++"}, {"compact", "compact"}}) {
+  for (const auto& [tag, name] : {std::pair<std::string, std::string>{"second", "clang++"},
+                                  {"compact", "compact"},
+                                  {"compact-second", "compact by clang++"}}) {
     INFO(tag);
     const std::string path = udot_candidate_path(e->library_path(), tag);
     const auto record = jit_cache::verified_record(path);
@@ -157,8 +160,42 @@ TEST_CASE("no u-dot candidates for short u-dot, no second compiler when told non
     const Model model = load_model(test::source_path("models/gravity_gradient_boom.yaml"));
     auto e = jit_load(model, codegen::jit_code_generator(), cache.options());
     CHECK_FALSE(fs::exists(udot_candidate_path(e->library_path(), "second")));
+    CHECK_FALSE(fs::exists(udot_candidate_path(e->library_path(), "compact-second")));
     CHECK(fs::exists(udot_candidate_path(e->library_path(), "compact")));
     CHECK(e->udot_compiler() != "clang++");
+    CHECK(e->udot_compiler() != "compact by clang++");
+  }
+}
+
+TEST_CASE("compact u-dot is raced against the second compiler's build of it", "[jit][udot-candidates]") {
+  REQUIRE(std::system("command -v clang++ > /dev/null 2>&1") == 0);
+  const SecondCompilerEnv env("clang++");
+  const SecondCompilerCache cache;
+  // a 12-link chain's u-dot as compact code (2,000 operations and more): its one candidate is clang++'s build
+  const Model model = load_model(test::write_temp("candidates_chain12.yaml", test::random_chain(12, 5)));
+  codegen::GeneratorOptions go;
+  go.udot_code = "compact";
+  auto e = jit_load(model, codegen::jit_code_generator(go), cache.options());
+  CHECK_FALSE(fs::exists(udot_candidate_path(e->library_path(), "compact")));
+  const std::string path = udot_candidate_path(e->library_path(), "second");
+  const auto record = jit_cache::verified_record(path);
+  REQUIRE(record);
+  CHECK(record->compiler == "clang++");
+  CHECK(record->udot_ns > 0);
+  CHECK(e->udot_compiler() == (record->preferred ? "clang++" : ""));
+  std::shared_ptr<void> handle;
+  const KanegenFunctionPtr fn = udot_of_library(path, record->api_symbol, handle);
+  GenericEngine g(model);
+  State s = initial_state(model);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> d(-1, 1);
+  for (int k = 0; k < 3; ++k) {
+    for (int i = 0; i < model.nq; ++i) s.q(i) = d(rng);
+    for (int i = 0; i < model.nu; ++i) s.u(i) = d(rng), s.tau(i) = d(rng);
+    VecX expected, by_candidate(model.nu);
+    g.udot(s.q, s.u, s.tau, expected);
+    REQUIRE(e->call_udot(fn, s.t, s.q, s.u, s.tau, by_candidate.data()) == 0);
+    CHECK(test::rel_err(by_candidate, expected) < 1e-11);
   }
 }
 
