@@ -169,8 +169,8 @@ std::string op_counts(const EmittedModel& m) {
       s += fmt::format(" -- {} form; composite {}, articulated {}", m.udot_form, m.udot_composite_ops.total(),
                        m.udot_articulated_ops.total());
     if (!f.kernels.empty())
-      s += fmt::format("; compact code: {} kernels ({} operations of code), {} calls", f.kernels.size(),
-                       f.kernel_ops.total(), f.kernel_calls);
+      s += fmt::format("; compact code: {} kernels ({} operations of code), {} calls, workspace {} ({} values)",
+                       f.kernels.size(), f.kernel_ops.total(), f.kernel_calls, f.workspace, f.workspace_values);
     if (!f.ops_by_pass.empty()) {
       std::vector<std::string> parts;
       for (const auto& [pass, n] : f.ops_by_pass) parts.push_back(fmt::format("{} {}", pass, n));

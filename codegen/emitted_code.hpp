@@ -54,6 +54,7 @@ struct EmittedFunction {
   std::string kernel_tables;  ///< the calls' tables (namespace scope, before the function)
   OpCount kernel_ops;  ///< the kernels' own code (each once); `ops` counts every call's
   int workspace = 0;
+  int workspace_values = 0;  ///< compact code: the values kept in its workspace (outlined_code.hpp)
   OpCount ops;
   std::vector<std::pair<std::string, long>> ops_by_pass;  ///< u-dot: its operations by pass (Program::ops_by_pass)
   std::string note;             ///< extra comment lines for the header section (may be empty)

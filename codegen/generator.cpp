@@ -59,6 +59,7 @@ void finish(const Program& p, const Constants& C, EmittedFunction& f, const Gene
     f.kernel_tables = std::move(o.tables);
     f.kernel_ops = o.kernel_ops;
     f.workspace = o.workspace;
+    f.workspace_values = o.workspace_values;
     return;
   }
   finish_straight(p, f, options);

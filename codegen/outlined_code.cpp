@@ -286,7 +286,7 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
     kernels[it->second].calls.push_back(gi);
   }
 
-  // 5. the layout (issue 38): each body's entries in a region of its own, the regions of one stride S, each call
+  // 5. the layout (issue 38): each body's entries in a region of its own, the regions of one stride, each call
   // given its region's start. An entry a kernel reads or writes at the same offset from every call's start is
   // addressed by that constant in the kernel's text; the rest through the call's table. Offsets are classes of
   // entries: a kernel's entry at one place joins the classes of its calls' entries at that place (when they lie
@@ -369,9 +369,18 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
     }
     stride = std::max(stride, o + 1);
   }
+  // the regions' starts: one stride, unless that would waste more than half the workspace (one body with far
+  // more values than the others, e.g. a flexible body's nodes among rigid links); then each region as long as
+  // it needs, and the kernels of like bodies next to a region of another length read through their tables
+  std::vector<int> region_start(nr + 1, 0);
+  long packed = 0;
+  for (int r = 0; r < nr; ++r) packed += std::max<long>(1, static_cast<long>(used[r].size()));
+  const bool one_stride = static_cast<long>(nr) * stride <= packed + packed / 2 + 64;
+  for (int r = 0; r < nr; ++r)
+    region_start[r + 1] = region_start[r] + (one_stride ? stride : std::max(1, static_cast<int>(used[r].size())));
   std::map<std::string, int> slot;
-  for (int e = 0; e < ne; ++e) slot[entry_name[e]] = entry_region[e] * stride + offset_of_root[find(e)];
-  auto base = [&](int g) { return region[g] * stride; };
+  for (int e = 0; e < ne; ++e) slot[entry_name[e]] = region_start[entry_region[e]] + offset_of_root[find(e)];
+  auto base = [&](int g) { return region_start[region[g]]; };
 
   // 6. the kernels' texts: an entry at one offset from every call's start by that offset, the others through
   // the call's table x
@@ -426,7 +435,8 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
   }
 
   // 8. the function's body
-  out.workspace = nr * stride;
+  out.workspace = region_start[nr];
+  out.workspace_values = ne;
   std::string& m = out.main;
   m = listing.preludes;
   m += fmt::format("{}T w[{}];\n", indent, std::max(1, out.workspace));

@@ -48,6 +48,7 @@ struct OutlinedBody {
   std::string tables;                ///< namespace-scope tables of the calls: NAME_x<k> (and NAME_c<k>)
   std::string main;                  ///< the function's body: workspace copies, the calls, the outputs
   int workspace = 0;                 ///< entries of T w[]
+  int workspace_values = 0;          ///< the values kept in it (the rest: gaps that align like bodies' regions)
   int calls = 0;                     ///< kernel calls (groups)
   OpCount kernel_ops;                ///< the operations of the kernels' code (each kernel once)
 };

@@ -18,7 +18,7 @@
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
 //   mass_matrix    11043 (4247 add, 6732 mul, 0 div, 64 func)
 //   forcing         3641 (1534 add, 2043 mul, 0 div, 64 func)
-//   udot            9407 (4199 add, 5052 mul, 92 div, 64 func) -- articulated form; composite 36420, articulated 9407; compact code: 19 kernels (2019 operations of code), 97 calls
+//   udot            9407 (4199 add, 5052 mul, 92 div, 64 func) -- articulated form; composite 36420, articulated 9407; compact code: 19 kernels (2019 operations of code), 97 calls, workspace 1881 (1808 values)
 //     udot by pass: outward pass (velocities) 1443; mass and velocity terms 646; bias force 650; articulated inertia and bias force (inward) 5572; accelerations (outward) 1096
 //   energy          1801 (686 add, 986 mul, 65 div, 64 func)
 //   momentum        3844 (1619 add, 2159 mul, 1 div, 65 func)

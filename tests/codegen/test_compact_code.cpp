@@ -99,6 +99,18 @@ TEST_CASE("compact u-dot code computes the straight-line code's u-dot and Jacobi
     auto straight = c.form == "auto" ? test::generated_engine(model) : engine_with(model, "straight-line", c.form);
     if (c.form == "auto") REQUIRE(codegen::generate(model).find("udot")->kernels.empty());
     auto compact = engine_with(model, "compact", c.form);
+    {
+      // the workspace's regions: like bodies' at one stride, but never more than half of it gaps (the flexible
+      // spacecraft's flexible body, with far more values than its rigid wheels, would take over three times its
+      // values at one stride)
+      codegen::GeneratorOptions g;
+      g.udot_code = "compact";
+      g.udot_form = c.form;
+      const codegen::EmittedModel m = codegen::generate(model, g);
+      const codegen::EmittedFunction& f = udot_of(m);
+      CHECK(f.workspace_values > 0);
+      CHECK(f.workspace <= f.workspace_values + f.workspace_values / 2 + 64);
+    }
     GenericEngine generic(model);
     // against the straight-line code: the same operations, the order of commutative operands aside
     std::mt19937 rng(3);
