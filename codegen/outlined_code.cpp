@@ -369,17 +369,25 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
     }
     stride = std::max(stride, o + 1);
   }
-  // the regions' starts: one stride, unless that would waste more than half the workspace (one body with far
-  // more values than the others, e.g. a flexible body's nodes among rigid links); then each region as long as
-  // it needs, and the kernels of like bodies next to a region of another length read through their tables
+  // the regions' starts: one stride while at most a third of the workspace is gaps; else each region as long
+  // as it needs (one body with far more values than the others, e.g. a flexible body's nodes among rigid
+  // links); else each region's values packed without gaps. The kernels of like bodies next to a region of
+  // another length, or whose values moved, read through their tables.
+  const long budget = ne + ne / 2 + 64;
+  long lengths = 0;
+  for (int r = 0; r < nr; ++r) lengths += static_cast<long>(used[r].size());
+  const bool one_stride = static_cast<long>(nr) * stride <= budget, gapless = !one_stride && lengths > budget;
+  std::vector<std::vector<int>> at(nr);  // region -> offset -> place in the region
   std::vector<int> region_start(nr + 1, 0);
-  long packed = 0;
-  for (int r = 0; r < nr; ++r) packed += std::max<long>(1, static_cast<long>(used[r].size()));
-  const bool one_stride = static_cast<long>(nr) * stride <= packed + packed / 2 + 64;
-  for (int r = 0; r < nr; ++r)
-    region_start[r + 1] = region_start[r] + (one_stride ? stride : std::max(1, static_cast<int>(used[r].size())));
+  for (int r = 0; r < nr; ++r) {
+    int n = 0;
+    for (bool u : used[r]) at[r].push_back(u && gapless ? n++ : static_cast<int>(at[r].size()));
+    const int length = one_stride ? stride : gapless ? n : static_cast<int>(used[r].size());
+    region_start[r + 1] = region_start[r] + length;
+  }
   std::map<std::string, int> slot;
-  for (int e = 0; e < ne; ++e) slot[entry_name[e]] = region_start[entry_region[e]] + offset_of_root[find(e)];
+  for (int e = 0; e < ne; ++e)
+    slot[entry_name[e]] = region_start[entry_region[e]] + at[entry_region[e]][offset_of_root[find(e)]];
   auto base = [&](int g) { return region_start[region[g]]; };
 
   // 6. the kernels' texts: an entry at one offset from every call's start by that offset, the others through

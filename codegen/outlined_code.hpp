@@ -16,12 +16,17 @@
 // whose locals are the group's temporaries (a0, a1, ... in order), whose
 // inputs are other groups' temporaries and the state and inputs (copied into
 // the workspace first), and whose model constants are c[i], from a table at
-// each call (namespace-scope constexpr arrays, internal linkage). The workspace is laid out in one
-// region per body, all of one stride; a call gets its region's start as w,
-// and a value every call of a kernel finds at the same offset from it (a
+// each call (namespace-scope constexpr arrays, internal linkage).
+//
+// The workspace holds one region per body, all of one stride (unless that
+// leaves more than a third of it gaps: then regions of their own lengths, or
+// packed). A call gets its region's start as w. A value that every call of a
+// kernel finds at the same offset from it is addressed by that constant (a
 // chain's like links keep like values at like offsets: classes of values
-// joined through the kernels that read them) is addressed by that constant,
-// the rest through the call's table x (w[x[i]]). Each group's text is
+// joined through the kernels that read them), the rest through the call's
+// table x (w[x[i]]).
+//
+// Each group's text is
 // canonical: its externals are numbered in a traversal that orders operands
 // by their shape (numbers, locals, an input by its role: which of its
 // group's values it is, or a constant by its role: Constants::role), never

@@ -100,9 +100,9 @@ TEST_CASE("compact u-dot code computes the straight-line code's u-dot and Jacobi
     if (c.form == "auto") REQUIRE(codegen::generate(model).find("udot")->kernels.empty());
     auto compact = engine_with(model, "compact", c.form);
     {
-      // the workspace's regions: like bodies' at one stride, but never more than half of it gaps (the flexible
-      // spacecraft's flexible body, with far more values than its rigid wheels, would take over three times its
-      // values at one stride)
+      // the workspace's regions: like bodies' at one stride, but never more than a third of it gaps (the
+      // flexible spacecraft's flexible body, with far more values than its rigid wheels, would take over three
+      // times its values at one stride)
       codegen::GeneratorOptions g;
       g.udot_code = "compact";
       g.udot_form = c.form;

@@ -11,6 +11,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <algorithm>
 #include <random>
 
 #include "codegen/jit_generator.hpp"
@@ -95,6 +96,7 @@ TEST_CASE("u-dot candidates are built, raced, the fastest served only when faste
   auto e = jit_load(model, codegen::jit_code_generator(), cache.options());
   GenericEngine g(model);
   const KanegenFunctionPtr own = e->function("udot");
+  const std::string main_form = codegen::generate(model).udot_form;
   int preferred = 0;
   std::string served;
   for (const auto& [tag, name] : {std::pair<std::string, std::string>{"second", "clang++"},
@@ -105,6 +107,8 @@ TEST_CASE("u-dot candidates are built, raced, the fastest served only when faste
     const auto record = jit_cache::verified_record(path);
     REQUIRE(record);
     CHECK(record->compiler == name);
+    // compact code in the form the main code has (the generator's choice: fewer operations)
+    CHECK(record->udot_form == main_form);
     CHECK(record->udot_ns > 0);
     CHECK(record->main_udot_ns > 0);
     // served only when measured 5 % faster (second_wins), and then the fastest of them
@@ -175,6 +179,7 @@ TEST_CASE("compact u-dot is raced against the second compiler's build of it", "[
   const Model model = load_model(test::write_temp("candidates_chain12.yaml", test::random_chain(12, 5)));
   codegen::GeneratorOptions go;
   go.udot_code = "compact";
+  REQUIRE_FALSE(codegen::generate(model, go).find("udot")->kernels.empty());
   auto e = jit_load(model, codegen::jit_code_generator(go), cache.options());
   CHECK_FALSE(fs::exists(udot_candidate_path(e->library_path(), "compact")));
   const std::string path = udot_candidate_path(e->library_path(), "second");
@@ -212,4 +217,54 @@ TEST_CASE("second_wins: agreeing outputs and a clear margin", "[jit][udot-candid
   r.max_rel_diff = 0;
   r.second_status = 3;  // a pivot the first did not meet
   CHECK_FALSE(second_wins(r));
+}
+
+TEST_CASE("the candidates planned: which code, which compiler, which entry file", "[jit][udot-candidates]") {
+  Manifest m;
+  m.udot_form = "composite";
+  m.udot_code = "straight-line";
+  m.functions.push_back({"udot", 3000});
+  JitOptions o;
+  o.compiler = "g++";
+  o.flags = default_jit_flags();
+  o.dispatch = false;  // the second compiler then builds for the baseline ISA: tags without -v3
+  o.include_dir = "/include";
+  const fs::path tmp = "/tmp/plan", entry = "/src/entry.cpp", compact = "/src/compact/entry.cpp";
+  auto tags = [](const std::vector<UdotCandidate>& cs) {
+    std::vector<std::string> t;
+    for (const UdotCandidate& c : cs) t.push_back(c.tag);
+    return t;
+  };
+  auto builds = [](const UdotCandidate& c, const fs::path& from) {
+    return std::find(c.argv.begin(), c.argv.end(), from.string()) != c.argv.end();
+  };
+  {
+    const SecondCompilerEnv env("clang++");
+    // long straight-line u-dot: clang++'s build of it, and compact code by both compilers
+    const auto cs = plan_udot_candidates(m, o, tmp, entry, compact, "composite");
+    REQUIRE(tags(cs) == std::vector<std::string>{"second", "compact", "compact-second"});
+    CHECK((cs[0].name == "clang++" && cs[0].argv.front() == "clang++" && builds(cs[0], entry) && !builds(cs[0], compact)));
+    CHECK((cs[1].name == "compact" && cs[1].argv.front() == "g++" && builds(cs[1], compact) && !builds(cs[1], entry)));
+    CHECK((cs[2].name == "compact by clang++" && cs[2].argv.front() == "clang++" && builds(cs[2], compact)));
+    for (const UdotCandidate& c : cs) CHECK(c.udot_form == "composite");
+    // compact main code: clang++'s build of that code only
+    Manifest mc = m;
+    mc.udot_code = "compact";
+    mc.udot_form = "articulated";
+    const auto cc = plan_udot_candidates(mc, o, tmp, entry, compact, "articulated");
+    REQUIRE(tags(cc) == std::vector<std::string>{"second"});
+    CHECK(builds(cc[0], entry));
+    // short u-dot, or a quick build: none
+    Manifest ms = m;
+    ms.functions = {{"udot", 1500}};
+    CHECK(plan_udot_candidates(ms, o, tmp, entry, compact, "composite").empty());
+    JitOptions quick = o;
+    quick.quick = true;
+    CHECK(plan_udot_candidates(m, quick, tmp, entry, compact, "composite").empty());
+  }
+  {
+    const SecondCompilerEnv env("none");
+    const auto cs = plan_udot_candidates(m, o, tmp, entry, compact, "composite");
+    CHECK(tags(cs) == std::vector<std::string>{"compact"});
+  }
 }
