@@ -49,7 +49,8 @@ std::string file_stem(const std::string& name) {
   return r.empty() ? std::string("model") : r;
 }
 
-std::optional<LibraryRecord> verified_record(const std::string& so_path) {
+std::optional<LibraryRecord> verified_record(const std::string& so_path,
+                                             const std::function<bool(const LibraryRecord&)>& wanted) {
   std::error_code ec;
   const auto size = fs::file_size(so_path, ec);
   if (ec) return std::nullopt;
@@ -71,7 +72,7 @@ std::optional<LibraryRecord> verified_record(const std::string& so_path) {
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;
   }
-  if (r.size != static_cast<long long>(size)) return std::nullopt;
+  if (r.size != static_cast<long long>(size) || (wanted && !wanted(r))) return std::nullopt;
   if (fnv1a64_hex(read_all(so_path)) != r.checksum) return std::nullopt;
   return r;
 }

@@ -9,6 +9,7 @@
 // a day are removed at the next build.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -37,8 +38,10 @@ std::string record_path(const std::string& so_path);
 std::string file_stem(const std::string& model_name);
 
 /// The record of `so_path` if it exists, parses, and the library's size and
-/// checksum match it; nullopt otherwise (missing, damaged or stale).
-std::optional<LibraryRecord> verified_record(const std::string& so_path);
+/// checksum match it; nullopt otherwise (missing, damaged or stale). `wanted`:
+/// nullopt also for a record it refuses, before the library is read and hashed.
+std::optional<LibraryRecord> verified_record(const std::string& so_path,
+                                             const std::function<bool(const LibraryRecord&)>& wanted = {});
 
 /// The record of a freshly built library file.
 LibraryRecord make_record(const std::string& library_file, const std::string& api_symbol);

@@ -180,10 +180,11 @@ void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::s
   for (const auto& [tag, name] : candidates) {
     if (name.empty()) continue;
     const std::string path = udot_candidate_path(so_path, tag);
-    auto record = jit_cache::verified_record(path);
-    if (!record || record->compiler != name || record->main_checksum != main_checksum ||
-        (!fresh && !record->preferred))
-      continue;
+    // (a cached load hashes only the preferred candidate's library)
+    const auto record = jit_cache::verified_record(path, [&](const jit_cache::LibraryRecord& r) {
+      return r.compiler == name && r.main_checksum == main_checksum && (fresh || r.preferred);
+    });
+    if (!record) continue;
     auto loaded = load_candidate(e, path, record->api_symbol);
     if (!loaded) continue;
     entries.push_back({path, *record, std::move(*loaded), {}});
