@@ -234,8 +234,9 @@ std::vector<CompileStep> plan_compile(const fs::path& entry, const fs::path& out
     for (std::size_t g = 0; g < groups; ++g) {
       auto& argv = grouped[g].argv;
       argv.insert(argv.end(), defines[g].begin(), defines[g].end());
-      const auto o_at = std::find(argv.begin(), argv.end(), "-o");
-      objects.push_back(*(o_at + 1));
+      // its object: after the last -o (the compiler's own words may hold one: "/usr/bin/time -o log c++")
+      const auto o_at = std::find(argv.rbegin(), argv.rend(), std::string("-o"));
+      objects.push_back(*o_at.base());
       grouped[g].cost = work[g];
     }
     steps = std::move(grouped);

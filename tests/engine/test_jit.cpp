@@ -623,6 +623,35 @@ TEST_CASE("a quick build without derivatives is cached apart, a full library, on
   CHECK(c->has_jacobian());
 }
 
+TEST_CASE("a compiler wrapped in a command that takes -o (e.g. /usr/bin/time -o log c++) builds", "[jit]") {
+  const TempCache cache;
+  // the wrapper: `wrap.sh -o LOG compiler args...` notes each call in LOG and runs the rest
+  const fs::path wrapper = cache.dir / "wrap.sh", log = cache.dir / "calls.log";
+  {
+    std::ofstream f(wrapper);
+    f << "#!/bin/sh\n[ \"$1\" = -o ] || exit 9\necho call >> \"$2\"\nshift 2\nexec \"$@\"\n";
+  }
+  fs::permissions(wrapper, fs::perms::owner_all);
+  const Model m = make_handwritten_pendulum();
+  for (const bool quick : {true, false}) {
+    INFO((quick ? "quick" : "optimized") << " build");
+    JitOptions o = cache.options();
+    o.quiet = true;
+    o.quick = quick;
+    o.dispatch = false;
+    o.compiler = fmt::format("{} -o {} c++", wrapper.string(), log.string());
+    const auto e = jit_load(m, codegen::jit_code_generator(), o);
+    GenericEngine generic(m);
+    VecX q(1), u(1), tau = VecX::Zero(1), ue, ug;
+    q << 0.4;
+    u << -0.3;
+    e->udot(q, u, tau, ue);
+    generic.udot(q, u, tau, ug);
+    CHECK(std::abs(ue(0) - ug(0)) <= 1e-14 * std::abs(ug(0)));
+  }
+  CHECK(fs::exists(log));
+}
+
 TEST_CASE("jit_load: editing a joint spring, damper or modal damping ratio reuses the cached library", "[jit]") {
   TempCache cache;
   JitOptions opts = cache.options();
