@@ -48,13 +48,6 @@ std::string env(const char* name) {
   return v ? std::string(v) : std::string();
 }
 
-std::vector<std::string> split_words(const std::string& s) {
-  std::vector<std::string> out;
-  std::istringstream in(s);
-  for (std::string w; in >> w;) out.push_back(w);
-  return out;
-}
-
 std::string shell_quote(const std::string& s) {
   if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=./,:@%") ==
                         std::string::npos)
@@ -497,6 +490,13 @@ std::string default_cache_dir() {
   if (auto d = env("XDG_CACHE_HOME"); !d.empty()) return (fs::path(d) / "kanegen").string();
   if (auto d = env("HOME"); !d.empty()) return (fs::path(d) / ".cache" / "kanegen").string();
   return (fs::temp_directory_path() / "kanegen-cache").string();
+}
+
+std::vector<std::string> split_words(const std::string& s) {
+  std::vector<std::string> out;
+  std::istringstream in(s);
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
 }
 
 std::string default_jit_flags() { return "-O2 -std=c++20 -fPIC -shared"; }

@@ -73,6 +73,9 @@ struct JitOptions {
 std::string default_cache_dir();
 /// "-O2 -std=c++20 -fPIC -shared"
 std::string default_jit_flags();
+
+/// The whitespace-separated words of a compiler or flags string ("ccache g++" -> {"ccache", "g++"}).
+std::vector<std::string> split_words(const std::string& s);
 /// JitOptions with every empty field replaced by its default (and quick set by $KANEGEN_JIT_QUICK=1).
 JitOptions resolved(const JitOptions& opts);
 

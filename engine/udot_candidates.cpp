@@ -23,13 +23,6 @@ namespace {
 /// clang's (chain_4: faster) and as compact code (docs/decisions.md).
 constexpr long kCandidateMinOps = 2000;
 
-std::vector<std::string> words(const std::string& s) {
-  std::vector<std::string> out;
-  std::istringstream in(s);
-  for (std::string w; in >> w;) out.push_back(w);
-  return out;
-}
-
 /// The executable `name` on $PATH, or empty.
 std::string on_path(const std::string& name) {
   const char* path = std::getenv("PATH");
@@ -105,7 +98,7 @@ std::optional<LoadedCandidate> load_candidate(const GeneratedEngine& e, const st
 
 std::string second_compiler(const JitOptions& o) {
   if (!optimized_default_build(o)) return {};
-  for (const std::string& w : words(o.compiler))
+  for (const std::string& w : split_words(o.compiler))
     if (fs::path(w).filename().string().find("clang") != std::string::npos) return {};
   const char* chosen = std::getenv("KANEGEN_SECOND_CXX");
   if (chosen && std::string(chosen) == "none") return {};
@@ -126,7 +119,7 @@ std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const 
   // the second compiler, for the instruction set the main library's u-dot runs at on this CPU
   auto by_second = [&](std::string name, std::string tag, const std::string& form, const fs::path& from,
                        const fs::path& so) {
-    UdotCandidate c{std::move(name), std::move(tag), form, words(second), so};
+    UdotCandidate c{std::move(name), std::move(tag), form, split_words(second), so};
     for (const char* f : {"-O2", "-std=c++20", "-fPIC", "-shared", "-fno-math-errno"}) c.argv.emplace_back(f);
     if (o.native) c.argv.emplace_back("-march=native");
     if (second_at_v3(o)) c.argv.emplace_back("-march=x86-64-v3");
@@ -137,8 +130,8 @@ std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const 
   if (!second.empty()) by_second(second, second_tag(o), manifest.udot_form, entry, tmp / "udot-second.so");
   if (!compact_entry.empty() && long_straight_line(manifest)) {
     // the main compiler at the main library's flags (its AVX2 clone too)
-    UdotCandidate c{"compact", "compact", compact_form, words(o.compiler), tmp / "udot-compact.so"};
-    for (const std::string& f : words(o.flags)) c.argv.push_back(f);
+    UdotCandidate c{"compact", "compact", compact_form, split_words(o.compiler), tmp / "udot-compact.so"};
+    for (const std::string& f : split_words(o.flags)) c.argv.push_back(f);
     if (o.native) c.argv.emplace_back("-march=native");
     if (!o.dispatch) c.argv.emplace_back("-DKANEGEN_NO_DISPATCH");
     udot_alone(c.argv, manifest, o, compact_entry, c.out);
