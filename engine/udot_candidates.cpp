@@ -185,9 +185,13 @@ void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::s
   if (entries.empty()) return;
   Entry* served = nullptr;
   if (fresh) {
-    const State s = initial_state(model);
-    for (Entry& en : entries) {
-      en.race = race_udot(e, e.udot_function(), en.loaded.udot, s);
+    // the library's own u-dot and every candidate in one race (engine/udot_race.hpp)
+    std::vector<KanegenFunctionPtr> fns{e.udot_function()};
+    for (const Entry& en : entries) fns.push_back(en.loaded.udot);
+    const std::vector<UdotRace> races = race_udots(e, fns, initial_state(model));
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      Entry& en = entries[k];
+      en.race = races[k];
       if (second_wins(en.race) && (!served || en.race.second_ns < served->race.second_ns)) served = &en;
     }
     std::string said;

@@ -32,42 +32,56 @@ double slice_ns(const std::function<void()>& call, long n) {
 
 UdotRace race_udot(const GeneratedEngine& engine, KanegenFunctionPtr first, KanegenFunctionPtr second,
                    const State& s, int rounds, double slice_us) {
+  return race_udots(engine, {first, second}, s, rounds, slice_us).front();
+}
+
+std::vector<UdotRace> race_udots(const GeneratedEngine& engine, const std::vector<KanegenFunctionPtr>& fns,
+                                 const State& s, int rounds, double slice_us) {
+  const std::size_t n_fns = fns.size();
+  if (n_fns < 2) return {};
   const int nu = engine.model().nu;
-  std::vector<double> out1(static_cast<std::size_t>(std::max(nu, 1))), out2(out1.size());
-  UdotRace r;
+  const std::size_t n_out = static_cast<std::size_t>(std::max(nu, 1));
+  std::vector<UdotRace> races(n_fns - 1);
   // agreement at the state and at one with every speed and input moved (a body at rest with no inputs has
-  // u-dot 0 from nearly any code), relative to the largest entry of either
+  // u-dot 0 from nearly any code), relative to the largest entry of the reference's
   State moved = s;
   for (int i = 0; i < nu; ++i) moved.u(i) += 0.1 * (1 + i % 3), moved.tau(i) += 0.05 * (1 + i % 2);
-  std::vector<double> a[2], b[2];
+  std::vector<std::vector<double>> out(n_fns, std::vector<double>(n_out));
+  std::vector<std::vector<double>> by[2];
   double scale = 1e-300;
   for (int k = 0; k < 2; ++k) {
     const State& at = k == 0 ? s : moved;
-    a[k].resize(out1.size()), b[k].resize(out1.size());
-    const int st1 = engine.call_udot(first, at.t, at.q, at.u, at.tau, a[k].data());
-    const int st2 = engine.call_udot(second, at.t, at.q, at.u, at.tau, b[k].data());
-    if (k == 0) r.first_status = st1, r.second_status = st2;
-    for (int i = 0; i < nu; ++i) scale = std::max(scale, std::abs(a[k][static_cast<std::size_t>(i)]));
+    by[k].assign(n_fns, std::vector<double>(n_out));
+    for (std::size_t f = 0; f < n_fns; ++f) {
+      const int status = engine.call_udot(fns[f], at.t, at.q, at.u, at.tau, by[k][f].data());
+      if (k == 0 && f == 0)
+        for (UdotRace& r : races) r.first_status = status;
+      else if (k == 0)
+        races[f - 1].second_status = status;
+      for (int i = 0; i < nu; ++i) scale = std::max(scale, std::abs(by[k][f][static_cast<std::size_t>(i)]));
+    }
   }
   for (int k = 0; k < 2; ++k)
-    for (int i = 0; i < nu; ++i) {
-      const double d = std::abs(a[k][static_cast<std::size_t>(i)] - b[k][static_cast<std::size_t>(i)]) / scale;
-      r.max_rel_diff = std::max(r.max_rel_diff, std::isnan(d) ? std::numeric_limits<double>::infinity() : d);
-    }
-  const std::function<void()> calls[2] = {
-      [&] { engine.call_udot(first, s.t, s.q, s.u, s.tau, out1.data()); },
-      [&] { engine.call_udot(second, s.t, s.q, s.u, s.tau, out2.data()); }};
-  const long n[2] = {calls_per_slice(calls[0], slice_us), calls_per_slice(calls[1], slice_us)};
-  double best[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    for (std::size_t f = 1; f < n_fns; ++f)
+      for (std::size_t i = 0; i < static_cast<std::size_t>(nu); ++i) {
+        const double d = std::abs(by[k][0][i] - by[k][f][i]) / scale;
+        UdotRace& r = races[f - 1];
+        r.max_rel_diff = std::max(r.max_rel_diff, std::isnan(d) ? std::numeric_limits<double>::infinity() : d);
+      }
+  std::vector<std::function<void()>> calls;
+  for (std::size_t f = 0; f < n_fns; ++f)
+    calls.emplace_back([&, f] { engine.call_udot(fns[f], s.t, s.q, s.u, s.tau, out[f].data()); });
+  std::vector<long> n;
+  for (const auto& c : calls) n.push_back(calls_per_slice(c, slice_us));
+  std::vector<double> best(n_fns, std::numeric_limits<double>::infinity());
   for (int k = 0; k < rounds; ++k)
-    for (int which = 0; which < 2; ++which) {
-      // alternate which goes first, so that neither always follows the other
-      const int f = (k % 2 == 0) ? which : 1 - which;
+    for (std::size_t which = 0; which < n_fns; ++which) {
+      // the order turned by one each round, so that none always follows the same other
+      const std::size_t f = (which + static_cast<std::size_t>(k)) % n_fns;
       best[f] = std::min(best[f], slice_ns(calls[f], n[f]));
     }
-  r.first_ns = best[0];
-  r.second_ns = best[1];
-  return r;
+  for (std::size_t f = 1; f < n_fns; ++f) races[f - 1].first_ns = best[0], races[f - 1].second_ns = best[f];
+  return races;
 }
 
 bool second_wins(const UdotRace& r, double tol, double margin) {

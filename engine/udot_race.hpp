@@ -5,6 +5,8 @@
 #pragma once
 
 #include "engine/generated_engine.hpp"
+#include <vector>
+
 #include "model/state_io.hpp"
 
 namespace kanegen {
@@ -21,6 +23,13 @@ struct UdotRace {
 /// at `state`, interleaved: `rounds` slices of about `slice_us` microseconds each per function.
 UdotRace race_udot(const GeneratedEngine& engine, KanegenFunctionPtr first, KanegenFunctionPtr second,
                    const State& state, int rounds = 9, double slice_us = 300);
+
+/// Times `fns[0]` (the reference, e.g. the library's own u-dot) and every other of `fns` in ONE race: each
+/// round times a slice of every function, in an order turned by one each round, so that a spell of load on
+/// the machine falls on all of them alike (pairwise races each against the reference, one after the other,
+/// let a spell during one of them pick the wrong winner). Entry i-1 of the result is fns[i] against fns[0].
+std::vector<UdotRace> race_udots(const GeneratedEngine& engine, const std::vector<KanegenFunctionPtr>& fns,
+                                 const State& state, int rounds = 21, double slice_us = 300);
 
 /// Whether the second of a race is worth using: its outputs agree with the first's to `tol` (relative)
 /// and it is faster by more than `margin` (0.05: 5 %), so that noise does not flip the choice.

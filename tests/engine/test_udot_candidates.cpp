@@ -204,6 +204,50 @@ TEST_CASE("compact u-dot is raced against the second compiler's build of it", "[
   }
 }
 
+namespace {
+KanegenFunctionPtr g_real_udot = nullptr;
+/// the real u-dot done eight times over: the same output, eight times the work
+int udot_eight_times(const KanegenArgs* a, double* out) {
+  int status = 0;
+  for (int k = 0; k < 8; ++k) status = g_real_udot(a, out);
+  return status;
+}
+/// the real u-dot with its first entry off by 1e-3 of the largest
+int udot_off(const KanegenArgs* a, double* out) {
+  const int status = g_real_udot(a, out);
+  out[0] += 1e-3 * (1 + std::abs(out[0]));
+  return status;
+}
+}  // namespace
+
+TEST_CASE("race_udots: every candidate against the reference in one race", "[jit][udot-candidates]") {
+  const SecondCompilerCache cache;
+  const SecondCompilerEnv env("none");
+  const Model model = load_model(test::source_path("models/double_pendulum.yaml"));
+  auto e = jit_load(model, codegen::jit_code_generator(), cache.options());
+  g_real_udot = e->udot_function();
+  State s = initial_state(model);
+  s.u(0) = 0.7, s.u(1) = -0.4;
+  const std::vector<UdotRace> races = race_udots(*e, {g_real_udot, g_real_udot, udot_eight_times, udot_off}, s);
+  REQUIRE(races.size() == 3);
+  for (const UdotRace& r : races) {
+    CHECK(r.first_status == 0);
+    CHECK(r.second_status == 0);
+    CHECK(r.first_ns == races.front().first_ns);  // one reference time for all
+    CHECK(r.first_ns > 0);
+  }
+  CHECK(races[0].max_rel_diff == 0);  // itself
+  CHECK(races[1].max_rel_diff == 0);  // the same output, eight times the work: ranked slower
+  CHECK(races[1].second_ns > 2 * races[1].first_ns);
+  CHECK_FALSE(second_wins(races[1]));
+  CHECK(races[2].max_rel_diff > 1e-4);  // another output: never served
+  CHECK_FALSE(second_wins(races[2]));
+  // the pairwise race is the two-function case of the same
+  const UdotRace pair = race_udot(*e, g_real_udot, udot_off, s);
+  CHECK(pair.max_rel_diff == races[2].max_rel_diff);
+  CHECK(race_udots(*e, {g_real_udot}, s).empty());
+}
+
 TEST_CASE("second_wins: agreeing outputs and a clear margin", "[jit][udot-candidates]") {
   UdotRace r;
   r.first_ns = 1000;
