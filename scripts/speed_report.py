@@ -75,21 +75,48 @@ def least_of_runs(runs):
     return j
 
 
-def peer_udot(bindir, model, quick, rows):
+def peer_processes(bindir, models, quick):
+    """The MuJoCo peer's processes of every model, PEER_PROCESSES passes over the models (one process of each
+    model per pass): MuJoCo's time (and ours) moves between processes by up to 1.5x (code and data placement),
+    more than within one, and the machine's load comes in spells of minutes; passes spread each model's
+    processes over the whole run, so that one spell does not fall on all of one model's processes (run back
+    to back, bus_4's three gave 396-410 ns in the report at 7dd69f5, 255-265 in three of four processes
+    rerun alone). Returns {model path: ([parsed outputs], last stderr)}; a model whose process fails is not run
+    again."""
+    out = {m: ([], "") for m in models}
+    mj = os.path.join(bindir, "kanegen_peer_mujoco")
+    if not os.path.exists(mj):
+        return out
+    failed = set()
+    for _ in range(1 if quick else PEER_PROCESSES):
+        for m in models:
+            if m in failed:
+                continue
+            code, o, err = run([mj, m, "--kanegen", "--native", "--rounds", "11" if quick else "31"])
+            if code != 0:
+                failed.add(m)
+                out[m] = (out[m][0], err)
+                continue
+            out[m] = (out[m][0] + [json.loads(o)], err)
+    return out
+
+
+def peer_udot_rows(bindir, models, quick):
+    """One row per model: the peer's processes (peer_processes), then Simbody's."""
+    procs = peer_processes(bindir, models, quick)
+    rows = []
+    for m in models:
+        peer_udot(bindir, m, quick, rows, procs[m])
+    return rows
+
+
+def peer_udot(bindir, model, quick, rows, processes):
     name = os.path.splitext(os.path.basename(model))[0]
     ops, form = udot_ops(os.path.join(bindir, "kanegen"), model)
     row = dict(model=name, ops=ops, form=form, floor=floor_ops(model))
     mj = os.path.join(bindir, "kanegen_peer_mujoco")
     if os.path.exists(mj):
-        # PEER_PROCESSES processes: MuJoCo's time (and ours) moves between processes by up to 1.5x (code and
-        # data placement), more than within one; the least of each engine over all of them is what a rerun can
-        # reproduce, and the ratio of each process is kept to show the spread
-        runs = []
-        for _ in range(1 if quick else PEER_PROCESSES):
-            code, out, err = run([mj, model, "--kanegen", "--native", "--rounds", "11" if quick else "31"])
-            if code != 0:
-                break
-            runs.append(json.loads(out))
+        runs, err = processes
         if runs:
             j = least_of_runs(runs)
             row["process_ratios"] = [r["min_ns_mujoco"] / r["min_ns_generated_baseline"] for r in runs
@@ -176,8 +203,9 @@ def udot_section(rows, provenance):
           "-O2 gets; the headline ratio), at the JIT's default flags (*dispatched*: an AVX2 clone picked at load "
           "time on this CPU) and with `--native` (`-march=native`), kanegen's generic engine and MuJoCo 2.2's "
           "`mj_forward` interleaved in one process; Simbody 3.7 (`realize` to Acceleration) in its own process "
-          "right after (its median). Each model's peer runs in 3 processes (1 with --quick): MuJoCo's time and ours "
-          "move between processes by up to 1.5x (code and data placement), more than within one; the times are the "
+          "afterwards (its median). Each model's peer runs in 3 processes (1 with --quick), one per pass over all the "
+          "models, so that a spell of load on the machine does not fall on all of one model's processes: MuJoCo's "
+          "time and ours move between processes by up to 1.5x (code and data placement), more than within one; the times are the "
           "least over the processes, the ratio their quotient, *per process* the range of the processes' own "
           "ratios. *baseline* and *dispatched* name the u-dot served where it is not the library's own (g++'s "
           "straight-line code): the JIT builds a long straight-line u-dot also with clang++ and as compact code, "
@@ -555,11 +583,8 @@ def main():
         work = tempfile.mkdtemp(prefix="kanegen_speed_")
         load_before = loadavg()
         print("u-dot against the peers", file=sys.stderr)
-        rows = []
-        for m in udot_models(work):
-            if a.models and os.path.splitext(os.path.basename(m))[0] not in a.models.split(","):
-                continue
-            peer_udot(bindir, m, a.quick, rows)
+        rows = peer_udot_rows(bindir, [m for m in udot_models(work) if not a.models or
+                                       os.path.splitext(os.path.basename(m))[0] in a.models.split(",")], a.quick)
         shutil.rmtree(work, ignore_errors=True)
         provenance = (f"*This section: `/usr/bin/python3 scripts/speed_report.py --only udot"
                       f"{' --quick' if a.quick else ''}` on {datetime.datetime.now():%Y-%m-%d %H:%M} (commit {commit}"
@@ -599,9 +624,7 @@ def main():
         chain128 = os.path.join(work, "chain_128.yaml")
         run([sys.executable, os.path.join(ROOT, "scripts", "make_bench_chain.py"), "128", "--seed", "1", "-o", chain128])
         print("u-dot against the peers", file=sys.stderr)
-        rows = []
-        for m in udot_models(work):
-            peer_udot(bindir, m, a.quick, rows)
+        rows = peer_udot_rows(bindir, udot_models(work), a.quick)
         print("work-precision", file=sys.stderr)
         img = os.path.join(ROOT, "docs", "img", "speed_work_precision.png")
         wp, wp_err = work_precision(bindir, img)
