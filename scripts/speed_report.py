@@ -88,16 +88,22 @@ def peer_processes(bindir, models, quick):
     if not os.path.exists(mj):
         return out
     failed = set()
+    # an empty JIT cache, as an outside rerun starts with: the first process of a model builds its libraries
+    # and races the u-dot candidates (engine/udot_candidates.hpp), the later ones load what that race chose
+    # (a user's cache could hold the choice of an older race, or of a busier moment)
+    cache = tempfile.mkdtemp(prefix="kanegen_speed_cache_")
+    env = dict(os.environ, KANEGEN_CACHE_DIR=cache)
     for _ in range(1 if quick else PEER_PROCESSES):
         for m in models:
             if m in failed:
                 continue
-            code, o, err = run([mj, m, "--kanegen", "--native", "--rounds", "11" if quick else "31"])
+            code, o, err = run([mj, m, "--kanegen", "--native", "--rounds", "11" if quick else "31"], env=env)
             if code != 0:
                 failed.add(m)
                 out[m] = (out[m][0], err)
                 continue
             out[m] = (out[m][0] + [json.loads(o)], err)
+    shutil.rmtree(cache, ignore_errors=True)
     return out
 
 
@@ -203,7 +209,8 @@ def udot_section(rows, provenance):
           "-O2 gets; the headline ratio), at the JIT's default flags (*dispatched*: an AVX2 clone picked at load "
           "time on this CPU) and with `--native` (`-march=native`), kanegen's generic engine and MuJoCo 2.2's "
           "`mj_forward` interleaved in one process; Simbody 3.7 (`realize` to Acceleration) in its own process "
-          "afterwards (its median). Each model's peer runs in 3 processes (1 with --quick), one per pass over all the "
+          "afterwards (its median). The JIT cache starts empty, as an outside rerun's: a model's first process builds "
+          "its libraries and races the u-dot candidates, the later ones load the choice. Each model's peer runs in 3 processes (1 with --quick), one per pass over all the "
           "models, so that a spell of load on the machine does not fall on all of one model's processes: MuJoCo's "
           "time and ours move between processes by up to 1.5x (code and data placement), more than within one; the times are the "
           "least over the processes, the ratio their quotient, *per process* the range of the processes' own "
