@@ -28,13 +28,16 @@ struct GeneratorOptions {
   std::string udot_code = "auto";
 };
 
-/// The cost model of udot_code "auto", from the speed report (docs/speed.md, "Compact code"): straight-line
-/// code runs at ~0.15 ns per operation while it fits the 32 KB instruction cache and at ~0.24 beyond it;
-/// compact code at ~0.18 once bodies share kernels. Measured at the baseline ISA: chain_16 (8,362 operations,
-/// 11 kernels for 46 calls) 1.35x faster compact, tree_15 (5,167, 28 kernels for 38 calls) 1.07x, chain_8
-/// (3,281) 0.96x, bus_4 (1,681) 0.90x.
-inline constexpr long kCompactAboveOps = 6000;
-inline constexpr double kCompactShare = 0.5;
+/// The cost model of udot_code "auto", measured at the baseline ISA (g++ -O2, what a harness compiling the
+/// header gets; docs/decisions.md, "Compact code from 2,000 operations"): compact code, addressed by constant
+/// offsets, beats straight-line code from about 2,000 operations once some of its code is shared: chain_8
+/// (2,917 operations, kernels 82 % of them) 514-528 ns against 638-652, tree_15 (4,885, 90 %) 1,021-1,043
+/// against 1,172, chain_16 1.35x; where nothing is shared it does not pay: explorer1 (6,503, 100 %) 1,310-1,336
+/// against 1,232-1,252, spacecraft_arrays (15,019, 100 %) 3,153-3,224 against 2,974-3,017,
+/// flexible_spacecraft (8,488, 93 %) 1,808-1,836 against 1,770-1,817; chain_4 (903) 156 against 128.
+/// The JIT races the other code beside it (engine/udot_candidates.hpp).
+inline constexpr long kCompactAboveOps = 2000;
+inline constexpr double kCompactShare = 0.9;
 
 EmittedModel generate(const Model& model, const GeneratorOptions& options = {});
 

@@ -21,6 +21,9 @@ CodeGenerator jit_code_generator(const GeneratorOptions& options) {
     GeneratorOptions compact = options;
     compact.udot_code = "compact";
     g.generate_compact_udot = sources_with(compact);
+    GeneratorOptions straight = options;
+    straight.udot_code = "straight-line";
+    g.generate_straight_udot = sources_with(straight);
   }
   return g;
 }

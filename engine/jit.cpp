@@ -290,10 +290,10 @@ int run_steps(const std::vector<CompileStep>& steps, const std::string& log_path
 
 /// Compiles `sources` in a private temp dir beside so_path and publishes the
 /// library and its record (jit_cache.hpp), and the u-dot candidates beside
-/// it (udot_candidates.hpp; `compact`: the sources with compact u-dot, if any)
+/// it (udot_candidates.hpp; `other`: the sources with u-dot in the other code, if any)
 /// that build.
 void build_library(const GeneratedSources& sources, const Manifest& manifest, const fs::path& so_path,
-                   const JitOptions& o, const std::optional<GeneratedSources>& compact = std::nullopt) {
+                   const JitOptions& o, const std::optional<GeneratedSources>& other = std::nullopt) {
   const fs::path dir = so_path.parent_path().empty() ? fs::path(".") : so_path.parent_path();
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -335,16 +335,16 @@ void build_library(const GeneratedSources& sources, const Manifest& manifest, co
   }
   const auto t0 = std::chrono::steady_clock::now();
   // the u-dot candidates are built alongside; one that fails is left out
-  fs::path compact_entry;
-  if (compact) {
-    fs::create_directories(tmp / "compact");
-    write_file(tmp / "compact" / "model.hpp", compact->header);
-    write_file(tmp / "compact" / "entry.cpp", compact->entry);
-    compact_entry = tmp / "compact" / "entry.cpp";
+  fs::path other_entry;
+  if (other) {
+    fs::create_directories(tmp / "other");
+    write_file(tmp / "other" / "model.hpp", other->header);
+    write_file(tmp / "other" / "entry.cpp", other->entry);
+    other_entry = tmp / "other" / "entry.cpp";
   }
   const std::vector<UdotCandidate> candidates = plan_udot_candidates(
-      manifest, o, tmp, entry_path, compact_entry,
-      compact ? parse_manifest(compact->manifest, "compact manifest of " + manifest.model).udot_form : std::string());
+      manifest, o, tmp, entry_path, other_entry,
+      other ? parse_manifest(other->manifest, "other code's manifest of " + manifest.model).udot_form : std::string());
   std::vector<int> candidate_status(candidates.size(), -1);
   std::vector<std::string> candidate_error(candidates.size());
   std::vector<std::jthread> candidate_builds;  // joined on every way out, before `cleanup` removes tmp
@@ -444,13 +444,14 @@ std::unique_ptr<GeneratedEngine> open_library(const Model& model, const std::str
 
 /// Loads so_path when its record verifies; otherwise builds it from the sources
 /// `make_sources()` gives (called only then), with the u-dot candidates
-/// (`make_compact()`: the sources with compact u-dot, or null), and loads the result.
+/// (`make_other(code)`: the sources with u-dot in `code`, "compact" or "straight-line", or null), and loads
+/// the result.
 template <class MakeSources>
 std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::string& so_path,
                                                const std::string& generator_hash, const JitOptions& o,
                                                MakeSources make_sources,
                                                const std::vector<RuntimeParameter>& implicit = {},
-                                               const std::function<GeneratedSources()>& make_compact = {}) {
+                                               const std::function<GeneratedSources(const std::string&)>& make_other = {}) {
   if (const auto record = jit_cache::verified_record(so_path)) {
     if (announce(o)) fmt::print(stderr, "kanegen: generated code for {} from the cache ({})\n", model.name, so_path);
     auto e = open_library(model, so_path, *record, generator_hash, implicit);
@@ -463,19 +464,19 @@ std::unique_ptr<GeneratedEngine> load_or_build(const Model& model, const std::st
     fmt::print(stderr, "kanegen: generated the equations of {} in {:.1f} s\n", model.name,
                std::chrono::duration<double>(std::chrono::steady_clock::now() - t_gen).count());
   const Manifest manifest = parse_manifest(sources.manifest, "generated manifest of " + model.name);
-  std::optional<GeneratedSources> compact;
-  if (make_compact && compact_candidate_wanted(manifest, o)) {
-    const auto t_compact = std::chrono::steady_clock::now();
+  std::optional<GeneratedSources> other;
+  if (const std::string code = other_udot_code(manifest, o); make_other && !code.empty()) {
+    const auto t_other = std::chrono::steady_clock::now();
     try {
-      compact = make_compact();
+      other = make_other(code);
     } catch (const std::exception& ex) {  // a candidate, not the library: left out
-      if (o.verbose) fmt::print(stderr, "kanegen: compact u-dot of {} not generated ({}); left out\n", model.name, ex.what());
+      if (o.verbose) fmt::print(stderr, "kanegen: {} u-dot of {} not generated ({}); left out\n", code, model.name, ex.what());
     }
-    if (compact && announce(o))
-      fmt::print(stderr, "kanegen: generated {}'s u-dot as compact code too, to race it, in {:.1f} s\n", model.name,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t_compact).count());
+    if (other && announce(o))
+      fmt::print(stderr, "kanegen: generated {}'s u-dot as {} code too, to race it, in {:.1f} s\n", model.name, code,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t_other).count());
   }
-  build_library(sources, manifest, so_path, o, compact);
+  build_library(sources, manifest, so_path, o, other);
   const auto record = jit_cache::verified_record(so_path);
   if (!record) throw std::runtime_error(fmt::format("kanegen: the library just built at {} does not verify", so_path));
   auto e = open_library(model, so_path, *record, generator_hash, implicit);
@@ -583,9 +584,14 @@ std::unique_ptr<GeneratedEngine> jit_load(const Model& model, const CodeGenerato
   const std::vector<RuntimeParameter> implicit =
       o.implicit_parameters ? implicit_parameters(model) : std::vector<RuntimeParameter>{};
   const Model& m = implicit.empty() ? model : with_parameters(model, implicit);
-  std::function<GeneratedSources()> compact;
-  if (generator.generate_compact_udot) compact = [&] { return generator.generate_compact_udot(m); };
-  return load_or_build(model, so_path, generator.hash, o, [&] { return generator.generate(m); }, implicit, compact);
+  std::function<GeneratedSources(const std::string&)> other;
+  if (generator.generate_compact_udot || generator.generate_straight_udot)
+    other = [&](const std::string& code) {
+      const auto& make = code == "compact" ? generator.generate_compact_udot : generator.generate_straight_udot;
+      if (!make) throw std::runtime_error("the generator has no " + code + " u-dot");
+      return make(m);
+    };
+  return load_or_build(model, so_path, generator.hash, o, [&] { return generator.generate(m); }, implicit, other);
 }
 
 }  // namespace kanegen

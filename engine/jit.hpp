@@ -30,6 +30,9 @@ struct CodeGenerator {
   /// The model's code with u-dot as compact code, which the JIT races against a straight-line u-dot
   /// (udot_candidates.hpp); empty: none.
   std::function<GeneratedSources(const Model&)> generate_compact_udot;
+  /// The model's code with u-dot as straight-line code, which the JIT races against a compact u-dot of
+  /// at most 6,000 operations; empty: none.
+  std::function<GeneratedSources(const Model&)> generate_straight_udot;
 };
 
 struct JitOptions {

@@ -23,6 +23,11 @@ namespace {
 /// clang's (chain_4: faster) and as compact code (docs/decisions.md).
 constexpr long kCandidateMinOps = 2000;
 
+/// Compact u-dot of at most this many operations is raced against straight-line code: near the generator's
+/// threshold (codegen/generator.hpp), AVX2 straight-line code can be faster (chain_8's by clang++ 408 ns against
+/// compact 480); beyond it compact code won on every model measured (chain_16 1.35x at the baseline ISA).
+constexpr long kStraightCandidateMaxOps = 6000;
+
 /// The executable `name` on $PATH, or empty.
 std::string on_path(const std::string& name) {
   const char* path = std::getenv("PATH");
@@ -59,10 +64,16 @@ bool long_udot(const Manifest& manifest) {
   return udot && udot->ops >= kCandidateMinOps;
 }
 
-bool long_straight_line(const Manifest& manifest) { return long_udot(manifest) && manifest.udot_code == "straight-line"; }
+/// The other code's candidates, by the main compiler and the second: tags and names.
+struct OtherCodeNames {
+  std::string tag, name, second_tag, second_name_prefix;
+};
 
-/// The file tag of compact code by the second compiler on this CPU (as second_tag).
-std::string compact_second_tag(const JitOptions& o) { return second_at_v3(o) ? "compact-second-v3" : "compact-second"; }
+OtherCodeNames other_code_names(const std::string& code, const JitOptions& o) {
+  const std::string v3 = second_at_v3(o) ? "-v3" : "";
+  if (code == "compact") return {"compact", "compact", "compact-second" + v3, "compact by "};
+  return {"straight", "straight-line", "straight-second" + v3, "straight-line by "};
+}
 
 /// The command's tail that builds a library of u-dot alone from `entry` (its table lists only u-dot).
 void udot_alone(std::vector<std::string>& argv, const Manifest& manifest, const JitOptions& o, const fs::path& entry,
@@ -106,13 +117,16 @@ std::string second_compiler(const JitOptions& o) {
   return on_path("clang++").empty() ? std::string() : std::string("clang++");
 }
 
-bool compact_candidate_wanted(const Manifest& manifest, const JitOptions& o) {
-  return optimized_default_build(o) && long_straight_line(manifest);
+std::string other_udot_code(const Manifest& manifest, const JitOptions& o) {
+  if (!optimized_default_build(o) || !long_udot(manifest)) return {};
+  if (manifest.udot_code == "straight-line") return "compact";
+  if (manifest.udot_code == "compact" && manifest.find("udot")->ops <= kStraightCandidateMaxOps) return "straight-line";
+  return {};
 }
 
 std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const JitOptions& o, const fs::path& tmp,
-                                                const fs::path& entry, const fs::path& compact_entry,
-                                                const std::string& compact_form) {
+                                                const fs::path& entry, const fs::path& other_entry,
+                                                const std::string& other_form) {
   std::vector<UdotCandidate> out;
   if (!optimized_default_build(o) || !long_udot(manifest)) return out;
   const std::string second = second_compiler(o);
@@ -128,17 +142,19 @@ std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const 
     out.push_back(std::move(c));
   };
   if (!second.empty()) by_second(second, second_tag(o), manifest.udot_form, entry, tmp / "udot-second.so");
-  if (!compact_entry.empty() && long_straight_line(manifest)) {
+  const std::string other = other_udot_code(manifest, o);
+  if (!other_entry.empty() && !other.empty()) {
+    const OtherCodeNames n = other_code_names(other, o);
     // the main compiler at the main library's flags (its AVX2 clone too)
-    UdotCandidate c{"compact", "compact", compact_form, split_words(o.compiler), tmp / "udot-compact.so"};
+    UdotCandidate c{n.name, n.tag, other_form, split_words(o.compiler), tmp / ("udot-" + n.tag + ".so")};
     for (const std::string& f : split_words(o.flags)) c.argv.push_back(f);
     if (o.native) c.argv.emplace_back("-march=native");
     if (!o.dispatch) c.argv.emplace_back("-DKANEGEN_NO_DISPATCH");
-    udot_alone(c.argv, manifest, o, compact_entry, c.out);
+    udot_alone(c.argv, manifest, o, other_entry, c.out);
     out.push_back(std::move(c));
     if (!second.empty())
-      by_second("compact by " + second, compact_second_tag(o), compact_form, compact_entry,
-                tmp / "udot-compact-second.so");
+      by_second(n.second_name_prefix + second, n.second_tag, other_form, other_entry,
+                tmp / ("udot-" + n.tag + "-second.so"));
   }
   return out;
 }
@@ -150,7 +166,8 @@ std::string udot_candidate_path(const std::string& so_path, const std::string& t
 }
 
 void remove_udot_candidates(const std::string& so_path) {
-  for (const char* tag : {"second", "second-v3", "compact", "compact-second", "compact-second-v3"}) {
+  for (const char* tag : {"second", "second-v3", "compact", "compact-second", "compact-second-v3", "straight",
+                          "straight-second", "straight-second-v3"}) {
     const std::string path = udot_candidate_path(so_path, tag);
     std::error_code ec;
     fs::remove(jit_cache::record_path(path), ec);  // the record first: a library without one is never loaded
@@ -168,8 +185,12 @@ void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::s
   };
   std::vector<Entry> entries;
   const std::string second = second_compiler(o);
-  const std::vector<std::pair<std::string, std::string>> candidates = {
-      {second_tag(o), second}, {"compact", "compact"}, {compact_second_tag(o), second.empty() ? "" : "compact by " + second}};
+  std::vector<std::pair<std::string, std::string>> candidates = {{second_tag(o), second}};
+  for (const char* code : {"compact", "straight-line"}) {
+    const OtherCodeNames n = other_code_names(code, o);
+    candidates.emplace_back(n.tag, n.name);
+    candidates.emplace_back(n.second_tag, second.empty() ? "" : n.second_name_prefix + second);
+  }
   for (const auto& [tag, name] : candidates) {
     if (name.empty()) continue;
     const std::string path = udot_candidate_path(so_path, tag);

@@ -7,10 +7,12 @@
 //     operations into SSE2 instructions, its code is smaller), and which is
 //     faster varies by model (on compact code too: chain_8's ran 5 % faster
 //     by clang++, chain_16's 4 % slower);
-//   - u-dot as compact code (kernels shared by bodies of one shape,
-//     codegen/outlined_code.hpp) in the main code's form, by each compiler,
-//     where the generator's cost model chose straight-line code near the
-//     instruction cache's size.
+//   - u-dot as the other code, by each compiler, in the main code's form:
+//     compact code (kernels shared by bodies of one shape,
+//     codegen/outlined_code.hpp) where the generator's cost model chose
+//     straight-line code, straight-line code where it chose compact code of
+//     at most 6,000 operations (near the cost model's threshold the
+//     instruction set decides: AVX2 straight-line code can be the faster).
 // Each is a library of u-dot alone, <stem>-<key>.udot-<tag>.so, with a cache
 // record that keeps the race's outcome; a later load serves what it says.
 #pragma once
@@ -26,10 +28,11 @@
 namespace kanegen {
 
 struct UdotCandidate {
-  /// what it is, for reports and its record: the second compiler, "compact", or "compact by " the second compiler
+  /// what it is, for reports and its record: the second compiler, "compact", "compact by " the second
+  /// compiler, "straight-line" or "straight-line by " the second compiler
   std::string name;
   /// its file: <stem>-<key>.udot-<tag>.so ("second", or "second-v3" when built for AVX2; "compact";
-  /// "compact-second", or "compact-second-v3")
+  /// "compact-second", or "compact-second-v3"; "straight"; "straight-second", or "straight-second-v3")
   std::string tag;
   std::string udot_form;           ///< its u-dot form (the main library's, or the compact code's)
   std::vector<std::string> argv;   ///< one command that compiles and links it
@@ -40,16 +43,18 @@ struct UdotCandidate {
 /// when it is on the PATH; only for optimized builds at the default flags by a main compiler not clang.
 std::string second_compiler(const JitOptions& o);
 
-/// Whether the JIT should generate the model's code with compact u-dot to race it: the library's u-dot is one
-/// straight-line function of at least 2,000 operations, the build is optimized at the default flags.
-bool compact_candidate_wanted(const Manifest& manifest, const JitOptions& o);
+/// The code the JIT should also generate u-dot in, to race it: "compact" when the library's u-dot is one
+/// straight-line function of at least 2,000 operations, "straight-line" when it is compact code of 2,000 to
+/// 6,000; empty: none (or not an optimized build at the default flags).
+std::string other_udot_code(const Manifest& manifest, const JitOptions& o);
 
 /// The candidates of a library of `manifest` built from `entry`, in the temporary directory `tmp`;
-/// `compact_entry`: the entry file of the compact code's sources (empty: no compact candidate).
+/// `other_entry`: the entry file of the sources with u-dot in other_udot_code() (empty: none), of u-dot form
+/// `other_form`.
 std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const JitOptions& o,
                                                 const std::filesystem::path& tmp, const std::filesystem::path& entry,
-                                                const std::filesystem::path& compact_entry,
-                                                const std::string& compact_form);
+                                                const std::filesystem::path& other_entry,
+                                                const std::string& other_form);
 
 /// Removes every candidate of the library `so_path` (before a new library is published there).
 void remove_udot_candidates(const std::string& so_path);

@@ -248,6 +248,49 @@ TEST_CASE("race_udots: every candidate against the reference in one race", "[jit
   CHECK(race_udots(*e, {g_real_udot}, s).empty());
 }
 
+TEST_CASE("compact u-dot near the threshold is raced against straight-line code by both compilers",
+          "[jit][udot-candidates]") {
+  REQUIRE(std::system("command -v clang++ > /dev/null 2>&1") == 0);
+  const SecondCompilerEnv env("clang++");
+  const SecondCompilerCache cache;
+  // an 8-link chain: compact code by the cost model (2,000 to 6,000 operations, kernels shared)
+  const Model model = load_model(test::write_temp("candidates_chain8.yaml", test::random_chain(8, 7)));
+  const codegen::EmittedFunction& main_udot = *codegen::generate(model).find("udot");
+  REQUIRE_FALSE(main_udot.kernels.empty());
+  REQUIRE(main_udot.ops.total() <= 6000);
+  auto e = jit_load(model, codegen::jit_code_generator(), cache.options());
+  CHECK_FALSE(fs::exists(udot_candidate_path(e->library_path(), "compact")));
+  GenericEngine g(model);
+  int preferred = 0;
+  std::string served;
+  for (const auto& [tag, name] : {std::pair<std::string, std::string>{"second", "clang++"},
+                                  {"straight", "straight-line"},
+                                  {"straight-second", "straight-line by clang++"}}) {
+    INFO(tag);
+    const std::string path = udot_candidate_path(e->library_path(), tag);
+    const auto record = jit_cache::verified_record(path);
+    REQUIRE(record);
+    CHECK(record->compiler == name);
+    CHECK(record->udot_form == e->udot_form());
+    if (record->preferred) ++preferred, served = name;
+    std::shared_ptr<void> handle;
+    const KanegenFunctionPtr fn = udot_of_library(path, record->api_symbol, handle);
+    State s = initial_state(model);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> d(-1, 1);
+    for (int k = 0; k < 3; ++k) {
+      for (int i = 0; i < model.nq; ++i) s.q(i) = d(rng);
+      for (int i = 0; i < model.nu; ++i) s.u(i) = d(rng), s.tau(i) = d(rng);
+      VecX expected, by_candidate(model.nu);
+      g.udot(s.q, s.u, s.tau, expected);
+      REQUIRE(e->call_udot(fn, s.t, s.q, s.u, s.tau, by_candidate.data()) == 0);
+      CHECK(test::rel_err(by_candidate, expected) < 1e-11);
+    }
+  }
+  CHECK(preferred <= 1);
+  CHECK(e->udot_compiler() == served);
+}
+
 TEST_CASE("second_wins: agreeing outputs and a clear margin", "[jit][udot-candidates]") {
   UdotRace r;
   r.first_ns = 1000;
@@ -285,22 +328,36 @@ TEST_CASE("the candidates planned: which code, which compiler, which entry file"
   {
     const SecondCompilerEnv env("clang++");
     // long straight-line u-dot: clang++'s build of it, and compact code by both compilers
+    CHECK(other_udot_code(m, o) == "compact");
     const auto cs = plan_udot_candidates(m, o, tmp, entry, compact, "composite");
     REQUIRE(tags(cs) == std::vector<std::string>{"second", "compact", "compact-second"});
     CHECK((cs[0].name == "clang++" && cs[0].argv.front() == "clang++" && builds(cs[0], entry) && !builds(cs[0], compact)));
     CHECK((cs[1].name == "compact" && cs[1].argv.front() == "g++" && builds(cs[1], compact) && !builds(cs[1], entry)));
     CHECK((cs[2].name == "compact by clang++" && cs[2].argv.front() == "clang++" && builds(cs[2], compact)));
     for (const UdotCandidate& c : cs) CHECK(c.udot_form == "composite");
-    // compact main code: clang++'s build of that code only
+    // compact main code of at most 6,000 operations: clang++'s build of it, and straight-line code by both
     Manifest mc = m;
     mc.udot_code = "compact";
     mc.udot_form = "articulated";
-    const auto cc = plan_udot_candidates(mc, o, tmp, entry, compact, "articulated");
-    REQUIRE(tags(cc) == std::vector<std::string>{"second"});
-    CHECK(builds(cc[0], entry));
+    CHECK(other_udot_code(mc, o) == "straight-line");
+    const fs::path straight = "/src/other/entry.cpp";
+    const auto cc = plan_udot_candidates(mc, o, tmp, entry, straight, "articulated");
+    REQUIRE(tags(cc) == std::vector<std::string>{"second", "straight", "straight-second"});
+    CHECK((builds(cc[0], entry) && !builds(cc[0], straight)));
+    CHECK((cc[1].name == "straight-line" && cc[1].argv.front() == "g++" && builds(cc[1], straight)));
+    CHECK((cc[2].name == "straight-line by clang++" && cc[2].argv.front() == "clang++" && builds(cc[2], straight)));
+    for (const UdotCandidate& c : cc) CHECK(c.udot_form == "articulated");
+    // longer compact code: clang++'s build of that code only (compact code wins there at every ISA)
+    Manifest ml = mc;
+    ml.functions = {{"udot", 9000}};
+    CHECK(other_udot_code(ml, o).empty());
+    const auto cl = plan_udot_candidates(ml, o, tmp, entry, straight, "articulated");
+    REQUIRE(tags(cl) == std::vector<std::string>{"second"});
+    CHECK(builds(cl[0], entry));
     // short u-dot, or a quick build: none
     Manifest ms = m;
     ms.functions = {{"udot", 1500}};
+    CHECK(other_udot_code(ms, o).empty());
     CHECK(plan_udot_candidates(ms, o, tmp, entry, compact, "composite").empty());
     JitOptions quick = o;
     quick.quick = true;
