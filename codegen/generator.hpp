@@ -22,9 +22,8 @@ struct GeneratorOptions {
   long split_above = 12000;
   long part_ops = 3000;
   /// u-dot as "straight-line" code (one function), "compact" code (kernels shared by the bodies whose code
-  /// has the same shape, outlined_code.hpp) or "auto": compact when the straight-line code is beyond the
-  /// instruction cache (more than kCompactAboveOps operations) and its kernels' own code is at most
-  /// kCompactShare of it (the bodies share it).
+  /// has the same shape, outlined_code.hpp) or "auto": compact when u-dot has more than kCompactAboveOps
+  /// operations and its kernels' own code is at most kCompactShare of it (the bodies share some of it).
   std::string udot_code = "auto";
 };
 

@@ -34,7 +34,7 @@ struct UdotCandidate {
   /// its file: <stem>-<key>.udot-<tag>.so ("second", or "second-v3" when built for AVX2; "compact";
   /// "compact-second", or "compact-second-v3"; "straight"; "straight-second", or "straight-second-v3")
   std::string tag;
-  std::string udot_form;           ///< its u-dot form (the main library's, or the compact code's)
+  std::string udot_form;           ///< its u-dot form (the main library's, or the other code's: the same)
   std::vector<std::string> argv;   ///< one command that compiles and links it
   std::filesystem::path out;       ///< where that command writes it
 };

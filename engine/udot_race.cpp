@@ -58,7 +58,8 @@ std::vector<UdotRace> race_udots(const GeneratedEngine& engine, const std::vecto
         for (UdotRace& r : races) r.first_status = status;
       else if (k == 0)
         races[f - 1].second_status = status;
-      for (int i = 0; i < nu; ++i) scale = std::max(scale, std::abs(by[k][f][static_cast<std::size_t>(i)]));
+      if (f == 0)  // the reference's outputs only: a candidate's huge ones must not hide another's error
+        for (int i = 0; i < nu; ++i) scale = std::max(scale, std::abs(by[k][f][static_cast<std::size_t>(i)]));
     }
   }
   for (int k = 0; k < 2; ++k)
@@ -76,8 +77,10 @@ std::vector<UdotRace> race_udots(const GeneratedEngine& engine, const std::vecto
   std::vector<double> best(n_fns, std::numeric_limits<double>::infinity());
   for (int k = 0; k < rounds; ++k)
     for (std::size_t which = 0; which < n_fns; ++which) {
-      // the order turned by one each round, so that none always follows the same other
-      const std::size_t f = (which + static_cast<std::size_t>(k)) % n_fns;
+      // the order turned by one each round and reversed every other round, so that none always follows the
+      // same other
+      const std::size_t pos = k % 2 == 0 ? which : n_fns - 1 - which;
+      const std::size_t f = (pos + static_cast<std::size_t>(k)) % n_fns;
       best[f] = std::min(best[f], slice_ns(calls[f], n[f]));
     }
   for (std::size_t f = 1; f < n_fns; ++f) races[f - 1].first_ns = best[0], races[f - 1].second_ns = best[f];

@@ -13,8 +13,8 @@ namespace kanegen {
 
 struct UdotRace {
   double first_ns = 0, second_ns = 0;  ///< least time per call of each
-  /// largest |difference| of their outputs over the largest |first's output|, at the state and at one with
-  /// moved speeds and inputs
+  /// largest |difference| of their outputs over the largest |first's output| (the reference's), at the state
+  /// and at one with moved speeds and inputs
   double max_rel_diff = 0;
   int first_status = 0, second_status = 0;
 };

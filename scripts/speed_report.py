@@ -91,19 +91,18 @@ def peer_processes(bindir, models, quick):
     # an empty JIT cache, as an outside rerun starts with: the first process of a model builds its libraries
     # and races the u-dot candidates (engine/udot_candidates.hpp), the later ones load what that race chose
     # (a user's cache could hold the choice of an older race, or of a busier moment)
-    cache = tempfile.mkdtemp(prefix="kanegen_speed_cache_")
-    env = dict(os.environ, KANEGEN_CACHE_DIR=cache)
-    for _ in range(1 if quick else PEER_PROCESSES):
-        for m in models:
-            if m in failed:
-                continue
-            code, o, err = run([mj, m, "--kanegen", "--native", "--rounds", "11" if quick else "31"], env=env)
-            if code != 0:
-                failed.add(m)
-                out[m] = (out[m][0], err)
-                continue
-            out[m] = (out[m][0] + [json.loads(o)], err)
-    shutil.rmtree(cache, ignore_errors=True)
+    with tempfile.TemporaryDirectory(prefix="kanegen_speed_cache_") as cache:  # removed on every way out
+        env = dict(os.environ, KANEGEN_CACHE_DIR=cache)
+        for _ in range(1 if quick else PEER_PROCESSES):
+            for m in models:
+                if m in failed:
+                    continue
+                code, o, err = run([mj, m, "--kanegen", "--native", "--rounds", "11" if quick else "31"], env=env)
+                if code != 0:
+                    failed.add(m)
+                    out[m] = (out[m][0], err)
+                    continue
+                out[m] = (out[m][0] + [json.loads(o)], err)
     return out
 
 

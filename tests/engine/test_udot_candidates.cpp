@@ -1,7 +1,8 @@
 // The JIT's u-dot candidates (engine/udot_candidates.hpp): a long u-dot is
-// also built by a second compiler (clang++), and a long straight-line one as
-// compact code by both compilers, each raced against the library's own at the initial state
-// (engine/udot_race.hpp) and served only when measured faster. Every build
+// also built by a second compiler (clang++), a long straight-line one as
+// compact code by both compilers, a compact one of 2,000-6,000 operations as
+// straight-line code by both, all raced in one race against the library's own
+// at the initial state (engine/udot_race.hpp) and served only when measured faster. Every build
 // must compute the same u-dot as the generic engine, whichever is served; the
 // choice is recorded and reused from the cache.
 #include <catch2/catch.hpp>
@@ -11,6 +12,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <algorithm>
 #include <random>
 
@@ -212,10 +214,19 @@ int udot_eight_times(const KanegenArgs* a, double* out) {
   for (int k = 0; k < 8; ++k) status = g_real_udot(a, out);
   return status;
 }
+int g_nu = 0;
 /// the real u-dot with its first entry off by 1e-3 of the largest
 int udot_off(const KanegenArgs* a, double* out) {
   const int status = g_real_udot(a, out);
-  out[0] += 1e-3 * (1 + std::abs(out[0]));
+  double largest = 0;
+  for (int i = 0; i < g_nu; ++i) largest = std::max(largest, std::abs(out[i]));
+  out[0] += 1e-3 * largest;
+  return status;
+}
+/// the real u-dot with its last entry 1e300 (a broken build)
+int udot_huge(const KanegenArgs* a, double* out) {
+  const int status = g_real_udot(a, out);
+  out[g_nu - 1] = 1e300;
   return status;
 }
 }  // namespace
@@ -226,6 +237,7 @@ TEST_CASE("race_udots: every candidate against the reference in one race", "[jit
   const Model model = load_model(test::source_path("models/double_pendulum.yaml"));
   auto e = jit_load(model, codegen::jit_code_generator(), cache.options());
   g_real_udot = e->udot_function();
+  g_nu = model.nu;
   State s = initial_state(model);
   s.u(0) = 0.7, s.u(1) = -0.4;
   const std::vector<UdotRace> races = race_udots(*e, {g_real_udot, g_real_udot, udot_eight_times, udot_off}, s);
@@ -240,8 +252,15 @@ TEST_CASE("race_udots: every candidate against the reference in one race", "[jit
   CHECK(races[1].max_rel_diff == 0);  // the same output, eight times the work: ranked slower
   CHECK(races[1].second_ns > 2 * races[1].first_ns);
   CHECK_FALSE(second_wins(races[1]));
-  CHECK(races[2].max_rel_diff > 1e-4);  // another output: never served
+  CHECK(races[2].max_rel_diff == Approx(1e-3).epsilon(1e-6));  // another output: never served
   CHECK_FALSE(second_wins(races[2]));
+  // agreement is measured against the reference's outputs: a broken candidate's huge ones hide nothing
+  const std::vector<UdotRace> with_huge = race_udots(*e, {g_real_udot, udot_huge, udot_off}, s, 3);
+  REQUIRE(with_huge.size() == 2);
+  CHECK(with_huge[0].max_rel_diff > 1e100);
+  CHECK_FALSE(second_wins(with_huge[0]));
+  CHECK(with_huge[1].max_rel_diff == races[2].max_rel_diff);
+  CHECK_FALSE(second_wins(with_huge[1]));
   // the pairwise race is the two-function case of the same
   const UdotRace pair = race_udot(*e, g_real_udot, udot_off, s);
   CHECK(pair.max_rel_diff == races[2].max_rel_diff);
@@ -289,6 +308,22 @@ TEST_CASE("compact u-dot near the threshold is raced against straight-line code 
   }
   CHECK(preferred <= 1);
   CHECK(e->udot_compiler() == served);
+  // a second load serves what the race chose, from the records
+  auto again = jit_load(model, codegen::jit_code_generator(), cache.options());
+  CHECK(again->udot_compiler() == served);
+  // publishing a library removes every candidate of the one it replaces, of every tag (records first)
+  const std::vector<std::string> all_tags{"second", "second-v3", "compact", "compact-second", "compact-second-v3",
+                                          "straight", "straight-second", "straight-second-v3"};
+  for (const std::string& tag : all_tags) {
+    const std::string path = udot_candidate_path(e->library_path(), tag);
+    if (!fs::exists(path)) std::ofstream(path) << "x", std::ofstream(jit_cache::record_path(path)) << "{}";
+  }
+  remove_udot_candidates(e->library_path());
+  for (const std::string& tag : all_tags) {
+    INFO(tag);
+    CHECK_FALSE(fs::exists(udot_candidate_path(e->library_path(), tag)));
+    CHECK_FALSE(fs::exists(jit_cache::record_path(udot_candidate_path(e->library_path(), tag))));
+  }
 }
 
 TEST_CASE("second_wins: agreeing outputs and a clear margin", "[jit][udot-candidates]") {
