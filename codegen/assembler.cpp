@@ -225,7 +225,11 @@ AssembledFiles assemble(const EmittedModel& m, const std::string& template_dir, 
   replace_all(h, "U_NAMES", join(m.u_names, ", "));
   replace_all(h, "OP_COUNTS", op_counts(m));
   replace_all(h, "CONSTANTS", m.constants);
-  replace_all(h, "SUPPORT", m.support_code + (m.orbit_frame_rules ? read_template(template_dir + "/orbit_frame.inc") : ""));
+  const bool joint_sincos =
+      std::any_of(m.functions.begin(), m.functions.end(), [](const EmittedFunction& f) { return f.joint_sincos; });
+  replace_all(h, "SUPPORT",
+              (joint_sincos ? read_template(template_dir + "/joint_sincos.inc") : std::string()) + m.support_code +
+                  (m.orbit_frame_rules ? read_template(template_dir + "/orbit_frame.inc") : ""));
   replace_all(h, "FUNCTIONS", functions);
   out.header = std::move(h);
 

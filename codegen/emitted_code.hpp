@@ -42,6 +42,7 @@ struct EmittedFunction {
   int out_size = 0;             ///< number of doubles written to out
   bool returns_status = false;  ///< int: 0 or the 1-based speed of a non-positive pivot; else void
   bool templated = true;        ///< template <class T> (false: double only, e.g. jacobian)
+  bool joint_sincos = false;    ///< computes joint angles' sin and cos in a batch (templates/joint_sincos.inc)
   std::string body;             ///< C++ statements (indented)
   /// Large functions: bodies of the helper functions NAME_part0, NAME_part1,
   /// ... that `body` runs first (same parameters plus the workspace T* w of

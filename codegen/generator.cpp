@@ -42,6 +42,7 @@ void finish(const Program& p, const Constants& C, EmittedFunction& f, const Gene
     if (constants.count(n))
       throw std::logic_error(fmt::format("generator: temporary '{}' would shadow a model constant", n));
   f.body = p.emit(kIndent, f.ops);
+  f.joint_sincos = p.has_sincos();
   if (f.name == "udot") f.ops_by_pass = p.ops_by_pass();
   const bool compact_wanted =
       options.udot_code == "compact" || (options.udot_code == "auto" && f.ops.total() > kCompactAboveOps);

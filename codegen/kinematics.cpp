@@ -4,6 +4,9 @@
 //   v_O_B = R_BP (v_P + w_P x p_PO_P + v_rel),  and the remainder accelerations.
 #include <fmt/format.h>
 
+#include <set>
+#include <tuple>
+
 #include "codegen/kane_context.hpp"
 #include "model/joints/joint_kinematics.hpp"
 
@@ -14,6 +17,15 @@ using namespace GiNaC;
 static const char* kAxis[3] = {"x", "y", "z"};
 
 namespace {
+
+/// Whether `e` reads no temporary of `P` (only state, time, parameters, constants and preludes' values).
+bool reads_no_temporary(const Program& P, const ex& e) {
+  std::set<std::string> syms;
+  collect_symbols(e, syms);
+  for (const std::string& n : syms)
+    if (P.names().count(n)) return false;
+  return true;
+}
 
 /// Q^T Rz(z) Ry(y) Rx(x) Q: the misalignment of body j's joint frame (runtime
 /// parameters, model axes) in the generator's frame B' (Q = R_BB').
@@ -295,7 +307,14 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
         const double offset = i < ctx.angle_offset.size() ? ctx.angle_offset[i] : 0.0;
         const ex angle = q_j + ctx.c(offset, n + "_angle_offset", "rad",
                                      "joint angle offset of the generator's body frame (joint_frames.hpp)");
-        const ex cq = A.let(cos(angle)), sq = A.let(sin(angle));
+        // one batch of every joint angle's sin and cos (Program::sincos), where the angle is a function of
+        // the state (a prescribed angle's prelude value too); otherwise the library's, bound here
+        ex cq, sq;
+        if (reads_no_temporary(ctx.P, angle)) {
+          std::tie(sq, cq) = ctx.P.sincos(angle);
+        } else {
+          cq = A.let(cos(angle)), sq = A.let(sin(angle));
+        }
         // Rot(a, th) = a a^T + cos th (I - a a^T) + sin th a^x
         const Eigen::Matrix3d aa = b.joint.axis_J * b.joint.axis_J.transpose();
         const SM3 Ax = Alg::skew(axis);

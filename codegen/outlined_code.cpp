@@ -447,6 +447,7 @@ OutlinedBody outline(const Program& program, const std::string& name, const Cons
   out.workspace_values = ne;
   std::string& m = out.main;
   m = listing.preludes;
+  ops += listing.prelude_ops;
   m += fmt::format("{}T w[{}];\n", indent, std::max(1, out.workspace));
   for (const std::string& n : runtime) m += fmt::format("{}w[{}] = {};\n", indent, slot.at(n), n);
   m += calls;

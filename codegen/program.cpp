@@ -49,6 +49,22 @@ void Program::prelude(const std::string& text, const std::vector<std::string>& d
   preludes_.push_back({text, defines});
 }
 
+std::pair<ex, ex> Program::sincos(const ex& angle_in) {
+  const ex angle = fold ? fold(angle_in) : angle_in;
+  std::set<std::string> syms;
+  collect_symbols(angle, syms);
+  for (const std::string& n : syms)
+    if (names_.count(n)) throw std::logic_error("Program::sincos: the angle reads the temporary " + n);
+  auto it = angle_index_.find(angle);
+  if (it == angle_index_.end()) {
+    const std::size_t i = angles_.size();
+    angles_.push_back({angle, symbol(fmt::format("angle_s[{}]", i)), symbol(fmt::format("angle_c[{}]", i))});
+    it = angle_index_.emplace(angle, i).first;
+  }
+  const Angle& a = angles_[it->second];
+  return {a.s, a.c};
+}
+
 void collect_symbols(const ex& e, std::set<std::string>& names) {
   if (is_a<symbol>(e)) {
     names.insert(ex_to<symbol>(e).get_name());
@@ -70,19 +86,48 @@ std::vector<bool> Program::liveness(std::set<std::string>& needed) const {
   return live;
 }
 
-std::string Program::used_preludes(const std::set<std::string>& needed, const std::string& indent) const {
-  std::string out;
+/// The angles' batch: `kanegen_sincos_n` of the arguments into angle_s and angle_c, local arrays or (`w_base` not
+/// negative) the workspace from w[w_base] (the first part of a function in parts); `alias`: only name the
+/// workspace's arrays (the later parts).
+static std::string angle_batch(const std::string& indent, int n, const std::string& list, int w_base = -1,
+                               bool alias = false) {
+  std::string out = fmt::format("{}// ---- joint angles' sin and cos, in one batch (joint_sincos.inc)\n", indent);
+  if (w_base >= 0) {
+    out += fmt::format("{}{}T* angle_s = w + {};\n", indent, alias ? "const " : "", w_base);
+    out += fmt::format("{}{}T* angle_c = w + {};\n", indent, alias ? "const " : "", w_base + n);
+    if (alias) return out + fmt::format("{}(void)angle_s; (void)angle_c;\n", indent);
+  } else {
+    out += fmt::format("{}T angle_s[{}], angle_c[{}];\n", indent, n, n);
+  }
+  out += fmt::format("{}const T angle_x[{}] = {{{}}};\n", indent, n, list);
+  out += fmt::format("{}kanegen_sincos_n(angle_x, angle_s, angle_c, {});\n", indent, n);
+  return out;
+}
+
+void Program::used_preludes(const std::set<std::string>& needed, const std::string& indent, Listing& out) const {
+  bool angles = false;
+  for (const Angle& a : angles_) angles = angles || needed.count(a.s.get_name()) || needed.count(a.c.get_name());
+  std::set<std::string> all = needed;  // and what the angles read (a prescribed angle's prelude value)
+  if (angles)
+    for (const Angle& a : angles_) collect_symbols(a.angle, all);
   for (const Prelude& p : preludes_) {
     bool used = false;
-    for (const auto& d : p.defines) used = used || needed.count(d);
-    if (used) out += indent + p.text + "\n";
+    for (const auto& d : p.defines) used = used || all.count(d);
+    if (used) out.plain_preludes += indent + p.text + "\n";
   }
-  return out;
+  out.preludes = out.plain_preludes;
+  if (!angles) return;
+  // every angle, so that the symbols' indices hold
+  out.angles = static_cast<int>(angles_.size());
+  for (const Angle& a : angles_) out.angle_list += (out.angle_list.empty() ? "" : ", ") + print_cpp(a.angle, out.prelude_ops);
+  out.prelude_ops.func += 2L * out.angles;
+  out.preludes += angle_batch(indent, out.angles, out.angle_list);
 }
 
 std::string Program::emit(const std::string& indent, OpCount& ops) const {
   const Listing l = listing(indent);
   std::string out = l.preludes;
+  ops += l.prelude_ops;
   for (const LiveTemp& t : l.temps) {
     if (!t.section.empty()) out += fmt::format("{}// ---- {}\n", indent, t.section);
     out += fmt::format("{}const T {} = {};\n", indent, t.sym.get_name(), print_cpp(t.value, ops));
@@ -100,7 +145,7 @@ Program::Listing Program::listing(const std::string& indent) const {
   std::set<std::string> needed;
   const std::vector<bool> live = liveness(needed);
   Listing out;
-  out.preludes = used_preludes(needed, indent);
+  used_preludes(needed, indent, out);
   const std::string* pending = nullptr;
   for (std::size_t k = 0; k < temps_.size(); ++k) {
     if (!temps_[k].section.empty()) {
@@ -126,6 +171,7 @@ std::vector<std::pair<std::string, long>> Program::ops_by_pass() const {
       }
     out.emplace_back(pass, ops);
   };
+  if (l.prelude_ops.total()) add("joint angles' sin and cos", l.prelude_ops.total());
   std::string pass = "(first values)";
   for (const LiveTemp& t : l.temps) {
     if (!t.section.empty()) {
@@ -147,6 +193,7 @@ std::vector<std::pair<std::string, long>> Program::ops_by_pass() const {
 
 ChunkedBody Program::emit_chunked(const std::string& indent, OpCount& ops, long max_chunk_ops) const {
   const Listing listed = listing(indent);
+  ops += listed.prelude_ops;  // the first part computes the angles' batch; the other preludes every part again
   // 1. the live temporaries in order, their text, cost and chunk
   struct Line {
     const LiveTemp* temp;       ///< a temporary, or nullptr for an output assignment
@@ -197,8 +244,16 @@ ChunkedBody Program::emit_chunked(const std::string& indent, OpCount& ops, long 
     if (s.lhs.empty()) uses(s.value, last);
   // 3. the parts
   ChunkedBody out;
-  out.parts.assign(last, listed.preludes);
-  std::string main = listed.preludes;
+  // the angles' batch once, in the first part, into the workspace after the parts' values; the later parts and
+  // the function itself read it there
+  const int batch_base = static_cast<int>(slot.size());
+  out.parts.assign(last, listed.plain_preludes);
+  std::string main = listed.plain_preludes;
+  if (listed.angles > 0) {
+    for (int p = 0; p < last; ++p)
+      out.parts[p] += angle_batch(indent, listed.angles, listed.angle_list, batch_base, p > 0);
+    main += angle_batch(indent, listed.angles, listed.angle_list, batch_base, true);
+  }
   auto load_text = [&](int part) {
     std::string t;
     for (const auto& n : loads[part]) t += fmt::format("{}const T {} = w[{}];\n", indent, n, slot.at(n));
@@ -220,7 +275,7 @@ ChunkedBody Program::emit_chunked(const std::string& indent, OpCount& ops, long 
   for (const Statement& s : listed.statements)
     if (s.lhs.empty()) main += indent + s.text + "\n";
   out.main = std::move(main);
-  out.workspace = static_cast<int>(slot.size());
+  out.workspace = static_cast<int>(slot.size()) + 2 * listed.angles;
   return out;
 }
 

@@ -59,6 +59,13 @@ class Program {
   /// symbols `defines` (e.g. the prescribed motion of a joint at t); emitted
   /// only when one of them is needed.
   void prelude(const std::string& text, const std::vector<std::string>& defines);
+  /// sin and cos of `angle`, a function of the state, the time, the runtime parameters and the preludes'
+  /// values only (no temporary): the symbols angle_s[i] and angle_c[i], computed with every other angle's
+  /// in one batch after the preludes (kanegen_sincos_n, templates/joint_sincos.inc); the same angle
+  /// gives the same symbols.
+  std::pair<ex, ex> sincos(const ex& angle);
+  /// Whether some angle's sin and cos were asked for (the header then needs templates/joint_sincos.inc).
+  bool has_sincos() const { return !angles_.empty(); }
 
   /// C++ body: temporaries that some output needs (dead ones dropped), in
   /// order, as `const T name = ...;`, then the outputs. Counts operations.
@@ -85,7 +92,12 @@ class Program {
   struct Listing {
     std::vector<LiveTemp> temps;
     std::vector<Statement> statements;
-    std::string preludes;  ///< the preludes some live expression needs, indented, one per line
+    std::string preludes;  ///< the preludes some live expression needs, indented, one per line, then the angles'
+                           ///< batch (into local arrays)
+    OpCount prelude_ops;   ///< their operations (the angles' sums, and a sin and a cos per angle)
+    int angles = 0;        ///< the batch's angles (0: none needed)
+    std::string plain_preludes;  ///< the preludes without the batch
+    std::string angle_list;      ///< the batch's arguments, printed, comma-separated
   };
   Listing listing(const std::string& indent) const;
   /// The operations of the live code by pass: the sections' titles without their body ("body link3: outward
@@ -96,8 +108,9 @@ class Program {
  private:
   /// Which temporaries some statement needs; `needed` gets their symbols.
   std::vector<bool> liveness(std::set<std::string>& needed) const;
-  /// The preludes that define a symbol in `needed`, one line each.
-  std::string used_preludes(const std::set<std::string>& needed, const std::string& indent) const;
+  /// The preludes that define a symbol in `needed`, one line each, then the angles' batch when one of its
+  /// symbols is needed; `ops` counts the batch's operations.
+  void used_preludes(const std::set<std::string>& needed, const std::string& indent, Listing& out) const;
   struct Temp {
     GiNaC::symbol sym;
     ex value;
@@ -118,6 +131,12 @@ class Program {
     std::vector<std::string> defines;
   };
   std::vector<Prelude> preludes_;
+  struct Angle {
+    ex angle;
+    GiNaC::symbol s, c;
+  };
+  std::vector<Angle> angles_;
+  std::map<ex, std::size_t, GiNaC::ex_is_less> angle_index_;
 };
 
 }  // namespace kanegen::codegen

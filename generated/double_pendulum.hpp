@@ -16,13 +16,13 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot               0 (0 add, 0 mul, 0 div, 0 func)
-//   mass_matrix       39 (16 add, 21 mul, 0 div, 2 func)
-//   forcing          132 (51 add, 77 mul, 0 div, 4 func)
-//   udot             176 (68 add, 103 mul, 1 div, 4 func) -- composite form; composite 176, articulated 215
-//     udot by pass: outward pass (velocities) 38; mass and velocity terms 38; composite inertia (inward) 27; its columns of M (walked to the root) 8; bias force 35; generalized forces (inward) 21; M u_dot = F: L^T D L along the dof tree 9
-//   energy            95 (33 add, 56 mul, 2 div, 4 func)
-//   momentum         158 (58 add, 96 mul, 0 div, 4 func)
-//   reactions        252 (106 add, 142 mul, 0 div, 4 func)
+//   mass_matrix       40 (15 add, 21 mul, 0 div, 4 func)
+//   forcing          131 (50 add, 77 mul, 0 div, 4 func)
+//   udot             175 (67 add, 103 mul, 1 div, 4 func) -- composite form; composite 175, articulated 214
+//     udot by pass: joint angles' sin and cos 5; outward pass (velocities) 32; mass and velocity terms 38; composite inertia (inward) 27; its columns of M (walked to the root) 8; bias force 35; generalized forces (inward) 21; M u_dot = F: L^T D L along the dof tree 9
+//   energy            94 (32 add, 56 mul, 2 div, 4 func)
+//   momentum         157 (57 add, 96 mul, 0 div, 4 func)
+//   reactions        251 (105 add, 142 mul, 0 div, 4 func)
 
 #pragma once
 
@@ -183,6 +183,135 @@ template <int W> inline bool operator>(double a, const Dual<W>& b) { return a > 
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }
+// ---- joint angles' sin and cos (templates/joint_sincos.inc) -------------------
+// Every joint angle's sin and cos, computed in one batch before the rest of a
+// function (issue 38, item 3: one evaluation per angle, shared by every use),
+// two angles at a time in SSE2 pairs (GCC/clang vector extensions, no header).
+// Accuracy (tests/codegen/test_joint_sincos.cpp, against sinl/cosl): at most
+// 0.51 ulp, the library's sin and cos 0.52-0.56 on the same arguments; beyond
+// |x| = 1e5 rad (and for inf and NaN) the library's sin and cos. (-ffast-math,
+// which reorders the exact sums, voids the bound.)
+// Method: x = k pi/32 + r, |r| <= pi/64, with pi/32 in four parts (three of 33
+// bits, exact products for |k| < 2^20) and r carried as r + rlo; sin and cos
+// of k pi/32 from a table as double-doubles (hi, lo, and hi split in 26-bit
+// halves for Dekker's exact product); sin r - r and cos r - 1 by their Taylor
+// series to r^9 and r^8 (truncation below 1e-20 on |r| <= pi/64);
+// sin x = S + C r + (S (cos r - 1) + C (sin r - r) + C rlo + S_lo), the sum
+// S + C r exact (TwoSum of the exact product), likewise cos x.
+
+// sin(j pi/32), j = 0..63: hi, lo (hi + lo to ~2^-106), and hi in two halves of 26 bits
+inline constexpr double kanegen_sin_table[64][4] = {
+    {0.0, 0.0, 0.0, 0.0},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.0000000000000p+0, 0.0, 0x1.0000000000000p+0, 0.0},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0.0, 0.0, 0.0, 0.0},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.0000000000000p+0, 0.0, -0x1.0000000000000p+0, 0.0},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+};
+
+typedef double kanegen_v2d __attribute__((vector_size(16)));
+
+/// sin and cos of x[0..n), in s and c.
+inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
+  for (int i = 0; i < n; i += 2) {
+    const int b = i + 1 < n ? i + 1 : i;  // an odd count's last angle twice
+    // beyond 1e5 rad (and inf, NaN) the library's, below; 0 meanwhile keeps the integer conversion defined
+    const double xi = x[i] <= 1.0e5 && x[i] >= -1.0e5 ? x[i] : 0.0, xb = x[b] <= 1.0e5 && x[b] >= -1.0e5 ? x[b] : 0.0;
+    const kanegen_v2d xv = {xi, xb};
+    const kanegen_v2d kn = (xv * 0x1.45f306dc9c883p+3 + 0x1.8p52) - 0x1.8p52;  // round(x 32/pi)
+    const kanegen_v2d t = xv - kn * 0x1.921fb54400000p-4, u2 = kn * 0x1.0b4611a600000p-38,
+                      u3 = kn * 0x1.3198a2e000000p-73;
+    const kanegen_v2d r1 = t - u2, e1 = (t - r1) - u2;
+    const kanegen_v2d r = r1 - u3, b3 = r - r1, e2 = (r1 - (r - b3)) - (u3 + b3);
+    const kanegen_v2d rlo = (e1 + e2) - kn * 0x1.b839a252049c1p-108;
+    const kanegen_v2d z = r * r;
+    const kanegen_v2d sr = (r * z) * (-1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 + z * (1.0 / 362880))));
+    const kanegen_v2d cm = z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320))));
+    const long k0 = static_cast<long>(kn[0]), k1 = static_cast<long>(kn[1]);
+    const double* Sa = kanegen_sin_table[k0 & 63];
+    const double* Sb = kanegen_sin_table[k1 & 63];
+    const double* Ca = kanegen_sin_table[(k0 + 16) & 63];
+    const double* Cb = kanegen_sin_table[(k1 + 16) & 63];
+    const kanegen_v2d S0 = {Sa[0], Sb[0]}, S1 = {Sa[1], Sb[1]}, S2 = {Sa[2], Sb[2]}, S3 = {Sa[3], Sb[3]};
+    const kanegen_v2d C0 = {Ca[0], Cb[0]}, C1 = {Ca[1], Cb[1]}, C2 = {Ca[2], Cb[2]}, C3 = {Ca[3], Cb[3]};
+    const kanegen_v2d g = 134217729.0 * r, rh = g - (g - r), rl = r - rh;  // r in 26-bit halves
+    const kanegen_v2d p = C0 * r, pe = (((C2 * rh - p) + C2 * rl) + C3 * rh) + C3 * rl;  // C r = p + pe
+    const kanegen_v2d s1 = S0 + p, bs = s1 - S0, se = (S0 - (s1 - bs)) + (p - bs);    // S + p = s1 + se
+    const kanegen_v2d sv = s1 + ((se + pe) + (S1 + C1 * r + C0 * rlo + S0 * cm + C0 * sr));
+    const kanegen_v2d q = S0 * r, qe = (((S2 * rh - q) + S2 * rl) + S3 * rh) + S3 * rl;  // S r = q + qe
+    const kanegen_v2d c1 = C0 - q, bc = c1 - C0, ce = (C0 - (c1 - bc)) + (-q - bc);      // C - q = c1 + ce
+    const kanegen_v2d cv = c1 + ((ce - qe) + (C1 - S1 * r - S0 * rlo + C0 * cm - S0 * sr));
+    s[i] = sv[0], c[i] = cv[0], s[b] = sv[1], c[b] = cv[1];
+    if (!(x[i] <= 1.0e5 && x[i] >= -1.0e5)) s[i] = std::sin(x[i]), c[i] = std::cos(x[i]);
+    if (!(x[b] <= 1.0e5 && x[b] >= -1.0e5)) s[b] = std::sin(x[b]), c[b] = std::cos(x[b]);
+  }
+}
+
+/// The same for any other number type (the dual numbers of the Jacobians): its own sin and cos.
+template <class T>
+inline void kanegen_sincos_n(const T* x, T* s, T* c, int n) {
+  using std::cos;
+  using std::sin;
+  for (int i = 0; i < n; ++i) s[i] = sin(x[i]), c[i] = cos(x[i]);
+}
 
 // ---- q_dot = W(q) u ------------------------------------------------------------
 template <class T>
@@ -198,34 +327,35 @@ template <class T>
 void mass_matrix(const T* q, T* M) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q;
-  // ---- body link2: outward pass (positions)
-  const T t6 = cos(link2_angle_offset + q[1]);
-  const T t7 = sin(link2_angle_offset + q[1]);
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[0], link2_angle_offset + q[1]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body link2: composite inertia (inward)
-  const T t34 = link2_S0_x*t6;
-  const T t35 = link2_S0_x*t7;
-  const T t36 = t7*t7;
-  const T t37 = t6*t7;
-  const T t39 = 2.0*link2_J0_xy*t37 - ka7b3ad17*t36;
-  const T t41 = link2_J0_yy + t39;
-  const T t44 = link2_J0_xz*t7 + link2_J0_yz*t6;
-  const T t48 = 2.0*link2_p_J_x*t34 + ka6ba76ae + t41;
-  const T t49 = -link2_p_J_z*t35 + t44;
-  const T t50 = 2.0*link2_p_J_x*t34 + kbe5816c7;
-  const T t54 = t48 - t50;
-  const T t55 = link2_R_PJ_yy_S2*t49 + link2_R_PJ_yy_ss*t54;
-  const T t57 = t50 + t55;
-  const T t66 = link1_J0_zz + t57;
+  const T t30 = angle_c[1]*link2_S0_x;
+  const T t31 = angle_s[1]*link2_S0_x;
+  const T t32 = angle_s[1]*angle_s[1];
+  const T t33 = angle_c[1]*angle_s[1];
+  const T t35 = 2.0*link2_J0_xy*t33 - ka7b3ad17*t32;
+  const T t37 = link2_J0_yy + t35;
+  const T t40 = angle_c[1]*link2_J0_yz + angle_s[1]*link2_J0_xz;
+  const T t44 = 2.0*link2_p_J_x*t30 + ka6ba76ae + t37;
+  const T t45 = -link2_p_J_z*t31 + t40;
+  const T t46 = 2.0*link2_p_J_x*t30 + kbe5816c7;
+  const T t50 = t44 - t46;
+  const T t51 = link2_R_PJ_yy_S2*t45 + link2_R_PJ_yy_ss*t50;
+  const T t53 = t46 + t51;
+  const T t62 = link1_J0_zz + t53;
   // ---- body link2: its columns of M (walked to the root)
-  const T t73 = -link2_S0_x*t7;
-  const T t75 = link2_p_J_z*t73;
-  const T t76 = link2_p_J_x*t34;
-  const T t78 = t44 + t75;
-  const T t79 = link2_J0_zz + t76;
-  const T t83 = link2_R_PJ_zy*t78 + link2_R_PJ_zz*t79;
-  M[0] = t66;
-  M[1] = t83;
-  M[2] = t83;
+  const T t69 = -angle_s[1]*link2_S0_x;
+  const T t71 = link2_p_J_z*t69;
+  const T t72 = link2_p_J_x*t30;
+  const T t74 = t40 + t71;
+  const T t75 = link2_J0_zz + t72;
+  const T t79 = link2_R_PJ_zy*t74 + link2_R_PJ_zz*t75;
+  M[0] = t62;
+  M[1] = t79;
+  M[2] = t79;
   M[3] = link2_J0_zz;
 }
 
@@ -234,71 +364,71 @@ template <class T>
 void forcing(const T* q, const T* u, const T* tau, T* F) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[0], link2_angle_offset + q[1]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body link1: outward pass (velocities)
-  const T t0 = cos(q[0]);
-  const T t1 = sin(q[0]);
-  const T t6 = k359ff293*t0 + k5bfb74db*t1;
-  const T t7 = -k359ff293*t1 + k5bfb74db*t0;
+  const T t4 = angle_c[0]*k359ff293 + angle_s[0]*k5bfb74db;
+  const T t5 = angle_c[0]*k5bfb74db - angle_s[0]*k359ff293;
   // ---- body link2: outward pass (velocities)
-  const T t8 = cos(link2_angle_offset + q[1]);
-  const T t9 = sin(link2_angle_offset + q[1]);
-  const T t22 = link2_R_PJ_zy*u[0];
-  const T t23 = link2_R_PJ_zz*u[0];
-  const T t24 = link2_p_J_z*t22;
-  const T t25 = link2_p_J_x*t23;
-  const T t26 = -link2_p_J_x*t22;
-  const T t27 = t22*t26 - t23*t25;
-  const T t28 = t23*t24;
-  const T t29 = -t22*t24;
-  const T t30 = link2_R_PJ_yy*t7;
-  const T t31 = link2_R_PJ_yz*t7;
-  const T t32 = t27 + t6;
-  const T t33 = t28 + t30;
-  const T t34 = t29 + t31;
-  const T t35 = t22*t9;
-  const T t36 = t22*t8;
-  const T w_B_link2_z = t23 + u[1];
-  const T t40 = t36*u[1];
-  const T t41 = -t35*u[1];
-  const T t43 = t32*t8 + t33*t9;
-  const T t44 = -t32*t9 + t33*t8;
+  const T t18 = link2_R_PJ_zy*u[0];
+  const T t19 = link2_R_PJ_zz*u[0];
+  const T t20 = link2_p_J_z*t18;
+  const T t21 = link2_p_J_x*t19;
+  const T t22 = -link2_p_J_x*t18;
+  const T t23 = t18*t22 - t19*t21;
+  const T t24 = t19*t20;
+  const T t25 = -t18*t20;
+  const T t26 = link2_R_PJ_yy*t5;
+  const T t27 = link2_R_PJ_yz*t5;
+  const T t28 = t23 + t4;
+  const T t29 = t24 + t26;
+  const T t30 = t25 + t27;
+  const T t31 = angle_s[1]*t18;
+  const T t32 = angle_c[1]*t18;
+  const T w_B_link2_z = t19 + u[1];
+  const T t36 = t32*u[1];
+  const T t37 = -t31*u[1];
+  const T t39 = angle_c[1]*t28 + angle_s[1]*t29;
+  const T t40 = angle_c[1]*t29 - angle_s[1]*t28;
   // ---- body link2: mass and velocity terms
-  const T t54 = link2_S0_z*t36;
-  const T t55 = link2_S0_x*w_B_link2_z - link2_S0_z*t35;
-  const T t56 = -link2_S0_x*t36;
-  const T t57 = t36*t56 - t55*w_B_link2_z;
-  const T t58 = -t35*t56 + t54*w_B_link2_z;
-  const T t59 = t35*t55 - t36*t54;
-  const T t60 = link2_J0_xx*t35 + link2_J0_xy*t36 + link2_J0_xz*w_B_link2_z;
-  const T t61 = link2_J0_xy*t35 + link2_J0_yy*t36 + link2_J0_yz*w_B_link2_z;
-  const T t62 = link2_J0_xz*t35 + link2_J0_yz*t36 + link2_J0_zz*w_B_link2_z;
-  const T t63 = t36*t62 - t61*w_B_link2_z;
-  const T t64 = -t35*t62 + t60*w_B_link2_z;
-  const T t65 = t35*t61 - t36*t60;
+  const T t50 = link2_S0_z*t32;
+  const T t51 = link2_S0_x*w_B_link2_z - link2_S0_z*t31;
+  const T t52 = -link2_S0_x*t32;
+  const T t53 = t32*t52 - t51*w_B_link2_z;
+  const T t54 = -t31*t52 + t50*w_B_link2_z;
+  const T t55 = t31*t51 - t32*t50;
+  const T t56 = link2_J0_xx*t31 + link2_J0_xy*t32 + link2_J0_xz*w_B_link2_z;
+  const T t57 = link2_J0_xy*t31 + link2_J0_yy*t32 + link2_J0_yz*w_B_link2_z;
+  const T t58 = link2_J0_xz*t31 + link2_J0_yz*t32 + link2_J0_zz*w_B_link2_z;
+  const T t59 = t32*t58 - t57*w_B_link2_z;
+  const T t60 = -t31*t58 + t56*w_B_link2_z;
+  const T t61 = t31*t57 - t32*t56;
   // ---- body link1: bias force
-  const T t70 = -link1_S0_x*t7 + link1_S0_y*t6;
+  const T t66 = -link1_S0_x*t5 + link1_S0_y*t4;
   // ---- body link2: bias force
-  const T t71 = -link2_S0_z*t41 - link2_mass*t43 - t57;
-  const T t72 = link2_S0_z*t40 - link2_mass*t44 - t58;
-  const T t73 = link2_S0_x*t41 - link2_mass*t34 - t59;
-  const T t74 = link2_S0_z*t44 - ((link2_J0_xx*t40 + link2_J0_xy*t41) + t63);
-  const T t75 = link2_S0_x*t34 - ((link2_J0_xy*t40 + link2_J0_yy*t41) + (link2_S0_z*t43 + t64));
-  const T t76 = -((link2_J0_xz*t40 + link2_J0_yz*t41) + (link2_S0_x*t44 + t65));
+  const T t67 = -link2_S0_z*t37 - link2_mass*t39 - t53;
+  const T t68 = link2_S0_z*t36 - link2_mass*t40 - t54;
+  const T t69 = link2_S0_x*t37 - link2_mass*t30 - t55;
+  const T t70 = link2_S0_z*t40 - ((link2_J0_xx*t36 + link2_J0_xy*t37) + t59);
+  const T t71 = link2_S0_x*t30 - ((link2_J0_xy*t36 + link2_J0_yy*t37) + (link2_S0_z*t39 + t60));
+  const T t72 = -((link2_J0_xz*t36 + link2_J0_yz*t37) + (link2_S0_x*t40 + t61));
   // ---- body link2: generalized forces (inward)
-  const T t77 = t76 + tau[1];
-  const T t78 = t71*t8 - t72*t9;
-  const T t79 = t71*t9 + t72*t8;
-  const T t81 = -link2_p_J_x*t73 + link2_p_J_z*t78;
-  const T t82 = link2_p_J_x*t79;
-  const T t84 = t74*t9 + t75*t8;
-  const T t86 = t81 + t84;
-  const T t87 = t76 + t82;
-  const T t91 = link2_R_PJ_zy*t86 + link2_R_PJ_zz*t87;
-  const T t96 = t70 + t91;
+  const T t73 = t72 + tau[1];
+  const T t74 = angle_c[1]*t67 - angle_s[1]*t68;
+  const T t75 = angle_c[1]*t68 + angle_s[1]*t67;
+  const T t77 = -link2_p_J_x*t69 + link2_p_J_z*t74;
+  const T t78 = link2_p_J_x*t75;
+  const T t80 = angle_c[1]*t71 + angle_s[1]*t70;
+  const T t82 = t77 + t80;
+  const T t83 = t72 + t78;
+  const T t87 = link2_R_PJ_zy*t82 + link2_R_PJ_zz*t83;
+  const T t92 = t66 + t87;
   // ---- body link1: generalized forces (inward)
-  const T t97 = t96 + tau[0];
-  F[0] = t97;
-  F[1] = t77;
+  const T t93 = t92 + tau[0];
+  F[0] = t93;
+  F[1] = t73;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
@@ -307,102 +437,102 @@ template <class T>
 int udot(const T* q, const T* u, const T* tau, T* udot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[0], link2_angle_offset + q[1]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body link1: outward pass (velocities)
-  const T t0 = cos(q[0]);
-  const T t1 = sin(q[0]);
-  const T t6 = k359ff293*t0 + k5bfb74db*t1;
-  const T t7 = -k359ff293*t1 + k5bfb74db*t0;
+  const T t4 = angle_c[0]*k359ff293 + angle_s[0]*k5bfb74db;
+  const T t5 = angle_c[0]*k5bfb74db - angle_s[0]*k359ff293;
   // ---- body link2: outward pass (velocities)
-  const T t8 = cos(link2_angle_offset + q[1]);
-  const T t9 = sin(link2_angle_offset + q[1]);
-  const T t22 = link2_R_PJ_zy*u[0];
-  const T t23 = link2_R_PJ_zz*u[0];
-  const T t24 = link2_p_J_z*t22;
-  const T t25 = link2_p_J_x*t23;
-  const T t26 = -link2_p_J_x*t22;
-  const T t27 = t22*t26 - t23*t25;
-  const T t28 = t23*t24;
-  const T t29 = -t22*t24;
-  const T t30 = link2_R_PJ_yy*t7;
-  const T t31 = link2_R_PJ_yz*t7;
-  const T t32 = t27 + t6;
-  const T t33 = t28 + t30;
-  const T t34 = t29 + t31;
-  const T t35 = t22*t9;
-  const T t36 = t22*t8;
-  const T w_B_link2_z = t23 + u[1];
-  const T t40 = t36*u[1];
-  const T t41 = -t35*u[1];
-  const T t43 = t32*t8 + t33*t9;
-  const T t44 = -t32*t9 + t33*t8;
+  const T t18 = link2_R_PJ_zy*u[0];
+  const T t19 = link2_R_PJ_zz*u[0];
+  const T t20 = link2_p_J_z*t18;
+  const T t21 = link2_p_J_x*t19;
+  const T t22 = -link2_p_J_x*t18;
+  const T t23 = t18*t22 - t19*t21;
+  const T t24 = t19*t20;
+  const T t25 = -t18*t20;
+  const T t26 = link2_R_PJ_yy*t5;
+  const T t27 = link2_R_PJ_yz*t5;
+  const T t28 = t23 + t4;
+  const T t29 = t24 + t26;
+  const T t30 = t25 + t27;
+  const T t31 = angle_s[1]*t18;
+  const T t32 = angle_c[1]*t18;
+  const T w_B_link2_z = t19 + u[1];
+  const T t36 = t32*u[1];
+  const T t37 = -t31*u[1];
+  const T t39 = angle_c[1]*t28 + angle_s[1]*t29;
+  const T t40 = angle_c[1]*t29 - angle_s[1]*t28;
   // ---- body link2: mass and velocity terms
-  const T t54 = link2_S0_z*t36;
-  const T t55 = link2_S0_x*w_B_link2_z - link2_S0_z*t35;
-  const T t56 = -link2_S0_x*t36;
-  const T t57 = t36*t56 - t55*w_B_link2_z;
-  const T t58 = -t35*t56 + t54*w_B_link2_z;
-  const T t59 = t35*t55 - t36*t54;
-  const T t60 = link2_J0_xx*t35 + link2_J0_xy*t36 + link2_J0_xz*w_B_link2_z;
-  const T t61 = link2_J0_xy*t35 + link2_J0_yy*t36 + link2_J0_yz*w_B_link2_z;
-  const T t62 = link2_J0_xz*t35 + link2_J0_yz*t36 + link2_J0_zz*w_B_link2_z;
-  const T t63 = t36*t62 - t61*w_B_link2_z;
-  const T t64 = -t35*t62 + t60*w_B_link2_z;
-  const T t65 = t35*t61 - t36*t60;
+  const T t50 = link2_S0_z*t32;
+  const T t51 = link2_S0_x*w_B_link2_z - link2_S0_z*t31;
+  const T t52 = -link2_S0_x*t32;
+  const T t53 = t32*t52 - t51*w_B_link2_z;
+  const T t54 = -t31*t52 + t50*w_B_link2_z;
+  const T t55 = t31*t51 - t32*t50;
+  const T t56 = link2_J0_xx*t31 + link2_J0_xy*t32 + link2_J0_xz*w_B_link2_z;
+  const T t57 = link2_J0_xy*t31 + link2_J0_yy*t32 + link2_J0_yz*w_B_link2_z;
+  const T t58 = link2_J0_xz*t31 + link2_J0_yz*t32 + link2_J0_zz*w_B_link2_z;
+  const T t59 = t32*t58 - t57*w_B_link2_z;
+  const T t60 = -t31*t58 + t56*w_B_link2_z;
+  const T t61 = t31*t57 - t32*t56;
   // ---- body link2: composite inertia (inward)
-  const T t66 = link2_S0_x*t8;
-  const T t67 = link2_S0_x*t9;
-  const T t68 = t9*t9;
-  const T t69 = t8*t9;
-  const T t71 = 2.0*link2_J0_xy*t69 - ka7b3ad17*t68;
-  const T t73 = link2_J0_yy + t71;
-  const T t76 = link2_J0_xz*t9 + link2_J0_yz*t8;
-  const T t80 = 2.0*link2_p_J_x*t66 + ka6ba76ae + t73;
-  const T t81 = -link2_p_J_z*t67 + t76;
-  const T t82 = 2.0*link2_p_J_x*t66 + kbe5816c7;
-  const T t86 = t80 - t82;
-  const T t87 = link2_R_PJ_yy_S2*t81 + link2_R_PJ_yy_ss*t86;
-  const T t89 = t82 + t87;
-  const T t98 = link1_J0_zz + t89;
+  const T t62 = angle_c[1]*link2_S0_x;
+  const T t63 = angle_s[1]*link2_S0_x;
+  const T t64 = angle_s[1]*angle_s[1];
+  const T t65 = angle_c[1]*angle_s[1];
+  const T t67 = 2.0*link2_J0_xy*t65 - ka7b3ad17*t64;
+  const T t69 = link2_J0_yy + t67;
+  const T t72 = angle_c[1]*link2_J0_yz + angle_s[1]*link2_J0_xz;
+  const T t76 = 2.0*link2_p_J_x*t62 + ka6ba76ae + t69;
+  const T t77 = -link2_p_J_z*t63 + t72;
+  const T t78 = 2.0*link2_p_J_x*t62 + kbe5816c7;
+  const T t82 = t76 - t78;
+  const T t83 = link2_R_PJ_yy_S2*t77 + link2_R_PJ_yy_ss*t82;
+  const T t85 = t78 + t83;
+  const T t94 = link1_J0_zz + t85;
   // ---- body link2: its columns of M (walked to the root)
-  const T t105 = -link2_S0_x*t9;
-  const T t107 = link2_p_J_z*t105;
-  const T t108 = link2_p_J_x*t66;
-  const T t110 = t107 + t76;
-  const T t111 = link2_J0_zz + t108;
-  const T t115 = link2_R_PJ_zy*t110 + link2_R_PJ_zz*t111;
+  const T t101 = -angle_s[1]*link2_S0_x;
+  const T t103 = link2_p_J_z*t101;
+  const T t104 = link2_p_J_x*t62;
+  const T t106 = t103 + t72;
+  const T t107 = link2_J0_zz + t104;
+  const T t111 = link2_R_PJ_zy*t106 + link2_R_PJ_zz*t107;
   // ---- body link1: bias force
-  const T t120 = -link1_S0_x*t7 + link1_S0_y*t6;
+  const T t116 = -link1_S0_x*t5 + link1_S0_y*t4;
   // ---- body link2: bias force
-  const T t121 = -link2_S0_z*t41 - link2_mass*t43 - t57;
-  const T t122 = link2_S0_z*t40 - link2_mass*t44 - t58;
-  const T t123 = link2_S0_x*t41 - link2_mass*t34 - t59;
-  const T t124 = link2_S0_z*t44 - ((link2_J0_xx*t40 + link2_J0_xy*t41) + t63);
-  const T t125 = link2_S0_x*t34 - ((link2_J0_xy*t40 + link2_J0_yy*t41) + (link2_S0_z*t43 + t64));
-  const T t126 = -((link2_J0_xz*t40 + link2_J0_yz*t41) + (link2_S0_x*t44 + t65));
+  const T t117 = -link2_S0_z*t37 - link2_mass*t39 - t53;
+  const T t118 = link2_S0_z*t36 - link2_mass*t40 - t54;
+  const T t119 = link2_S0_x*t37 - link2_mass*t30 - t55;
+  const T t120 = link2_S0_z*t40 - ((link2_J0_xx*t36 + link2_J0_xy*t37) + t59);
+  const T t121 = link2_S0_x*t30 - ((link2_J0_xy*t36 + link2_J0_yy*t37) + (link2_S0_z*t39 + t60));
+  const T t122 = -((link2_J0_xz*t36 + link2_J0_yz*t37) + (link2_S0_x*t40 + t61));
   // ---- body link2: generalized forces (inward)
-  const T t127 = t126 + tau[1];
-  const T t128 = t121*t8 - t122*t9;
-  const T t129 = t121*t9 + t122*t8;
-  const T t131 = -link2_p_J_x*t123 + link2_p_J_z*t128;
-  const T t132 = link2_p_J_x*t129;
-  const T t134 = t124*t9 + t125*t8;
-  const T t136 = t131 + t134;
-  const T t137 = t126 + t132;
-  const T t141 = link2_R_PJ_zy*t136 + link2_R_PJ_zz*t137;
-  const T t146 = t120 + t141;
+  const T t123 = t122 + tau[1];
+  const T t124 = angle_c[1]*t117 - angle_s[1]*t118;
+  const T t125 = angle_c[1]*t118 + angle_s[1]*t117;
+  const T t127 = -link2_p_J_x*t119 + link2_p_J_z*t124;
+  const T t128 = link2_p_J_x*t125;
+  const T t130 = angle_c[1]*t121 + angle_s[1]*t120;
+  const T t132 = t127 + t130;
+  const T t133 = t122 + t128;
+  const T t137 = link2_R_PJ_zy*t132 + link2_R_PJ_zz*t133;
+  const T t142 = t116 + t137;
   // ---- body link1: generalized forces (inward)
-  const T t147 = t146 + tau[0];
+  const T t143 = t142 + tau[0];
   // ---- M u_dot = F: L^T D L along the dof tree
-  const T t148 = kb7e5959a*t115;
-  const T t149 = -t115*t148 + t98;
-  const T t151 = -t127*t148 + t147;
-  const T t152 = t151/t149;
-  const T t153 = kb7e5959a*t127;
-  const T t154 = -t148*t152 + t153;
-  if (!(t149 > 1e-14*t98)) return 1;
+  const T t144 = kb7e5959a*t111;
+  const T t145 = -t111*t144 + t94;
+  const T t147 = -t123*t144 + t143;
+  const T t148 = t147/t145;
+  const T t149 = kb7e5959a*t123;
+  const T t150 = -t144*t148 + t149;
+  if (!(t145 > 1e-14*t94)) return 1;
   if (!(link2_J0_zz > 0.0)) return 2;
-  udot[0] = t152;
-  udot[1] = t154;
+  udot[0] = t148;
+  udot[1] = t150;
   return 0;
 }
 
@@ -411,46 +541,46 @@ template <class T>
 void energy(const T* q, const T* u, T* TV) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[0], link2_angle_offset + q[1]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body link1: outward pass (velocities)
-  const T t0 = cos(q[0]);
-  const T t1 = sin(q[0]);
-  const T R_PB_link1_zx = link1_R_PJ_zx*t0 + link1_R_PJ_zy*t1;
-  const T R_PB_link1_zy = -link1_R_PJ_zx*t1 + link1_R_PJ_zy*t0;
+  const T R_PB_link1_zx = angle_c[0]*link1_R_PJ_zx + angle_s[0]*link1_R_PJ_zy;
+  const T R_PB_link1_zy = angle_c[0]*link1_R_PJ_zy - angle_s[0]*link1_R_PJ_zx;
   // ---- body link2: outward pass (velocities)
-  const T t8 = cos(link2_angle_offset + q[1]);
-  const T t9 = sin(link2_angle_offset + q[1]);
-  const T R_PB_link2_yx = link2_R_PJ_yy*t9;
-  const T R_NB_link2_zx = R_PB_link1_zx*t8 + R_PB_link1_zy*R_PB_link2_yx;
+  const T R_PB_link2_yx = angle_s[1]*link2_R_PJ_yy;
+  const T R_NB_link2_zx = R_PB_link1_zx*angle_c[1] + R_PB_link1_zy*R_PB_link2_yx;
   const T R_NB_link2_zz = R_PB_link1_zy*link2_R_PJ_yz;
-  const T t21 = R_PB_link1_zx*link2_p_PJ_x + R_PB_link1_zy*link2_p_PJ_y;
-  const T t22 = link2_R_PJ_zy*u[0];
-  const T t23 = link2_R_PJ_zz*u[0];
-  const T t24 = link2_p_J_z*t22;
-  const T t25 = link2_p_J_x*t23;
-  const T t26 = -link2_p_J_x*t22;
-  const T t35 = t22*t9;
-  const T t36 = t22*t8;
-  const T w_B_link2_z = t23 + u[1];
-  const T t38 = t24*t8 + t25*t9;
-  const T t39 = -t24*t9 + t25*t8;
+  const T t17 = R_PB_link1_zx*link2_p_PJ_x + R_PB_link1_zy*link2_p_PJ_y;
+  const T t18 = link2_R_PJ_zy*u[0];
+  const T t19 = link2_R_PJ_zz*u[0];
+  const T t20 = link2_p_J_z*t18;
+  const T t21 = link2_p_J_x*t19;
+  const T t22 = -link2_p_J_x*t18;
+  const T t31 = angle_s[1]*t18;
+  const T t32 = angle_c[1]*t18;
+  const T w_B_link2_z = t19 + u[1];
+  const T t34 = angle_c[1]*t20 + angle_s[1]*t21;
+  const T t35 = angle_c[1]*t21 - angle_s[1]*t20;
   // ---- body link1: mass and velocity terms
-  const T t51 = link1_J0_zz*u[0];
+  const T t47 = link1_J0_zz*u[0];
   // ---- body link2: mass and velocity terms
-  const T t66 = t51*u[0];
-  const T t67 = link2_S0_z*t36 + link2_mass*t38;
-  const T t68 = link2_S0_x*w_B_link2_z - link2_S0_z*t35 + link2_mass*t39;
-  const T t69 = -link2_S0_x*t36 + link2_mass*t26;
-  const T t70 = ((link2_J0_xx*t35 + link2_J0_xy*t36) + link2_J0_xz*w_B_link2_z) - link2_S0_z*t39;
-  const T t71 = ((link2_J0_xy*t35 + link2_J0_yy*t36) + (link2_J0_yz*w_B_link2_z + link2_S0_z*t38)) - link2_S0_x*t26;
-  const T t72 = (link2_J0_xz*t35 + link2_J0_yz*t36) + (link2_J0_zz*w_B_link2_z + link2_S0_x*t39);
-  const T t73 = ((t26*t69 + t35*t70) + t36*t71) + ((t38*t67 + t39*t68) + t72*w_B_link2_z);
-  const T t74 = t66/2.0 + t73/2.0;
-  const T t76 = R_PB_link1_zx*link1_S0_x + R_PB_link1_zy*link1_S0_y;
-  const T t77 = -gravity_z*t76;
-  const T t80 = R_NB_link2_zx*link2_S0_x + R_NB_link2_zz*link2_S0_z;
-  const T t81 = -(link2_mass*t21 + t80)*gravity_z + t77;
-  TV[0] = t74;
-  TV[1] = t81;
+  const T t62 = t47*u[0];
+  const T t63 = link2_S0_z*t32 + link2_mass*t34;
+  const T t64 = link2_S0_x*w_B_link2_z - link2_S0_z*t31 + link2_mass*t35;
+  const T t65 = -link2_S0_x*t32 + link2_mass*t22;
+  const T t66 = ((link2_J0_xx*t31 + link2_J0_xy*t32) + link2_J0_xz*w_B_link2_z) - link2_S0_z*t35;
+  const T t67 = ((link2_J0_xy*t31 + link2_J0_yy*t32) + (link2_J0_yz*w_B_link2_z + link2_S0_z*t34)) - link2_S0_x*t22;
+  const T t68 = (link2_J0_xz*t31 + link2_J0_yz*t32) + (link2_J0_zz*w_B_link2_z + link2_S0_x*t35);
+  const T t69 = ((t22*t65 + t31*t66) + t32*t67) + ((t34*t63 + t35*t64) + t68*w_B_link2_z);
+  const T t70 = t62/2.0 + t69/2.0;
+  const T t72 = R_PB_link1_zx*link1_S0_x + R_PB_link1_zy*link1_S0_y;
+  const T t73 = -gravity_z*t72;
+  const T t76 = R_NB_link2_zx*link2_S0_x + R_NB_link2_zz*link2_S0_z;
+  const T t77 = -(link2_mass*t17 + t76)*gravity_z + t73;
+  TV[0] = t70;
+  TV[1] = t77;
 }
 
 // ---- momentum: p_N[3], H_N[3] about N's origin ---------------------------------
@@ -458,82 +588,82 @@ template <class T>
 void momentum(const T* q, const T* u, T* pH) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[0], link2_angle_offset + q[1]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body link1: outward pass (velocities)
-  const T t0 = cos(q[0]);
-  const T t1 = sin(q[0]);
-  const T R_PB_link1_xx = link1_R_PJ_xx*t0 + link1_R_PJ_xy*t1;
-  const T R_PB_link1_xy = -link1_R_PJ_xx*t1 + link1_R_PJ_xy*t0;
-  const T R_PB_link1_zx = link1_R_PJ_zx*t0 + link1_R_PJ_zy*t1;
-  const T R_PB_link1_zy = -link1_R_PJ_zx*t1 + link1_R_PJ_zy*t0;
+  const T R_PB_link1_xx = angle_c[0]*link1_R_PJ_xx + angle_s[0]*link1_R_PJ_xy;
+  const T R_PB_link1_xy = angle_c[0]*link1_R_PJ_xy - angle_s[0]*link1_R_PJ_xx;
+  const T R_PB_link1_zx = angle_c[0]*link1_R_PJ_zx + angle_s[0]*link1_R_PJ_zy;
+  const T R_PB_link1_zy = angle_c[0]*link1_R_PJ_zy - angle_s[0]*link1_R_PJ_zx;
   // ---- body link2: outward pass (velocities)
-  const T t8 = cos(link2_angle_offset + q[1]);
-  const T t9 = sin(link2_angle_offset + q[1]);
-  const T R_PB_link2_yx = link2_R_PJ_yy*t9;
-  const T R_PB_link2_yy = link2_R_PJ_yy*t8;
-  const T R_PB_link2_zx = link2_R_PJ_zy*t9;
-  const T R_PB_link2_zy = link2_R_PJ_zy*t8;
-  const T R_NB_link2_xx = R_PB_link1_xx*t8 + R_PB_link1_xy*R_PB_link2_yx;
-  const T R_NB_link2_xy = -R_PB_link1_xx*t9 + R_PB_link1_xy*R_PB_link2_yy;
+  const T R_PB_link2_yx = angle_s[1]*link2_R_PJ_yy;
+  const T R_PB_link2_yy = angle_c[1]*link2_R_PJ_yy;
+  const T R_PB_link2_zx = angle_s[1]*link2_R_PJ_zy;
+  const T R_PB_link2_zy = angle_c[1]*link2_R_PJ_zy;
+  const T R_NB_link2_xx = R_PB_link1_xx*angle_c[1] + R_PB_link1_xy*R_PB_link2_yx;
+  const T R_NB_link2_xy = -R_PB_link1_xx*angle_s[1] + R_PB_link1_xy*R_PB_link2_yy;
   const T R_NB_link2_xz = R_PB_link1_xy*link2_R_PJ_yz;
-  const T R_NB_link2_zx = R_PB_link1_zx*t8 + R_PB_link1_zy*R_PB_link2_yx;
-  const T R_NB_link2_zy = -R_PB_link1_zx*t9 + R_PB_link1_zy*R_PB_link2_yy;
+  const T R_NB_link2_zx = R_PB_link1_zx*angle_c[1] + R_PB_link1_zy*R_PB_link2_yx;
+  const T R_NB_link2_zy = -R_PB_link1_zx*angle_s[1] + R_PB_link1_zy*R_PB_link2_yy;
   const T R_NB_link2_zz = R_PB_link1_zy*link2_R_PJ_yz;
-  const T t20 = R_PB_link1_xx*link2_p_PJ_x + R_PB_link1_xy*link2_p_PJ_y;
-  const T t21 = R_PB_link1_zx*link2_p_PJ_x + R_PB_link1_zy*link2_p_PJ_y;
-  const T t22 = link2_R_PJ_zy*u[0];
-  const T t23 = link2_R_PJ_zz*u[0];
-  const T t24 = link2_p_J_z*t22;
-  const T t25 = link2_p_J_x*t23;
-  const T t26 = -link2_p_J_x*t22;
-  const T t35 = t22*t9;
-  const T t36 = t22*t8;
-  const T w_B_link2_z = t23 + u[1];
-  const T t38 = t24*t8 + t25*t9;
-  const T t39 = -t24*t9 + t25*t8;
+  const T t16 = R_PB_link1_xx*link2_p_PJ_x + R_PB_link1_xy*link2_p_PJ_y;
+  const T t17 = R_PB_link1_zx*link2_p_PJ_x + R_PB_link1_zy*link2_p_PJ_y;
+  const T t18 = link2_R_PJ_zy*u[0];
+  const T t19 = link2_R_PJ_zz*u[0];
+  const T t20 = link2_p_J_z*t18;
+  const T t21 = link2_p_J_x*t19;
+  const T t22 = -link2_p_J_x*t18;
+  const T t31 = angle_s[1]*t18;
+  const T t32 = angle_c[1]*t18;
+  const T w_B_link2_z = t19 + u[1];
+  const T t34 = angle_c[1]*t20 + angle_s[1]*t21;
+  const T t35 = angle_c[1]*t21 - angle_s[1]*t20;
   // ---- body link1: mass and velocity terms
-  const T t45 = -link1_S0_y*u[0];
-  const T t46 = link1_S0_x*u[0];
-  const T t49 = link1_J0_xz*u[0];
-  const T t50 = link1_J0_yz*u[0];
-  const T t51 = link1_J0_zz*u[0];
+  const T t41 = -link1_S0_y*u[0];
+  const T t42 = link1_S0_x*u[0];
+  const T t45 = link1_J0_xz*u[0];
+  const T t46 = link1_J0_yz*u[0];
+  const T t47 = link1_J0_zz*u[0];
   // ---- body link2: mass and velocity terms
-  const T t66 = R_PB_link1_xx*t45 + R_PB_link1_xy*t46;
-  const T t67 = R_PB_link1_zx*t45 + R_PB_link1_zy*t46;
-  const T t68 = R_PB_link1_xx*t49 + R_PB_link1_xy*t50;
-  const T t69 = R_PB_link1_zx*t49 + R_PB_link1_zy*t50;
-  const T t70 = link1_p_PJ_y*t67;
-  const T t71 = -link1_p_PJ_y*t66;
-  const T t72 = t68 + t70;
-  const T t73 = t69 + t71;
-  const T t74 = link2_S0_z*t36 + link2_mass*t38;
-  const T t75 = link2_S0_x*w_B_link2_z - link2_S0_z*t35 + link2_mass*t39;
-  const T t76 = -link2_S0_x*t36 + link2_mass*t26;
-  const T t77 = ((link2_J0_xx*t35 + link2_J0_xy*t36) + link2_J0_xz*w_B_link2_z) - link2_S0_z*t39;
-  const T t78 = ((link2_J0_xy*t35 + link2_J0_yy*t36) + (link2_J0_yz*w_B_link2_z + link2_S0_z*t38)) - link2_S0_x*t26;
-  const T t79 = (link2_J0_xz*t35 + link2_J0_yz*t36) + (link2_J0_zz*w_B_link2_z + link2_S0_x*t39);
-  const T t80 = R_NB_link2_xx*t74 + R_NB_link2_xy*t75 + R_NB_link2_xz*t76;
-  const T t81 = R_PB_link2_zx*t74 + R_PB_link2_zy*t75 + link2_R_PJ_zz*t76;
-  const T t82 = R_NB_link2_zx*t74 + R_NB_link2_zy*t75 + R_NB_link2_zz*t76;
-  const T t83 = R_NB_link2_xx*t77 + R_NB_link2_xy*t78 + R_NB_link2_xz*t79;
-  const T t84 = R_PB_link2_zx*t77 + R_PB_link2_zy*t78 + link2_R_PJ_zz*t79;
-  const T t85 = R_NB_link2_zx*t77 + R_NB_link2_zy*t78 + R_NB_link2_zz*t79;
-  const T t86 = k154fd1a6*t82 - t21*t81;
-  const T t87 = -t20*t82 + t21*t80;
-  const T t88 = -k154fd1a6*t80 + t20*t81;
-  const T t89 = t83 + t86;
-  const T t90 = t84 + t87;
-  const T t91 = t85 + t88;
-  const T t92 = t66 + t80;
-  const T t93 = t67 + t82;
-  const T t94 = t72 + t89;
-  const T t95 = t51 + t90;
-  const T t96 = t73 + t91;
-  pH[0] = t92;
-  pH[1] = t81;
-  pH[2] = t93;
-  pH[3] = t94;
-  pH[4] = t95;
-  pH[5] = t96;
+  const T t62 = R_PB_link1_xx*t41 + R_PB_link1_xy*t42;
+  const T t63 = R_PB_link1_zx*t41 + R_PB_link1_zy*t42;
+  const T t64 = R_PB_link1_xx*t45 + R_PB_link1_xy*t46;
+  const T t65 = R_PB_link1_zx*t45 + R_PB_link1_zy*t46;
+  const T t66 = link1_p_PJ_y*t63;
+  const T t67 = -link1_p_PJ_y*t62;
+  const T t68 = t64 + t66;
+  const T t69 = t65 + t67;
+  const T t70 = link2_S0_z*t32 + link2_mass*t34;
+  const T t71 = link2_S0_x*w_B_link2_z - link2_S0_z*t31 + link2_mass*t35;
+  const T t72 = -link2_S0_x*t32 + link2_mass*t22;
+  const T t73 = ((link2_J0_xx*t31 + link2_J0_xy*t32) + link2_J0_xz*w_B_link2_z) - link2_S0_z*t35;
+  const T t74 = ((link2_J0_xy*t31 + link2_J0_yy*t32) + (link2_J0_yz*w_B_link2_z + link2_S0_z*t34)) - link2_S0_x*t22;
+  const T t75 = (link2_J0_xz*t31 + link2_J0_yz*t32) + (link2_J0_zz*w_B_link2_z + link2_S0_x*t35);
+  const T t76 = R_NB_link2_xx*t70 + R_NB_link2_xy*t71 + R_NB_link2_xz*t72;
+  const T t77 = R_PB_link2_zx*t70 + R_PB_link2_zy*t71 + link2_R_PJ_zz*t72;
+  const T t78 = R_NB_link2_zx*t70 + R_NB_link2_zy*t71 + R_NB_link2_zz*t72;
+  const T t79 = R_NB_link2_xx*t73 + R_NB_link2_xy*t74 + R_NB_link2_xz*t75;
+  const T t80 = R_PB_link2_zx*t73 + R_PB_link2_zy*t74 + link2_R_PJ_zz*t75;
+  const T t81 = R_NB_link2_zx*t73 + R_NB_link2_zy*t74 + R_NB_link2_zz*t75;
+  const T t82 = k154fd1a6*t78 - t17*t77;
+  const T t83 = -t16*t78 + t17*t76;
+  const T t84 = -k154fd1a6*t76 + t16*t77;
+  const T t85 = t79 + t82;
+  const T t86 = t80 + t83;
+  const T t87 = t81 + t84;
+  const T t88 = t62 + t76;
+  const T t89 = t63 + t78;
+  const T t90 = t68 + t85;
+  const T t91 = t47 + t86;
+  const T t92 = t69 + t87;
+  pH[0] = t88;
+  pH[1] = t77;
+  pH[2] = t89;
+  pH[3] = t90;
+  pH[4] = t91;
+  pH[5] = t92;
 }
 
 // ---- reactions on each body from its parent: [force; torque about O_B], body axes ---
@@ -541,122 +671,122 @@ template <class T>
 void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)udot_in;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[0], link2_angle_offset + q[1]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body link1: outward pass (velocities)
-  const T t0 = cos(q[0]);
-  const T t1 = sin(q[0]);
-  const T t6 = k359ff293*t0 + k5bfb74db*t1;
-  const T t7 = -k359ff293*t1 + k5bfb74db*t0;
+  const T t4 = angle_c[0]*k359ff293 + angle_s[0]*k5bfb74db;
+  const T t5 = angle_c[0]*k5bfb74db - angle_s[0]*k359ff293;
   // ---- body link2: outward pass (velocities)
-  const T t8 = cos(link2_angle_offset + q[1]);
-  const T t9 = sin(link2_angle_offset + q[1]);
-  const T t22 = link2_R_PJ_zy*u[0];
-  const T t23 = link2_R_PJ_zz*u[0];
-  const T t24 = link2_p_J_z*t22;
-  const T t25 = link2_p_J_x*t23;
-  const T t26 = -link2_p_J_x*t22;
-  const T t27 = t22*t26 - t23*t25;
-  const T t28 = t23*t24;
-  const T t29 = -t22*t24;
-  const T t30 = link2_R_PJ_yy*t7;
-  const T t31 = link2_R_PJ_yz*t7;
-  const T t32 = t27 + t6;
-  const T t33 = t28 + t30;
-  const T t34 = t29 + t31;
-  const T t35 = t22*t9;
-  const T t36 = t22*t8;
-  const T w_B_link2_z = t23 + u[1];
-  const T t40 = t36*u[1];
-  const T t41 = -t35*u[1];
-  const T t43 = t32*t8 + t33*t9;
-  const T t44 = -t32*t9 + t33*t8;
+  const T t18 = link2_R_PJ_zy*u[0];
+  const T t19 = link2_R_PJ_zz*u[0];
+  const T t20 = link2_p_J_z*t18;
+  const T t21 = link2_p_J_x*t19;
+  const T t22 = -link2_p_J_x*t18;
+  const T t23 = t18*t22 - t19*t21;
+  const T t24 = t19*t20;
+  const T t25 = -t18*t20;
+  const T t26 = link2_R_PJ_yy*t5;
+  const T t27 = link2_R_PJ_yz*t5;
+  const T t28 = t23 + t4;
+  const T t29 = t24 + t26;
+  const T t30 = t25 + t27;
+  const T t31 = angle_s[1]*t18;
+  const T t32 = angle_c[1]*t18;
+  const T w_B_link2_z = t19 + u[1];
+  const T t36 = t32*u[1];
+  const T t37 = -t31*u[1];
+  const T t39 = angle_c[1]*t28 + angle_s[1]*t29;
+  const T t40 = angle_c[1]*t29 - angle_s[1]*t28;
   // ---- body link1: mass and velocity terms
-  const T t45 = -link1_S0_y*u[0];
-  const T t46 = link1_S0_x*u[0];
-  const T t47 = -t46*u[0];
-  const T t48 = t45*u[0];
-  const T t49 = link1_J0_xz*u[0];
-  const T t50 = link1_J0_yz*u[0];
-  const T t52 = -t50*u[0];
-  const T t53 = t49*u[0];
+  const T t41 = -link1_S0_y*u[0];
+  const T t42 = link1_S0_x*u[0];
+  const T t43 = -t42*u[0];
+  const T t44 = t41*u[0];
+  const T t45 = link1_J0_xz*u[0];
+  const T t46 = link1_J0_yz*u[0];
+  const T t48 = -t46*u[0];
+  const T t49 = t45*u[0];
   // ---- body link2: mass and velocity terms
-  const T t54 = link2_S0_z*t36;
-  const T t55 = link2_S0_x*w_B_link2_z - link2_S0_z*t35;
-  const T t56 = -link2_S0_x*t36;
-  const T t57 = t36*t56 - t55*w_B_link2_z;
-  const T t58 = -t35*t56 + t54*w_B_link2_z;
-  const T t59 = t35*t55 - t36*t54;
-  const T t60 = link2_J0_xx*t35 + link2_J0_xy*t36 + link2_J0_xz*w_B_link2_z;
-  const T t61 = link2_J0_xy*t35 + link2_J0_yy*t36 + link2_J0_yz*w_B_link2_z;
-  const T t62 = link2_J0_xz*t35 + link2_J0_yz*t36 + link2_J0_zz*w_B_link2_z;
-  const T t63 = t36*t62 - t61*w_B_link2_z;
-  const T t64 = -t35*t62 + t60*w_B_link2_z;
-  const T t65 = t35*t61 - t36*t60;
-  const T t66 = -link1_S0_y*udot_in[0] + t47 + t6;
-  const T t67 = link1_S0_x*udot_in[0] + t48 + t7;
-  const T t68 = link1_J0_xz*udot_in[0] - link1_S0_z*t7 + t52;
-  const T t69 = link1_J0_yz*udot_in[0] + link1_S0_z*t6 + t53;
-  const T t70 = link1_J0_zz*udot_in[0] + link1_S0_x*t7 - link1_S0_y*t6;
-  const T t71 = link2_R_PJ_zy*udot_in[0];
-  const T t72 = link2_R_PJ_zz*udot_in[0];
-  const T t73 = link2_p_J_z*t71;
-  const T t74 = link2_p_J_x*t72;
-  const T t75 = -link2_p_J_x*t71;
-  const T t76 = t73*t8 + t74*t9;
-  const T t77 = -t73*t9 + t74*t8;
-  const T t78 = t71*t9;
-  const T t79 = t71*t8;
-  const T t80 = t72 + udot_in[1];
-  const T t81 = (t41 + t79)*link2_S0_z + (t43 + t76)*link2_mass + t57;
-  const T t82 = (((t44 + t77)*link2_mass + link2_S0_x*t80) + t58) - (t40 + t78)*link2_S0_z;
-  const T t83 = (t34 + t75)*link2_mass - (t41 + t79)*link2_S0_x + t59;
-  const T t84 = (((t40 + t78)*link2_J0_xx + (t41 + t79)*link2_J0_xy) + (link2_J0_xz*t80 + t63)) - (t44 + t77)*link2_S0_z;
-  const T t85 = ((((t40 + t78)*link2_J0_xy + (t41 + t79)*link2_J0_yy) + (t43 + t76)*link2_S0_z) + (link2_J0_yz*t80 + t64)) - (t34 + t75)*link2_S0_x;
-  const T t86 = (((t40 + t78)*link2_J0_xz + (t41 + t79)*link2_J0_yz) + (t44 + t77)*link2_S0_x) + (link2_J0_zz*t80 + t65);
-  const T t87 = t8*t81 - t82*t9;
-  const T t88 = t8*t82 + t81*t9;
-  const T t89 = -link2_p_J_z*t88;
-  const T t90 = -link2_p_J_x*t83 + link2_p_J_z*t87;
-  const T t91 = link2_p_J_x*t88;
-  const T t92 = t8*t84 - t85*t9;
-  const T t93 = t8*t85 + t84*t9;
-  const T t94 = t89 + t92;
-  const T t95 = t90 + t93;
-  const T t96 = t86 + t91;
-  const T t97 = link2_R_PJ_yy*t88 + link2_R_PJ_yz*t83;
-  const T t98 = link2_R_PJ_zy*t88 + link2_R_PJ_zz*t83;
-  const T t99 = link2_R_PJ_yy*t95 + link2_R_PJ_yz*t96;
-  const T t100 = link2_R_PJ_zy*t95 + link2_R_PJ_zz*t96;
-  const T t101 = t66 + t87;
-  const T t102 = t67 + t97;
-  const T t103 = t68 + t94;
-  const T t104 = t69 + t99;
-  const T t105 = t100 + t70;
-  const T t106 = link1_R_BBp_xx*t101 + link1_R_BBp_xy*t102;
-  const T t107 = link1_R_BBp_zx*t101 + link1_R_BBp_zy*t102;
-  const T t108 = link1_R_BBp_xx*t103 + link1_R_BBp_xy*t104;
-  const T t109 = link1_R_BBp_zx*t103 + link1_R_BBp_zy*t104;
-  const T t110 = link1_o_B_y*t107;
-  const T t111 = -link1_o_B_y*t106;
-  const T t112 = t108 + t110;
-  const T t113 = t109 + t111;
-  const T t114 = link2_R_BBp_xx*t81 + link2_R_BBp_xy*t82 + link2_R_BBp_xz*t83;
-  const T t115 = link2_R_BBp_yx*t81 + link2_R_BBp_yy*t82;
-  const T t116 = link2_R_BBp_zx*t81 + link2_R_BBp_zy*t82 + link2_R_BBp_zz*t83;
-  const T t117 = link2_R_BBp_xx*t84 + link2_R_BBp_xy*t85 + link2_R_BBp_xz*t86;
-  const T t118 = link2_R_BBp_yx*t84 + link2_R_BBp_yy*t85;
-  const T t119 = link2_R_BBp_zx*t84 + link2_R_BBp_zy*t85 + link2_R_BBp_zz*t86;
-  wrenches[0] = t106;
-  wrenches[3] = t112;
-  wrenches[1] = t98;
-  wrenches[4] = t105;
-  wrenches[2] = t107;
-  wrenches[5] = t113;
-  wrenches[6] = t114;
-  wrenches[9] = t117;
-  wrenches[7] = t115;
-  wrenches[10] = t118;
-  wrenches[8] = t116;
-  wrenches[11] = t119;
+  const T t50 = link2_S0_z*t32;
+  const T t51 = link2_S0_x*w_B_link2_z - link2_S0_z*t31;
+  const T t52 = -link2_S0_x*t32;
+  const T t53 = t32*t52 - t51*w_B_link2_z;
+  const T t54 = -t31*t52 + t50*w_B_link2_z;
+  const T t55 = t31*t51 - t32*t50;
+  const T t56 = link2_J0_xx*t31 + link2_J0_xy*t32 + link2_J0_xz*w_B_link2_z;
+  const T t57 = link2_J0_xy*t31 + link2_J0_yy*t32 + link2_J0_yz*w_B_link2_z;
+  const T t58 = link2_J0_xz*t31 + link2_J0_yz*t32 + link2_J0_zz*w_B_link2_z;
+  const T t59 = t32*t58 - t57*w_B_link2_z;
+  const T t60 = -t31*t58 + t56*w_B_link2_z;
+  const T t61 = t31*t57 - t32*t56;
+  const T t62 = -link1_S0_y*udot_in[0] + t4 + t43;
+  const T t63 = link1_S0_x*udot_in[0] + t44 + t5;
+  const T t64 = link1_J0_xz*udot_in[0] - link1_S0_z*t5 + t48;
+  const T t65 = link1_J0_yz*udot_in[0] + link1_S0_z*t4 + t49;
+  const T t66 = link1_J0_zz*udot_in[0] + link1_S0_x*t5 - link1_S0_y*t4;
+  const T t67 = link2_R_PJ_zy*udot_in[0];
+  const T t68 = link2_R_PJ_zz*udot_in[0];
+  const T t69 = link2_p_J_z*t67;
+  const T t70 = link2_p_J_x*t68;
+  const T t71 = -link2_p_J_x*t67;
+  const T t72 = angle_c[1]*t69 + angle_s[1]*t70;
+  const T t73 = angle_c[1]*t70 - angle_s[1]*t69;
+  const T t74 = angle_s[1]*t67;
+  const T t75 = angle_c[1]*t67;
+  const T t76 = t68 + udot_in[1];
+  const T t77 = (t37 + t75)*link2_S0_z + (t39 + t72)*link2_mass + t53;
+  const T t78 = (((t40 + t73)*link2_mass + link2_S0_x*t76) + t54) - (t36 + t74)*link2_S0_z;
+  const T t79 = (t30 + t71)*link2_mass - (t37 + t75)*link2_S0_x + t55;
+  const T t80 = (((t36 + t74)*link2_J0_xx + (t37 + t75)*link2_J0_xy) + (link2_J0_xz*t76 + t59)) - (t40 + t73)*link2_S0_z;
+  const T t81 = ((((t36 + t74)*link2_J0_xy + (t37 + t75)*link2_J0_yy) + (t39 + t72)*link2_S0_z) + (link2_J0_yz*t76 + t60)) - (t30 + t71)*link2_S0_x;
+  const T t82 = (((t36 + t74)*link2_J0_xz + (t37 + t75)*link2_J0_yz) + (t40 + t73)*link2_S0_x) + (link2_J0_zz*t76 + t61);
+  const T t83 = angle_c[1]*t77 - angle_s[1]*t78;
+  const T t84 = angle_c[1]*t78 + angle_s[1]*t77;
+  const T t85 = -link2_p_J_z*t84;
+  const T t86 = -link2_p_J_x*t79 + link2_p_J_z*t83;
+  const T t87 = link2_p_J_x*t84;
+  const T t88 = angle_c[1]*t80 - angle_s[1]*t81;
+  const T t89 = angle_c[1]*t81 + angle_s[1]*t80;
+  const T t90 = t85 + t88;
+  const T t91 = t86 + t89;
+  const T t92 = t82 + t87;
+  const T t93 = link2_R_PJ_yy*t84 + link2_R_PJ_yz*t79;
+  const T t94 = link2_R_PJ_zy*t84 + link2_R_PJ_zz*t79;
+  const T t95 = link2_R_PJ_yy*t91 + link2_R_PJ_yz*t92;
+  const T t96 = link2_R_PJ_zy*t91 + link2_R_PJ_zz*t92;
+  const T t97 = t62 + t83;
+  const T t98 = t63 + t93;
+  const T t99 = t64 + t90;
+  const T t100 = t65 + t95;
+  const T t101 = t66 + t96;
+  const T t102 = link1_R_BBp_xx*t97 + link1_R_BBp_xy*t98;
+  const T t103 = link1_R_BBp_zx*t97 + link1_R_BBp_zy*t98;
+  const T t104 = link1_R_BBp_xx*t99 + link1_R_BBp_xy*t100;
+  const T t105 = link1_R_BBp_zx*t99 + link1_R_BBp_zy*t100;
+  const T t106 = link1_o_B_y*t103;
+  const T t107 = -link1_o_B_y*t102;
+  const T t108 = t104 + t106;
+  const T t109 = t105 + t107;
+  const T t110 = link2_R_BBp_xx*t77 + link2_R_BBp_xy*t78 + link2_R_BBp_xz*t79;
+  const T t111 = link2_R_BBp_yx*t77 + link2_R_BBp_yy*t78;
+  const T t112 = link2_R_BBp_zx*t77 + link2_R_BBp_zy*t78 + link2_R_BBp_zz*t79;
+  const T t113 = link2_R_BBp_xx*t80 + link2_R_BBp_xy*t81 + link2_R_BBp_xz*t82;
+  const T t114 = link2_R_BBp_yx*t80 + link2_R_BBp_yy*t81;
+  const T t115 = link2_R_BBp_zx*t80 + link2_R_BBp_zy*t81 + link2_R_BBp_zz*t82;
+  wrenches[0] = t102;
+  wrenches[3] = t108;
+  wrenches[1] = t94;
+  wrenches[4] = t101;
+  wrenches[2] = t103;
+  wrenches[5] = t109;
+  wrenches[6] = t110;
+  wrenches[9] = t113;
+  wrenches[7] = t111;
+  wrenches[10] = t114;
+  wrenches[8] = t112;
+  wrenches[11] = t115;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

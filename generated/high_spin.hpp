@@ -19,7 +19,7 @@
 //   mass_matrix       62 (32 add, 26 mul, 0 div, 4 func)
 //   forcing          233 (95 add, 134 mul, 0 div, 4 func)
 //   udot             402 (170 add, 218 mul, 10 div, 4 func) -- composite form; composite 402, articulated 430
-//     udot by pass: outward pass (velocities) 63; mass and velocity terms 68; composite inertia (inward) 52; its columns of M (walked to the root) 6; bias force 46; generalized forces (inward) 56; M u_dot = F: L^T D L along the dof tree 111
+//     udot by pass: joint angles' sin and cos 4; outward pass (velocities) 59; mass and velocity terms 68; composite inertia (inward) 52; its columns of M (walked to the root) 6; bias force 46; generalized forces (inward) 56; M u_dot = F: L^T D L along the dof tree 111
 //   energy           137 (50 add, 78 mul, 5 div, 4 func)
 //   momentum         330 (131 add, 193 mul, 1 div, 5 func)
 
@@ -139,6 +139,135 @@ template <int W> inline bool operator>(double a, const Dual<W>& b) { return a > 
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }
+// ---- joint angles' sin and cos (templates/joint_sincos.inc) -------------------
+// Every joint angle's sin and cos, computed in one batch before the rest of a
+// function (issue 38, item 3: one evaluation per angle, shared by every use),
+// two angles at a time in SSE2 pairs (GCC/clang vector extensions, no header).
+// Accuracy (tests/codegen/test_joint_sincos.cpp, against sinl/cosl): at most
+// 0.51 ulp, the library's sin and cos 0.52-0.56 on the same arguments; beyond
+// |x| = 1e5 rad (and for inf and NaN) the library's sin and cos. (-ffast-math,
+// which reorders the exact sums, voids the bound.)
+// Method: x = k pi/32 + r, |r| <= pi/64, with pi/32 in four parts (three of 33
+// bits, exact products for |k| < 2^20) and r carried as r + rlo; sin and cos
+// of k pi/32 from a table as double-doubles (hi, lo, and hi split in 26-bit
+// halves for Dekker's exact product); sin r - r and cos r - 1 by their Taylor
+// series to r^9 and r^8 (truncation below 1e-20 on |r| <= pi/64);
+// sin x = S + C r + (S (cos r - 1) + C (sin r - r) + C rlo + S_lo), the sum
+// S + C r exact (TwoSum of the exact product), likewise cos x.
+
+// sin(j pi/32), j = 0..63: hi, lo (hi + lo to ~2^-106), and hi in two halves of 26 bits
+inline constexpr double kanegen_sin_table[64][4] = {
+    {0.0, 0.0, 0.0, 0.0},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.0000000000000p+0, 0.0, 0x1.0000000000000p+0, 0.0},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0.0, 0.0, 0.0, 0.0},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.0000000000000p+0, 0.0, -0x1.0000000000000p+0, 0.0},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+};
+
+typedef double kanegen_v2d __attribute__((vector_size(16)));
+
+/// sin and cos of x[0..n), in s and c.
+inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
+  for (int i = 0; i < n; i += 2) {
+    const int b = i + 1 < n ? i + 1 : i;  // an odd count's last angle twice
+    // beyond 1e5 rad (and inf, NaN) the library's, below; 0 meanwhile keeps the integer conversion defined
+    const double xi = x[i] <= 1.0e5 && x[i] >= -1.0e5 ? x[i] : 0.0, xb = x[b] <= 1.0e5 && x[b] >= -1.0e5 ? x[b] : 0.0;
+    const kanegen_v2d xv = {xi, xb};
+    const kanegen_v2d kn = (xv * 0x1.45f306dc9c883p+3 + 0x1.8p52) - 0x1.8p52;  // round(x 32/pi)
+    const kanegen_v2d t = xv - kn * 0x1.921fb54400000p-4, u2 = kn * 0x1.0b4611a600000p-38,
+                      u3 = kn * 0x1.3198a2e000000p-73;
+    const kanegen_v2d r1 = t - u2, e1 = (t - r1) - u2;
+    const kanegen_v2d r = r1 - u3, b3 = r - r1, e2 = (r1 - (r - b3)) - (u3 + b3);
+    const kanegen_v2d rlo = (e1 + e2) - kn * 0x1.b839a252049c1p-108;
+    const kanegen_v2d z = r * r;
+    const kanegen_v2d sr = (r * z) * (-1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 + z * (1.0 / 362880))));
+    const kanegen_v2d cm = z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320))));
+    const long k0 = static_cast<long>(kn[0]), k1 = static_cast<long>(kn[1]);
+    const double* Sa = kanegen_sin_table[k0 & 63];
+    const double* Sb = kanegen_sin_table[k1 & 63];
+    const double* Ca = kanegen_sin_table[(k0 + 16) & 63];
+    const double* Cb = kanegen_sin_table[(k1 + 16) & 63];
+    const kanegen_v2d S0 = {Sa[0], Sb[0]}, S1 = {Sa[1], Sb[1]}, S2 = {Sa[2], Sb[2]}, S3 = {Sa[3], Sb[3]};
+    const kanegen_v2d C0 = {Ca[0], Cb[0]}, C1 = {Ca[1], Cb[1]}, C2 = {Ca[2], Cb[2]}, C3 = {Ca[3], Cb[3]};
+    const kanegen_v2d g = 134217729.0 * r, rh = g - (g - r), rl = r - rh;  // r in 26-bit halves
+    const kanegen_v2d p = C0 * r, pe = (((C2 * rh - p) + C2 * rl) + C3 * rh) + C3 * rl;  // C r = p + pe
+    const kanegen_v2d s1 = S0 + p, bs = s1 - S0, se = (S0 - (s1 - bs)) + (p - bs);    // S + p = s1 + se
+    const kanegen_v2d sv = s1 + ((se + pe) + (S1 + C1 * r + C0 * rlo + S0 * cm + C0 * sr));
+    const kanegen_v2d q = S0 * r, qe = (((S2 * rh - q) + S2 * rl) + S3 * rh) + S3 * rl;  // S r = q + qe
+    const kanegen_v2d c1 = C0 - q, bc = c1 - C0, ce = (C0 - (c1 - bc)) + (-q - bc);      // C - q = c1 + ce
+    const kanegen_v2d cv = c1 + ((ce - qe) + (C1 - S1 * r - S0 * rlo + C0 * cm - S0 * sr));
+    s[i] = sv[0], c[i] = cv[0], s[b] = sv[1], c[b] = cv[1];
+    if (!(x[i] <= 1.0e5 && x[i] >= -1.0e5)) s[i] = std::sin(x[i]), c[i] = std::cos(x[i]);
+    if (!(x[b] <= 1.0e5 && x[b] >= -1.0e5)) s[b] = std::sin(x[b]), c[b] = std::cos(x[b]);
+  }
+}
+
+/// The same for any other number type (the dual numbers of the Jacobians): its own sin and cos.
+template <class T>
+inline void kanegen_sincos_n(const T* x, T* s, T* c, int n) {
+  using std::cos;
+  using std::sin;
+  for (int i = 0; i < n; ++i) s[i] = sin(x[i]), c[i] = cos(x[i]);
+}
 
 // ---- q_dot = W(q) u ------------------------------------------------------------
 template <class T>
@@ -178,123 +307,121 @@ template <class T>
 void mass_matrix(const T* q, T* M) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q;
-  // ---- body boom_a: outward pass (positions)
-  const T t23 = cos(q[7]);
-  const T t24 = sin(q[7]);
-  // ---- body boom_b: outward pass (positions)
-  const T t37 = cos(q[8]);
-  const T t38 = sin(q[8]);
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body boom_b: composite inertia (inward)
-  const T t51 = boom_b_S0_x*t37;
-  const T t52 = boom_b_S0_x*t38;
-  const T t53 = t38*t38;
-  const T t54 = t37*t38;
-  const T t56 = -k045960e5*t53;
-  const T t57 = boom_b_J0_xx - t56;
-  const T t58 = boom_b_J0_yy + t56;
-  const T t59 = -k045960e5*t54;
-  const T t60 = -boom_b_p_J_x*t52 + t59;
-  const T t61 = 2.0*boom_b_p_J_x*t51 + k86563293 + t58;
-  const T t62 = 2.0*boom_b_p_J_x*t51 + k6a252898;
-  const T t63 = k1ee5eefe + t51;
-  const T t64 = drum_J0_xx + t57;
-  const T t65 = drum_J0_xz + t60;
-  const T t66 = drum_J0_yy + t62;
-  const T t67 = drum_J0_zz + t61;
-  const T t68 = -drum_S0_z + t52;
-  const T t69 = drum_S0_z - t52;
-  const T t70 = -drum_S0_x + t63;
-  const T t71 = drum_S0_x - t63;
+  const T t47 = angle_c[1]*boom_b_S0_x;
+  const T t48 = angle_s[1]*boom_b_S0_x;
+  const T t49 = angle_s[1]*angle_s[1];
+  const T t50 = angle_c[1]*angle_s[1];
+  const T t52 = -k045960e5*t49;
+  const T t53 = boom_b_J0_xx - t52;
+  const T t54 = boom_b_J0_yy + t52;
+  const T t55 = -k045960e5*t50;
+  const T t56 = -boom_b_p_J_x*t48 + t55;
+  const T t57 = 2.0*boom_b_p_J_x*t47 + k86563293 + t54;
+  const T t58 = 2.0*boom_b_p_J_x*t47 + k6a252898;
+  const T t59 = k1ee5eefe + t47;
+  const T t60 = drum_J0_xx + t53;
+  const T t61 = drum_J0_xz + t56;
+  const T t62 = drum_J0_yy + t58;
+  const T t63 = drum_J0_zz + t57;
+  const T t64 = -drum_S0_z + t48;
+  const T t65 = drum_S0_z - t48;
+  const T t66 = -drum_S0_x + t59;
+  const T t67 = drum_S0_x - t59;
   // ---- body boom_a: composite inertia (inward)
-  const T t72 = boom_a_S0_x*t23;
-  const T t73 = boom_a_S0_x*t24;
-  const T t74 = t24*t24;
-  const T t75 = t23*t24;
-  const T t77 = -kcabccadd*t74;
-  const T t78 = boom_a_J0_xx - t77;
-  const T t79 = boom_a_J0_yy + t77;
-  const T t80 = -kcabccadd*t75;
-  const T t81 = -boom_a_p_J_x*t73 + t80;
-  const T t82 = 2.0*boom_a_p_J_x*t72 + k9ea44c44 + t79;
-  const T t83 = 2.0*boom_a_p_J_x*t72 + kd72e89ac;
-  const T t84 = k843d8d08 + t72;
-  const T t85 = t64 + t78;
-  const T t86 = t65 - t81;
-  const T t87 = t66 + t83;
-  const T t88 = t67 + t82;
-  const T t89 = t68 + t73;
-  const T t90 = t69 - t73;
-  const T t91 = t70 - t84;
-  const T t92 = t71 + t84;
+  const T t68 = angle_c[0]*boom_a_S0_x;
+  const T t69 = angle_s[0]*boom_a_S0_x;
+  const T t70 = angle_s[0]*angle_s[0];
+  const T t71 = angle_c[0]*angle_s[0];
+  const T t73 = -kcabccadd*t70;
+  const T t74 = boom_a_J0_xx - t73;
+  const T t75 = boom_a_J0_yy + t73;
+  const T t76 = -kcabccadd*t71;
+  const T t77 = -boom_a_p_J_x*t69 + t76;
+  const T t78 = 2.0*boom_a_p_J_x*t68 + k9ea44c44 + t75;
+  const T t79 = 2.0*boom_a_p_J_x*t68 + kd72e89ac;
+  const T t80 = k843d8d08 + t68;
+  const T t81 = t60 + t74;
+  const T t82 = t61 - t77;
+  const T t83 = t62 + t79;
+  const T t84 = t63 + t78;
+  const T t85 = t64 + t69;
+  const T t86 = t65 - t69;
+  const T t87 = t66 - t80;
+  const T t88 = t67 + t80;
   // ---- body boom_a: its columns of M (walked to the root)
-  const T t93 = -boom_a_S0_x*t24;
-  const T t94 = boom_a_p_J_x*t72;
-  const T t95 = boom_a_J0_zz + t94;
+  const T t89 = -angle_s[0]*boom_a_S0_x;
+  const T t90 = boom_a_p_J_x*t68;
+  const T t91 = boom_a_J0_zz + t90;
   // ---- body boom_b: its columns of M (walked to the root)
-  const T t96 = -boom_b_S0_x*t38;
-  const T t97 = boom_b_p_J_x*t51;
-  const T t98 = boom_b_J0_zz + t97;
+  const T t92 = -angle_s[1]*boom_b_S0_x;
+  const T t93 = boom_b_p_J_x*t47;
+  const T t94 = boom_b_J0_zz + t93;
   M[0] = k8601161c;
   M[1] = 0.0;
   M[2] = 0.0;
   M[3] = 0.0;
-  M[4] = t90;
+  M[4] = t86;
   M[5] = 0.0;
-  M[6] = t93;
-  M[7] = -t96;
+  M[6] = t89;
+  M[7] = -t92;
   M[8] = 0.0;
   M[9] = k8601161c;
   M[10] = 0.0;
-  M[11] = t89;
+  M[11] = t85;
   M[12] = 0.0;
-  M[13] = t92;
+  M[13] = t88;
   M[14] = 0.0;
   M[15] = 0.0;
   M[16] = 0.0;
   M[17] = 0.0;
   M[18] = k8601161c;
   M[19] = 0.0;
-  M[20] = t91;
+  M[20] = t87;
   M[21] = 0.0;
-  M[22] = -t72;
-  M[23] = -t51;
+  M[22] = -t68;
+  M[23] = -t47;
   M[24] = 0.0;
-  M[25] = t89;
+  M[25] = t85;
   M[26] = 0.0;
-  M[27] = t85;
+  M[27] = t81;
   M[28] = 0.0;
-  M[29] = t86;
+  M[29] = t82;
   M[30] = 0.0;
   M[31] = 0.0;
-  M[32] = t90;
+  M[32] = t86;
   M[33] = 0.0;
-  M[34] = t91;
+  M[34] = t87;
   M[35] = 0.0;
-  M[36] = t87;
+  M[36] = t83;
   M[37] = 0.0;
-  M[38] = t95;
-  M[39] = -t98;
+  M[38] = t91;
+  M[39] = -t94;
   M[40] = 0.0;
-  M[41] = t92;
+  M[41] = t88;
   M[42] = 0.0;
-  M[43] = t86;
+  M[43] = t82;
   M[44] = 0.0;
-  M[45] = t88;
+  M[45] = t84;
   M[46] = 0.0;
   M[47] = 0.0;
-  M[48] = t93;
+  M[48] = t89;
   M[49] = 0.0;
-  M[50] = -t72;
+  M[50] = -t68;
   M[51] = 0.0;
-  M[52] = t95;
+  M[52] = t91;
   M[53] = 0.0;
   M[54] = boom_a_J0_zz;
   M[55] = 0.0;
-  M[56] = -t96;
+  M[56] = -t92;
   M[57] = 0.0;
-  M[58] = -t51;
+  M[58] = -t47;
   M[59] = 0.0;
-  M[60] = -t98;
+  M[60] = -t94;
   M[61] = 0.0;
   M[62] = 0.0;
   M[63] = boom_b_J0_zz;
@@ -305,153 +432,153 @@ template <class T>
 void forcing(const T* q, const T* u, const T* tau, T* F) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body drum: outward pass (velocities)
   const T t23 = -u[1]*u[5] + u[2]*u[4];
   const T t24 = u[0]*u[5] - u[2]*u[3];
   const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body boom_a: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = boom_a_p_J_x*u[4];
-  const T t41 = boom_a_p_J_x*u[5];
-  const T t44 = -t40*u[4] - t41*u[5];
-  const T t45 = -t41*u[3];
-  const T t46 = t40*u[3];
-  const T t47 = t23 + t44;
-  const T t48 = -t25 + t45;
-  const T t49 = t24 + t46;
-  const T t50 = t26*u[3] - t27*u[5];
-  const T t51 = -t26*u[5] - t27*u[3];
+  const T t38 = boom_a_p_J_x*u[4];
+  const T t39 = boom_a_p_J_x*u[5];
+  const T t42 = -t38*u[4] - t39*u[5];
+  const T t43 = -t39*u[3];
+  const T t44 = t38*u[3];
+  const T t45 = t23 + t42;
+  const T t46 = -t25 + t43;
+  const T t47 = t24 + t44;
+  const T t48 = angle_c[0]*u[3] - angle_s[0]*u[5];
+  const T t49 = -angle_c[0]*u[5] - angle_s[0]*u[3];
   const T w_B_boom_a_z = u[4] + u[6];
-  const T t55 = t51*u[6];
-  const T t56 = -t50*u[6];
-  const T t58 = t26*t47 + t27*t48;
-  const T t59 = t26*t48 - t27*t47;
+  const T t53 = t49*u[6];
+  const T t54 = -t48*u[6];
+  const T t56 = angle_c[0]*t45 + angle_s[0]*t46;
+  const T t57 = angle_c[0]*t46 - angle_s[0]*t45;
   // ---- body boom_b: outward pass (velocities)
-  const T t60 = cos(q[8]);
-  const T t61 = sin(q[8]);
-  const T t74 = -boom_b_p_J_x*u[4];
-  const T t75 = boom_b_p_J_x*u[5];
-  const T t78 = t74*u[4] - t75*u[5];
-  const T t79 = t75*u[3];
-  const T t80 = -t74*u[3];
-  const T t81 = -t23 + t78;
-  const T t82 = -t25 + t79;
-  const T t83 = -t24 + t80;
-  const T t84 = -t60*u[3] - t61*u[5];
-  const T t85 = -t60*u[5] + t61*u[3];
+  const T t70 = -boom_b_p_J_x*u[4];
+  const T t71 = boom_b_p_J_x*u[5];
+  const T t74 = t70*u[4] - t71*u[5];
+  const T t75 = t71*u[3];
+  const T t76 = -t70*u[3];
+  const T t77 = -t23 + t74;
+  const T t78 = -t25 + t75;
+  const T t79 = -t24 + t76;
+  const T t80 = -angle_c[1]*u[3] - angle_s[1]*u[5];
+  const T t81 = -angle_c[1]*u[5] + angle_s[1]*u[3];
   const T w_B_boom_b_z = -u[4] + u[7];
-  const T t89 = t85*u[7];
-  const T t90 = -t84*u[7];
-  const T t92 = t60*t81 + t61*t82;
-  const T t93 = t60*t82 - t61*t81;
+  const T t85 = t81*u[7];
+  const T t86 = -t80*u[7];
+  const T t88 = angle_c[1]*t77 + angle_s[1]*t78;
+  const T t89 = angle_c[1]*t78 - angle_s[1]*t77;
   // ---- body drum: mass and velocity terms
-  const T t94 = drum_S0_z*u[4];
-  const T t95 = drum_S0_x*u[5] - drum_S0_z*u[3];
-  const T t96 = -drum_S0_x*u[4];
-  const T t97 = -t95*u[5] + t96*u[4];
-  const T t98 = t94*u[5] - t96*u[3];
-  const T t99 = -t94*u[4] + t95*u[3];
-  const T t100 = drum_J0_xx*u[3] + drum_J0_xz*u[5];
-  const T t101 = drum_J0_yy*u[4];
-  const T t102 = drum_J0_xz*u[3] + drum_J0_zz*u[5];
-  const T t103 = -t101*u[5] + t102*u[4];
-  const T t104 = t100*u[5] - t102*u[3];
-  const T t105 = -t100*u[4] + t101*u[3];
+  const T t90 = drum_S0_z*u[4];
+  const T t91 = drum_S0_x*u[5] - drum_S0_z*u[3];
+  const T t92 = -drum_S0_x*u[4];
+  const T t93 = -t91*u[5] + t92*u[4];
+  const T t94 = t90*u[5] - t92*u[3];
+  const T t95 = -t90*u[4] + t91*u[3];
+  const T t96 = drum_J0_xx*u[3] + drum_J0_xz*u[5];
+  const T t97 = drum_J0_yy*u[4];
+  const T t98 = drum_J0_xz*u[3] + drum_J0_zz*u[5];
+  const T t99 = -t97*u[5] + t98*u[4];
+  const T t100 = t96*u[5] - t98*u[3];
+  const T t101 = -t96*u[4] + t97*u[3];
   // ---- body boom_a: mass and velocity terms
-  const T t106 = boom_a_S0_x*w_B_boom_a_z;
-  const T t107 = -boom_a_S0_x*t51;
-  const T t108 = -t106*w_B_boom_a_z + t107*t51;
-  const T t109 = -t107*t50;
-  const T t110 = t106*t50;
-  const T t111 = boom_a_J0_xx*t50;
-  const T t112 = boom_a_J0_yy*t51;
-  const T t113 = boom_a_J0_zz*w_B_boom_a_z;
-  const T t114 = -t112*w_B_boom_a_z + t113*t51;
-  const T t115 = t111*w_B_boom_a_z - t113*t50;
-  const T t116 = -t111*t51 + t112*t50;
+  const T t102 = boom_a_S0_x*w_B_boom_a_z;
+  const T t103 = -boom_a_S0_x*t49;
+  const T t104 = -t102*w_B_boom_a_z + t103*t49;
+  const T t105 = -t103*t48;
+  const T t106 = t102*t48;
+  const T t107 = boom_a_J0_xx*t48;
+  const T t108 = boom_a_J0_yy*t49;
+  const T t109 = boom_a_J0_zz*w_B_boom_a_z;
+  const T t110 = -t108*w_B_boom_a_z + t109*t49;
+  const T t111 = t107*w_B_boom_a_z - t109*t48;
+  const T t112 = -t107*t49 + t108*t48;
   // ---- body boom_b: mass and velocity terms
-  const T t117 = boom_b_S0_x*w_B_boom_b_z;
-  const T t118 = -boom_b_S0_x*t85;
-  const T t119 = -t117*w_B_boom_b_z + t118*t85;
-  const T t120 = -t118*t84;
-  const T t121 = t117*t84;
-  const T t122 = boom_b_J0_xx*t84;
-  const T t123 = boom_b_J0_yy*t85;
-  const T t124 = boom_b_J0_zz*w_B_boom_b_z;
-  const T t125 = -t123*w_B_boom_b_z + t124*t85;
-  const T t126 = t122*w_B_boom_b_z - t124*t84;
-  const T t127 = -t122*t85 + t123*t84;
+  const T t113 = boom_b_S0_x*w_B_boom_b_z;
+  const T t114 = -boom_b_S0_x*t81;
+  const T t115 = -t113*w_B_boom_b_z + t114*t81;
+  const T t116 = -t114*t80;
+  const T t117 = t113*t80;
+  const T t118 = boom_b_J0_xx*t80;
+  const T t119 = boom_b_J0_yy*t81;
+  const T t120 = boom_b_J0_zz*w_B_boom_b_z;
+  const T t121 = -t119*w_B_boom_b_z + t120*t81;
+  const T t122 = t118*w_B_boom_b_z - t120*t80;
+  const T t123 = -t118*t81 + t119*t80;
   // ---- body drum: bias force
-  const T t128 = -drum_mass*t23 - t97;
-  const T t129 = -drum_mass*t24 - t98;
-  const T t130 = -drum_mass*t25 - t99;
-  const T t131 = drum_S0_z*t24 - t103;
-  const T t132 = drum_S0_x*t25 - drum_S0_z*t23 - t104;
-  const T t133 = -drum_S0_x*t24 - t105;
+  const T t124 = -drum_mass*t23 - t93;
+  const T t125 = -drum_mass*t24 - t94;
+  const T t126 = -drum_mass*t25 - t95;
+  const T t127 = drum_S0_z*t24 - t99;
+  const T t128 = drum_S0_x*t25 - drum_S0_z*t23 - t100;
+  const T t129 = -drum_S0_x*t24 - t101;
   // ---- body boom_a: bias force
-  const T t134 = -boom_a_mass*t58 - t108;
-  const T t135 = -boom_a_mass*t59 - t109;
-  const T t136 = boom_a_S0_x*t56 - boom_a_mass*t49 - t110;
-  const T t137 = -boom_a_J0_xx*t55 - t114;
-  const T t138 = -boom_a_J0_yy*t56 + boom_a_S0_x*t49 - t115;
-  const T t139 = -boom_a_S0_x*t59 - t116;
+  const T t130 = -boom_a_mass*t56 - t104;
+  const T t131 = -boom_a_mass*t57 - t105;
+  const T t132 = boom_a_S0_x*t54 - boom_a_mass*t47 - t106;
+  const T t133 = -boom_a_J0_xx*t53 - t110;
+  const T t134 = -boom_a_J0_yy*t54 + boom_a_S0_x*t47 - t111;
+  const T t135 = -boom_a_S0_x*t57 - t112;
   // ---- body boom_b: bias force
-  const T t140 = -boom_b_mass*t92 - t119;
-  const T t141 = -boom_b_mass*t93 - t120;
-  const T t142 = boom_b_S0_x*t90 - boom_b_mass*t83 - t121;
-  const T t143 = -boom_b_J0_xx*t89 - t125;
-  const T t144 = -boom_b_J0_yy*t90 + boom_b_S0_x*t83 - t126;
-  const T t145 = -boom_b_S0_x*t93 - t127;
+  const T t136 = -boom_b_mass*t88 - t115;
+  const T t137 = -boom_b_mass*t89 - t116;
+  const T t138 = boom_b_S0_x*t86 - boom_b_mass*t79 - t117;
+  const T t139 = -boom_b_J0_xx*t85 - t121;
+  const T t140 = -boom_b_J0_yy*t86 + boom_b_S0_x*t79 - t122;
+  const T t141 = -boom_b_S0_x*t89 - t123;
   // ---- body boom_b: generalized forces (inward)
-  const T t146 = -boom_b_k*q[8] + tau[7];
-  const T t147 = t145 + t146;
-  const T t148 = t140*t60 - t141*t61;
-  const T t149 = t140*t61 + t141*t60;
-  const T t150 = -boom_b_p_J_x*t142;
-  const T t151 = boom_b_p_J_x*t149;
-  const T t152 = t143*t60 - t144*t61;
-  const T t153 = t143*t61 + t144*t60;
-  const T t154 = t150 + t153;
-  const T t155 = t145 + t151;
-  const T t156 = t128 - t148;
-  const T t157 = t129 - t142;
-  const T t158 = t130 - t149;
-  const T t159 = t131 - t152;
-  const T t160 = t132 - t155;
-  const T t161 = t133 - t154;
+  const T t142 = -boom_b_k*q[8] + tau[7];
+  const T t143 = t141 + t142;
+  const T t144 = angle_c[1]*t136 - angle_s[1]*t137;
+  const T t145 = angle_c[1]*t137 + angle_s[1]*t136;
+  const T t146 = -boom_b_p_J_x*t138;
+  const T t147 = boom_b_p_J_x*t145;
+  const T t148 = angle_c[1]*t139 - angle_s[1]*t140;
+  const T t149 = angle_c[1]*t140 + angle_s[1]*t139;
+  const T t150 = t146 + t149;
+  const T t151 = t141 + t147;
+  const T t152 = t124 - t144;
+  const T t153 = t125 - t138;
+  const T t154 = t126 - t145;
+  const T t155 = t127 - t148;
+  const T t156 = t128 - t151;
+  const T t157 = t129 - t150;
   // ---- body boom_a: generalized forces (inward)
-  const T t162 = -boom_a_k*q[7] + tau[6];
-  const T t163 = t139 + t162;
-  const T t164 = t134*t26 - t135*t27;
-  const T t165 = t134*t27 + t135*t26;
-  const T t166 = -boom_a_p_J_x*t136;
-  const T t167 = boom_a_p_J_x*t165;
-  const T t168 = t137*t26 - t138*t27;
-  const T t169 = t137*t27 + t138*t26;
-  const T t170 = t166 + t169;
-  const T t171 = t139 + t167;
-  const T t172 = t156 + t164;
-  const T t173 = t136 + t157;
-  const T t174 = t158 - t165;
-  const T t175 = t159 + t168;
-  const T t176 = t160 + t171;
-  const T t177 = t161 - t170;
+  const T t158 = -boom_a_k*q[7] + tau[6];
+  const T t159 = t135 + t158;
+  const T t160 = angle_c[0]*t130 - angle_s[0]*t131;
+  const T t161 = angle_c[0]*t131 + angle_s[0]*t130;
+  const T t162 = -boom_a_p_J_x*t132;
+  const T t163 = boom_a_p_J_x*t161;
+  const T t164 = angle_c[0]*t133 - angle_s[0]*t134;
+  const T t165 = angle_c[0]*t134 + angle_s[0]*t133;
+  const T t166 = t162 + t165;
+  const T t167 = t135 + t163;
+  const T t168 = t152 + t160;
+  const T t169 = t132 + t153;
+  const T t170 = t154 - t161;
+  const T t171 = t155 + t164;
+  const T t172 = t156 + t167;
+  const T t173 = t157 - t166;
   // ---- body drum: generalized forces (inward)
-  const T t178 = t172 + tau[0];
-  const T t179 = t173 + tau[1];
-  const T t180 = t174 + tau[2];
-  const T t181 = t175 + tau[3];
-  const T t182 = t176 + tau[4];
-  const T t183 = t177 + tau[5];
-  F[0] = t178;
-  F[1] = t179;
-  F[2] = t180;
-  F[3] = t181;
-  F[4] = t182;
-  F[5] = t183;
-  F[6] = t163;
-  F[7] = t147;
+  const T t174 = t168 + tau[0];
+  const T t175 = t169 + tau[1];
+  const T t176 = t170 + tau[2];
+  const T t177 = t171 + tau[3];
+  const T t178 = t172 + tau[4];
+  const T t179 = t173 + tau[5];
+  F[0] = t174;
+  F[1] = t175;
+  F[2] = t176;
+  F[3] = t177;
+  F[4] = t178;
+  F[5] = t179;
+  F[6] = t159;
+  F[7] = t143;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
@@ -460,280 +587,280 @@ template <class T>
 int udot(const T* q, const T* u, const T* tau, T* udot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body drum: outward pass (velocities)
   const T t23 = -u[1]*u[5] + u[2]*u[4];
   const T t24 = u[0]*u[5] - u[2]*u[3];
   const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body boom_a: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = boom_a_p_J_x*u[4];
-  const T t41 = boom_a_p_J_x*u[5];
-  const T t44 = -t40*u[4] - t41*u[5];
-  const T t45 = -t41*u[3];
-  const T t46 = t40*u[3];
-  const T t47 = t23 + t44;
-  const T t48 = -t25 + t45;
-  const T t49 = t24 + t46;
-  const T t50 = t26*u[3] - t27*u[5];
-  const T t51 = -t26*u[5] - t27*u[3];
+  const T t38 = boom_a_p_J_x*u[4];
+  const T t39 = boom_a_p_J_x*u[5];
+  const T t42 = -t38*u[4] - t39*u[5];
+  const T t43 = -t39*u[3];
+  const T t44 = t38*u[3];
+  const T t45 = t23 + t42;
+  const T t46 = -t25 + t43;
+  const T t47 = t24 + t44;
+  const T t48 = angle_c[0]*u[3] - angle_s[0]*u[5];
+  const T t49 = -angle_c[0]*u[5] - angle_s[0]*u[3];
   const T w_B_boom_a_z = u[4] + u[6];
-  const T t55 = t51*u[6];
-  const T t56 = -t50*u[6];
-  const T t58 = t26*t47 + t27*t48;
-  const T t59 = t26*t48 - t27*t47;
+  const T t53 = t49*u[6];
+  const T t54 = -t48*u[6];
+  const T t56 = angle_c[0]*t45 + angle_s[0]*t46;
+  const T t57 = angle_c[0]*t46 - angle_s[0]*t45;
   // ---- body boom_b: outward pass (velocities)
-  const T t60 = cos(q[8]);
-  const T t61 = sin(q[8]);
-  const T t74 = -boom_b_p_J_x*u[4];
-  const T t75 = boom_b_p_J_x*u[5];
-  const T t78 = t74*u[4] - t75*u[5];
-  const T t79 = t75*u[3];
-  const T t80 = -t74*u[3];
-  const T t81 = -t23 + t78;
-  const T t82 = -t25 + t79;
-  const T t83 = -t24 + t80;
-  const T t84 = -t60*u[3] - t61*u[5];
-  const T t85 = -t60*u[5] + t61*u[3];
+  const T t70 = -boom_b_p_J_x*u[4];
+  const T t71 = boom_b_p_J_x*u[5];
+  const T t74 = t70*u[4] - t71*u[5];
+  const T t75 = t71*u[3];
+  const T t76 = -t70*u[3];
+  const T t77 = -t23 + t74;
+  const T t78 = -t25 + t75;
+  const T t79 = -t24 + t76;
+  const T t80 = -angle_c[1]*u[3] - angle_s[1]*u[5];
+  const T t81 = -angle_c[1]*u[5] + angle_s[1]*u[3];
   const T w_B_boom_b_z = -u[4] + u[7];
-  const T t89 = t85*u[7];
-  const T t90 = -t84*u[7];
-  const T t92 = t60*t81 + t61*t82;
-  const T t93 = t60*t82 - t61*t81;
+  const T t85 = t81*u[7];
+  const T t86 = -t80*u[7];
+  const T t88 = angle_c[1]*t77 + angle_s[1]*t78;
+  const T t89 = angle_c[1]*t78 - angle_s[1]*t77;
   // ---- body drum: mass and velocity terms
-  const T t94 = drum_S0_z*u[4];
-  const T t95 = drum_S0_x*u[5] - drum_S0_z*u[3];
-  const T t96 = -drum_S0_x*u[4];
-  const T t97 = -t95*u[5] + t96*u[4];
-  const T t98 = t94*u[5] - t96*u[3];
-  const T t99 = -t94*u[4] + t95*u[3];
-  const T t100 = drum_J0_xx*u[3] + drum_J0_xz*u[5];
-  const T t101 = drum_J0_yy*u[4];
-  const T t102 = drum_J0_xz*u[3] + drum_J0_zz*u[5];
-  const T t103 = -t101*u[5] + t102*u[4];
-  const T t104 = t100*u[5] - t102*u[3];
-  const T t105 = -t100*u[4] + t101*u[3];
+  const T t90 = drum_S0_z*u[4];
+  const T t91 = drum_S0_x*u[5] - drum_S0_z*u[3];
+  const T t92 = -drum_S0_x*u[4];
+  const T t93 = -t91*u[5] + t92*u[4];
+  const T t94 = t90*u[5] - t92*u[3];
+  const T t95 = -t90*u[4] + t91*u[3];
+  const T t96 = drum_J0_xx*u[3] + drum_J0_xz*u[5];
+  const T t97 = drum_J0_yy*u[4];
+  const T t98 = drum_J0_xz*u[3] + drum_J0_zz*u[5];
+  const T t99 = -t97*u[5] + t98*u[4];
+  const T t100 = t96*u[5] - t98*u[3];
+  const T t101 = -t96*u[4] + t97*u[3];
   // ---- body boom_a: mass and velocity terms
-  const T t106 = boom_a_S0_x*w_B_boom_a_z;
-  const T t107 = -boom_a_S0_x*t51;
-  const T t108 = -t106*w_B_boom_a_z + t107*t51;
-  const T t109 = -t107*t50;
-  const T t110 = t106*t50;
-  const T t111 = boom_a_J0_xx*t50;
-  const T t112 = boom_a_J0_yy*t51;
-  const T t113 = boom_a_J0_zz*w_B_boom_a_z;
-  const T t114 = -t112*w_B_boom_a_z + t113*t51;
-  const T t115 = t111*w_B_boom_a_z - t113*t50;
-  const T t116 = -t111*t51 + t112*t50;
+  const T t102 = boom_a_S0_x*w_B_boom_a_z;
+  const T t103 = -boom_a_S0_x*t49;
+  const T t104 = -t102*w_B_boom_a_z + t103*t49;
+  const T t105 = -t103*t48;
+  const T t106 = t102*t48;
+  const T t107 = boom_a_J0_xx*t48;
+  const T t108 = boom_a_J0_yy*t49;
+  const T t109 = boom_a_J0_zz*w_B_boom_a_z;
+  const T t110 = -t108*w_B_boom_a_z + t109*t49;
+  const T t111 = t107*w_B_boom_a_z - t109*t48;
+  const T t112 = -t107*t49 + t108*t48;
   // ---- body boom_b: mass and velocity terms
-  const T t117 = boom_b_S0_x*w_B_boom_b_z;
-  const T t118 = -boom_b_S0_x*t85;
-  const T t119 = -t117*w_B_boom_b_z + t118*t85;
-  const T t120 = -t118*t84;
-  const T t121 = t117*t84;
-  const T t122 = boom_b_J0_xx*t84;
-  const T t123 = boom_b_J0_yy*t85;
-  const T t124 = boom_b_J0_zz*w_B_boom_b_z;
-  const T t125 = -t123*w_B_boom_b_z + t124*t85;
-  const T t126 = t122*w_B_boom_b_z - t124*t84;
-  const T t127 = -t122*t85 + t123*t84;
+  const T t113 = boom_b_S0_x*w_B_boom_b_z;
+  const T t114 = -boom_b_S0_x*t81;
+  const T t115 = -t113*w_B_boom_b_z + t114*t81;
+  const T t116 = -t114*t80;
+  const T t117 = t113*t80;
+  const T t118 = boom_b_J0_xx*t80;
+  const T t119 = boom_b_J0_yy*t81;
+  const T t120 = boom_b_J0_zz*w_B_boom_b_z;
+  const T t121 = -t119*w_B_boom_b_z + t120*t81;
+  const T t122 = t118*w_B_boom_b_z - t120*t80;
+  const T t123 = -t118*t81 + t119*t80;
   // ---- body boom_b: composite inertia (inward)
-  const T t128 = boom_b_S0_x*t60;
-  const T t129 = boom_b_S0_x*t61;
-  const T t130 = t61*t61;
-  const T t131 = t60*t61;
-  const T t133 = -k045960e5*t130;
-  const T t134 = boom_b_J0_xx - t133;
-  const T t135 = boom_b_J0_yy + t133;
-  const T t136 = -k045960e5*t131;
-  const T t137 = -boom_b_p_J_x*t129 + t136;
-  const T t138 = 2.0*boom_b_p_J_x*t128 + k86563293 + t135;
-  const T t139 = 2.0*boom_b_p_J_x*t128 + k6a252898;
-  const T t140 = k1ee5eefe + t128;
-  const T t141 = drum_J0_xx + t134;
-  const T t142 = drum_J0_xz + t137;
-  const T t143 = drum_J0_yy + t139;
-  const T t144 = drum_J0_zz + t138;
-  const T t145 = -drum_S0_z + t129;
-  const T t146 = drum_S0_z - t129;
-  const T t147 = -drum_S0_x + t140;
-  const T t148 = drum_S0_x - t140;
+  const T t124 = angle_c[1]*boom_b_S0_x;
+  const T t125 = angle_s[1]*boom_b_S0_x;
+  const T t126 = angle_s[1]*angle_s[1];
+  const T t127 = angle_c[1]*angle_s[1];
+  const T t129 = -k045960e5*t126;
+  const T t130 = boom_b_J0_xx - t129;
+  const T t131 = boom_b_J0_yy + t129;
+  const T t132 = -k045960e5*t127;
+  const T t133 = -boom_b_p_J_x*t125 + t132;
+  const T t134 = 2.0*boom_b_p_J_x*t124 + k86563293 + t131;
+  const T t135 = 2.0*boom_b_p_J_x*t124 + k6a252898;
+  const T t136 = k1ee5eefe + t124;
+  const T t137 = drum_J0_xx + t130;
+  const T t138 = drum_J0_xz + t133;
+  const T t139 = drum_J0_yy + t135;
+  const T t140 = drum_J0_zz + t134;
+  const T t141 = -drum_S0_z + t125;
+  const T t142 = drum_S0_z - t125;
+  const T t143 = -drum_S0_x + t136;
+  const T t144 = drum_S0_x - t136;
   // ---- body boom_a: composite inertia (inward)
-  const T t149 = boom_a_S0_x*t26;
-  const T t150 = boom_a_S0_x*t27;
-  const T t151 = t27*t27;
-  const T t152 = t26*t27;
-  const T t154 = -kcabccadd*t151;
-  const T t155 = boom_a_J0_xx - t154;
-  const T t156 = boom_a_J0_yy + t154;
-  const T t157 = -kcabccadd*t152;
-  const T t158 = -boom_a_p_J_x*t150 + t157;
-  const T t159 = 2.0*boom_a_p_J_x*t149 + k9ea44c44 + t156;
-  const T t160 = 2.0*boom_a_p_J_x*t149 + kd72e89ac;
-  const T t161 = k843d8d08 + t149;
-  const T t162 = t141 + t155;
-  const T t163 = t142 - t158;
-  const T t164 = t143 + t160;
-  const T t165 = t144 + t159;
-  const T t166 = t145 + t150;
-  const T t167 = t146 - t150;
-  const T t168 = t147 - t161;
-  const T t169 = t148 + t161;
+  const T t145 = angle_c[0]*boom_a_S0_x;
+  const T t146 = angle_s[0]*boom_a_S0_x;
+  const T t147 = angle_s[0]*angle_s[0];
+  const T t148 = angle_c[0]*angle_s[0];
+  const T t150 = -kcabccadd*t147;
+  const T t151 = boom_a_J0_xx - t150;
+  const T t152 = boom_a_J0_yy + t150;
+  const T t153 = -kcabccadd*t148;
+  const T t154 = -boom_a_p_J_x*t146 + t153;
+  const T t155 = 2.0*boom_a_p_J_x*t145 + k9ea44c44 + t152;
+  const T t156 = 2.0*boom_a_p_J_x*t145 + kd72e89ac;
+  const T t157 = k843d8d08 + t145;
+  const T t158 = t137 + t151;
+  const T t159 = t138 - t154;
+  const T t160 = t139 + t156;
+  const T t161 = t140 + t155;
+  const T t162 = t141 + t146;
+  const T t163 = t142 - t146;
+  const T t164 = t143 - t157;
+  const T t165 = t144 + t157;
   // ---- body boom_a: its columns of M (walked to the root)
-  const T t170 = -boom_a_S0_x*t27;
-  const T t171 = boom_a_p_J_x*t149;
-  const T t172 = boom_a_J0_zz + t171;
+  const T t166 = -angle_s[0]*boom_a_S0_x;
+  const T t167 = boom_a_p_J_x*t145;
+  const T t168 = boom_a_J0_zz + t167;
   // ---- body boom_b: its columns of M (walked to the root)
-  const T t173 = -boom_b_S0_x*t61;
-  const T t174 = boom_b_p_J_x*t128;
-  const T t175 = boom_b_J0_zz + t174;
+  const T t169 = -angle_s[1]*boom_b_S0_x;
+  const T t170 = boom_b_p_J_x*t124;
+  const T t171 = boom_b_J0_zz + t170;
   // ---- body drum: bias force
-  const T t176 = -drum_mass*t23 - t97;
-  const T t177 = -drum_mass*t24 - t98;
-  const T t178 = -drum_mass*t25 - t99;
-  const T t179 = drum_S0_z*t24 - t103;
-  const T t180 = drum_S0_x*t25 - drum_S0_z*t23 - t104;
-  const T t181 = -drum_S0_x*t24 - t105;
+  const T t172 = -drum_mass*t23 - t93;
+  const T t173 = -drum_mass*t24 - t94;
+  const T t174 = -drum_mass*t25 - t95;
+  const T t175 = drum_S0_z*t24 - t99;
+  const T t176 = drum_S0_x*t25 - drum_S0_z*t23 - t100;
+  const T t177 = -drum_S0_x*t24 - t101;
   // ---- body boom_a: bias force
-  const T t182 = -boom_a_mass*t58 - t108;
-  const T t183 = -boom_a_mass*t59 - t109;
-  const T t184 = boom_a_S0_x*t56 - boom_a_mass*t49 - t110;
-  const T t185 = -boom_a_J0_xx*t55 - t114;
-  const T t186 = -boom_a_J0_yy*t56 + boom_a_S0_x*t49 - t115;
-  const T t187 = -boom_a_S0_x*t59 - t116;
+  const T t178 = -boom_a_mass*t56 - t104;
+  const T t179 = -boom_a_mass*t57 - t105;
+  const T t180 = boom_a_S0_x*t54 - boom_a_mass*t47 - t106;
+  const T t181 = -boom_a_J0_xx*t53 - t110;
+  const T t182 = -boom_a_J0_yy*t54 + boom_a_S0_x*t47 - t111;
+  const T t183 = -boom_a_S0_x*t57 - t112;
   // ---- body boom_b: bias force
-  const T t188 = -boom_b_mass*t92 - t119;
-  const T t189 = -boom_b_mass*t93 - t120;
-  const T t190 = boom_b_S0_x*t90 - boom_b_mass*t83 - t121;
-  const T t191 = -boom_b_J0_xx*t89 - t125;
-  const T t192 = -boom_b_J0_yy*t90 + boom_b_S0_x*t83 - t126;
-  const T t193 = -boom_b_S0_x*t93 - t127;
+  const T t184 = -boom_b_mass*t88 - t115;
+  const T t185 = -boom_b_mass*t89 - t116;
+  const T t186 = boom_b_S0_x*t86 - boom_b_mass*t79 - t117;
+  const T t187 = -boom_b_J0_xx*t85 - t121;
+  const T t188 = -boom_b_J0_yy*t86 + boom_b_S0_x*t79 - t122;
+  const T t189 = -boom_b_S0_x*t89 - t123;
   // ---- body boom_b: generalized forces (inward)
-  const T t194 = -boom_b_k*q[8] + tau[7];
-  const T t195 = t193 + t194;
-  const T t196 = t188*t60 - t189*t61;
-  const T t197 = t188*t61 + t189*t60;
-  const T t198 = -boom_b_p_J_x*t190;
-  const T t199 = boom_b_p_J_x*t197;
-  const T t200 = t191*t60 - t192*t61;
-  const T t201 = t191*t61 + t192*t60;
-  const T t202 = t198 + t201;
-  const T t203 = t193 + t199;
-  const T t204 = t176 - t196;
-  const T t205 = t177 - t190;
-  const T t206 = t178 - t197;
-  const T t207 = t179 - t200;
-  const T t208 = t180 - t203;
-  const T t209 = t181 - t202;
+  const T t190 = -boom_b_k*q[8] + tau[7];
+  const T t191 = t189 + t190;
+  const T t192 = angle_c[1]*t184 - angle_s[1]*t185;
+  const T t193 = angle_c[1]*t185 + angle_s[1]*t184;
+  const T t194 = -boom_b_p_J_x*t186;
+  const T t195 = boom_b_p_J_x*t193;
+  const T t196 = angle_c[1]*t187 - angle_s[1]*t188;
+  const T t197 = angle_c[1]*t188 + angle_s[1]*t187;
+  const T t198 = t194 + t197;
+  const T t199 = t189 + t195;
+  const T t200 = t172 - t192;
+  const T t201 = t173 - t186;
+  const T t202 = t174 - t193;
+  const T t203 = t175 - t196;
+  const T t204 = t176 - t199;
+  const T t205 = t177 - t198;
   // ---- body boom_a: generalized forces (inward)
-  const T t210 = -boom_a_k*q[7] + tau[6];
-  const T t211 = t187 + t210;
-  const T t212 = t182*t26 - t183*t27;
-  const T t213 = t182*t27 + t183*t26;
-  const T t214 = -boom_a_p_J_x*t184;
-  const T t215 = boom_a_p_J_x*t213;
-  const T t216 = t185*t26 - t186*t27;
-  const T t217 = t185*t27 + t186*t26;
-  const T t218 = t214 + t217;
-  const T t219 = t187 + t215;
-  const T t220 = t204 + t212;
-  const T t221 = t184 + t205;
-  const T t222 = t206 - t213;
-  const T t223 = t207 + t216;
-  const T t224 = t208 + t219;
-  const T t225 = t209 - t218;
+  const T t206 = -boom_a_k*q[7] + tau[6];
+  const T t207 = t183 + t206;
+  const T t208 = angle_c[0]*t178 - angle_s[0]*t179;
+  const T t209 = angle_c[0]*t179 + angle_s[0]*t178;
+  const T t210 = -boom_a_p_J_x*t180;
+  const T t211 = boom_a_p_J_x*t209;
+  const T t212 = angle_c[0]*t181 - angle_s[0]*t182;
+  const T t213 = angle_c[0]*t182 + angle_s[0]*t181;
+  const T t214 = t210 + t213;
+  const T t215 = t183 + t211;
+  const T t216 = t200 + t208;
+  const T t217 = t180 + t201;
+  const T t218 = t202 - t209;
+  const T t219 = t203 + t212;
+  const T t220 = t204 + t215;
+  const T t221 = t205 - t214;
   // ---- body drum: generalized forces (inward)
-  const T t226 = t220 + tau[0];
-  const T t227 = t221 + tau[1];
-  const T t228 = t222 + tau[2];
-  const T t229 = t223 + tau[3];
-  const T t230 = t224 + tau[4];
-  const T t231 = t225 + tau[5];
+  const T t222 = t216 + tau[0];
+  const T t223 = t217 + tau[1];
+  const T t224 = t218 + tau[2];
+  const T t225 = t219 + tau[3];
+  const T t226 = t220 + tau[4];
+  const T t227 = t221 + tau[5];
   // ---- M u_dot = F: L^T D L along the dof tree
-  const T t232 = -k815cdab6*t175;
-  const T t233 = t164 + t175*t232;
-  const T t234 = t128*t232 + t168;
-  const T t235 = t167 + t173*t232;
-  const T t236 = -k815cdab6*t128;
-  const T t237 = k8601161c + t128*t236;
-  const T t238 = t173*t236;
-  const T t239 = -k815cdab6*t173;
-  const T t240 = k8601161c + t173*t239;
-  const T t241 = k5dbc2b02*t172;
-  const T t242 = -t172*t241 + t233;
-  const T t243 = t149*t241 + t234;
-  const T t244 = -t170*t241 + t235;
-  const T t245 = -k5dbc2b02*t149;
-  const T t246 = t149*t245 + t237;
-  const T t247 = -t170*t245 + t238;
-  const T t248 = k5dbc2b02*t170;
-  const T t249 = -t170*t248 + t240;
-  const T t250 = 1.0/t165;
-  const T t251 = t163*t250;
-  const T t252 = t162 - t163*t251;
-  const T t253 = t166 - t169*t251;
-  const T t254 = t169*t250;
-  const T t255 = k8601161c - t169*t254;
-  const T t256 = 1.0/t242;
-  const T t257 = t243*t256;
-  const T t258 = -t243*t257 + t246;
-  const T t259 = -t244*t257 + t247;
-  const T t260 = t244*t256;
-  const T t261 = -t244*t260 + t249;
-  const T t262 = 1.0/t252;
-  const T t263 = t253*t262;
-  const T t264 = -t253*t263 + t255;
-  const T t265 = 1.0/t258;
-  const T t266 = t259*t265;
-  const T t267 = -t259*t266 + t261;
-  const T t270 = -t195*t232 + t230;
-  const T t271 = -t195*t236 + t228;
-  const T t272 = -t195*t239 + t226;
-  const T t273 = -t211*t241 + t270;
-  const T t274 = -t211*t245 + t271;
-  const T t275 = -t211*t248 + t272;
-  const T t276 = t229 - t231*t251;
-  const T t277 = t227 - t231*t254;
-  const T t278 = -t257*t273 + t274;
-  const T t279 = -t260*t273 + t275;
-  const T t280 = -t263*t276 + t277;
-  const T t281 = -t266*t278 + t279;
-  const T t282 = t281/t267;
-  const T t283 = t280/t264;
-  const T t284 = t278/t258;
-  const T t285 = t276/t252;
-  const T t286 = t273/t242;
-  const T t287 = t231/t165;
-  const T t288 = k5dbc2b02*t211;
-  const T t289 = k815cdab6*t195;
-  const T t290 = -t266*t282 + t284;
-  const T t291 = -t263*t283 + t285;
-  const T t292 = -t257*t290 + t286;
-  const T t293 = -t260*t282 + t292;
-  const T t294 = -t251*t291 + t287;
-  const T t295 = -t254*t283 + t294;
-  const T t296 = -t241*t293 + t288;
-  const T t297 = -t245*t290 + t296;
-  const T t298 = -t248*t282 + t297;
-  const T t299 = -t232*t293 + t289;
-  const T t300 = -t236*t290 + t299;
-  const T t301 = -t239*t282 + t300;
-  if (!(t267 > 1e-14*k8601161c)) return 1;
-  if (!(t264 > 1e-14*k8601161c)) return 2;
-  if (!(t258 > 1e-14*k8601161c)) return 3;
-  if (!(t252 > 1e-14*t162)) return 4;
-  if (!(t242 > 1e-14*t164)) return 5;
-  if (!(t165 > 0.0)) return 6;
+  const T t228 = -k815cdab6*t171;
+  const T t229 = t160 + t171*t228;
+  const T t230 = t124*t228 + t164;
+  const T t231 = t163 + t169*t228;
+  const T t232 = -k815cdab6*t124;
+  const T t233 = k8601161c + t124*t232;
+  const T t234 = t169*t232;
+  const T t235 = -k815cdab6*t169;
+  const T t236 = k8601161c + t169*t235;
+  const T t237 = k5dbc2b02*t168;
+  const T t238 = -t168*t237 + t229;
+  const T t239 = t145*t237 + t230;
+  const T t240 = -t166*t237 + t231;
+  const T t241 = -k5dbc2b02*t145;
+  const T t242 = t145*t241 + t233;
+  const T t243 = -t166*t241 + t234;
+  const T t244 = k5dbc2b02*t166;
+  const T t245 = -t166*t244 + t236;
+  const T t246 = 1.0/t161;
+  const T t247 = t159*t246;
+  const T t248 = t158 - t159*t247;
+  const T t249 = t162 - t165*t247;
+  const T t250 = t165*t246;
+  const T t251 = k8601161c - t165*t250;
+  const T t252 = 1.0/t238;
+  const T t253 = t239*t252;
+  const T t254 = -t239*t253 + t242;
+  const T t255 = -t240*t253 + t243;
+  const T t256 = t240*t252;
+  const T t257 = -t240*t256 + t245;
+  const T t258 = 1.0/t248;
+  const T t259 = t249*t258;
+  const T t260 = -t249*t259 + t251;
+  const T t261 = 1.0/t254;
+  const T t262 = t255*t261;
+  const T t263 = -t255*t262 + t257;
+  const T t266 = -t191*t228 + t226;
+  const T t267 = -t191*t232 + t224;
+  const T t268 = -t191*t235 + t222;
+  const T t269 = -t207*t237 + t266;
+  const T t270 = -t207*t241 + t267;
+  const T t271 = -t207*t244 + t268;
+  const T t272 = t225 - t227*t247;
+  const T t273 = t223 - t227*t250;
+  const T t274 = -t253*t269 + t270;
+  const T t275 = -t256*t269 + t271;
+  const T t276 = -t259*t272 + t273;
+  const T t277 = -t262*t274 + t275;
+  const T t278 = t277/t263;
+  const T t279 = t276/t260;
+  const T t280 = t274/t254;
+  const T t281 = t272/t248;
+  const T t282 = t269/t238;
+  const T t283 = t227/t161;
+  const T t284 = k5dbc2b02*t207;
+  const T t285 = k815cdab6*t191;
+  const T t286 = -t262*t278 + t280;
+  const T t287 = -t259*t279 + t281;
+  const T t288 = -t253*t286 + t282;
+  const T t289 = -t256*t278 + t288;
+  const T t290 = -t247*t287 + t283;
+  const T t291 = -t250*t279 + t290;
+  const T t292 = -t237*t289 + t284;
+  const T t293 = -t241*t286 + t292;
+  const T t294 = -t244*t278 + t293;
+  const T t295 = -t228*t289 + t285;
+  const T t296 = -t232*t286 + t295;
+  const T t297 = -t235*t278 + t296;
+  if (!(t263 > 1e-14*k8601161c)) return 1;
+  if (!(t260 > 1e-14*k8601161c)) return 2;
+  if (!(t254 > 1e-14*k8601161c)) return 3;
+  if (!(t248 > 1e-14*t158)) return 4;
+  if (!(t238 > 1e-14*t160)) return 5;
+  if (!(t161 > 0.0)) return 6;
   if (!(boom_a_J0_zz > 0.0)) return 7;
   if (!(boom_b_J0_zz > 0.0)) return 8;
-  udot[0] = t282;
-  udot[1] = t283;
-  udot[2] = t290;
-  udot[3] = t291;
-  udot[4] = t293;
-  udot[5] = t295;
-  udot[6] = t298;
-  udot[7] = t301;
+  udot[0] = t278;
+  udot[1] = t279;
+  udot[2] = t286;
+  udot[3] = t287;
+  udot[4] = t289;
+  udot[5] = t291;
+  udot[6] = t294;
+  udot[7] = t297;
   return 0;
 }
 
@@ -742,58 +869,58 @@ template <class T>
 void energy(const T* q, const T* u, T* TV) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body boom_a: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = boom_a_p_J_x*u[4];
-  const T t41 = boom_a_p_J_x*u[5];
-  const T t42 = t40 - u[2];
-  const T t43 = t41 + u[1];
-  const T t50 = t26*u[3] - t27*u[5];
-  const T t51 = -t26*u[5] - t27*u[3];
+  const T t38 = boom_a_p_J_x*u[4];
+  const T t39 = boom_a_p_J_x*u[5];
+  const T t40 = t38 - u[2];
+  const T t41 = t39 + u[1];
+  const T t48 = angle_c[0]*u[3] - angle_s[0]*u[5];
+  const T t49 = -angle_c[0]*u[5] - angle_s[0]*u[3];
   const T w_B_boom_a_z = u[4] + u[6];
-  const T t53 = t26*u[0] + t27*t42;
-  const T t54 = t26*t42 - t27*u[0];
+  const T t51 = angle_c[0]*u[0] + angle_s[0]*t40;
+  const T t52 = angle_c[0]*t40 - angle_s[0]*u[0];
   // ---- body boom_b: outward pass (velocities)
-  const T t60 = cos(q[8]);
-  const T t61 = sin(q[8]);
-  const T t74 = -boom_b_p_J_x*u[4];
-  const T t75 = boom_b_p_J_x*u[5];
-  const T t76 = t74 - u[2];
-  const T t77 = t75 - u[1];
-  const T t84 = -t60*u[3] - t61*u[5];
-  const T t85 = -t60*u[5] + t61*u[3];
+  const T t70 = -boom_b_p_J_x*u[4];
+  const T t71 = boom_b_p_J_x*u[5];
+  const T t72 = t70 - u[2];
+  const T t73 = t71 - u[1];
+  const T t80 = -angle_c[1]*u[3] - angle_s[1]*u[5];
+  const T t81 = -angle_c[1]*u[5] + angle_s[1]*u[3];
   const T w_B_boom_b_z = -u[4] + u[7];
-  const T t87 = -t60*u[0] + t61*t76;
-  const T t88 = t60*t76 + t61*u[0];
+  const T t83 = -angle_c[1]*u[0] + angle_s[1]*t72;
+  const T t84 = angle_c[1]*t72 + angle_s[1]*u[0];
   // ---- body boom_a: mass and velocity terms
-  const T t111 = boom_a_J0_xx*t50;
+  const T t107 = boom_a_J0_xx*t48;
   // ---- body boom_b: mass and velocity terms
-  const T t122 = boom_b_J0_xx*t84;
-  const T t128 = drum_S0_z*u[4] + drum_mass*u[0];
-  const T t129 = drum_S0_x*u[5] - drum_S0_z*u[3] + drum_mass*u[1];
-  const T t130 = -drum_S0_x*u[4] + drum_mass*u[2];
-  const T t131 = drum_J0_xx*u[3] + drum_J0_xz*u[5] - drum_S0_z*u[1];
-  const T t132 = drum_J0_yy*u[4] - drum_S0_x*u[2] + drum_S0_z*u[0];
-  const T t133 = drum_J0_xz*u[3] + drum_J0_zz*u[5] + drum_S0_x*u[1];
-  const T t134 = ((t128*u[0] + t129*u[1]) + t130*u[2]) + ((t131*u[3] + t132*u[4]) + t133*u[5]);
-  const T t135 = boom_a_mass*t53;
-  const T t136 = boom_a_S0_x*w_B_boom_a_z + boom_a_mass*t54;
-  const T t137 = -boom_a_S0_x*t51 + boom_a_mass*t43;
-  const T t138 = boom_a_J0_yy*t51 - boom_a_S0_x*t43;
-  const T t139 = boom_a_J0_zz*w_B_boom_a_z + boom_a_S0_x*t54;
-  const T t140 = ((t111*t50 + t135*t53) + t136*t54) + ((t137*t43 + t138*t51) + t139*w_B_boom_a_z);
-  const T t141 = boom_b_mass*t87;
-  const T t142 = boom_b_S0_x*w_B_boom_b_z + boom_b_mass*t88;
-  const T t143 = -boom_b_S0_x*t85 + boom_b_mass*t77;
-  const T t144 = boom_b_J0_yy*t85 - boom_b_S0_x*t77;
-  const T t145 = boom_b_J0_zz*w_B_boom_b_z + boom_b_S0_x*t88;
-  const T t146 = ((t122*t84 + t141*t87) + t142*t88) + ((t143*t77 + t144*t85) + t145*w_B_boom_b_z);
-  const T t147 = t134/2.0 + t140/2.0 + t146/2.0;
-  const T t148 = boom_a_k*q[7]*q[7]/2.0;
-  const T t149 = boom_b_k*q[8]*q[8]/2.0 + t148;
-  TV[0] = t147;
-  TV[1] = t149;
+  const T t118 = boom_b_J0_xx*t80;
+  const T t124 = drum_S0_z*u[4] + drum_mass*u[0];
+  const T t125 = drum_S0_x*u[5] - drum_S0_z*u[3] + drum_mass*u[1];
+  const T t126 = -drum_S0_x*u[4] + drum_mass*u[2];
+  const T t127 = drum_J0_xx*u[3] + drum_J0_xz*u[5] - drum_S0_z*u[1];
+  const T t128 = drum_J0_yy*u[4] - drum_S0_x*u[2] + drum_S0_z*u[0];
+  const T t129 = drum_J0_xz*u[3] + drum_J0_zz*u[5] + drum_S0_x*u[1];
+  const T t130 = ((t124*u[0] + t125*u[1]) + t126*u[2]) + ((t127*u[3] + t128*u[4]) + t129*u[5]);
+  const T t131 = boom_a_mass*t51;
+  const T t132 = boom_a_S0_x*w_B_boom_a_z + boom_a_mass*t52;
+  const T t133 = -boom_a_S0_x*t49 + boom_a_mass*t41;
+  const T t134 = boom_a_J0_yy*t49 - boom_a_S0_x*t41;
+  const T t135 = boom_a_J0_zz*w_B_boom_a_z + boom_a_S0_x*t52;
+  const T t136 = ((t107*t48 + t131*t51) + t132*t52) + ((t133*t41 + t134*t49) + t135*w_B_boom_a_z);
+  const T t137 = boom_b_mass*t83;
+  const T t138 = boom_b_S0_x*w_B_boom_b_z + boom_b_mass*t84;
+  const T t139 = -boom_b_S0_x*t81 + boom_b_mass*t73;
+  const T t140 = boom_b_J0_yy*t81 - boom_b_S0_x*t73;
+  const T t141 = boom_b_J0_zz*w_B_boom_b_z + boom_b_S0_x*t84;
+  const T t142 = ((t118*t80 + t137*t83) + t138*t84) + ((t139*t73 + t140*t81) + t141*w_B_boom_b_z);
+  const T t143 = t130/2.0 + t136/2.0 + t142/2.0;
+  const T t144 = boom_a_k*q[7]*q[7]/2.0;
+  const T t145 = boom_b_k*q[8]*q[8]/2.0 + t144;
+  TV[0] = t143;
+  TV[1] = t145;
 }
 
 // ---- momentum: p_N[3], H_N[3] about N's origin ---------------------------------
@@ -801,6 +928,10 @@ template <class T>
 void momentum(const T* q, const T* u, T* pH) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body drum: outward pass (velocities)
   const T t0 = (1.0/sqrt((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
   const T t1 = q[3]*t0;
@@ -826,127 +957,123 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t21 = 2.0*t10 + 2.0*t11;
   const T t22 = 1.0 - 2.0*t5 - 2.0*t6;
   // ---- body boom_a: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T R_NB_boom_a_xx = t14*t26 - t16*t27;
-  const T R_NB_boom_a_xy = -t14*t27 - t16*t26;
-  const T R_NB_boom_a_yx = t17*t26 - t19*t27;
-  const T R_NB_boom_a_yy = -t17*t27 - t19*t26;
-  const T R_NB_boom_a_zx = t20*t26 - t22*t27;
-  const T R_NB_boom_a_zy = -t20*t27 - t22*t26;
-  const T t34 = boom_a_p_PJ_x*t14;
-  const T t35 = boom_a_p_PJ_x*t17;
-  const T t36 = boom_a_p_PJ_x*t20;
-  const T r_NO_N_boom_a_x = q[0] + t34;
-  const T r_NO_N_boom_a_y = q[1] + t35;
-  const T r_NO_N_boom_a_z = q[2] + t36;
-  const T t40 = boom_a_p_J_x*u[4];
-  const T t41 = boom_a_p_J_x*u[5];
-  const T t42 = t40 - u[2];
-  const T t43 = t41 + u[1];
-  const T t50 = t26*u[3] - t27*u[5];
-  const T t51 = -t26*u[5] - t27*u[3];
+  const T R_NB_boom_a_xx = angle_c[0]*t14 - angle_s[0]*t16;
+  const T R_NB_boom_a_xy = -angle_c[0]*t16 - angle_s[0]*t14;
+  const T R_NB_boom_a_yx = angle_c[0]*t17 - angle_s[0]*t19;
+  const T R_NB_boom_a_yy = -angle_c[0]*t19 - angle_s[0]*t17;
+  const T R_NB_boom_a_zx = angle_c[0]*t20 - angle_s[0]*t22;
+  const T R_NB_boom_a_zy = -angle_c[0]*t22 - angle_s[0]*t20;
+  const T t32 = boom_a_p_PJ_x*t14;
+  const T t33 = boom_a_p_PJ_x*t17;
+  const T t34 = boom_a_p_PJ_x*t20;
+  const T r_NO_N_boom_a_x = q[0] + t32;
+  const T r_NO_N_boom_a_y = q[1] + t33;
+  const T r_NO_N_boom_a_z = q[2] + t34;
+  const T t38 = boom_a_p_J_x*u[4];
+  const T t39 = boom_a_p_J_x*u[5];
+  const T t40 = t38 - u[2];
+  const T t41 = t39 + u[1];
+  const T t48 = angle_c[0]*u[3] - angle_s[0]*u[5];
+  const T t49 = -angle_c[0]*u[5] - angle_s[0]*u[3];
   const T w_B_boom_a_z = u[4] + u[6];
-  const T t53 = t26*u[0] + t27*t42;
-  const T t54 = t26*t42 - t27*u[0];
+  const T t51 = angle_c[0]*u[0] + angle_s[0]*t40;
+  const T t52 = angle_c[0]*t40 - angle_s[0]*u[0];
   // ---- body boom_b: outward pass (velocities)
-  const T t60 = cos(q[8]);
-  const T t61 = sin(q[8]);
-  const T R_NB_boom_b_xx = -t14*t60 - t16*t61;
-  const T R_NB_boom_b_xy = t14*t61 - t16*t60;
-  const T R_NB_boom_b_yx = -t17*t60 - t19*t61;
-  const T R_NB_boom_b_yy = t17*t61 - t19*t60;
-  const T R_NB_boom_b_zx = -t20*t60 - t22*t61;
-  const T R_NB_boom_b_zy = t20*t61 - t22*t60;
-  const T t68 = boom_b_p_PJ_x*t14;
-  const T t69 = boom_b_p_PJ_x*t17;
-  const T t70 = boom_b_p_PJ_x*t20;
-  const T r_NO_N_boom_b_x = q[0] + t68;
-  const T r_NO_N_boom_b_y = q[1] + t69;
-  const T r_NO_N_boom_b_z = q[2] + t70;
-  const T t74 = -boom_b_p_J_x*u[4];
-  const T t75 = boom_b_p_J_x*u[5];
-  const T t76 = t74 - u[2];
-  const T t77 = t75 - u[1];
-  const T t84 = -t60*u[3] - t61*u[5];
-  const T t85 = -t60*u[5] + t61*u[3];
+  const T R_NB_boom_b_xx = -angle_c[1]*t14 - angle_s[1]*t16;
+  const T R_NB_boom_b_xy = -angle_c[1]*t16 + angle_s[1]*t14;
+  const T R_NB_boom_b_yx = -angle_c[1]*t17 - angle_s[1]*t19;
+  const T R_NB_boom_b_yy = -angle_c[1]*t19 + angle_s[1]*t17;
+  const T R_NB_boom_b_zx = -angle_c[1]*t20 - angle_s[1]*t22;
+  const T R_NB_boom_b_zy = -angle_c[1]*t22 + angle_s[1]*t20;
+  const T t64 = boom_b_p_PJ_x*t14;
+  const T t65 = boom_b_p_PJ_x*t17;
+  const T t66 = boom_b_p_PJ_x*t20;
+  const T r_NO_N_boom_b_x = q[0] + t64;
+  const T r_NO_N_boom_b_y = q[1] + t65;
+  const T r_NO_N_boom_b_z = q[2] + t66;
+  const T t70 = -boom_b_p_J_x*u[4];
+  const T t71 = boom_b_p_J_x*u[5];
+  const T t72 = t70 - u[2];
+  const T t73 = t71 - u[1];
+  const T t80 = -angle_c[1]*u[3] - angle_s[1]*u[5];
+  const T t81 = -angle_c[1]*u[5] + angle_s[1]*u[3];
   const T w_B_boom_b_z = -u[4] + u[7];
-  const T t87 = -t60*u[0] + t61*t76;
-  const T t88 = t60*t76 + t61*u[0];
+  const T t83 = -angle_c[1]*u[0] + angle_s[1]*t72;
+  const T t84 = angle_c[1]*t72 + angle_s[1]*u[0];
   // ---- body boom_a: mass and velocity terms
-  const T t111 = boom_a_J0_xx*t50;
+  const T t107 = boom_a_J0_xx*t48;
   // ---- body boom_b: mass and velocity terms
-  const T t122 = boom_b_J0_xx*t84;
-  const T t128 = drum_S0_z*u[4] + drum_mass*u[0];
-  const T t129 = drum_S0_x*u[5] - drum_S0_z*u[3] + drum_mass*u[1];
-  const T t130 = -drum_S0_x*u[4] + drum_mass*u[2];
-  const T t131 = drum_J0_xx*u[3] + drum_J0_xz*u[5] - drum_S0_z*u[1];
-  const T t132 = drum_J0_yy*u[4] - drum_S0_x*u[2] + drum_S0_z*u[0];
-  const T t133 = drum_J0_xz*u[3] + drum_J0_zz*u[5] + drum_S0_x*u[1];
-  const T t134 = t128*t14 + t129*t15 + t130*t16;
-  const T t135 = t128*t17 + t129*t18 + t130*t19;
-  const T t136 = t128*t20 + t129*t21 + t130*t22;
-  const T t137 = t131*t14 + t132*t15 + t133*t16;
-  const T t138 = t131*t17 + t132*t18 + t133*t19;
-  const T t139 = t131*t20 + t132*t21 + t133*t22;
-  const T t140 = q[1]*t136 - q[2]*t135;
-  const T t141 = -q[0]*t136 + q[2]*t134;
-  const T t142 = q[0]*t135 - q[1]*t134;
-  const T t143 = t137 + t140;
-  const T t144 = t138 + t141;
-  const T t145 = t139 + t142;
-  const T t146 = boom_a_mass*t53;
-  const T t147 = boom_a_S0_x*w_B_boom_a_z + boom_a_mass*t54;
-  const T t148 = -boom_a_S0_x*t51 + boom_a_mass*t43;
-  const T t149 = boom_a_J0_yy*t51 - boom_a_S0_x*t43;
-  const T t150 = boom_a_J0_zz*w_B_boom_a_z + boom_a_S0_x*t54;
-  const T t151 = R_NB_boom_a_xx*t146 + R_NB_boom_a_xy*t147 + t148*t15;
-  const T t152 = R_NB_boom_a_yx*t146 + R_NB_boom_a_yy*t147 + t148*t18;
-  const T t153 = R_NB_boom_a_zx*t146 + R_NB_boom_a_zy*t147 + t148*t21;
-  const T t154 = R_NB_boom_a_xx*t111 + R_NB_boom_a_xy*t149 + t15*t150;
-  const T t155 = R_NB_boom_a_yx*t111 + R_NB_boom_a_yy*t149 + t150*t18;
-  const T t156 = R_NB_boom_a_zx*t111 + R_NB_boom_a_zy*t149 + t150*t21;
-  const T t157 = r_NO_N_boom_a_y*t153 - r_NO_N_boom_a_z*t152;
-  const T t158 = -r_NO_N_boom_a_x*t153 + r_NO_N_boom_a_z*t151;
-  const T t159 = r_NO_N_boom_a_x*t152 - r_NO_N_boom_a_y*t151;
-  const T t160 = t154 + t157;
-  const T t161 = t155 + t158;
-  const T t162 = t156 + t159;
-  const T t163 = t134 + t151;
-  const T t164 = t135 + t152;
-  const T t165 = t136 + t153;
-  const T t166 = t143 + t160;
-  const T t167 = t144 + t161;
-  const T t168 = t145 + t162;
-  const T t169 = boom_b_mass*t87;
-  const T t170 = boom_b_S0_x*w_B_boom_b_z + boom_b_mass*t88;
-  const T t171 = -boom_b_S0_x*t85 + boom_b_mass*t77;
-  const T t172 = boom_b_J0_yy*t85 - boom_b_S0_x*t77;
-  const T t173 = boom_b_J0_zz*w_B_boom_b_z + boom_b_S0_x*t88;
-  const T t174 = R_NB_boom_b_xx*t169 + R_NB_boom_b_xy*t170 - t15*t171;
-  const T t175 = R_NB_boom_b_yx*t169 + R_NB_boom_b_yy*t170 - t171*t18;
-  const T t176 = R_NB_boom_b_zx*t169 + R_NB_boom_b_zy*t170 - t171*t21;
-  const T t177 = R_NB_boom_b_xx*t122 + R_NB_boom_b_xy*t172 - t15*t173;
-  const T t178 = R_NB_boom_b_yx*t122 + R_NB_boom_b_yy*t172 - t173*t18;
-  const T t179 = R_NB_boom_b_zx*t122 + R_NB_boom_b_zy*t172 - t173*t21;
-  const T t180 = r_NO_N_boom_b_y*t176 - r_NO_N_boom_b_z*t175;
-  const T t181 = -r_NO_N_boom_b_x*t176 + r_NO_N_boom_b_z*t174;
-  const T t182 = r_NO_N_boom_b_x*t175 - r_NO_N_boom_b_y*t174;
-  const T t183 = t177 + t180;
-  const T t184 = t178 + t181;
-  const T t185 = t179 + t182;
-  const T t186 = t163 + t174;
-  const T t187 = t164 + t175;
-  const T t188 = t165 + t176;
-  const T t189 = t166 + t183;
-  const T t190 = t167 + t184;
-  const T t191 = t168 + t185;
-  pH[0] = t186;
-  pH[1] = t187;
-  pH[2] = t188;
-  pH[3] = t189;
-  pH[4] = t190;
-  pH[5] = t191;
+  const T t118 = boom_b_J0_xx*t80;
+  const T t124 = drum_S0_z*u[4] + drum_mass*u[0];
+  const T t125 = drum_S0_x*u[5] - drum_S0_z*u[3] + drum_mass*u[1];
+  const T t126 = -drum_S0_x*u[4] + drum_mass*u[2];
+  const T t127 = drum_J0_xx*u[3] + drum_J0_xz*u[5] - drum_S0_z*u[1];
+  const T t128 = drum_J0_yy*u[4] - drum_S0_x*u[2] + drum_S0_z*u[0];
+  const T t129 = drum_J0_xz*u[3] + drum_J0_zz*u[5] + drum_S0_x*u[1];
+  const T t130 = t124*t14 + t125*t15 + t126*t16;
+  const T t131 = t124*t17 + t125*t18 + t126*t19;
+  const T t132 = t124*t20 + t125*t21 + t126*t22;
+  const T t133 = t127*t14 + t128*t15 + t129*t16;
+  const T t134 = t127*t17 + t128*t18 + t129*t19;
+  const T t135 = t127*t20 + t128*t21 + t129*t22;
+  const T t136 = q[1]*t132 - q[2]*t131;
+  const T t137 = -q[0]*t132 + q[2]*t130;
+  const T t138 = q[0]*t131 - q[1]*t130;
+  const T t139 = t133 + t136;
+  const T t140 = t134 + t137;
+  const T t141 = t135 + t138;
+  const T t142 = boom_a_mass*t51;
+  const T t143 = boom_a_S0_x*w_B_boom_a_z + boom_a_mass*t52;
+  const T t144 = -boom_a_S0_x*t49 + boom_a_mass*t41;
+  const T t145 = boom_a_J0_yy*t49 - boom_a_S0_x*t41;
+  const T t146 = boom_a_J0_zz*w_B_boom_a_z + boom_a_S0_x*t52;
+  const T t147 = R_NB_boom_a_xx*t142 + R_NB_boom_a_xy*t143 + t144*t15;
+  const T t148 = R_NB_boom_a_yx*t142 + R_NB_boom_a_yy*t143 + t144*t18;
+  const T t149 = R_NB_boom_a_zx*t142 + R_NB_boom_a_zy*t143 + t144*t21;
+  const T t150 = R_NB_boom_a_xx*t107 + R_NB_boom_a_xy*t145 + t146*t15;
+  const T t151 = R_NB_boom_a_yx*t107 + R_NB_boom_a_yy*t145 + t146*t18;
+  const T t152 = R_NB_boom_a_zx*t107 + R_NB_boom_a_zy*t145 + t146*t21;
+  const T t153 = r_NO_N_boom_a_y*t149 - r_NO_N_boom_a_z*t148;
+  const T t154 = -r_NO_N_boom_a_x*t149 + r_NO_N_boom_a_z*t147;
+  const T t155 = r_NO_N_boom_a_x*t148 - r_NO_N_boom_a_y*t147;
+  const T t156 = t150 + t153;
+  const T t157 = t151 + t154;
+  const T t158 = t152 + t155;
+  const T t159 = t130 + t147;
+  const T t160 = t131 + t148;
+  const T t161 = t132 + t149;
+  const T t162 = t139 + t156;
+  const T t163 = t140 + t157;
+  const T t164 = t141 + t158;
+  const T t165 = boom_b_mass*t83;
+  const T t166 = boom_b_S0_x*w_B_boom_b_z + boom_b_mass*t84;
+  const T t167 = -boom_b_S0_x*t81 + boom_b_mass*t73;
+  const T t168 = boom_b_J0_yy*t81 - boom_b_S0_x*t73;
+  const T t169 = boom_b_J0_zz*w_B_boom_b_z + boom_b_S0_x*t84;
+  const T t170 = R_NB_boom_b_xx*t165 + R_NB_boom_b_xy*t166 - t15*t167;
+  const T t171 = R_NB_boom_b_yx*t165 + R_NB_boom_b_yy*t166 - t167*t18;
+  const T t172 = R_NB_boom_b_zx*t165 + R_NB_boom_b_zy*t166 - t167*t21;
+  const T t173 = R_NB_boom_b_xx*t118 + R_NB_boom_b_xy*t168 - t15*t169;
+  const T t174 = R_NB_boom_b_yx*t118 + R_NB_boom_b_yy*t168 - t169*t18;
+  const T t175 = R_NB_boom_b_zx*t118 + R_NB_boom_b_zy*t168 - t169*t21;
+  const T t176 = r_NO_N_boom_b_y*t172 - r_NO_N_boom_b_z*t171;
+  const T t177 = -r_NO_N_boom_b_x*t172 + r_NO_N_boom_b_z*t170;
+  const T t178 = r_NO_N_boom_b_x*t171 - r_NO_N_boom_b_y*t170;
+  const T t179 = t173 + t176;
+  const T t180 = t174 + t177;
+  const T t181 = t175 + t178;
+  const T t182 = t159 + t170;
+  const T t183 = t160 + t171;
+  const T t184 = t161 + t172;
+  const T t185 = t162 + t179;
+  const T t186 = t163 + t180;
+  const T t187 = t164 + t181;
+  pH[0] = t182;
+  pH[1] = t183;
+  pH[2] = t184;
+  pH[3] = t185;
+  pH[4] = t186;
+  pH[5] = t187;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

@@ -19,7 +19,7 @@
 //   mass_matrix       44 (23 add, 17 mul, 0 div, 4 func)
 //   forcing          247 (104 add, 139 mul, 0 div, 4 func)
 //   udot             450 (195 add, 240 mul, 11 div, 4 func) -- composite form; composite 450, articulated 582
-//     udot by pass: outward pass (velocities) 63; mass and velocity terms 78; composite inertia (inward) 37; its columns of M (walked to the root) 3; bias force 50; generalized forces (inward) 56; M u_dot = F: L^T D L along the dof tree 163
+//     udot by pass: joint angles' sin and cos 4; outward pass (velocities) 59; mass and velocity terms 78; composite inertia (inward) 37; its columns of M (walked to the root) 3; bias force 50; generalized forces (inward) 56; M u_dot = F: L^T D L along the dof tree 163
 //   energy           149 (58 add, 82 mul, 5 div, 4 func)
 //   momentum         342 (139 add, 197 mul, 1 div, 5 func)
 
@@ -144,6 +144,135 @@ template <int W> inline bool operator>(double a, const Dual<W>& b) { return a > 
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }
+// ---- joint angles' sin and cos (templates/joint_sincos.inc) -------------------
+// Every joint angle's sin and cos, computed in one batch before the rest of a
+// function (issue 38, item 3: one evaluation per angle, shared by every use),
+// two angles at a time in SSE2 pairs (GCC/clang vector extensions, no header).
+// Accuracy (tests/codegen/test_joint_sincos.cpp, against sinl/cosl): at most
+// 0.51 ulp, the library's sin and cos 0.52-0.56 on the same arguments; beyond
+// |x| = 1e5 rad (and for inf and NaN) the library's sin and cos. (-ffast-math,
+// which reorders the exact sums, voids the bound.)
+// Method: x = k pi/32 + r, |r| <= pi/64, with pi/32 in four parts (three of 33
+// bits, exact products for |k| < 2^20) and r carried as r + rlo; sin and cos
+// of k pi/32 from a table as double-doubles (hi, lo, and hi split in 26-bit
+// halves for Dekker's exact product); sin r - r and cos r - 1 by their Taylor
+// series to r^9 and r^8 (truncation below 1e-20 on |r| <= pi/64);
+// sin x = S + C r + (S (cos r - 1) + C (sin r - r) + C rlo + S_lo), the sum
+// S + C r exact (TwoSum of the exact product), likewise cos x.
+
+// sin(j pi/32), j = 0..63: hi, lo (hi + lo to ~2^-106), and hi in two halves of 26 bits
+inline constexpr double kanegen_sin_table[64][4] = {
+    {0.0, 0.0, 0.0, 0.0},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.0000000000000p+0, 0.0, 0x1.0000000000000p+0, 0.0},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0.0, 0.0, 0.0, 0.0},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.0000000000000p+0, 0.0, -0x1.0000000000000p+0, 0.0},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+};
+
+typedef double kanegen_v2d __attribute__((vector_size(16)));
+
+/// sin and cos of x[0..n), in s and c.
+inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
+  for (int i = 0; i < n; i += 2) {
+    const int b = i + 1 < n ? i + 1 : i;  // an odd count's last angle twice
+    // beyond 1e5 rad (and inf, NaN) the library's, below; 0 meanwhile keeps the integer conversion defined
+    const double xi = x[i] <= 1.0e5 && x[i] >= -1.0e5 ? x[i] : 0.0, xb = x[b] <= 1.0e5 && x[b] >= -1.0e5 ? x[b] : 0.0;
+    const kanegen_v2d xv = {xi, xb};
+    const kanegen_v2d kn = (xv * 0x1.45f306dc9c883p+3 + 0x1.8p52) - 0x1.8p52;  // round(x 32/pi)
+    const kanegen_v2d t = xv - kn * 0x1.921fb54400000p-4, u2 = kn * 0x1.0b4611a600000p-38,
+                      u3 = kn * 0x1.3198a2e000000p-73;
+    const kanegen_v2d r1 = t - u2, e1 = (t - r1) - u2;
+    const kanegen_v2d r = r1 - u3, b3 = r - r1, e2 = (r1 - (r - b3)) - (u3 + b3);
+    const kanegen_v2d rlo = (e1 + e2) - kn * 0x1.b839a252049c1p-108;
+    const kanegen_v2d z = r * r;
+    const kanegen_v2d sr = (r * z) * (-1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 + z * (1.0 / 362880))));
+    const kanegen_v2d cm = z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320))));
+    const long k0 = static_cast<long>(kn[0]), k1 = static_cast<long>(kn[1]);
+    const double* Sa = kanegen_sin_table[k0 & 63];
+    const double* Sb = kanegen_sin_table[k1 & 63];
+    const double* Ca = kanegen_sin_table[(k0 + 16) & 63];
+    const double* Cb = kanegen_sin_table[(k1 + 16) & 63];
+    const kanegen_v2d S0 = {Sa[0], Sb[0]}, S1 = {Sa[1], Sb[1]}, S2 = {Sa[2], Sb[2]}, S3 = {Sa[3], Sb[3]};
+    const kanegen_v2d C0 = {Ca[0], Cb[0]}, C1 = {Ca[1], Cb[1]}, C2 = {Ca[2], Cb[2]}, C3 = {Ca[3], Cb[3]};
+    const kanegen_v2d g = 134217729.0 * r, rh = g - (g - r), rl = r - rh;  // r in 26-bit halves
+    const kanegen_v2d p = C0 * r, pe = (((C2 * rh - p) + C2 * rl) + C3 * rh) + C3 * rl;  // C r = p + pe
+    const kanegen_v2d s1 = S0 + p, bs = s1 - S0, se = (S0 - (s1 - bs)) + (p - bs);    // S + p = s1 + se
+    const kanegen_v2d sv = s1 + ((se + pe) + (S1 + C1 * r + C0 * rlo + S0 * cm + C0 * sr));
+    const kanegen_v2d q = S0 * r, qe = (((S2 * rh - q) + S2 * rl) + S3 * rh) + S3 * rl;  // S r = q + qe
+    const kanegen_v2d c1 = C0 - q, bc = c1 - C0, ce = (C0 - (c1 - bc)) + (-q - bc);      // C - q = c1 + ce
+    const kanegen_v2d cv = c1 + ((ce - qe) + (C1 - S1 * r - S0 * rlo + C0 * cm - S0 * sr));
+    s[i] = sv[0], c[i] = cv[0], s[b] = sv[1], c[b] = cv[1];
+    if (!(x[i] <= 1.0e5 && x[i] >= -1.0e5)) s[i] = std::sin(x[i]), c[i] = std::cos(x[i]);
+    if (!(x[b] <= 1.0e5 && x[b] >= -1.0e5)) s[b] = std::sin(x[b]), c[b] = std::cos(x[b]);
+  }
+}
+
+/// The same for any other number type (the dual numbers of the Jacobians): its own sin and cos.
+template <class T>
+inline void kanegen_sincos_n(const T* x, T* s, T* c, int n) {
+  using std::cos;
+  using std::sin;
+  for (int i = 0; i < n; ++i) s[i] = sin(x[i]), c[i] = cos(x[i]);
+}
 
 // ---- q_dot = W(q) u ------------------------------------------------------------
 template <class T>
@@ -183,102 +312,100 @@ template <class T>
 void mass_matrix(const T* q, T* M) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q;
-  // ---- body panel_a: outward pass (positions)
-  const T t23 = cos(q[7]);
-  const T t24 = sin(q[7]);
-  // ---- body panel_b: outward pass (positions)
-  const T t37 = cos(q[8]);
-  const T t38 = sin(q[8]);
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body panel_b: composite inertia (inward)
-  const T t51 = t38*t38;
-  const T t52 = t37*t38;
-  const T t54 = k32ed8d95*t51;
-  const T t55 = panel_b_J0_xx - t54;
-  const T t56 = panel_b_J0_yy + t54;
-  const T t57 = k32ed8d95*t52;
-  const T t58 = k257d0e65 + t55;
-  const T t59 = k257d0e65 + t56;
-  const T t60 = hub_J0_yy + t59;
-  const T t61 = hub_J0_yz + t57;
-  const T t62 = hub_J0_zz + t58;
+  const T t47 = angle_s[1]*angle_s[1];
+  const T t48 = angle_c[1]*angle_s[1];
+  const T t50 = k32ed8d95*t47;
+  const T t51 = panel_b_J0_xx - t50;
+  const T t52 = panel_b_J0_yy + t50;
+  const T t53 = k32ed8d95*t48;
+  const T t54 = k257d0e65 + t51;
+  const T t55 = k257d0e65 + t52;
+  const T t56 = hub_J0_yy + t55;
+  const T t57 = hub_J0_yz + t53;
+  const T t58 = hub_J0_zz + t54;
   // ---- body panel_a: composite inertia (inward)
-  const T t63 = panel_a_S0_x*t23;
-  const T t64 = panel_a_S0_x*t24;
-  const T t65 = t24*t24;
-  const T t66 = t23*t24;
-  const T t68 = -ke6ae794a*t65;
-  const T t69 = panel_a_J0_xx - t68;
-  const T t70 = panel_a_J0_yy + t68;
-  const T t71 = -ke6ae794a*t66;
-  const T t72 = -panel_a_p_J_x*t64 + t71;
-  const T t73 = 2.0*panel_a_p_J_x*t63 + k4fb1083a + t70;
-  const T t74 = 2.0*panel_a_p_J_x*t63 + k58539d89;
-  const T t75 = kd17a335d + t63;
-  const T t76 = kc7bdeba1 + t69;
-  const T t77 = hub_J0_xz - t72;
-  const T t78 = t60 + t74;
-  const T t79 = t62 + t73;
-  const T t80 = -hub_S0_z + t64;
-  const T t81 = hub_S0_z - t64;
-  const T t82 = k55ca917c - t75;
-  const T t83 = -k55ca917c + t75;
+  const T t59 = angle_c[0]*panel_a_S0_x;
+  const T t60 = angle_s[0]*panel_a_S0_x;
+  const T t61 = angle_s[0]*angle_s[0];
+  const T t62 = angle_c[0]*angle_s[0];
+  const T t64 = -ke6ae794a*t61;
+  const T t65 = panel_a_J0_xx - t64;
+  const T t66 = panel_a_J0_yy + t64;
+  const T t67 = -ke6ae794a*t62;
+  const T t68 = -panel_a_p_J_x*t60 + t67;
+  const T t69 = 2.0*panel_a_p_J_x*t59 + k4fb1083a + t66;
+  const T t70 = 2.0*panel_a_p_J_x*t59 + k58539d89;
+  const T t71 = kd17a335d + t59;
+  const T t72 = kc7bdeba1 + t65;
+  const T t73 = hub_J0_xz - t68;
+  const T t74 = t56 + t70;
+  const T t75 = t58 + t69;
+  const T t76 = -hub_S0_z + t60;
+  const T t77 = hub_S0_z - t60;
+  const T t78 = k55ca917c - t71;
+  const T t79 = -k55ca917c + t71;
   // ---- body panel_a: its columns of M (walked to the root)
-  const T t84 = -panel_a_S0_x*t24;
-  const T t85 = panel_a_p_J_x*t63;
-  const T t86 = panel_a_J0_zz + t85;
+  const T t80 = -angle_s[0]*panel_a_S0_x;
+  const T t81 = panel_a_p_J_x*t59;
+  const T t82 = panel_a_J0_zz + t81;
   M[0] = ka56682f0;
   M[1] = 0.0;
   M[2] = 0.0;
   M[3] = 0.0;
-  M[4] = t81;
+  M[4] = t77;
   M[5] = 1.0;
-  M[6] = t84;
+  M[6] = t80;
   M[7] = 0.0;
   M[8] = 0.0;
   M[9] = ka56682f0;
   M[10] = 0.0;
-  M[11] = t80;
+  M[11] = t76;
   M[12] = 0.0;
-  M[13] = t83;
+  M[13] = t79;
   M[14] = 0.0;
   M[15] = 0.0;
   M[16] = 0.0;
   M[17] = 0.0;
   M[18] = ka56682f0;
   M[19] = -1.0;
-  M[20] = t82;
+  M[20] = t78;
   M[21] = 0.0;
-  M[22] = -t63;
+  M[22] = -t59;
   M[23] = 0.0;
   M[24] = 0.0;
-  M[25] = t80;
+  M[25] = t76;
   M[26] = -1.0;
-  M[27] = t76;
+  M[27] = t72;
   M[28] = hub_J0_xy;
-  M[29] = t77;
+  M[29] = t73;
   M[30] = 0.0;
   M[31] = -panel_b_J0_zz;
-  M[32] = t81;
+  M[32] = t77;
   M[33] = 0.0;
-  M[34] = t82;
+  M[34] = t78;
   M[35] = hub_J0_xy;
-  M[36] = t78;
-  M[37] = t61;
-  M[38] = t86;
+  M[36] = t74;
+  M[37] = t57;
+  M[38] = t82;
   M[39] = 0.0;
   M[40] = 1.0;
-  M[41] = t83;
+  M[41] = t79;
   M[42] = 0.0;
-  M[43] = t77;
-  M[44] = t61;
-  M[45] = t79;
+  M[43] = t73;
+  M[44] = t57;
+  M[45] = t75;
   M[46] = 0.0;
   M[47] = 0.0;
-  M[48] = t84;
+  M[48] = t80;
   M[49] = 0.0;
-  M[50] = -t63;
+  M[50] = -t59;
   M[51] = 0.0;
-  M[52] = t86;
+  M[52] = t82;
   M[53] = 0.0;
   M[54] = panel_a_J0_zz;
   M[55] = 0.0;
@@ -297,152 +424,152 @@ template <class T>
 void forcing(const T* q, const T* u, const T* tau, T* F) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body hub: outward pass (velocities)
   const T t23 = -u[1]*u[5] + u[2]*u[4];
   const T t24 = u[0]*u[5] - u[2]*u[3];
   const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body panel_a: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = panel_a_p_J_x*u[4];
-  const T t41 = panel_a_p_J_x*u[5];
-  const T t44 = -t40*u[4] - t41*u[5];
-  const T t45 = -t41*u[3];
-  const T t46 = t40*u[3];
-  const T t47 = t23 + t44;
-  const T t48 = -t25 + t45;
-  const T t49 = t24 + t46;
-  const T t50 = t26*u[3] - t27*u[5];
-  const T t51 = -t26*u[5] - t27*u[3];
+  const T t38 = panel_a_p_J_x*u[4];
+  const T t39 = panel_a_p_J_x*u[5];
+  const T t42 = -t38*u[4] - t39*u[5];
+  const T t43 = -t39*u[3];
+  const T t44 = t38*u[3];
+  const T t45 = t23 + t42;
+  const T t46 = -t25 + t43;
+  const T t47 = t24 + t44;
+  const T t48 = angle_c[0]*u[3] - angle_s[0]*u[5];
+  const T t49 = -angle_c[0]*u[5] - angle_s[0]*u[3];
   const T w_B_panel_a_z = u[4] + u[6];
-  const T t55 = t51*u[6];
-  const T t56 = -t50*u[6];
-  const T t58 = t26*t47 + t27*t48;
-  const T t59 = t26*t48 - t27*t47;
+  const T t53 = t49*u[6];
+  const T t54 = -t48*u[6];
+  const T t56 = angle_c[0]*t45 + angle_s[0]*t46;
+  const T t57 = angle_c[0]*t46 - angle_s[0]*t45;
   // ---- body panel_b: outward pass (velocities)
-  const T t60 = cos(q[8]);
-  const T t61 = sin(q[8]);
-  const T t74 = panel_b_p_J_z*u[4];
-  const T t75 = -panel_b_p_J_z*u[5];
-  const T t78 = t75*u[3];
-  const T t79 = -t74*u[3];
-  const T t80 = -t74*u[4] + t75*u[5];
-  const T t81 = t25 + t78;
-  const T t82 = t24 + t79;
-  const T t83 = -t23 + t80;
-  const T t84 = t60*u[5] + t61*u[4];
-  const T t85 = t60*u[4] - t61*u[5];
+  const T t70 = panel_b_p_J_z*u[4];
+  const T t71 = -panel_b_p_J_z*u[5];
+  const T t74 = t71*u[3];
+  const T t75 = -t70*u[3];
+  const T t76 = -t70*u[4] + t71*u[5];
+  const T t77 = t25 + t74;
+  const T t78 = t24 + t75;
+  const T t79 = -t23 + t76;
+  const T t80 = angle_c[1]*u[5] + angle_s[1]*u[4];
+  const T t81 = angle_c[1]*u[4] - angle_s[1]*u[5];
   const T w_B_panel_b_z = -u[3] + u[7];
-  const T t89 = t85*u[7];
-  const T t90 = -t84*u[7];
-  const T t92 = t60*t81 + t61*t82;
-  const T t93 = t60*t82 - t61*t81;
+  const T t85 = t81*u[7];
+  const T t86 = -t80*u[7];
+  const T t88 = angle_c[1]*t77 + angle_s[1]*t78;
+  const T t89 = angle_c[1]*t78 - angle_s[1]*t77;
   // ---- body hub: mass and velocity terms
-  const T t94 = hub_S0_z*u[4] + u[5];
-  const T t95 = hub_S0_x*u[5] - hub_S0_z*u[3];
-  const T t96 = -hub_S0_x*u[4] - u[3];
-  const T t97 = -t95*u[5] + t96*u[4];
-  const T t98 = t94*u[5] - t96*u[3];
-  const T t99 = -t94*u[4] + t95*u[3];
-  const T t100 = hub_J0_xx*u[3] + hub_J0_xy*u[4] + hub_J0_xz*u[5];
-  const T t101 = hub_J0_xy*u[3] + hub_J0_yy*u[4] + hub_J0_yz*u[5];
-  const T t102 = hub_J0_xz*u[3] + hub_J0_yz*u[4] + hub_J0_zz*u[5];
-  const T t103 = -t101*u[5] + t102*u[4];
-  const T t104 = t100*u[5] - t102*u[3];
-  const T t105 = -t100*u[4] + t101*u[3];
+  const T t90 = hub_S0_z*u[4] + u[5];
+  const T t91 = hub_S0_x*u[5] - hub_S0_z*u[3];
+  const T t92 = -hub_S0_x*u[4] - u[3];
+  const T t93 = -t91*u[5] + t92*u[4];
+  const T t94 = t90*u[5] - t92*u[3];
+  const T t95 = -t90*u[4] + t91*u[3];
+  const T t96 = hub_J0_xx*u[3] + hub_J0_xy*u[4] + hub_J0_xz*u[5];
+  const T t97 = hub_J0_xy*u[3] + hub_J0_yy*u[4] + hub_J0_yz*u[5];
+  const T t98 = hub_J0_xz*u[3] + hub_J0_yz*u[4] + hub_J0_zz*u[5];
+  const T t99 = -t97*u[5] + t98*u[4];
+  const T t100 = t96*u[5] - t98*u[3];
+  const T t101 = -t96*u[4] + t97*u[3];
   // ---- body panel_a: mass and velocity terms
-  const T t106 = panel_a_S0_x*w_B_panel_a_z;
-  const T t107 = -panel_a_S0_x*t51;
-  const T t108 = -t106*w_B_panel_a_z + t107*t51;
-  const T t109 = -t107*t50;
-  const T t110 = t106*t50;
-  const T t111 = panel_a_J0_xx*t50;
-  const T t112 = panel_a_J0_yy*t51;
-  const T t113 = panel_a_J0_zz*w_B_panel_a_z;
-  const T t114 = -t112*w_B_panel_a_z + t113*t51;
-  const T t115 = t111*w_B_panel_a_z - t113*t50;
-  const T t116 = -t111*t51 + t112*t50;
+  const T t102 = panel_a_S0_x*w_B_panel_a_z;
+  const T t103 = -panel_a_S0_x*t49;
+  const T t104 = -t102*w_B_panel_a_z + t103*t49;
+  const T t105 = -t103*t48;
+  const T t106 = t102*t48;
+  const T t107 = panel_a_J0_xx*t48;
+  const T t108 = panel_a_J0_yy*t49;
+  const T t109 = panel_a_J0_zz*w_B_panel_a_z;
+  const T t110 = -t108*w_B_panel_a_z + t109*t49;
+  const T t111 = t107*w_B_panel_a_z - t109*t48;
+  const T t112 = -t107*t49 + t108*t48;
   // ---- body panel_b: mass and velocity terms
-  const T t117 = panel_b_S0_z*t85;
-  const T t118 = -panel_b_S0_z*t84;
-  const T t119 = -t118*w_B_panel_b_z;
-  const T t120 = t117*w_B_panel_b_z;
-  const T t121 = -t117*t85 + t118*t84;
-  const T t122 = panel_b_J0_xx*t84;
-  const T t123 = panel_b_J0_yy*t85;
-  const T t124 = panel_b_J0_zz*w_B_panel_b_z;
-  const T t125 = -t123*w_B_panel_b_z + t124*t85;
-  const T t126 = t122*w_B_panel_b_z - t124*t84;
-  const T t127 = -t122*t85 + t123*t84;
+  const T t113 = panel_b_S0_z*t81;
+  const T t114 = -panel_b_S0_z*t80;
+  const T t115 = -t114*w_B_panel_b_z;
+  const T t116 = t113*w_B_panel_b_z;
+  const T t117 = -t113*t81 + t114*t80;
+  const T t118 = panel_b_J0_xx*t80;
+  const T t119 = panel_b_J0_yy*t81;
+  const T t120 = panel_b_J0_zz*w_B_panel_b_z;
+  const T t121 = -t119*w_B_panel_b_z + t120*t81;
+  const T t122 = t118*w_B_panel_b_z - t120*t80;
+  const T t123 = -t118*t81 + t119*t80;
   // ---- body hub: bias force
-  const T t128 = -hub_mass*t23 - t97;
-  const T t129 = -hub_mass*t24 - t98;
-  const T t130 = -hub_mass*t25 - t99;
-  const T t131 = hub_S0_z*t24 - t103 + t25;
-  const T t132 = hub_S0_x*t25 - hub_S0_z*t23 - t104;
-  const T t133 = -hub_S0_x*t24 - t105 - t23;
+  const T t124 = -hub_mass*t23 - t93;
+  const T t125 = -hub_mass*t24 - t94;
+  const T t126 = -hub_mass*t25 - t95;
+  const T t127 = hub_S0_z*t24 + t25 - t99;
+  const T t128 = hub_S0_x*t25 - hub_S0_z*t23 - t100;
+  const T t129 = -hub_S0_x*t24 - t101 - t23;
   // ---- body panel_a: bias force
-  const T t134 = -panel_a_mass*t58 - t108;
-  const T t135 = -panel_a_mass*t59 - t109;
-  const T t136 = panel_a_S0_x*t56 - panel_a_mass*t49 - t110;
-  const T t137 = -panel_a_J0_xx*t55 - t114;
-  const T t138 = -panel_a_J0_yy*t56 + panel_a_S0_x*t49 - t115;
-  const T t139 = -panel_a_S0_x*t59 - t116;
+  const T t130 = -panel_a_mass*t56 - t104;
+  const T t131 = -panel_a_mass*t57 - t105;
+  const T t132 = panel_a_S0_x*t54 - panel_a_mass*t47 - t106;
+  const T t133 = -panel_a_J0_xx*t53 - t110;
+  const T t134 = -panel_a_J0_yy*t54 + panel_a_S0_x*t47 - t111;
+  const T t135 = -panel_a_S0_x*t57 - t112;
   // ---- body panel_b: bias force
-  const T t140 = -panel_b_S0_z*t90 - panel_b_mass*t92 - t119;
-  const T t141 = panel_b_S0_z*t89 - panel_b_mass*t93 - t120;
-  const T t142 = -panel_b_mass*t83 - t121;
-  const T t143 = -panel_b_J0_xx*t89 + panel_b_S0_z*t93 - t125;
-  const T t144 = -panel_b_J0_yy*t90 - panel_b_S0_z*t92 - t126;
+  const T t136 = -panel_b_S0_z*t86 - panel_b_mass*t88 - t115;
+  const T t137 = panel_b_S0_z*t85 - panel_b_mass*t89 - t116;
+  const T t138 = -panel_b_mass*t79 - t117;
+  const T t139 = -panel_b_J0_xx*t85 + panel_b_S0_z*t89 - t121;
+  const T t140 = -panel_b_J0_yy*t86 - panel_b_S0_z*t88 - t122;
   // ---- body panel_b: generalized forces (inward)
-  const T t145 = -panel_b_k*q[8] + tau[7];
-  const T t146 = -t127 + t145;
-  const T t147 = t140*t60 - t141*t61;
-  const T t148 = t140*t61 + t141*t60;
-  const T t149 = -panel_b_p_J_z*t148;
-  const T t150 = panel_b_p_J_z*t147;
-  const T t151 = t143*t60 - t144*t61;
-  const T t152 = t143*t61 + t144*t60;
-  const T t153 = t149 + t151;
-  const T t154 = t150 + t152;
-  const T t155 = t128 - t142;
-  const T t156 = t129 + t148;
-  const T t157 = t130 + t147;
-  const T t158 = t127 + t131;
-  const T t159 = t132 + t154;
-  const T t160 = t133 + t153;
+  const T t141 = -panel_b_k*q[8] + tau[7];
+  const T t142 = -t123 + t141;
+  const T t143 = angle_c[1]*t136 - angle_s[1]*t137;
+  const T t144 = angle_c[1]*t137 + angle_s[1]*t136;
+  const T t145 = -panel_b_p_J_z*t144;
+  const T t146 = panel_b_p_J_z*t143;
+  const T t147 = angle_c[1]*t139 - angle_s[1]*t140;
+  const T t148 = angle_c[1]*t140 + angle_s[1]*t139;
+  const T t149 = t145 + t147;
+  const T t150 = t146 + t148;
+  const T t151 = t124 - t138;
+  const T t152 = t125 + t144;
+  const T t153 = t126 + t143;
+  const T t154 = t123 + t127;
+  const T t155 = t128 + t150;
+  const T t156 = t129 + t149;
   // ---- body panel_a: generalized forces (inward)
-  const T t161 = -panel_a_k*q[7] + tau[6];
-  const T t162 = t139 + t161;
-  const T t163 = t134*t26 - t135*t27;
-  const T t164 = t134*t27 + t135*t26;
-  const T t165 = -panel_a_p_J_x*t136;
-  const T t166 = panel_a_p_J_x*t164;
-  const T t167 = t137*t26 - t138*t27;
-  const T t168 = t137*t27 + t138*t26;
-  const T t169 = t165 + t168;
-  const T t170 = t139 + t166;
-  const T t171 = t155 + t163;
-  const T t172 = t136 + t156;
-  const T t173 = t157 - t164;
-  const T t174 = t158 + t167;
-  const T t175 = t159 + t170;
-  const T t176 = t160 - t169;
+  const T t157 = -panel_a_k*q[7] + tau[6];
+  const T t158 = t135 + t157;
+  const T t159 = angle_c[0]*t130 - angle_s[0]*t131;
+  const T t160 = angle_c[0]*t131 + angle_s[0]*t130;
+  const T t161 = -panel_a_p_J_x*t132;
+  const T t162 = panel_a_p_J_x*t160;
+  const T t163 = angle_c[0]*t133 - angle_s[0]*t134;
+  const T t164 = angle_c[0]*t134 + angle_s[0]*t133;
+  const T t165 = t161 + t164;
+  const T t166 = t135 + t162;
+  const T t167 = t151 + t159;
+  const T t168 = t132 + t152;
+  const T t169 = t153 - t160;
+  const T t170 = t154 + t163;
+  const T t171 = t155 + t166;
+  const T t172 = t156 - t165;
   // ---- body hub: generalized forces (inward)
-  const T t177 = t171 + tau[0];
-  const T t178 = t172 + tau[1];
-  const T t179 = t173 + tau[2];
-  const T t180 = t174 + tau[3];
-  const T t181 = t175 + tau[4];
-  const T t182 = t176 + tau[5];
-  F[0] = t177;
-  F[1] = t178;
-  F[2] = t179;
-  F[3] = t180;
-  F[4] = t181;
-  F[5] = t182;
-  F[6] = t162;
-  F[7] = t146;
+  const T t173 = t167 + tau[0];
+  const T t174 = t168 + tau[1];
+  const T t175 = t169 + tau[2];
+  const T t176 = t170 + tau[3];
+  const T t177 = t171 + tau[4];
+  const T t178 = t172 + tau[5];
+  F[0] = t173;
+  F[1] = t174;
+  F[2] = t175;
+  F[3] = t176;
+  F[4] = t177;
+  F[5] = t178;
+  F[6] = t158;
+  F[7] = t142;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
@@ -451,298 +578,298 @@ template <class T>
 int udot(const T* q, const T* u, const T* tau, T* udot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body hub: outward pass (velocities)
   const T t23 = -u[1]*u[5] + u[2]*u[4];
   const T t24 = u[0]*u[5] - u[2]*u[3];
   const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body panel_a: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = panel_a_p_J_x*u[4];
-  const T t41 = panel_a_p_J_x*u[5];
-  const T t44 = -t40*u[4] - t41*u[5];
-  const T t45 = -t41*u[3];
-  const T t46 = t40*u[3];
-  const T t47 = t23 + t44;
-  const T t48 = -t25 + t45;
-  const T t49 = t24 + t46;
-  const T t50 = t26*u[3] - t27*u[5];
-  const T t51 = -t26*u[5] - t27*u[3];
+  const T t38 = panel_a_p_J_x*u[4];
+  const T t39 = panel_a_p_J_x*u[5];
+  const T t42 = -t38*u[4] - t39*u[5];
+  const T t43 = -t39*u[3];
+  const T t44 = t38*u[3];
+  const T t45 = t23 + t42;
+  const T t46 = -t25 + t43;
+  const T t47 = t24 + t44;
+  const T t48 = angle_c[0]*u[3] - angle_s[0]*u[5];
+  const T t49 = -angle_c[0]*u[5] - angle_s[0]*u[3];
   const T w_B_panel_a_z = u[4] + u[6];
-  const T t55 = t51*u[6];
-  const T t56 = -t50*u[6];
-  const T t58 = t26*t47 + t27*t48;
-  const T t59 = t26*t48 - t27*t47;
+  const T t53 = t49*u[6];
+  const T t54 = -t48*u[6];
+  const T t56 = angle_c[0]*t45 + angle_s[0]*t46;
+  const T t57 = angle_c[0]*t46 - angle_s[0]*t45;
   // ---- body panel_b: outward pass (velocities)
-  const T t60 = cos(q[8]);
-  const T t61 = sin(q[8]);
-  const T t74 = panel_b_p_J_z*u[4];
-  const T t75 = -panel_b_p_J_z*u[5];
-  const T t78 = t75*u[3];
-  const T t79 = -t74*u[3];
-  const T t80 = -t74*u[4] + t75*u[5];
-  const T t81 = t25 + t78;
-  const T t82 = t24 + t79;
-  const T t83 = -t23 + t80;
-  const T t84 = t60*u[5] + t61*u[4];
-  const T t85 = t60*u[4] - t61*u[5];
+  const T t70 = panel_b_p_J_z*u[4];
+  const T t71 = -panel_b_p_J_z*u[5];
+  const T t74 = t71*u[3];
+  const T t75 = -t70*u[3];
+  const T t76 = -t70*u[4] + t71*u[5];
+  const T t77 = t25 + t74;
+  const T t78 = t24 + t75;
+  const T t79 = -t23 + t76;
+  const T t80 = angle_c[1]*u[5] + angle_s[1]*u[4];
+  const T t81 = angle_c[1]*u[4] - angle_s[1]*u[5];
   const T w_B_panel_b_z = -u[3] + u[7];
-  const T t89 = t85*u[7];
-  const T t90 = -t84*u[7];
-  const T t92 = t60*t81 + t61*t82;
-  const T t93 = t60*t82 - t61*t81;
+  const T t85 = t81*u[7];
+  const T t86 = -t80*u[7];
+  const T t88 = angle_c[1]*t77 + angle_s[1]*t78;
+  const T t89 = angle_c[1]*t78 - angle_s[1]*t77;
   // ---- body hub: mass and velocity terms
-  const T t94 = hub_S0_z*u[4] + u[5];
-  const T t95 = hub_S0_x*u[5] - hub_S0_z*u[3];
-  const T t96 = -hub_S0_x*u[4] - u[3];
-  const T t97 = -t95*u[5] + t96*u[4];
-  const T t98 = t94*u[5] - t96*u[3];
-  const T t99 = -t94*u[4] + t95*u[3];
-  const T t100 = hub_J0_xx*u[3] + hub_J0_xy*u[4] + hub_J0_xz*u[5];
-  const T t101 = hub_J0_xy*u[3] + hub_J0_yy*u[4] + hub_J0_yz*u[5];
-  const T t102 = hub_J0_xz*u[3] + hub_J0_yz*u[4] + hub_J0_zz*u[5];
-  const T t103 = -t101*u[5] + t102*u[4];
-  const T t104 = t100*u[5] - t102*u[3];
-  const T t105 = -t100*u[4] + t101*u[3];
+  const T t90 = hub_S0_z*u[4] + u[5];
+  const T t91 = hub_S0_x*u[5] - hub_S0_z*u[3];
+  const T t92 = -hub_S0_x*u[4] - u[3];
+  const T t93 = -t91*u[5] + t92*u[4];
+  const T t94 = t90*u[5] - t92*u[3];
+  const T t95 = -t90*u[4] + t91*u[3];
+  const T t96 = hub_J0_xx*u[3] + hub_J0_xy*u[4] + hub_J0_xz*u[5];
+  const T t97 = hub_J0_xy*u[3] + hub_J0_yy*u[4] + hub_J0_yz*u[5];
+  const T t98 = hub_J0_xz*u[3] + hub_J0_yz*u[4] + hub_J0_zz*u[5];
+  const T t99 = -t97*u[5] + t98*u[4];
+  const T t100 = t96*u[5] - t98*u[3];
+  const T t101 = -t96*u[4] + t97*u[3];
   // ---- body panel_a: mass and velocity terms
-  const T t106 = panel_a_S0_x*w_B_panel_a_z;
-  const T t107 = -panel_a_S0_x*t51;
-  const T t108 = -t106*w_B_panel_a_z + t107*t51;
-  const T t109 = -t107*t50;
-  const T t110 = t106*t50;
-  const T t111 = panel_a_J0_xx*t50;
-  const T t112 = panel_a_J0_yy*t51;
-  const T t113 = panel_a_J0_zz*w_B_panel_a_z;
-  const T t114 = -t112*w_B_panel_a_z + t113*t51;
-  const T t115 = t111*w_B_panel_a_z - t113*t50;
-  const T t116 = -t111*t51 + t112*t50;
+  const T t102 = panel_a_S0_x*w_B_panel_a_z;
+  const T t103 = -panel_a_S0_x*t49;
+  const T t104 = -t102*w_B_panel_a_z + t103*t49;
+  const T t105 = -t103*t48;
+  const T t106 = t102*t48;
+  const T t107 = panel_a_J0_xx*t48;
+  const T t108 = panel_a_J0_yy*t49;
+  const T t109 = panel_a_J0_zz*w_B_panel_a_z;
+  const T t110 = -t108*w_B_panel_a_z + t109*t49;
+  const T t111 = t107*w_B_panel_a_z - t109*t48;
+  const T t112 = -t107*t49 + t108*t48;
   // ---- body panel_b: mass and velocity terms
-  const T t117 = panel_b_S0_z*t85;
-  const T t118 = -panel_b_S0_z*t84;
-  const T t119 = -t118*w_B_panel_b_z;
-  const T t120 = t117*w_B_panel_b_z;
-  const T t121 = -t117*t85 + t118*t84;
-  const T t122 = panel_b_J0_xx*t84;
-  const T t123 = panel_b_J0_yy*t85;
-  const T t124 = panel_b_J0_zz*w_B_panel_b_z;
-  const T t125 = -t123*w_B_panel_b_z + t124*t85;
-  const T t126 = t122*w_B_panel_b_z - t124*t84;
-  const T t127 = -t122*t85 + t123*t84;
+  const T t113 = panel_b_S0_z*t81;
+  const T t114 = -panel_b_S0_z*t80;
+  const T t115 = -t114*w_B_panel_b_z;
+  const T t116 = t113*w_B_panel_b_z;
+  const T t117 = -t113*t81 + t114*t80;
+  const T t118 = panel_b_J0_xx*t80;
+  const T t119 = panel_b_J0_yy*t81;
+  const T t120 = panel_b_J0_zz*w_B_panel_b_z;
+  const T t121 = -t119*w_B_panel_b_z + t120*t81;
+  const T t122 = t118*w_B_panel_b_z - t120*t80;
+  const T t123 = -t118*t81 + t119*t80;
   // ---- body panel_b: composite inertia (inward)
-  const T t128 = t61*t61;
-  const T t129 = t60*t61;
-  const T t131 = k32ed8d95*t128;
-  const T t132 = panel_b_J0_xx - t131;
-  const T t133 = panel_b_J0_yy + t131;
-  const T t134 = k32ed8d95*t129;
-  const T t135 = k257d0e65 + t132;
-  const T t136 = k257d0e65 + t133;
-  const T t137 = hub_J0_yy + t136;
-  const T t138 = hub_J0_yz + t134;
-  const T t139 = hub_J0_zz + t135;
+  const T t124 = angle_s[1]*angle_s[1];
+  const T t125 = angle_c[1]*angle_s[1];
+  const T t127 = k32ed8d95*t124;
+  const T t128 = panel_b_J0_xx - t127;
+  const T t129 = panel_b_J0_yy + t127;
+  const T t130 = k32ed8d95*t125;
+  const T t131 = k257d0e65 + t128;
+  const T t132 = k257d0e65 + t129;
+  const T t133 = hub_J0_yy + t132;
+  const T t134 = hub_J0_yz + t130;
+  const T t135 = hub_J0_zz + t131;
   // ---- body panel_a: composite inertia (inward)
-  const T t140 = panel_a_S0_x*t26;
-  const T t141 = panel_a_S0_x*t27;
-  const T t142 = t27*t27;
-  const T t143 = t26*t27;
-  const T t145 = -ke6ae794a*t142;
-  const T t146 = panel_a_J0_xx - t145;
-  const T t147 = panel_a_J0_yy + t145;
-  const T t148 = -ke6ae794a*t143;
-  const T t149 = -panel_a_p_J_x*t141 + t148;
-  const T t150 = 2.0*panel_a_p_J_x*t140 + k4fb1083a + t147;
-  const T t151 = 2.0*panel_a_p_J_x*t140 + k58539d89;
-  const T t152 = kd17a335d + t140;
-  const T t153 = kc7bdeba1 + t146;
-  const T t154 = hub_J0_xz - t149;
-  const T t155 = t137 + t151;
-  const T t156 = t139 + t150;
-  const T t157 = -hub_S0_z + t141;
-  const T t158 = hub_S0_z - t141;
-  const T t159 = k55ca917c - t152;
-  const T t160 = -k55ca917c + t152;
+  const T t136 = angle_c[0]*panel_a_S0_x;
+  const T t137 = angle_s[0]*panel_a_S0_x;
+  const T t138 = angle_s[0]*angle_s[0];
+  const T t139 = angle_c[0]*angle_s[0];
+  const T t141 = -ke6ae794a*t138;
+  const T t142 = panel_a_J0_xx - t141;
+  const T t143 = panel_a_J0_yy + t141;
+  const T t144 = -ke6ae794a*t139;
+  const T t145 = -panel_a_p_J_x*t137 + t144;
+  const T t146 = 2.0*panel_a_p_J_x*t136 + k4fb1083a + t143;
+  const T t147 = 2.0*panel_a_p_J_x*t136 + k58539d89;
+  const T t148 = kd17a335d + t136;
+  const T t149 = kc7bdeba1 + t142;
+  const T t150 = hub_J0_xz - t145;
+  const T t151 = t133 + t147;
+  const T t152 = t135 + t146;
+  const T t153 = -hub_S0_z + t137;
+  const T t154 = hub_S0_z - t137;
+  const T t155 = k55ca917c - t148;
+  const T t156 = -k55ca917c + t148;
   // ---- body panel_a: its columns of M (walked to the root)
-  const T t161 = -panel_a_S0_x*t27;
-  const T t162 = panel_a_p_J_x*t140;
-  const T t163 = panel_a_J0_zz + t162;
+  const T t157 = -angle_s[0]*panel_a_S0_x;
+  const T t158 = panel_a_p_J_x*t136;
+  const T t159 = panel_a_J0_zz + t158;
   // ---- body hub: bias force
-  const T t164 = -hub_mass*t23 - t97;
-  const T t165 = -hub_mass*t24 - t98;
-  const T t166 = -hub_mass*t25 - t99;
-  const T t167 = hub_S0_z*t24 - t103 + t25;
-  const T t168 = hub_S0_x*t25 - hub_S0_z*t23 - t104;
-  const T t169 = -hub_S0_x*t24 - t105 - t23;
+  const T t160 = -hub_mass*t23 - t93;
+  const T t161 = -hub_mass*t24 - t94;
+  const T t162 = -hub_mass*t25 - t95;
+  const T t163 = hub_S0_z*t24 + t25 - t99;
+  const T t164 = hub_S0_x*t25 - hub_S0_z*t23 - t100;
+  const T t165 = -hub_S0_x*t24 - t101 - t23;
   // ---- body panel_a: bias force
-  const T t170 = -panel_a_mass*t58 - t108;
-  const T t171 = -panel_a_mass*t59 - t109;
-  const T t172 = panel_a_S0_x*t56 - panel_a_mass*t49 - t110;
-  const T t173 = -panel_a_J0_xx*t55 - t114;
-  const T t174 = -panel_a_J0_yy*t56 + panel_a_S0_x*t49 - t115;
-  const T t175 = -panel_a_S0_x*t59 - t116;
+  const T t166 = -panel_a_mass*t56 - t104;
+  const T t167 = -panel_a_mass*t57 - t105;
+  const T t168 = panel_a_S0_x*t54 - panel_a_mass*t47 - t106;
+  const T t169 = -panel_a_J0_xx*t53 - t110;
+  const T t170 = -panel_a_J0_yy*t54 + panel_a_S0_x*t47 - t111;
+  const T t171 = -panel_a_S0_x*t57 - t112;
   // ---- body panel_b: bias force
-  const T t176 = -panel_b_S0_z*t90 - panel_b_mass*t92 - t119;
-  const T t177 = panel_b_S0_z*t89 - panel_b_mass*t93 - t120;
-  const T t178 = -panel_b_mass*t83 - t121;
-  const T t179 = -panel_b_J0_xx*t89 + panel_b_S0_z*t93 - t125;
-  const T t180 = -panel_b_J0_yy*t90 - panel_b_S0_z*t92 - t126;
+  const T t172 = -panel_b_S0_z*t86 - panel_b_mass*t88 - t115;
+  const T t173 = panel_b_S0_z*t85 - panel_b_mass*t89 - t116;
+  const T t174 = -panel_b_mass*t79 - t117;
+  const T t175 = -panel_b_J0_xx*t85 + panel_b_S0_z*t89 - t121;
+  const T t176 = -panel_b_J0_yy*t86 - panel_b_S0_z*t88 - t122;
   // ---- body panel_b: generalized forces (inward)
-  const T t181 = -panel_b_k*q[8] + tau[7];
-  const T t182 = -t127 + t181;
-  const T t183 = t176*t60 - t177*t61;
-  const T t184 = t176*t61 + t177*t60;
-  const T t185 = -panel_b_p_J_z*t184;
-  const T t186 = panel_b_p_J_z*t183;
-  const T t187 = t179*t60 - t180*t61;
-  const T t188 = t179*t61 + t180*t60;
-  const T t189 = t185 + t187;
-  const T t190 = t186 + t188;
-  const T t191 = t164 - t178;
-  const T t192 = t165 + t184;
-  const T t193 = t166 + t183;
-  const T t194 = t127 + t167;
-  const T t195 = t168 + t190;
-  const T t196 = t169 + t189;
+  const T t177 = -panel_b_k*q[8] + tau[7];
+  const T t178 = -t123 + t177;
+  const T t179 = angle_c[1]*t172 - angle_s[1]*t173;
+  const T t180 = angle_c[1]*t173 + angle_s[1]*t172;
+  const T t181 = -panel_b_p_J_z*t180;
+  const T t182 = panel_b_p_J_z*t179;
+  const T t183 = angle_c[1]*t175 - angle_s[1]*t176;
+  const T t184 = angle_c[1]*t176 + angle_s[1]*t175;
+  const T t185 = t181 + t183;
+  const T t186 = t182 + t184;
+  const T t187 = t160 - t174;
+  const T t188 = t161 + t180;
+  const T t189 = t162 + t179;
+  const T t190 = t123 + t163;
+  const T t191 = t164 + t186;
+  const T t192 = t165 + t185;
   // ---- body panel_a: generalized forces (inward)
-  const T t197 = -panel_a_k*q[7] + tau[6];
-  const T t198 = t175 + t197;
-  const T t199 = t170*t26 - t171*t27;
-  const T t200 = t170*t27 + t171*t26;
-  const T t201 = -panel_a_p_J_x*t172;
-  const T t202 = panel_a_p_J_x*t200;
-  const T t203 = t173*t26 - t174*t27;
-  const T t204 = t173*t27 + t174*t26;
-  const T t205 = t201 + t204;
-  const T t206 = t175 + t202;
-  const T t207 = t191 + t199;
-  const T t208 = t172 + t192;
-  const T t209 = t193 - t200;
-  const T t210 = t194 + t203;
-  const T t211 = t195 + t206;
-  const T t212 = t196 - t205;
+  const T t193 = -panel_a_k*q[7] + tau[6];
+  const T t194 = t171 + t193;
+  const T t195 = angle_c[0]*t166 - angle_s[0]*t167;
+  const T t196 = angle_c[0]*t167 + angle_s[0]*t166;
+  const T t197 = -panel_a_p_J_x*t168;
+  const T t198 = panel_a_p_J_x*t196;
+  const T t199 = angle_c[0]*t169 - angle_s[0]*t170;
+  const T t200 = angle_c[0]*t170 + angle_s[0]*t169;
+  const T t201 = t197 + t200;
+  const T t202 = t171 + t198;
+  const T t203 = t187 + t195;
+  const T t204 = t168 + t188;
+  const T t205 = t189 - t196;
+  const T t206 = t190 + t199;
+  const T t207 = t191 + t202;
+  const T t208 = t192 - t201;
   // ---- body hub: generalized forces (inward)
-  const T t213 = t207 + tau[0];
-  const T t214 = t208 + tau[1];
-  const T t215 = t209 + tau[2];
-  const T t216 = t210 + tau[3];
-  const T t217 = t211 + tau[4];
-  const T t218 = t212 + tau[5];
+  const T t209 = t203 + tau[0];
+  const T t210 = t204 + tau[1];
+  const T t211 = t205 + tau[2];
+  const T t212 = t206 + tau[3];
+  const T t213 = t207 + tau[4];
+  const T t214 = t208 + tau[5];
   // ---- M u_dot = F: L^T D L along the dof tree
-  const T t219 = -panel_b_J0_zz + t153;
-  const T t220 = kce8776b3*t163;
-  const T t221 = t155 - t163*t220;
-  const T t222 = t140*t220 + t159;
-  const T t223 = t158 - t161*t220;
-  const T t224 = -kce8776b3*t140;
-  const T t225 = ka56682f0 + t140*t224;
-  const T t226 = -t161*t224;
-  const T t227 = kce8776b3*t161;
-  const T t228 = ka56682f0 - t161*t227;
-  const T t229 = 1.0/t156;
-  const T t230 = t138*t229;
-  const T t231 = -t138*t230 + t221;
-  const T t232 = hub_J0_xy - t154*t230;
-  const T t233 = -t160*t230;
-  const T t234 = t223 - t230;
-  const T t235 = t154*t229;
-  const T t236 = -t154*t235 + t219;
-  const T t237 = t157 - t160*t235;
-  const T t238 = t160*t229;
-  const T t239 = ka56682f0 - t160*t238;
-  const T t240 = t228 - t229;
-  const T t241 = 1.0/t231;
-  const T t242 = t232*t241;
-  const T t243 = -t232*t242 + t236;
-  const T t244 = -1.0 - t222*t242;
-  const T t245 = -t233*t242 + t237;
-  const T t246 = -t234*t242 - t235;
-  const T t247 = t222*t241;
-  const T t248 = -t222*t247 + t225;
-  const T t249 = -t233*t247;
-  const T t250 = t226 - t234*t247;
-  const T t251 = t233*t241;
-  const T t252 = -t233*t251 + t239;
-  const T t253 = -t234*t251 - t238;
-  const T t254 = t234*t241;
-  const T t255 = -t234*t254 + t240;
-  const T t256 = 1.0/t243;
-  const T t257 = t244*t256;
-  const T t258 = -t244*t257 + t248;
-  const T t259 = -t245*t257 + t249;
-  const T t260 = -t246*t257 + t250;
-  const T t261 = t245*t256;
-  const T t262 = -t245*t261 + t252;
-  const T t263 = -t246*t261 + t253;
-  const T t264 = t246*t256;
-  const T t265 = -t246*t264 + t255;
-  const T t266 = 1.0/t258;
-  const T t267 = t259*t266;
-  const T t268 = -t259*t267 + t262;
-  const T t269 = -t260*t267 + t263;
-  const T t270 = t260*t266;
-  const T t271 = -t260*t270 + t265;
-  const T t272 = 1.0/t268;
-  const T t273 = t269*t272;
-  const T t274 = -t269*t273 + t271;
-  const T t276 = t182 + t216;
-  const T t277 = -t198*t220 + t217;
-  const T t278 = -t198*t224 + t215;
-  const T t279 = -t198*t227 + t213;
-  const T t280 = -t218*t230 + t277;
-  const T t281 = -t218*t235 + t276;
-  const T t282 = t214 - t218*t238;
-  const T t283 = -t218*t229 + t279;
-  const T t284 = -t242*t280 + t281;
-  const T t285 = -t247*t280 + t278;
-  const T t286 = -t251*t280 + t282;
-  const T t287 = -t254*t280 + t283;
-  const T t288 = -t257*t284 + t285;
-  const T t289 = -t261*t284 + t286;
-  const T t290 = -t264*t284 + t287;
-  const T t291 = -t267*t288 + t289;
-  const T t292 = -t270*t288 + t290;
-  const T t293 = -t273*t291 + t292;
-  const T t294 = t293/t274;
-  const T t295 = t291/t268;
-  const T t296 = t288/t258;
-  const T t297 = t284/t243;
-  const T t298 = t280/t231;
-  const T t299 = t218/t156;
-  const T t300 = kce8776b3*t198;
-  const T t301 = k49580a9d*t182;
-  const T t302 = -t273*t294 + t295;
-  const T t303 = -t267*t302 + t296;
-  const T t304 = -t270*t294 + t303;
-  const T t305 = -t257*t304 + t297;
-  const T t306 = -t261*t302 + t305;
-  const T t307 = -t264*t294 + t306;
-  const T t308 = -t242*t307 + t298;
-  const T t309 = -t247*t304 + t308;
-  const T t310 = -t251*t302 + t309;
-  const T t311 = -t254*t294 + t310;
-  const T t312 = -t230*t311 + t299;
-  const T t313 = -t235*t307 + t312;
-  const T t314 = -t238*t302 + t313;
-  const T t315 = -t229*t294 + t314;
-  const T t316 = -t220*t311 + t300;
-  const T t317 = -t224*t304 + t316;
-  const T t318 = -t227*t294 + t317;
-  const T t319 = t301 + t307;
-  if (!(t274 > 1e-14*ka56682f0)) return 1;
-  if (!(t268 > 1e-14*ka56682f0)) return 2;
-  if (!(t258 > 1e-14*ka56682f0)) return 3;
-  if (!(t243 > 1e-14*t153)) return 4;
-  if (!(t231 > 1e-14*t155)) return 5;
-  if (!(t156 > 0.0)) return 6;
+  const T t215 = -panel_b_J0_zz + t149;
+  const T t216 = kce8776b3*t159;
+  const T t217 = t151 - t159*t216;
+  const T t218 = t136*t216 + t155;
+  const T t219 = t154 - t157*t216;
+  const T t220 = -kce8776b3*t136;
+  const T t221 = ka56682f0 + t136*t220;
+  const T t222 = -t157*t220;
+  const T t223 = kce8776b3*t157;
+  const T t224 = ka56682f0 - t157*t223;
+  const T t225 = 1.0/t152;
+  const T t226 = t134*t225;
+  const T t227 = -t134*t226 + t217;
+  const T t228 = hub_J0_xy - t150*t226;
+  const T t229 = -t156*t226;
+  const T t230 = t219 - t226;
+  const T t231 = t150*t225;
+  const T t232 = -t150*t231 + t215;
+  const T t233 = t153 - t156*t231;
+  const T t234 = t156*t225;
+  const T t235 = ka56682f0 - t156*t234;
+  const T t236 = t224 - t225;
+  const T t237 = 1.0/t227;
+  const T t238 = t228*t237;
+  const T t239 = -t228*t238 + t232;
+  const T t240 = -1.0 - t218*t238;
+  const T t241 = -t229*t238 + t233;
+  const T t242 = -t230*t238 - t231;
+  const T t243 = t218*t237;
+  const T t244 = -t218*t243 + t221;
+  const T t245 = -t229*t243;
+  const T t246 = t222 - t230*t243;
+  const T t247 = t229*t237;
+  const T t248 = -t229*t247 + t235;
+  const T t249 = -t230*t247 - t234;
+  const T t250 = t230*t237;
+  const T t251 = -t230*t250 + t236;
+  const T t252 = 1.0/t239;
+  const T t253 = t240*t252;
+  const T t254 = -t240*t253 + t244;
+  const T t255 = -t241*t253 + t245;
+  const T t256 = -t242*t253 + t246;
+  const T t257 = t241*t252;
+  const T t258 = -t241*t257 + t248;
+  const T t259 = -t242*t257 + t249;
+  const T t260 = t242*t252;
+  const T t261 = -t242*t260 + t251;
+  const T t262 = 1.0/t254;
+  const T t263 = t255*t262;
+  const T t264 = -t255*t263 + t258;
+  const T t265 = -t256*t263 + t259;
+  const T t266 = t256*t262;
+  const T t267 = -t256*t266 + t261;
+  const T t268 = 1.0/t264;
+  const T t269 = t265*t268;
+  const T t270 = -t265*t269 + t267;
+  const T t272 = t178 + t212;
+  const T t273 = -t194*t216 + t213;
+  const T t274 = -t194*t220 + t211;
+  const T t275 = -t194*t223 + t209;
+  const T t276 = -t214*t226 + t273;
+  const T t277 = -t214*t231 + t272;
+  const T t278 = t210 - t214*t234;
+  const T t279 = -t214*t225 + t275;
+  const T t280 = -t238*t276 + t277;
+  const T t281 = -t243*t276 + t274;
+  const T t282 = -t247*t276 + t278;
+  const T t283 = -t250*t276 + t279;
+  const T t284 = -t253*t280 + t281;
+  const T t285 = -t257*t280 + t282;
+  const T t286 = -t260*t280 + t283;
+  const T t287 = -t263*t284 + t285;
+  const T t288 = -t266*t284 + t286;
+  const T t289 = -t269*t287 + t288;
+  const T t290 = t289/t270;
+  const T t291 = t287/t264;
+  const T t292 = t284/t254;
+  const T t293 = t280/t239;
+  const T t294 = t276/t227;
+  const T t295 = t214/t152;
+  const T t296 = kce8776b3*t194;
+  const T t297 = k49580a9d*t178;
+  const T t298 = -t269*t290 + t291;
+  const T t299 = -t263*t298 + t292;
+  const T t300 = -t266*t290 + t299;
+  const T t301 = -t253*t300 + t293;
+  const T t302 = -t257*t298 + t301;
+  const T t303 = -t260*t290 + t302;
+  const T t304 = -t238*t303 + t294;
+  const T t305 = -t243*t300 + t304;
+  const T t306 = -t247*t298 + t305;
+  const T t307 = -t250*t290 + t306;
+  const T t308 = -t226*t307 + t295;
+  const T t309 = -t231*t303 + t308;
+  const T t310 = -t234*t298 + t309;
+  const T t311 = -t225*t290 + t310;
+  const T t312 = -t216*t307 + t296;
+  const T t313 = -t220*t300 + t312;
+  const T t314 = -t223*t290 + t313;
+  const T t315 = t297 + t303;
+  if (!(t270 > 1e-14*ka56682f0)) return 1;
+  if (!(t264 > 1e-14*ka56682f0)) return 2;
+  if (!(t254 > 1e-14*ka56682f0)) return 3;
+  if (!(t239 > 1e-14*t149)) return 4;
+  if (!(t227 > 1e-14*t151)) return 5;
+  if (!(t152 > 0.0)) return 6;
   if (!(panel_a_J0_zz > 0.0)) return 7;
   if (!(panel_b_J0_zz > 0.0)) return 8;
-  udot[0] = t294;
-  udot[1] = t302;
-  udot[2] = t304;
-  udot[3] = t307;
-  udot[4] = t311;
-  udot[5] = t315;
-  udot[6] = t318;
-  udot[7] = t319;
+  udot[0] = t290;
+  udot[1] = t298;
+  udot[2] = t300;
+  udot[3] = t303;
+  udot[4] = t307;
+  udot[5] = t311;
+  udot[6] = t314;
+  udot[7] = t315;
   return 0;
 }
 
@@ -751,58 +878,58 @@ template <class T>
 void energy(const T* q, const T* u, T* TV) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body panel_a: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = panel_a_p_J_x*u[4];
-  const T t41 = panel_a_p_J_x*u[5];
-  const T t42 = t40 - u[2];
-  const T t43 = t41 + u[1];
-  const T t50 = t26*u[3] - t27*u[5];
-  const T t51 = -t26*u[5] - t27*u[3];
+  const T t38 = panel_a_p_J_x*u[4];
+  const T t39 = panel_a_p_J_x*u[5];
+  const T t40 = t38 - u[2];
+  const T t41 = t39 + u[1];
+  const T t48 = angle_c[0]*u[3] - angle_s[0]*u[5];
+  const T t49 = -angle_c[0]*u[5] - angle_s[0]*u[3];
   const T w_B_panel_a_z = u[4] + u[6];
-  const T t53 = t26*u[0] + t27*t42;
-  const T t54 = t26*t42 - t27*u[0];
+  const T t51 = angle_c[0]*u[0] + angle_s[0]*t40;
+  const T t52 = angle_c[0]*t40 - angle_s[0]*u[0];
   // ---- body panel_b: outward pass (velocities)
-  const T t60 = cos(q[8]);
-  const T t61 = sin(q[8]);
-  const T t74 = panel_b_p_J_z*u[4];
-  const T t75 = -panel_b_p_J_z*u[5];
-  const T t76 = t74 + u[2];
-  const T t77 = t75 + u[1];
-  const T t84 = t60*u[5] + t61*u[4];
-  const T t85 = t60*u[4] - t61*u[5];
+  const T t70 = panel_b_p_J_z*u[4];
+  const T t71 = -panel_b_p_J_z*u[5];
+  const T t72 = t70 + u[2];
+  const T t73 = t71 + u[1];
+  const T t80 = angle_c[1]*u[5] + angle_s[1]*u[4];
+  const T t81 = angle_c[1]*u[4] - angle_s[1]*u[5];
   const T w_B_panel_b_z = -u[3] + u[7];
-  const T t87 = t60*t76 + t61*t77;
-  const T t88 = t60*t77 - t61*t76;
+  const T t83 = angle_c[1]*t72 + angle_s[1]*t73;
+  const T t84 = angle_c[1]*t73 - angle_s[1]*t72;
   // ---- body panel_a: mass and velocity terms
-  const T t111 = panel_a_J0_xx*t50;
+  const T t107 = panel_a_J0_xx*t48;
   // ---- body panel_b: mass and velocity terms
-  const T t124 = panel_b_J0_zz*w_B_panel_b_z;
-  const T t128 = hub_S0_z*u[4] + hub_mass*u[0] + u[5];
-  const T t129 = hub_S0_x*u[5] - hub_S0_z*u[3] + hub_mass*u[1];
-  const T t130 = -hub_S0_x*u[4] + hub_mass*u[2] - u[3];
-  const T t131 = ((hub_J0_xx*u[3] + hub_J0_xy*u[4]) + hub_J0_xz*u[5]) - (hub_S0_z*u[1] + u[2]);
-  const T t132 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + (hub_J0_yz*u[5] + hub_S0_z*u[0])) - hub_S0_x*u[2];
-  const T t133 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + hub_J0_zz*u[5]) + (hub_S0_x*u[1] + u[0]);
-  const T t134 = ((t128*u[0] + t129*u[1]) + t130*u[2]) + ((t131*u[3] + t132*u[4]) + t133*u[5]);
-  const T t135 = panel_a_mass*t53;
-  const T t136 = panel_a_S0_x*w_B_panel_a_z + panel_a_mass*t54;
-  const T t137 = -panel_a_S0_x*t51 + panel_a_mass*t43;
-  const T t138 = panel_a_J0_yy*t51 - panel_a_S0_x*t43;
-  const T t139 = panel_a_J0_zz*w_B_panel_a_z + panel_a_S0_x*t54;
-  const T t140 = ((t111*t50 + t135*t53) + t136*t54) + ((t137*t43 + t138*t51) + t139*w_B_panel_a_z);
-  const T t141 = panel_b_S0_z*t85 + panel_b_mass*t87;
-  const T t142 = -panel_b_S0_z*t84 + panel_b_mass*t88;
-  const T t143 = -panel_b_mass*u[0];
-  const T t144 = panel_b_J0_xx*t84 - panel_b_S0_z*t88;
-  const T t145 = panel_b_J0_yy*t85 + panel_b_S0_z*t87;
-  const T t146 = (((t124*w_B_panel_b_z + t141*t87) + t142*t88) + (t144*t84 + t145*t85)) - t143*u[0];
-  const T t147 = t134/2.0 + t140/2.0 + t146/2.0;
-  const T t148 = panel_a_k*q[7]*q[7]/2.0;
-  const T t149 = panel_b_k*q[8]*q[8]/2.0 + t148;
-  TV[0] = t147;
-  TV[1] = t149;
+  const T t120 = panel_b_J0_zz*w_B_panel_b_z;
+  const T t124 = hub_S0_z*u[4] + hub_mass*u[0] + u[5];
+  const T t125 = hub_S0_x*u[5] - hub_S0_z*u[3] + hub_mass*u[1];
+  const T t126 = -hub_S0_x*u[4] + hub_mass*u[2] - u[3];
+  const T t127 = ((hub_J0_xx*u[3] + hub_J0_xy*u[4]) + hub_J0_xz*u[5]) - (hub_S0_z*u[1] + u[2]);
+  const T t128 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + (hub_J0_yz*u[5] + hub_S0_z*u[0])) - hub_S0_x*u[2];
+  const T t129 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + hub_J0_zz*u[5]) + (hub_S0_x*u[1] + u[0]);
+  const T t130 = ((t124*u[0] + t125*u[1]) + t126*u[2]) + ((t127*u[3] + t128*u[4]) + t129*u[5]);
+  const T t131 = panel_a_mass*t51;
+  const T t132 = panel_a_S0_x*w_B_panel_a_z + panel_a_mass*t52;
+  const T t133 = -panel_a_S0_x*t49 + panel_a_mass*t41;
+  const T t134 = panel_a_J0_yy*t49 - panel_a_S0_x*t41;
+  const T t135 = panel_a_J0_zz*w_B_panel_a_z + panel_a_S0_x*t52;
+  const T t136 = ((t107*t48 + t131*t51) + t132*t52) + ((t133*t41 + t134*t49) + t135*w_B_panel_a_z);
+  const T t137 = panel_b_S0_z*t81 + panel_b_mass*t83;
+  const T t138 = -panel_b_S0_z*t80 + panel_b_mass*t84;
+  const T t139 = -panel_b_mass*u[0];
+  const T t140 = panel_b_J0_xx*t80 - panel_b_S0_z*t84;
+  const T t141 = panel_b_J0_yy*t81 + panel_b_S0_z*t83;
+  const T t142 = (((t120*w_B_panel_b_z + t137*t83) + t138*t84) + (t140*t80 + t141*t81)) - t139*u[0];
+  const T t143 = t130/2.0 + t136/2.0 + t142/2.0;
+  const T t144 = panel_a_k*q[7]*q[7]/2.0;
+  const T t145 = panel_b_k*q[8]*q[8]/2.0 + t144;
+  TV[0] = t143;
+  TV[1] = t145;
 }
 
 // ---- momentum: p_N[3], H_N[3] about N's origin ---------------------------------
@@ -810,6 +937,10 @@ template <class T>
 void momentum(const T* q, const T* u, T* pH) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body hub: outward pass (velocities)
   const T t0 = (1.0/sqrt((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
   const T t1 = q[3]*t0;
@@ -835,127 +966,123 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t21 = 2.0*t10 + 2.0*t11;
   const T t22 = 1.0 - 2.0*t5 - 2.0*t6;
   // ---- body panel_a: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T R_NB_panel_a_xx = t14*t26 - t16*t27;
-  const T R_NB_panel_a_xy = -t14*t27 - t16*t26;
-  const T R_NB_panel_a_yx = t17*t26 - t19*t27;
-  const T R_NB_panel_a_yy = -t17*t27 - t19*t26;
-  const T R_NB_panel_a_zx = t20*t26 - t22*t27;
-  const T R_NB_panel_a_zy = -t20*t27 - t22*t26;
-  const T t34 = panel_a_p_PJ_x*t14;
-  const T t35 = panel_a_p_PJ_x*t17;
-  const T t36 = panel_a_p_PJ_x*t20;
-  const T r_NO_N_panel_a_x = q[0] + t34;
-  const T r_NO_N_panel_a_y = q[1] + t35;
-  const T r_NO_N_panel_a_z = q[2] + t36;
-  const T t40 = panel_a_p_J_x*u[4];
-  const T t41 = panel_a_p_J_x*u[5];
-  const T t42 = t40 - u[2];
-  const T t43 = t41 + u[1];
-  const T t50 = t26*u[3] - t27*u[5];
-  const T t51 = -t26*u[5] - t27*u[3];
+  const T R_NB_panel_a_xx = angle_c[0]*t14 - angle_s[0]*t16;
+  const T R_NB_panel_a_xy = -angle_c[0]*t16 - angle_s[0]*t14;
+  const T R_NB_panel_a_yx = angle_c[0]*t17 - angle_s[0]*t19;
+  const T R_NB_panel_a_yy = -angle_c[0]*t19 - angle_s[0]*t17;
+  const T R_NB_panel_a_zx = angle_c[0]*t20 - angle_s[0]*t22;
+  const T R_NB_panel_a_zy = -angle_c[0]*t22 - angle_s[0]*t20;
+  const T t32 = panel_a_p_PJ_x*t14;
+  const T t33 = panel_a_p_PJ_x*t17;
+  const T t34 = panel_a_p_PJ_x*t20;
+  const T r_NO_N_panel_a_x = q[0] + t32;
+  const T r_NO_N_panel_a_y = q[1] + t33;
+  const T r_NO_N_panel_a_z = q[2] + t34;
+  const T t38 = panel_a_p_J_x*u[4];
+  const T t39 = panel_a_p_J_x*u[5];
+  const T t40 = t38 - u[2];
+  const T t41 = t39 + u[1];
+  const T t48 = angle_c[0]*u[3] - angle_s[0]*u[5];
+  const T t49 = -angle_c[0]*u[5] - angle_s[0]*u[3];
   const T w_B_panel_a_z = u[4] + u[6];
-  const T t53 = t26*u[0] + t27*t42;
-  const T t54 = t26*t42 - t27*u[0];
+  const T t51 = angle_c[0]*u[0] + angle_s[0]*t40;
+  const T t52 = angle_c[0]*t40 - angle_s[0]*u[0];
   // ---- body panel_b: outward pass (velocities)
-  const T t60 = cos(q[8]);
-  const T t61 = sin(q[8]);
-  const T R_NB_panel_b_xx = t15*t61 + t16*t60;
-  const T R_NB_panel_b_xy = t15*t60 - t16*t61;
-  const T R_NB_panel_b_yx = t18*t61 + t19*t60;
-  const T R_NB_panel_b_yy = t18*t60 - t19*t61;
-  const T R_NB_panel_b_zx = t21*t61 + t22*t60;
-  const T R_NB_panel_b_zy = t21*t60 - t22*t61;
-  const T t68 = panel_b_p_PJ_x*t14;
-  const T t69 = panel_b_p_PJ_x*t17;
-  const T t70 = panel_b_p_PJ_x*t20;
-  const T r_NO_N_panel_b_x = q[0] + t68;
-  const T r_NO_N_panel_b_y = q[1] + t69;
-  const T r_NO_N_panel_b_z = q[2] + t70;
-  const T t74 = panel_b_p_J_z*u[4];
-  const T t75 = -panel_b_p_J_z*u[5];
-  const T t76 = t74 + u[2];
-  const T t77 = t75 + u[1];
-  const T t84 = t60*u[5] + t61*u[4];
-  const T t85 = t60*u[4] - t61*u[5];
+  const T R_NB_panel_b_xx = angle_c[1]*t16 + angle_s[1]*t15;
+  const T R_NB_panel_b_xy = angle_c[1]*t15 - angle_s[1]*t16;
+  const T R_NB_panel_b_yx = angle_c[1]*t19 + angle_s[1]*t18;
+  const T R_NB_panel_b_yy = angle_c[1]*t18 - angle_s[1]*t19;
+  const T R_NB_panel_b_zx = angle_c[1]*t22 + angle_s[1]*t21;
+  const T R_NB_panel_b_zy = angle_c[1]*t21 - angle_s[1]*t22;
+  const T t64 = panel_b_p_PJ_x*t14;
+  const T t65 = panel_b_p_PJ_x*t17;
+  const T t66 = panel_b_p_PJ_x*t20;
+  const T r_NO_N_panel_b_x = q[0] + t64;
+  const T r_NO_N_panel_b_y = q[1] + t65;
+  const T r_NO_N_panel_b_z = q[2] + t66;
+  const T t70 = panel_b_p_J_z*u[4];
+  const T t71 = -panel_b_p_J_z*u[5];
+  const T t72 = t70 + u[2];
+  const T t73 = t71 + u[1];
+  const T t80 = angle_c[1]*u[5] + angle_s[1]*u[4];
+  const T t81 = angle_c[1]*u[4] - angle_s[1]*u[5];
   const T w_B_panel_b_z = -u[3] + u[7];
-  const T t87 = t60*t76 + t61*t77;
-  const T t88 = t60*t77 - t61*t76;
+  const T t83 = angle_c[1]*t72 + angle_s[1]*t73;
+  const T t84 = angle_c[1]*t73 - angle_s[1]*t72;
   // ---- body panel_a: mass and velocity terms
-  const T t111 = panel_a_J0_xx*t50;
+  const T t107 = panel_a_J0_xx*t48;
   // ---- body panel_b: mass and velocity terms
-  const T t124 = panel_b_J0_zz*w_B_panel_b_z;
-  const T t128 = hub_S0_z*u[4] + hub_mass*u[0] + u[5];
-  const T t129 = hub_S0_x*u[5] - hub_S0_z*u[3] + hub_mass*u[1];
-  const T t130 = -hub_S0_x*u[4] + hub_mass*u[2] - u[3];
-  const T t131 = ((hub_J0_xx*u[3] + hub_J0_xy*u[4]) + hub_J0_xz*u[5]) - (hub_S0_z*u[1] + u[2]);
-  const T t132 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + (hub_J0_yz*u[5] + hub_S0_z*u[0])) - hub_S0_x*u[2];
-  const T t133 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + hub_J0_zz*u[5]) + (hub_S0_x*u[1] + u[0]);
-  const T t134 = t128*t14 + t129*t15 + t130*t16;
-  const T t135 = t128*t17 + t129*t18 + t130*t19;
-  const T t136 = t128*t20 + t129*t21 + t130*t22;
-  const T t137 = t131*t14 + t132*t15 + t133*t16;
-  const T t138 = t131*t17 + t132*t18 + t133*t19;
-  const T t139 = t131*t20 + t132*t21 + t133*t22;
-  const T t140 = q[1]*t136 - q[2]*t135;
-  const T t141 = -q[0]*t136 + q[2]*t134;
-  const T t142 = q[0]*t135 - q[1]*t134;
-  const T t143 = t137 + t140;
-  const T t144 = t138 + t141;
-  const T t145 = t139 + t142;
-  const T t146 = panel_a_mass*t53;
-  const T t147 = panel_a_S0_x*w_B_panel_a_z + panel_a_mass*t54;
-  const T t148 = -panel_a_S0_x*t51 + panel_a_mass*t43;
-  const T t149 = panel_a_J0_yy*t51 - panel_a_S0_x*t43;
-  const T t150 = panel_a_J0_zz*w_B_panel_a_z + panel_a_S0_x*t54;
-  const T t151 = R_NB_panel_a_xx*t146 + R_NB_panel_a_xy*t147 + t148*t15;
-  const T t152 = R_NB_panel_a_yx*t146 + R_NB_panel_a_yy*t147 + t148*t18;
-  const T t153 = R_NB_panel_a_zx*t146 + R_NB_panel_a_zy*t147 + t148*t21;
-  const T t154 = R_NB_panel_a_xx*t111 + R_NB_panel_a_xy*t149 + t15*t150;
-  const T t155 = R_NB_panel_a_yx*t111 + R_NB_panel_a_yy*t149 + t150*t18;
-  const T t156 = R_NB_panel_a_zx*t111 + R_NB_panel_a_zy*t149 + t150*t21;
-  const T t157 = r_NO_N_panel_a_y*t153 - r_NO_N_panel_a_z*t152;
-  const T t158 = -r_NO_N_panel_a_x*t153 + r_NO_N_panel_a_z*t151;
-  const T t159 = r_NO_N_panel_a_x*t152 - r_NO_N_panel_a_y*t151;
-  const T t160 = t154 + t157;
-  const T t161 = t155 + t158;
-  const T t162 = t156 + t159;
-  const T t163 = t134 + t151;
-  const T t164 = t135 + t152;
-  const T t165 = t136 + t153;
-  const T t166 = t143 + t160;
-  const T t167 = t144 + t161;
-  const T t168 = t145 + t162;
-  const T t169 = panel_b_S0_z*t85 + panel_b_mass*t87;
-  const T t170 = -panel_b_S0_z*t84 + panel_b_mass*t88;
-  const T t171 = -panel_b_mass*u[0];
-  const T t172 = panel_b_J0_xx*t84 - panel_b_S0_z*t88;
-  const T t173 = panel_b_J0_yy*t85 + panel_b_S0_z*t87;
-  const T t174 = R_NB_panel_b_xx*t169 + R_NB_panel_b_xy*t170 - t14*t171;
-  const T t175 = R_NB_panel_b_yx*t169 + R_NB_panel_b_yy*t170 - t17*t171;
-  const T t176 = R_NB_panel_b_zx*t169 + R_NB_panel_b_zy*t170 - t171*t20;
-  const T t177 = R_NB_panel_b_xx*t172 + R_NB_panel_b_xy*t173 - t124*t14;
-  const T t178 = R_NB_panel_b_yx*t172 + R_NB_panel_b_yy*t173 - t124*t17;
-  const T t179 = R_NB_panel_b_zx*t172 + R_NB_panel_b_zy*t173 - t124*t20;
-  const T t180 = r_NO_N_panel_b_y*t176 - r_NO_N_panel_b_z*t175;
-  const T t181 = -r_NO_N_panel_b_x*t176 + r_NO_N_panel_b_z*t174;
-  const T t182 = r_NO_N_panel_b_x*t175 - r_NO_N_panel_b_y*t174;
-  const T t183 = t177 + t180;
-  const T t184 = t178 + t181;
-  const T t185 = t179 + t182;
-  const T t186 = t163 + t174;
-  const T t187 = t164 + t175;
-  const T t188 = t165 + t176;
-  const T t189 = t166 + t183;
-  const T t190 = t167 + t184;
-  const T t191 = t168 + t185;
-  pH[0] = t186;
-  pH[1] = t187;
-  pH[2] = t188;
-  pH[3] = t189;
-  pH[4] = t190;
-  pH[5] = t191;
+  const T t120 = panel_b_J0_zz*w_B_panel_b_z;
+  const T t124 = hub_S0_z*u[4] + hub_mass*u[0] + u[5];
+  const T t125 = hub_S0_x*u[5] - hub_S0_z*u[3] + hub_mass*u[1];
+  const T t126 = -hub_S0_x*u[4] + hub_mass*u[2] - u[3];
+  const T t127 = ((hub_J0_xx*u[3] + hub_J0_xy*u[4]) + hub_J0_xz*u[5]) - (hub_S0_z*u[1] + u[2]);
+  const T t128 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + (hub_J0_yz*u[5] + hub_S0_z*u[0])) - hub_S0_x*u[2];
+  const T t129 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + hub_J0_zz*u[5]) + (hub_S0_x*u[1] + u[0]);
+  const T t130 = t124*t14 + t125*t15 + t126*t16;
+  const T t131 = t124*t17 + t125*t18 + t126*t19;
+  const T t132 = t124*t20 + t125*t21 + t126*t22;
+  const T t133 = t127*t14 + t128*t15 + t129*t16;
+  const T t134 = t127*t17 + t128*t18 + t129*t19;
+  const T t135 = t127*t20 + t128*t21 + t129*t22;
+  const T t136 = q[1]*t132 - q[2]*t131;
+  const T t137 = -q[0]*t132 + q[2]*t130;
+  const T t138 = q[0]*t131 - q[1]*t130;
+  const T t139 = t133 + t136;
+  const T t140 = t134 + t137;
+  const T t141 = t135 + t138;
+  const T t142 = panel_a_mass*t51;
+  const T t143 = panel_a_S0_x*w_B_panel_a_z + panel_a_mass*t52;
+  const T t144 = -panel_a_S0_x*t49 + panel_a_mass*t41;
+  const T t145 = panel_a_J0_yy*t49 - panel_a_S0_x*t41;
+  const T t146 = panel_a_J0_zz*w_B_panel_a_z + panel_a_S0_x*t52;
+  const T t147 = R_NB_panel_a_xx*t142 + R_NB_panel_a_xy*t143 + t144*t15;
+  const T t148 = R_NB_panel_a_yx*t142 + R_NB_panel_a_yy*t143 + t144*t18;
+  const T t149 = R_NB_panel_a_zx*t142 + R_NB_panel_a_zy*t143 + t144*t21;
+  const T t150 = R_NB_panel_a_xx*t107 + R_NB_panel_a_xy*t145 + t146*t15;
+  const T t151 = R_NB_panel_a_yx*t107 + R_NB_panel_a_yy*t145 + t146*t18;
+  const T t152 = R_NB_panel_a_zx*t107 + R_NB_panel_a_zy*t145 + t146*t21;
+  const T t153 = r_NO_N_panel_a_y*t149 - r_NO_N_panel_a_z*t148;
+  const T t154 = -r_NO_N_panel_a_x*t149 + r_NO_N_panel_a_z*t147;
+  const T t155 = r_NO_N_panel_a_x*t148 - r_NO_N_panel_a_y*t147;
+  const T t156 = t150 + t153;
+  const T t157 = t151 + t154;
+  const T t158 = t152 + t155;
+  const T t159 = t130 + t147;
+  const T t160 = t131 + t148;
+  const T t161 = t132 + t149;
+  const T t162 = t139 + t156;
+  const T t163 = t140 + t157;
+  const T t164 = t141 + t158;
+  const T t165 = panel_b_S0_z*t81 + panel_b_mass*t83;
+  const T t166 = -panel_b_S0_z*t80 + panel_b_mass*t84;
+  const T t167 = -panel_b_mass*u[0];
+  const T t168 = panel_b_J0_xx*t80 - panel_b_S0_z*t84;
+  const T t169 = panel_b_J0_yy*t81 + panel_b_S0_z*t83;
+  const T t170 = R_NB_panel_b_xx*t165 + R_NB_panel_b_xy*t166 - t14*t167;
+  const T t171 = R_NB_panel_b_yx*t165 + R_NB_panel_b_yy*t166 - t167*t17;
+  const T t172 = R_NB_panel_b_zx*t165 + R_NB_panel_b_zy*t166 - t167*t20;
+  const T t173 = R_NB_panel_b_xx*t168 + R_NB_panel_b_xy*t169 - t120*t14;
+  const T t174 = R_NB_panel_b_yx*t168 + R_NB_panel_b_yy*t169 - t120*t17;
+  const T t175 = R_NB_panel_b_zx*t168 + R_NB_panel_b_zy*t169 - t120*t20;
+  const T t176 = r_NO_N_panel_b_y*t172 - r_NO_N_panel_b_z*t171;
+  const T t177 = -r_NO_N_panel_b_x*t172 + r_NO_N_panel_b_z*t170;
+  const T t178 = r_NO_N_panel_b_x*t171 - r_NO_N_panel_b_y*t170;
+  const T t179 = t173 + t176;
+  const T t180 = t174 + t177;
+  const T t181 = t175 + t178;
+  const T t182 = t159 + t170;
+  const T t183 = t160 + t171;
+  const T t184 = t161 + t172;
+  const T t185 = t162 + t179;
+  const T t186 = t163 + t180;
+  const T t187 = t164 + t181;
+  pH[0] = t182;
+  pH[1] = t183;
+  pH[2] = t184;
+  pH[3] = t185;
+  pH[4] = t186;
+  pH[5] = t187;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

@@ -16,12 +16,12 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
-//   mass_matrix       98 (49 add, 45 mul, 0 div, 4 func)
-//   forcing          272 (115 add, 153 mul, 0 div, 4 func)
-//   udot             644 (279 add, 348 mul, 13 div, 4 func) -- composite form; composite 644, articulated 804
-//     udot by pass: outward pass (velocities) 78; mass and velocity terms 80; composite inertia (inward) 71; its columns of M (walked to the root) 21; bias force 54; generalized forces (inward) 60; M u_dot = F: L^T D L along the dof tree 280
-//   energy           159 (62 add, 88 mul, 5 div, 4 func)
-//   momentum         358 (146 add, 206 mul, 1 div, 5 func)
+//   mass_matrix       97 (48 add, 45 mul, 0 div, 4 func)
+//   forcing          271 (114 add, 153 mul, 0 div, 4 func)
+//   udot             643 (278 add, 348 mul, 13 div, 4 func) -- composite form; composite 643, articulated 803
+//     udot by pass: joint angles' sin and cos 5; outward pass (velocities) 72; mass and velocity terms 80; composite inertia (inward) 71; its columns of M (walked to the root) 21; bias force 54; generalized forces (inward) 60; M u_dot = F: L^T D L along the dof tree 280
+//   energy           158 (61 add, 88 mul, 5 div, 4 func)
+//   momentum         357 (145 add, 206 mul, 1 div, 5 func)
 
 #pragma once
 
@@ -141,6 +141,135 @@ template <int W> inline bool operator>(double a, const Dual<W>& b) { return a > 
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }
+// ---- joint angles' sin and cos (templates/joint_sincos.inc) -------------------
+// Every joint angle's sin and cos, computed in one batch before the rest of a
+// function (issue 38, item 3: one evaluation per angle, shared by every use),
+// two angles at a time in SSE2 pairs (GCC/clang vector extensions, no header).
+// Accuracy (tests/codegen/test_joint_sincos.cpp, against sinl/cosl): at most
+// 0.51 ulp, the library's sin and cos 0.52-0.56 on the same arguments; beyond
+// |x| = 1e5 rad (and for inf and NaN) the library's sin and cos. (-ffast-math,
+// which reorders the exact sums, voids the bound.)
+// Method: x = k pi/32 + r, |r| <= pi/64, with pi/32 in four parts (three of 33
+// bits, exact products for |k| < 2^20) and r carried as r + rlo; sin and cos
+// of k pi/32 from a table as double-doubles (hi, lo, and hi split in 26-bit
+// halves for Dekker's exact product); sin r - r and cos r - 1 by their Taylor
+// series to r^9 and r^8 (truncation below 1e-20 on |r| <= pi/64);
+// sin x = S + C r + (S (cos r - 1) + C (sin r - r) + C rlo + S_lo), the sum
+// S + C r exact (TwoSum of the exact product), likewise cos x.
+
+// sin(j pi/32), j = 0..63: hi, lo (hi + lo to ~2^-106), and hi in two halves of 26 bits
+inline constexpr double kanegen_sin_table[64][4] = {
+    {0.0, 0.0, 0.0, 0.0},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.0000000000000p+0, 0.0, 0x1.0000000000000p+0, 0.0},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0.0, 0.0, 0.0, 0.0},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.0000000000000p+0, 0.0, -0x1.0000000000000p+0, 0.0},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+};
+
+typedef double kanegen_v2d __attribute__((vector_size(16)));
+
+/// sin and cos of x[0..n), in s and c.
+inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
+  for (int i = 0; i < n; i += 2) {
+    const int b = i + 1 < n ? i + 1 : i;  // an odd count's last angle twice
+    // beyond 1e5 rad (and inf, NaN) the library's, below; 0 meanwhile keeps the integer conversion defined
+    const double xi = x[i] <= 1.0e5 && x[i] >= -1.0e5 ? x[i] : 0.0, xb = x[b] <= 1.0e5 && x[b] >= -1.0e5 ? x[b] : 0.0;
+    const kanegen_v2d xv = {xi, xb};
+    const kanegen_v2d kn = (xv * 0x1.45f306dc9c883p+3 + 0x1.8p52) - 0x1.8p52;  // round(x 32/pi)
+    const kanegen_v2d t = xv - kn * 0x1.921fb54400000p-4, u2 = kn * 0x1.0b4611a600000p-38,
+                      u3 = kn * 0x1.3198a2e000000p-73;
+    const kanegen_v2d r1 = t - u2, e1 = (t - r1) - u2;
+    const kanegen_v2d r = r1 - u3, b3 = r - r1, e2 = (r1 - (r - b3)) - (u3 + b3);
+    const kanegen_v2d rlo = (e1 + e2) - kn * 0x1.b839a252049c1p-108;
+    const kanegen_v2d z = r * r;
+    const kanegen_v2d sr = (r * z) * (-1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 + z * (1.0 / 362880))));
+    const kanegen_v2d cm = z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320))));
+    const long k0 = static_cast<long>(kn[0]), k1 = static_cast<long>(kn[1]);
+    const double* Sa = kanegen_sin_table[k0 & 63];
+    const double* Sb = kanegen_sin_table[k1 & 63];
+    const double* Ca = kanegen_sin_table[(k0 + 16) & 63];
+    const double* Cb = kanegen_sin_table[(k1 + 16) & 63];
+    const kanegen_v2d S0 = {Sa[0], Sb[0]}, S1 = {Sa[1], Sb[1]}, S2 = {Sa[2], Sb[2]}, S3 = {Sa[3], Sb[3]};
+    const kanegen_v2d C0 = {Ca[0], Cb[0]}, C1 = {Ca[1], Cb[1]}, C2 = {Ca[2], Cb[2]}, C3 = {Ca[3], Cb[3]};
+    const kanegen_v2d g = 134217729.0 * r, rh = g - (g - r), rl = r - rh;  // r in 26-bit halves
+    const kanegen_v2d p = C0 * r, pe = (((C2 * rh - p) + C2 * rl) + C3 * rh) + C3 * rl;  // C r = p + pe
+    const kanegen_v2d s1 = S0 + p, bs = s1 - S0, se = (S0 - (s1 - bs)) + (p - bs);    // S + p = s1 + se
+    const kanegen_v2d sv = s1 + ((se + pe) + (S1 + C1 * r + C0 * rlo + S0 * cm + C0 * sr));
+    const kanegen_v2d q = S0 * r, qe = (((S2 * rh - q) + S2 * rl) + S3 * rh) + S3 * rl;  // S r = q + qe
+    const kanegen_v2d c1 = C0 - q, bc = c1 - C0, ce = (C0 - (c1 - bc)) + (-q - bc);      // C - q = c1 + ce
+    const kanegen_v2d cv = c1 + ((ce - qe) + (C1 - S1 * r - S0 * rlo + C0 * cm - S0 * sr));
+    s[i] = sv[0], c[i] = cv[0], s[b] = sv[1], c[b] = cv[1];
+    if (!(x[i] <= 1.0e5 && x[i] >= -1.0e5)) s[i] = std::sin(x[i]), c[i] = std::cos(x[i]);
+    if (!(x[b] <= 1.0e5 && x[b] >= -1.0e5)) s[b] = std::sin(x[b]), c[b] = std::cos(x[b]);
+  }
+}
+
+/// The same for any other number type (the dual numbers of the Jacobians): its own sin and cos.
+template <class T>
+inline void kanegen_sincos_n(const T* x, T* s, T* c, int n) {
+  using std::cos;
+  using std::sin;
+  for (int i = 0; i < n; ++i) s[i] = sin(x[i]), c[i] = cos(x[i]);
+}
 
 // ---- q_dot = W(q) u ------------------------------------------------------------
 template <class T>
@@ -180,144 +309,142 @@ template <class T>
 void mass_matrix(const T* q, T* M) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q;
-  // ---- body arm: outward pass (positions)
-  const T t23 = cos(q[7]);
-  const T t24 = sin(q[7]);
-  // ---- body sensor: outward pass (positions)
-  const T t37 = cos(q[8] + sensor_angle_offset);
-  const T t38 = sin(q[8] + sensor_angle_offset);
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8] + sensor_angle_offset};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body sensor: composite inertia (inward)
-  const T t51 = sensor_S0_x*t37;
-  const T t52 = sensor_S0_x*t38;
-  const T t53 = t38*t38;
-  const T t54 = t37*t38;
-  const T t56 = -kaa5c1197*t53;
-  const T t57 = sensor_J0_xx - t56;
-  const T t58 = sensor_J0_yy + t56;
-  const T t59 = -kaa5c1197*t54;
-  const T t60 = -sensor_p_J_x*t52 + t59;
-  const T t61 = 2.0*sensor_p_J_x*t51 + k2b5ff873 + t58;
-  const T t62 = 2.0*sensor_p_J_x*t51 + k49081188;
-  const T t63 = kdc6e78e8 + t51;
-  const T t64 = arm_J0_xx + t57;
-  const T t65 = arm_J0_yy + t62;
-  const T t66 = arm_J0_zz + t61;
-  const T t68 = arm_S0_x + t63;
+  const T t47 = angle_c[1]*sensor_S0_x;
+  const T t48 = angle_s[1]*sensor_S0_x;
+  const T t49 = angle_s[1]*angle_s[1];
+  const T t50 = angle_c[1]*angle_s[1];
+  const T t52 = -kaa5c1197*t49;
+  const T t53 = sensor_J0_xx - t52;
+  const T t54 = sensor_J0_yy + t52;
+  const T t55 = -kaa5c1197*t50;
+  const T t56 = -sensor_p_J_x*t48 + t55;
+  const T t57 = 2.0*sensor_p_J_x*t47 + k2b5ff873 + t54;
+  const T t58 = 2.0*sensor_p_J_x*t47 + k49081188;
+  const T t59 = kdc6e78e8 + t47;
+  const T t60 = arm_J0_xx + t53;
+  const T t61 = arm_J0_yy + t58;
+  const T t62 = arm_J0_zz + t57;
+  const T t64 = arm_S0_x + t59;
   // ---- body arm: composite inertia (inward)
-  const T t69 = t23*t68;
-  const T t70 = t24*t68;
-  const T t71 = t24*t24;
-  const T t72 = t23*t24;
-  const T t74 = t64 - t65;
-  const T t75 = t71*t74;
-  const T t76 = t64 - t75;
-  const T t77 = t65 + t75;
-  const T t78 = t72*t74;
-  const T t79 = t23*t60;
-  const T t80 = t24*t60;
-  const T t81 = 2.0*arm_p_J_z*t52 + k44bd7af3 + t76;
-  const T t82 = -arm_p_J_x*t70 + t78;
-  const T t83 = t79 - ((arm_p_J_x*t52 + arm_p_J_z*t69) + kfecc247c);
-  const T t84 = (2.0*arm_p_J_x*t69 + 2.0*arm_p_J_z*t52) + (k8b74a21f + t77);
-  const T t85 = -arm_p_J_z*t70 + t80;
-  const T t86 = 2.0*arm_p_J_x*t69 + k7e2ba37a + t66;
-  const T t87 = k28dea4a2 + t69;
-  const T t88 = k753a7a93 + t52;
-  const T t89 = station_J0_xx + t81;
-  const T t90 = station_J0_xy + t82;
-  const T t91 = station_J0_xz - t83;
-  const T t92 = station_J0_yy + t84;
-  const T t93 = station_J0_yz - t85;
-  const T t94 = station_J0_zz + t86;
-  const T t95 = -station_S0_z - t88;
-  const T t96 = station_S0_y - t70;
-  const T t97 = station_S0_z + t88;
-  const T t98 = -station_S0_x + t87;
-  const T t99 = -station_S0_y + t70;
-  const T t100 = station_S0_x - t87;
+  const T t65 = angle_c[0]*t64;
+  const T t66 = angle_s[0]*t64;
+  const T t67 = angle_s[0]*angle_s[0];
+  const T t68 = angle_c[0]*angle_s[0];
+  const T t70 = t60 - t61;
+  const T t71 = t67*t70;
+  const T t72 = t60 - t71;
+  const T t73 = t61 + t71;
+  const T t74 = t68*t70;
+  const T t75 = angle_c[0]*t56;
+  const T t76 = angle_s[0]*t56;
+  const T t77 = 2.0*arm_p_J_z*t48 + k44bd7af3 + t72;
+  const T t78 = -arm_p_J_x*t66 + t74;
+  const T t79 = t75 - ((arm_p_J_x*t48 + arm_p_J_z*t65) + kfecc247c);
+  const T t80 = (2.0*arm_p_J_x*t65 + 2.0*arm_p_J_z*t48) + (k8b74a21f + t73);
+  const T t81 = -arm_p_J_z*t66 + t76;
+  const T t82 = 2.0*arm_p_J_x*t65 + k7e2ba37a + t62;
+  const T t83 = k28dea4a2 + t65;
+  const T t84 = k753a7a93 + t48;
+  const T t85 = station_J0_xx + t77;
+  const T t86 = station_J0_xy + t78;
+  const T t87 = station_J0_xz - t79;
+  const T t88 = station_J0_yy + t80;
+  const T t89 = station_J0_yz - t81;
+  const T t90 = station_J0_zz + t82;
+  const T t91 = -station_S0_z - t84;
+  const T t92 = station_S0_y - t66;
+  const T t93 = station_S0_z + t84;
+  const T t94 = -station_S0_x + t83;
+  const T t95 = -station_S0_y + t66;
+  const T t96 = station_S0_x - t83;
   // ---- body arm: its columns of M (walked to the root)
-  const T t101 = -t24*t68;
-  const T t102 = -arm_p_J_z*t69;
-  const T t103 = arm_p_J_z*t101;
-  const T t104 = arm_p_J_x*t69;
-  const T t105 = t102 + t79;
-  const T t106 = t103 + t80;
-  const T t107 = t104 + t66;
+  const T t97 = -angle_s[0]*t64;
+  const T t98 = -arm_p_J_z*t65;
+  const T t99 = arm_p_J_z*t97;
+  const T t100 = arm_p_J_x*t65;
+  const T t101 = t75 + t98;
+  const T t102 = t76 + t99;
+  const T t103 = t100 + t62;
   // ---- body sensor: its columns of M (walked to the root)
-  const T t108 = -sensor_S0_x*t38;
-  const T t109 = sensor_p_J_x*t51;
-  const T t110 = sensor_J0_zz + t109;
-  const T t111 = t108*t23;
-  const T t112 = t108*t24;
-  const T t113 = -arm_p_J_z*t112;
-  const T t114 = -arm_p_J_x*t51 + arm_p_J_z*t111;
-  const T t115 = arm_p_J_x*t112;
-  const T t116 = t110*t24;
-  const T t117 = -t110*t23;
-  const T t118 = t113 + t116;
-  const T t119 = t114 + t117;
+  const T t104 = -angle_s[1]*sensor_S0_x;
+  const T t105 = sensor_p_J_x*t47;
+  const T t106 = sensor_J0_zz + t105;
+  const T t107 = angle_c[0]*t104;
+  const T t108 = angle_s[0]*t104;
+  const T t109 = -arm_p_J_z*t108;
+  const T t110 = -arm_p_J_x*t47 + arm_p_J_z*t107;
+  const T t111 = arm_p_J_x*t108;
+  const T t112 = angle_s[0]*t106;
+  const T t113 = -angle_c[0]*t106;
+  const T t114 = t109 + t112;
+  const T t115 = t110 + t113;
   M[0] = k5612693a;
   M[1] = 0.0;
   M[2] = 0.0;
   M[3] = 0.0;
-  M[4] = t97;
-  M[5] = t99;
-  M[6] = -t101;
-  M[7] = -t111;
+  M[4] = t93;
+  M[5] = t95;
+  M[6] = -t97;
+  M[7] = -t107;
   M[8] = 0.0;
   M[9] = k5612693a;
   M[10] = 0.0;
-  M[11] = t95;
+  M[11] = t91;
   M[12] = 0.0;
-  M[13] = t100;
-  M[14] = -t69;
-  M[15] = -t112;
+  M[13] = t96;
+  M[14] = -t65;
+  M[15] = -t108;
   M[16] = 0.0;
   M[17] = 0.0;
   M[18] = k5612693a;
-  M[19] = t96;
-  M[20] = t98;
+  M[19] = t92;
+  M[20] = t94;
   M[21] = 0.0;
   M[22] = 0.0;
-  M[23] = t51;
+  M[23] = t47;
   M[24] = 0.0;
-  M[25] = t95;
-  M[26] = t96;
-  M[27] = t89;
-  M[28] = t90;
-  M[29] = t91;
-  M[30] = -t105;
-  M[31] = -t118;
-  M[32] = t97;
+  M[25] = t91;
+  M[26] = t92;
+  M[27] = t85;
+  M[28] = t86;
+  M[29] = t87;
+  M[30] = -t101;
+  M[31] = -t114;
+  M[32] = t93;
   M[33] = 0.0;
-  M[34] = t98;
-  M[35] = t90;
-  M[36] = t92;
-  M[37] = t93;
-  M[38] = -t106;
-  M[39] = -t119;
-  M[40] = t99;
-  M[41] = t100;
+  M[34] = t94;
+  M[35] = t86;
+  M[36] = t88;
+  M[37] = t89;
+  M[38] = -t102;
+  M[39] = -t115;
+  M[40] = t95;
+  M[41] = t96;
   M[42] = 0.0;
-  M[43] = t91;
-  M[44] = t93;
-  M[45] = t94;
-  M[46] = t107;
-  M[47] = t115;
-  M[48] = -t101;
-  M[49] = -t69;
+  M[43] = t87;
+  M[44] = t89;
+  M[45] = t90;
+  M[46] = t103;
+  M[47] = t111;
+  M[48] = -t97;
+  M[49] = -t65;
   M[50] = 0.0;
-  M[51] = -t105;
-  M[52] = -t106;
-  M[53] = t107;
-  M[54] = t66;
+  M[51] = -t101;
+  M[52] = -t102;
+  M[53] = t103;
+  M[54] = t62;
   M[55] = 0.0;
-  M[56] = -t111;
-  M[57] = -t112;
-  M[58] = t51;
-  M[59] = -t118;
-  M[60] = -t119;
-  M[61] = t115;
+  M[56] = -t107;
+  M[57] = -t108;
+  M[58] = t47;
+  M[59] = -t114;
+  M[60] = -t115;
+  M[61] = t111;
   M[62] = 0.0;
   M[63] = sensor_J0_zz;
 }
@@ -327,162 +454,162 @@ template <class T>
 void forcing(const T* q, const T* u, const T* tau, T* F) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8] + sensor_angle_offset};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body station: outward pass (velocities)
   const T t23 = -u[1]*u[5] + u[2]*u[4];
   const T t24 = u[0]*u[5] - u[2]*u[3];
   const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body arm: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = -arm_p_J_z*u[4];
-  const T t41 = arm_p_J_x*u[5] + arm_p_J_z*u[3];
-  const T t42 = arm_p_J_x*u[4];
-  const T t46 = -t41*u[5] - t42*u[4];
-  const T t47 = t40*u[5] + t42*u[3];
-  const T t48 = t40*u[4] - t41*u[3];
-  const T t49 = -t23 + t46;
-  const T t50 = -t24 + t47;
-  const T t51 = t25 + t48;
-  const T t52 = -t26*u[3] - t27*u[4];
-  const T t53 = -t26*u[4] + t27*u[3];
+  const T t38 = -arm_p_J_z*u[4];
+  const T t39 = arm_p_J_x*u[5] + arm_p_J_z*u[3];
+  const T t40 = arm_p_J_x*u[4];
+  const T t44 = -t39*u[5] - t40*u[4];
+  const T t45 = t38*u[5] + t40*u[3];
+  const T t46 = t38*u[4] - t39*u[3];
+  const T t47 = -t23 + t44;
+  const T t48 = -t24 + t45;
+  const T t49 = t25 + t46;
+  const T t50 = -angle_c[0]*u[3] - angle_s[0]*u[4];
+  const T t51 = -angle_c[0]*u[4] + angle_s[0]*u[3];
   const T w_B_arm_z = u[5] + u[6];
-  const T t57 = t53*u[6];
-  const T t58 = -t52*u[6];
-  const T t60 = t26*t49 + t27*t50;
-  const T t61 = t26*t50 - t27*t49;
+  const T t55 = t51*u[6];
+  const T t56 = -t50*u[6];
+  const T t58 = angle_c[0]*t47 + angle_s[0]*t48;
+  const T t59 = angle_c[0]*t48 - angle_s[0]*t47;
   // ---- body sensor: outward pass (velocities)
-  const T t62 = cos(q[8] + sensor_angle_offset);
-  const T t63 = sin(q[8] + sensor_angle_offset);
-  const T t76 = -sensor_p_J_x*t53;
-  const T t77 = -sensor_p_J_x*w_B_arm_z;
-  const T t80 = t53*t76 + t77*w_B_arm_z;
-  const T t81 = -t52*t77;
-  const T t82 = t52*t76;
-  const T t83 = -sensor_p_J_x*t58;
-  const T t84 = t51 + t83;
-  const T t85 = t60 + t80;
-  const T t86 = t81 + t84;
-  const T t87 = -t61 + t82;
-  const T t88 = t52*t62 + t63*w_B_arm_z;
-  const T t89 = -t52*t63 + t62*w_B_arm_z;
-  const T w_B_sensor_z = -t53 + u[7];
-  const T t93 = t89*u[7];
-  const T t94 = -t88*u[7];
-  const T t95 = t57*t62;
-  const T t96 = -t57*t63;
-  const T alpha_R_B_sensor_x = t93 + t95;
-  const T alpha_R_B_sensor_y = t94 + t96;
-  const T t100 = t62*t85 + t63*t86;
-  const T t101 = t62*t86 - t63*t85;
+  const T t72 = -sensor_p_J_x*t51;
+  const T t73 = -sensor_p_J_x*w_B_arm_z;
+  const T t76 = t51*t72 + t73*w_B_arm_z;
+  const T t77 = -t50*t73;
+  const T t78 = t50*t72;
+  const T t79 = -sensor_p_J_x*t56;
+  const T t80 = t49 + t79;
+  const T t81 = t58 + t76;
+  const T t82 = t77 + t80;
+  const T t83 = -t59 + t78;
+  const T t84 = angle_c[1]*t50 + angle_s[1]*w_B_arm_z;
+  const T t85 = angle_c[1]*w_B_arm_z - angle_s[1]*t50;
+  const T w_B_sensor_z = -t51 + u[7];
+  const T t89 = t85*u[7];
+  const T t90 = -t84*u[7];
+  const T t91 = angle_c[1]*t55;
+  const T t92 = -angle_s[1]*t55;
+  const T alpha_R_B_sensor_x = t89 + t91;
+  const T alpha_R_B_sensor_y = t90 + t92;
+  const T t96 = angle_c[1]*t81 + angle_s[1]*t82;
+  const T t97 = angle_c[1]*t82 - angle_s[1]*t81;
   // ---- body station: mass and velocity terms
-  const T t102 = -station_S0_y*u[5] + station_S0_z*u[4];
-  const T t103 = station_S0_x*u[5] - station_S0_z*u[3];
-  const T t104 = -station_S0_x*u[4] + station_S0_y*u[3];
-  const T t105 = -t103*u[5] + t104*u[4];
-  const T t106 = t102*u[5] - t104*u[3];
-  const T t107 = -t102*u[4] + t103*u[3];
-  const T t108 = station_J0_xx*u[3] + station_J0_xy*u[4] + station_J0_xz*u[5];
-  const T t109 = station_J0_xy*u[3] + station_J0_yy*u[4] + station_J0_yz*u[5];
-  const T t110 = station_J0_xz*u[3] + station_J0_yz*u[4] + station_J0_zz*u[5];
-  const T t111 = -t109*u[5] + t110*u[4];
-  const T t112 = t108*u[5] - t110*u[3];
-  const T t113 = -t108*u[4] + t109*u[3];
+  const T t98 = -station_S0_y*u[5] + station_S0_z*u[4];
+  const T t99 = station_S0_x*u[5] - station_S0_z*u[3];
+  const T t100 = -station_S0_x*u[4] + station_S0_y*u[3];
+  const T t101 = t100*u[4] - t99*u[5];
+  const T t102 = -t100*u[3] + t98*u[5];
+  const T t103 = -t98*u[4] + t99*u[3];
+  const T t104 = station_J0_xx*u[3] + station_J0_xy*u[4] + station_J0_xz*u[5];
+  const T t105 = station_J0_xy*u[3] + station_J0_yy*u[4] + station_J0_yz*u[5];
+  const T t106 = station_J0_xz*u[3] + station_J0_yz*u[4] + station_J0_zz*u[5];
+  const T t107 = -t105*u[5] + t106*u[4];
+  const T t108 = t104*u[5] - t106*u[3];
+  const T t109 = -t104*u[4] + t105*u[3];
   // ---- body arm: mass and velocity terms
-  const T t114 = arm_S0_x*w_B_arm_z;
-  const T t115 = -arm_S0_x*t53;
-  const T t116 = -t114*w_B_arm_z + t115*t53;
-  const T t117 = -t115*t52;
-  const T t118 = t114*t52;
-  const T t119 = arm_J0_xx*t52;
-  const T t120 = arm_J0_yy*t53;
-  const T t121 = arm_J0_zz*w_B_arm_z;
-  const T t122 = -t120*w_B_arm_z + t121*t53;
-  const T t123 = t119*w_B_arm_z - t121*t52;
-  const T t124 = -t119*t53 + t120*t52;
+  const T t110 = arm_S0_x*w_B_arm_z;
+  const T t111 = -arm_S0_x*t51;
+  const T t112 = -t110*w_B_arm_z + t111*t51;
+  const T t113 = -t111*t50;
+  const T t114 = t110*t50;
+  const T t115 = arm_J0_xx*t50;
+  const T t116 = arm_J0_yy*t51;
+  const T t117 = arm_J0_zz*w_B_arm_z;
+  const T t118 = -t116*w_B_arm_z + t117*t51;
+  const T t119 = t115*w_B_arm_z - t117*t50;
+  const T t120 = -t115*t51 + t116*t50;
   // ---- body sensor: mass and velocity terms
-  const T t125 = sensor_S0_x*w_B_sensor_z;
-  const T t126 = -sensor_S0_x*t89;
-  const T t127 = -t125*w_B_sensor_z + t126*t89;
-  const T t128 = -t126*t88;
-  const T t129 = t125*t88;
-  const T t130 = sensor_J0_xx*t88;
-  const T t131 = sensor_J0_yy*t89;
-  const T t132 = sensor_J0_zz*w_B_sensor_z;
-  const T t133 = -t131*w_B_sensor_z + t132*t89;
-  const T t134 = t130*w_B_sensor_z - t132*t88;
-  const T t135 = -t130*t89 + t131*t88;
+  const T t121 = sensor_S0_x*w_B_sensor_z;
+  const T t122 = -sensor_S0_x*t85;
+  const T t123 = -t121*w_B_sensor_z + t122*t85;
+  const T t124 = -t122*t84;
+  const T t125 = t121*t84;
+  const T t126 = sensor_J0_xx*t84;
+  const T t127 = sensor_J0_yy*t85;
+  const T t128 = sensor_J0_zz*w_B_sensor_z;
+  const T t129 = -t127*w_B_sensor_z + t128*t85;
+  const T t130 = t126*w_B_sensor_z - t128*t84;
+  const T t131 = -t126*t85 + t127*t84;
   // ---- body station: bias force
-  const T t136 = -station_mass*t23 - t105;
-  const T t137 = -station_mass*t24 - t106;
-  const T t138 = -station_mass*t25 - t107;
-  const T t139 = -station_S0_y*t25 + station_S0_z*t24 - t111;
-  const T t140 = station_S0_x*t25 - station_S0_z*t23 - t112;
-  const T t141 = -station_S0_x*t24 + station_S0_y*t23 - t113;
+  const T t132 = -station_mass*t23 - t101;
+  const T t133 = -station_mass*t24 - t102;
+  const T t134 = -station_mass*t25 - t103;
+  const T t135 = -station_S0_y*t25 + station_S0_z*t24 - t107;
+  const T t136 = station_S0_x*t25 - station_S0_z*t23 - t108;
+  const T t137 = -station_S0_x*t24 + station_S0_y*t23 - t109;
   // ---- body arm: bias force
-  const T t142 = -arm_mass*t60 - t116;
-  const T t143 = -arm_mass*t61 - t117;
-  const T t144 = arm_S0_x*t58 - arm_mass*t51 - t118;
-  const T t145 = -arm_J0_xx*t57 - t122;
-  const T t146 = -arm_J0_yy*t58 + arm_S0_x*t51 - t123;
-  const T t147 = -arm_S0_x*t61 - t124;
+  const T t138 = -arm_mass*t58 - t112;
+  const T t139 = -arm_mass*t59 - t113;
+  const T t140 = arm_S0_x*t56 - arm_mass*t49 - t114;
+  const T t141 = -arm_J0_xx*t55 - t118;
+  const T t142 = -arm_J0_yy*t56 + arm_S0_x*t49 - t119;
+  const T t143 = -arm_S0_x*t59 - t120;
   // ---- body sensor: bias force
-  const T t148 = -sensor_mass*t100 - t127;
-  const T t149 = sensor_S0_x*t58 - sensor_mass*t101 - t128;
-  const T t150 = alpha_R_B_sensor_y*sensor_S0_x - sensor_mass*t87 - t129;
-  const T t151 = -alpha_R_B_sensor_x*sensor_J0_xx - t133;
-  const T t152 = -alpha_R_B_sensor_y*sensor_J0_yy + sensor_S0_x*t87 - t134;
-  const T t153 = sensor_J0_zz*t58 - sensor_S0_x*t101 - t135;
+  const T t144 = -sensor_mass*t96 - t123;
+  const T t145 = sensor_S0_x*t56 - sensor_mass*t97 - t124;
+  const T t146 = alpha_R_B_sensor_y*sensor_S0_x - sensor_mass*t83 - t125;
+  const T t147 = -alpha_R_B_sensor_x*sensor_J0_xx - t129;
+  const T t148 = -alpha_R_B_sensor_y*sensor_J0_yy + sensor_S0_x*t83 - t130;
+  const T t149 = sensor_J0_zz*t56 - sensor_S0_x*t97 - t131;
   // ---- body sensor: generalized forces (inward)
-  const T t154 = -q[8]*sensor_k + tau[7];
-  const T t155 = t153 + t154;
-  const T t156 = t148*t62 - t149*t63;
-  const T t157 = t148*t63 + t149*t62;
-  const T t158 = -sensor_p_J_x*t150;
-  const T t159 = sensor_p_J_x*t157;
-  const T t160 = t151*t62 - t152*t63;
-  const T t161 = t151*t63 + t152*t62;
-  const T t162 = t158 + t161;
-  const T t163 = t153 + t159;
-  const T t164 = t142 + t156;
-  const T t165 = t143 - t150;
-  const T t166 = t144 + t157;
-  const T t167 = t145 + t160;
-  const T t168 = t146 - t163;
-  const T t169 = t147 + t162;
+  const T t150 = -q[8]*sensor_k + tau[7];
+  const T t151 = t149 + t150;
+  const T t152 = angle_c[1]*t144 - angle_s[1]*t145;
+  const T t153 = angle_c[1]*t145 + angle_s[1]*t144;
+  const T t154 = -sensor_p_J_x*t146;
+  const T t155 = sensor_p_J_x*t153;
+  const T t156 = angle_c[1]*t147 - angle_s[1]*t148;
+  const T t157 = angle_c[1]*t148 + angle_s[1]*t147;
+  const T t158 = t154 + t157;
+  const T t159 = t149 + t155;
+  const T t160 = t138 + t152;
+  const T t161 = t139 - t146;
+  const T t162 = t140 + t153;
+  const T t163 = t141 + t156;
+  const T t164 = t142 - t159;
+  const T t165 = t143 + t158;
   // ---- body arm: generalized forces (inward)
-  const T t170 = -arm_k*q[7] + tau[6];
-  const T t171 = t169 + t170;
-  const T t172 = t164*t26 - t165*t27;
-  const T t173 = t164*t27 + t165*t26;
-  const T t174 = -arm_p_J_z*t173;
-  const T t175 = -arm_p_J_x*t166 + arm_p_J_z*t172;
-  const T t176 = arm_p_J_x*t173;
-  const T t177 = t167*t26 - t168*t27;
-  const T t178 = t167*t27 + t168*t26;
-  const T t179 = t174 + t177;
-  const T t180 = t175 + t178;
-  const T t181 = t169 + t176;
-  const T t182 = t136 - t172;
-  const T t183 = t137 - t173;
-  const T t184 = t138 + t166;
-  const T t185 = t139 - t179;
-  const T t186 = t140 - t180;
-  const T t187 = t141 + t181;
+  const T t166 = -arm_k*q[7] + tau[6];
+  const T t167 = t165 + t166;
+  const T t168 = angle_c[0]*t160 - angle_s[0]*t161;
+  const T t169 = angle_c[0]*t161 + angle_s[0]*t160;
+  const T t170 = -arm_p_J_z*t169;
+  const T t171 = -arm_p_J_x*t162 + arm_p_J_z*t168;
+  const T t172 = arm_p_J_x*t169;
+  const T t173 = angle_c[0]*t163 - angle_s[0]*t164;
+  const T t174 = angle_c[0]*t164 + angle_s[0]*t163;
+  const T t175 = t170 + t173;
+  const T t176 = t171 + t174;
+  const T t177 = t165 + t172;
+  const T t178 = t132 - t168;
+  const T t179 = t133 - t169;
+  const T t180 = t134 + t162;
+  const T t181 = t135 - t175;
+  const T t182 = t136 - t176;
+  const T t183 = t137 + t177;
   // ---- body station: generalized forces (inward)
-  const T t188 = t182 + tau[0];
-  const T t189 = t183 + tau[1];
-  const T t190 = t184 + tau[2];
-  const T t191 = t185 + tau[3];
-  const T t192 = t186 + tau[4];
-  const T t193 = t187 + tau[5];
-  F[0] = t188;
-  F[1] = t189;
-  F[2] = t190;
-  F[3] = t191;
-  F[4] = t192;
-  F[5] = t193;
-  F[6] = t171;
-  F[7] = t155;
+  const T t184 = t178 + tau[0];
+  const T t185 = t179 + tau[1];
+  const T t186 = t180 + tau[2];
+  const T t187 = t181 + tau[3];
+  const T t188 = t182 + tau[4];
+  const T t189 = t183 + tau[5];
+  F[0] = t184;
+  F[1] = t185;
+  F[2] = t186;
+  F[3] = t187;
+  F[4] = t188;
+  F[5] = t189;
+  F[6] = t167;
+  F[7] = t151;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
@@ -491,404 +618,404 @@ template <class T>
 int udot(const T* q, const T* u, const T* tau, T* udot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8] + sensor_angle_offset};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body station: outward pass (velocities)
   const T t23 = -u[1]*u[5] + u[2]*u[4];
   const T t24 = u[0]*u[5] - u[2]*u[3];
   const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body arm: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = -arm_p_J_z*u[4];
-  const T t41 = arm_p_J_x*u[5] + arm_p_J_z*u[3];
-  const T t42 = arm_p_J_x*u[4];
-  const T t46 = -t41*u[5] - t42*u[4];
-  const T t47 = t40*u[5] + t42*u[3];
-  const T t48 = t40*u[4] - t41*u[3];
-  const T t49 = -t23 + t46;
-  const T t50 = -t24 + t47;
-  const T t51 = t25 + t48;
-  const T t52 = -t26*u[3] - t27*u[4];
-  const T t53 = -t26*u[4] + t27*u[3];
+  const T t38 = -arm_p_J_z*u[4];
+  const T t39 = arm_p_J_x*u[5] + arm_p_J_z*u[3];
+  const T t40 = arm_p_J_x*u[4];
+  const T t44 = -t39*u[5] - t40*u[4];
+  const T t45 = t38*u[5] + t40*u[3];
+  const T t46 = t38*u[4] - t39*u[3];
+  const T t47 = -t23 + t44;
+  const T t48 = -t24 + t45;
+  const T t49 = t25 + t46;
+  const T t50 = -angle_c[0]*u[3] - angle_s[0]*u[4];
+  const T t51 = -angle_c[0]*u[4] + angle_s[0]*u[3];
   const T w_B_arm_z = u[5] + u[6];
-  const T t57 = t53*u[6];
-  const T t58 = -t52*u[6];
-  const T t60 = t26*t49 + t27*t50;
-  const T t61 = t26*t50 - t27*t49;
+  const T t55 = t51*u[6];
+  const T t56 = -t50*u[6];
+  const T t58 = angle_c[0]*t47 + angle_s[0]*t48;
+  const T t59 = angle_c[0]*t48 - angle_s[0]*t47;
   // ---- body sensor: outward pass (velocities)
-  const T t62 = cos(q[8] + sensor_angle_offset);
-  const T t63 = sin(q[8] + sensor_angle_offset);
-  const T t76 = -sensor_p_J_x*t53;
-  const T t77 = -sensor_p_J_x*w_B_arm_z;
-  const T t80 = t53*t76 + t77*w_B_arm_z;
-  const T t81 = -t52*t77;
-  const T t82 = t52*t76;
-  const T t83 = -sensor_p_J_x*t58;
-  const T t84 = t51 + t83;
-  const T t85 = t60 + t80;
-  const T t86 = t81 + t84;
-  const T t87 = -t61 + t82;
-  const T t88 = t52*t62 + t63*w_B_arm_z;
-  const T t89 = -t52*t63 + t62*w_B_arm_z;
-  const T w_B_sensor_z = -t53 + u[7];
-  const T t93 = t89*u[7];
-  const T t94 = -t88*u[7];
-  const T t95 = t57*t62;
-  const T t96 = -t57*t63;
-  const T alpha_R_B_sensor_x = t93 + t95;
-  const T alpha_R_B_sensor_y = t94 + t96;
-  const T t100 = t62*t85 + t63*t86;
-  const T t101 = t62*t86 - t63*t85;
+  const T t72 = -sensor_p_J_x*t51;
+  const T t73 = -sensor_p_J_x*w_B_arm_z;
+  const T t76 = t51*t72 + t73*w_B_arm_z;
+  const T t77 = -t50*t73;
+  const T t78 = t50*t72;
+  const T t79 = -sensor_p_J_x*t56;
+  const T t80 = t49 + t79;
+  const T t81 = t58 + t76;
+  const T t82 = t77 + t80;
+  const T t83 = -t59 + t78;
+  const T t84 = angle_c[1]*t50 + angle_s[1]*w_B_arm_z;
+  const T t85 = angle_c[1]*w_B_arm_z - angle_s[1]*t50;
+  const T w_B_sensor_z = -t51 + u[7];
+  const T t89 = t85*u[7];
+  const T t90 = -t84*u[7];
+  const T t91 = angle_c[1]*t55;
+  const T t92 = -angle_s[1]*t55;
+  const T alpha_R_B_sensor_x = t89 + t91;
+  const T alpha_R_B_sensor_y = t90 + t92;
+  const T t96 = angle_c[1]*t81 + angle_s[1]*t82;
+  const T t97 = angle_c[1]*t82 - angle_s[1]*t81;
   // ---- body station: mass and velocity terms
-  const T t102 = -station_S0_y*u[5] + station_S0_z*u[4];
-  const T t103 = station_S0_x*u[5] - station_S0_z*u[3];
-  const T t104 = -station_S0_x*u[4] + station_S0_y*u[3];
-  const T t105 = -t103*u[5] + t104*u[4];
-  const T t106 = t102*u[5] - t104*u[3];
-  const T t107 = -t102*u[4] + t103*u[3];
-  const T t108 = station_J0_xx*u[3] + station_J0_xy*u[4] + station_J0_xz*u[5];
-  const T t109 = station_J0_xy*u[3] + station_J0_yy*u[4] + station_J0_yz*u[5];
-  const T t110 = station_J0_xz*u[3] + station_J0_yz*u[4] + station_J0_zz*u[5];
-  const T t111 = -t109*u[5] + t110*u[4];
-  const T t112 = t108*u[5] - t110*u[3];
-  const T t113 = -t108*u[4] + t109*u[3];
+  const T t98 = -station_S0_y*u[5] + station_S0_z*u[4];
+  const T t99 = station_S0_x*u[5] - station_S0_z*u[3];
+  const T t100 = -station_S0_x*u[4] + station_S0_y*u[3];
+  const T t101 = t100*u[4] - t99*u[5];
+  const T t102 = -t100*u[3] + t98*u[5];
+  const T t103 = -t98*u[4] + t99*u[3];
+  const T t104 = station_J0_xx*u[3] + station_J0_xy*u[4] + station_J0_xz*u[5];
+  const T t105 = station_J0_xy*u[3] + station_J0_yy*u[4] + station_J0_yz*u[5];
+  const T t106 = station_J0_xz*u[3] + station_J0_yz*u[4] + station_J0_zz*u[5];
+  const T t107 = -t105*u[5] + t106*u[4];
+  const T t108 = t104*u[5] - t106*u[3];
+  const T t109 = -t104*u[4] + t105*u[3];
   // ---- body arm: mass and velocity terms
-  const T t114 = arm_S0_x*w_B_arm_z;
-  const T t115 = -arm_S0_x*t53;
-  const T t116 = -t114*w_B_arm_z + t115*t53;
-  const T t117 = -t115*t52;
-  const T t118 = t114*t52;
-  const T t119 = arm_J0_xx*t52;
-  const T t120 = arm_J0_yy*t53;
-  const T t121 = arm_J0_zz*w_B_arm_z;
-  const T t122 = -t120*w_B_arm_z + t121*t53;
-  const T t123 = t119*w_B_arm_z - t121*t52;
-  const T t124 = -t119*t53 + t120*t52;
+  const T t110 = arm_S0_x*w_B_arm_z;
+  const T t111 = -arm_S0_x*t51;
+  const T t112 = -t110*w_B_arm_z + t111*t51;
+  const T t113 = -t111*t50;
+  const T t114 = t110*t50;
+  const T t115 = arm_J0_xx*t50;
+  const T t116 = arm_J0_yy*t51;
+  const T t117 = arm_J0_zz*w_B_arm_z;
+  const T t118 = -t116*w_B_arm_z + t117*t51;
+  const T t119 = t115*w_B_arm_z - t117*t50;
+  const T t120 = -t115*t51 + t116*t50;
   // ---- body sensor: mass and velocity terms
-  const T t125 = sensor_S0_x*w_B_sensor_z;
-  const T t126 = -sensor_S0_x*t89;
-  const T t127 = -t125*w_B_sensor_z + t126*t89;
-  const T t128 = -t126*t88;
-  const T t129 = t125*t88;
-  const T t130 = sensor_J0_xx*t88;
-  const T t131 = sensor_J0_yy*t89;
-  const T t132 = sensor_J0_zz*w_B_sensor_z;
-  const T t133 = -t131*w_B_sensor_z + t132*t89;
-  const T t134 = t130*w_B_sensor_z - t132*t88;
-  const T t135 = -t130*t89 + t131*t88;
+  const T t121 = sensor_S0_x*w_B_sensor_z;
+  const T t122 = -sensor_S0_x*t85;
+  const T t123 = -t121*w_B_sensor_z + t122*t85;
+  const T t124 = -t122*t84;
+  const T t125 = t121*t84;
+  const T t126 = sensor_J0_xx*t84;
+  const T t127 = sensor_J0_yy*t85;
+  const T t128 = sensor_J0_zz*w_B_sensor_z;
+  const T t129 = -t127*w_B_sensor_z + t128*t85;
+  const T t130 = t126*w_B_sensor_z - t128*t84;
+  const T t131 = -t126*t85 + t127*t84;
   // ---- body sensor: composite inertia (inward)
-  const T t136 = sensor_S0_x*t62;
-  const T t137 = sensor_S0_x*t63;
-  const T t138 = t63*t63;
-  const T t139 = t62*t63;
-  const T t141 = -kaa5c1197*t138;
-  const T t142 = sensor_J0_xx - t141;
-  const T t143 = sensor_J0_yy + t141;
-  const T t144 = -kaa5c1197*t139;
-  const T t145 = -sensor_p_J_x*t137 + t144;
-  const T t146 = 2.0*sensor_p_J_x*t136 + k2b5ff873 + t143;
-  const T t147 = 2.0*sensor_p_J_x*t136 + k49081188;
-  const T t148 = kdc6e78e8 + t136;
-  const T t149 = arm_J0_xx + t142;
-  const T t150 = arm_J0_yy + t147;
-  const T t151 = arm_J0_zz + t146;
-  const T t153 = arm_S0_x + t148;
+  const T t132 = angle_c[1]*sensor_S0_x;
+  const T t133 = angle_s[1]*sensor_S0_x;
+  const T t134 = angle_s[1]*angle_s[1];
+  const T t135 = angle_c[1]*angle_s[1];
+  const T t137 = -kaa5c1197*t134;
+  const T t138 = sensor_J0_xx - t137;
+  const T t139 = sensor_J0_yy + t137;
+  const T t140 = -kaa5c1197*t135;
+  const T t141 = -sensor_p_J_x*t133 + t140;
+  const T t142 = 2.0*sensor_p_J_x*t132 + k2b5ff873 + t139;
+  const T t143 = 2.0*sensor_p_J_x*t132 + k49081188;
+  const T t144 = kdc6e78e8 + t132;
+  const T t145 = arm_J0_xx + t138;
+  const T t146 = arm_J0_yy + t143;
+  const T t147 = arm_J0_zz + t142;
+  const T t149 = arm_S0_x + t144;
   // ---- body arm: composite inertia (inward)
-  const T t154 = t153*t26;
-  const T t155 = t153*t27;
-  const T t156 = t27*t27;
-  const T t157 = t26*t27;
-  const T t159 = t149 - t150;
-  const T t160 = t156*t159;
-  const T t161 = t149 - t160;
-  const T t162 = t150 + t160;
-  const T t163 = t157*t159;
-  const T t164 = t145*t26;
-  const T t165 = t145*t27;
-  const T t166 = 2.0*arm_p_J_z*t137 + k44bd7af3 + t161;
-  const T t167 = -arm_p_J_x*t155 + t163;
-  const T t168 = t164 - ((arm_p_J_x*t137 + arm_p_J_z*t154) + kfecc247c);
-  const T t169 = (2.0*arm_p_J_x*t154 + 2.0*arm_p_J_z*t137) + (k8b74a21f + t162);
-  const T t170 = -arm_p_J_z*t155 + t165;
-  const T t171 = 2.0*arm_p_J_x*t154 + k7e2ba37a + t151;
-  const T t172 = k28dea4a2 + t154;
-  const T t173 = k753a7a93 + t137;
-  const T t174 = station_J0_xx + t166;
-  const T t175 = station_J0_xy + t167;
-  const T t176 = station_J0_xz - t168;
-  const T t177 = station_J0_yy + t169;
-  const T t178 = station_J0_yz - t170;
-  const T t179 = station_J0_zz + t171;
-  const T t180 = -station_S0_z - t173;
-  const T t181 = station_S0_y - t155;
-  const T t182 = station_S0_z + t173;
-  const T t183 = -station_S0_x + t172;
-  const T t184 = -station_S0_y + t155;
-  const T t185 = station_S0_x - t172;
+  const T t150 = angle_c[0]*t149;
+  const T t151 = angle_s[0]*t149;
+  const T t152 = angle_s[0]*angle_s[0];
+  const T t153 = angle_c[0]*angle_s[0];
+  const T t155 = t145 - t146;
+  const T t156 = t152*t155;
+  const T t157 = t145 - t156;
+  const T t158 = t146 + t156;
+  const T t159 = t153*t155;
+  const T t160 = angle_c[0]*t141;
+  const T t161 = angle_s[0]*t141;
+  const T t162 = 2.0*arm_p_J_z*t133 + k44bd7af3 + t157;
+  const T t163 = -arm_p_J_x*t151 + t159;
+  const T t164 = t160 - ((arm_p_J_x*t133 + arm_p_J_z*t150) + kfecc247c);
+  const T t165 = (2.0*arm_p_J_x*t150 + 2.0*arm_p_J_z*t133) + (k8b74a21f + t158);
+  const T t166 = -arm_p_J_z*t151 + t161;
+  const T t167 = 2.0*arm_p_J_x*t150 + k7e2ba37a + t147;
+  const T t168 = k28dea4a2 + t150;
+  const T t169 = k753a7a93 + t133;
+  const T t170 = station_J0_xx + t162;
+  const T t171 = station_J0_xy + t163;
+  const T t172 = station_J0_xz - t164;
+  const T t173 = station_J0_yy + t165;
+  const T t174 = station_J0_yz - t166;
+  const T t175 = station_J0_zz + t167;
+  const T t176 = -station_S0_z - t169;
+  const T t177 = station_S0_y - t151;
+  const T t178 = station_S0_z + t169;
+  const T t179 = -station_S0_x + t168;
+  const T t180 = -station_S0_y + t151;
+  const T t181 = station_S0_x - t168;
   // ---- body arm: its columns of M (walked to the root)
-  const T t186 = -t153*t27;
-  const T t187 = -arm_p_J_z*t154;
-  const T t188 = arm_p_J_z*t186;
-  const T t189 = arm_p_J_x*t154;
-  const T t190 = t164 + t187;
-  const T t191 = t165 + t188;
-  const T t192 = t151 + t189;
+  const T t182 = -angle_s[0]*t149;
+  const T t183 = -arm_p_J_z*t150;
+  const T t184 = arm_p_J_z*t182;
+  const T t185 = arm_p_J_x*t150;
+  const T t186 = t160 + t183;
+  const T t187 = t161 + t184;
+  const T t188 = t147 + t185;
   // ---- body sensor: its columns of M (walked to the root)
-  const T t193 = -sensor_S0_x*t63;
-  const T t194 = sensor_p_J_x*t136;
-  const T t195 = sensor_J0_zz + t194;
-  const T t196 = t193*t26;
-  const T t197 = t193*t27;
-  const T t198 = -arm_p_J_z*t197;
-  const T t199 = -arm_p_J_x*t136 + arm_p_J_z*t196;
-  const T t200 = arm_p_J_x*t197;
-  const T t201 = t195*t27;
-  const T t202 = -t195*t26;
-  const T t203 = t198 + t201;
-  const T t204 = t199 + t202;
+  const T t189 = -angle_s[1]*sensor_S0_x;
+  const T t190 = sensor_p_J_x*t132;
+  const T t191 = sensor_J0_zz + t190;
+  const T t192 = angle_c[0]*t189;
+  const T t193 = angle_s[0]*t189;
+  const T t194 = -arm_p_J_z*t193;
+  const T t195 = -arm_p_J_x*t132 + arm_p_J_z*t192;
+  const T t196 = arm_p_J_x*t193;
+  const T t197 = angle_s[0]*t191;
+  const T t198 = -angle_c[0]*t191;
+  const T t199 = t194 + t197;
+  const T t200 = t195 + t198;
   // ---- body station: bias force
-  const T t205 = -station_mass*t23 - t105;
-  const T t206 = -station_mass*t24 - t106;
-  const T t207 = -station_mass*t25 - t107;
-  const T t208 = -station_S0_y*t25 + station_S0_z*t24 - t111;
-  const T t209 = station_S0_x*t25 - station_S0_z*t23 - t112;
-  const T t210 = -station_S0_x*t24 + station_S0_y*t23 - t113;
+  const T t201 = -station_mass*t23 - t101;
+  const T t202 = -station_mass*t24 - t102;
+  const T t203 = -station_mass*t25 - t103;
+  const T t204 = -station_S0_y*t25 + station_S0_z*t24 - t107;
+  const T t205 = station_S0_x*t25 - station_S0_z*t23 - t108;
+  const T t206 = -station_S0_x*t24 + station_S0_y*t23 - t109;
   // ---- body arm: bias force
-  const T t211 = -arm_mass*t60 - t116;
-  const T t212 = -arm_mass*t61 - t117;
-  const T t213 = arm_S0_x*t58 - arm_mass*t51 - t118;
-  const T t214 = -arm_J0_xx*t57 - t122;
-  const T t215 = -arm_J0_yy*t58 + arm_S0_x*t51 - t123;
-  const T t216 = -arm_S0_x*t61 - t124;
+  const T t207 = -arm_mass*t58 - t112;
+  const T t208 = -arm_mass*t59 - t113;
+  const T t209 = arm_S0_x*t56 - arm_mass*t49 - t114;
+  const T t210 = -arm_J0_xx*t55 - t118;
+  const T t211 = -arm_J0_yy*t56 + arm_S0_x*t49 - t119;
+  const T t212 = -arm_S0_x*t59 - t120;
   // ---- body sensor: bias force
-  const T t217 = -sensor_mass*t100 - t127;
-  const T t218 = sensor_S0_x*t58 - sensor_mass*t101 - t128;
-  const T t219 = alpha_R_B_sensor_y*sensor_S0_x - sensor_mass*t87 - t129;
-  const T t220 = -alpha_R_B_sensor_x*sensor_J0_xx - t133;
-  const T t221 = -alpha_R_B_sensor_y*sensor_J0_yy + sensor_S0_x*t87 - t134;
-  const T t222 = sensor_J0_zz*t58 - sensor_S0_x*t101 - t135;
+  const T t213 = -sensor_mass*t96 - t123;
+  const T t214 = sensor_S0_x*t56 - sensor_mass*t97 - t124;
+  const T t215 = alpha_R_B_sensor_y*sensor_S0_x - sensor_mass*t83 - t125;
+  const T t216 = -alpha_R_B_sensor_x*sensor_J0_xx - t129;
+  const T t217 = -alpha_R_B_sensor_y*sensor_J0_yy + sensor_S0_x*t83 - t130;
+  const T t218 = sensor_J0_zz*t56 - sensor_S0_x*t97 - t131;
   // ---- body sensor: generalized forces (inward)
-  const T t223 = -q[8]*sensor_k + tau[7];
-  const T t224 = t222 + t223;
-  const T t225 = t217*t62 - t218*t63;
-  const T t226 = t217*t63 + t218*t62;
-  const T t227 = -sensor_p_J_x*t219;
-  const T t228 = sensor_p_J_x*t226;
-  const T t229 = t220*t62 - t221*t63;
-  const T t230 = t220*t63 + t221*t62;
-  const T t231 = t227 + t230;
-  const T t232 = t222 + t228;
-  const T t233 = t211 + t225;
-  const T t234 = t212 - t219;
-  const T t235 = t213 + t226;
-  const T t236 = t214 + t229;
-  const T t237 = t215 - t232;
-  const T t238 = t216 + t231;
+  const T t219 = -q[8]*sensor_k + tau[7];
+  const T t220 = t218 + t219;
+  const T t221 = angle_c[1]*t213 - angle_s[1]*t214;
+  const T t222 = angle_c[1]*t214 + angle_s[1]*t213;
+  const T t223 = -sensor_p_J_x*t215;
+  const T t224 = sensor_p_J_x*t222;
+  const T t225 = angle_c[1]*t216 - angle_s[1]*t217;
+  const T t226 = angle_c[1]*t217 + angle_s[1]*t216;
+  const T t227 = t223 + t226;
+  const T t228 = t218 + t224;
+  const T t229 = t207 + t221;
+  const T t230 = t208 - t215;
+  const T t231 = t209 + t222;
+  const T t232 = t210 + t225;
+  const T t233 = t211 - t228;
+  const T t234 = t212 + t227;
   // ---- body arm: generalized forces (inward)
-  const T t239 = -arm_k*q[7] + tau[6];
-  const T t240 = t238 + t239;
-  const T t241 = t233*t26 - t234*t27;
-  const T t242 = t233*t27 + t234*t26;
-  const T t243 = -arm_p_J_z*t242;
-  const T t244 = -arm_p_J_x*t235 + arm_p_J_z*t241;
-  const T t245 = arm_p_J_x*t242;
-  const T t246 = t236*t26 - t237*t27;
-  const T t247 = t236*t27 + t237*t26;
-  const T t248 = t243 + t246;
-  const T t249 = t244 + t247;
-  const T t250 = t238 + t245;
-  const T t251 = t205 - t241;
-  const T t252 = t206 - t242;
-  const T t253 = t207 + t235;
-  const T t254 = t208 - t248;
-  const T t255 = t209 - t249;
-  const T t256 = t210 + t250;
+  const T t235 = -arm_k*q[7] + tau[6];
+  const T t236 = t234 + t235;
+  const T t237 = angle_c[0]*t229 - angle_s[0]*t230;
+  const T t238 = angle_c[0]*t230 + angle_s[0]*t229;
+  const T t239 = -arm_p_J_z*t238;
+  const T t240 = -arm_p_J_x*t231 + arm_p_J_z*t237;
+  const T t241 = arm_p_J_x*t238;
+  const T t242 = angle_c[0]*t232 - angle_s[0]*t233;
+  const T t243 = angle_c[0]*t233 + angle_s[0]*t232;
+  const T t244 = t239 + t242;
+  const T t245 = t240 + t243;
+  const T t246 = t234 + t241;
+  const T t247 = t201 - t237;
+  const T t248 = t202 - t238;
+  const T t249 = t203 + t231;
+  const T t250 = t204 - t244;
+  const T t251 = t205 - t245;
+  const T t252 = t206 + t246;
   // ---- body station: generalized forces (inward)
-  const T t257 = t251 + tau[0];
-  const T t258 = t252 + tau[1];
-  const T t259 = t253 + tau[2];
-  const T t260 = t254 + tau[3];
-  const T t261 = t255 + tau[4];
-  const T t262 = t256 + tau[5];
+  const T t253 = t247 + tau[0];
+  const T t254 = t248 + tau[1];
+  const T t255 = t249 + tau[2];
+  const T t256 = t250 + tau[3];
+  const T t257 = t251 + tau[4];
+  const T t258 = t252 + tau[5];
   // ---- M u_dot = F: L^T D L along the dof tree
-  const T t263 = k4a99e1de*t200;
-  const T t264 = t179 - t200*t263;
-  const T t265 = t178 + t204*t263;
-  const T t266 = t176 + t203*t263;
-  const T t267 = -t136*t263;
-  const T t268 = t185 + t197*t263;
-  const T t269 = t184 + t196*t263;
-  const T t270 = -k4a99e1de*t204;
-  const T t271 = t177 + t204*t270;
-  const T t272 = t175 + t203*t270;
-  const T t273 = -t136*t270 + t183;
-  const T t274 = t197*t270;
-  const T t275 = t182 + t196*t270;
-  const T t276 = -k4a99e1de*t203;
-  const T t277 = t174 + t203*t276;
-  const T t278 = -t136*t276 + t181;
-  const T t279 = t180 + t197*t276;
-  const T t280 = t196*t276;
-  const T t281 = k4a99e1de*t136;
-  const T t282 = k5612693a - t136*t281;
-  const T t283 = t197*t281;
-  const T t284 = t196*t281;
-  const T t285 = -k4a99e1de*t197;
-  const T t286 = k5612693a + t197*t285;
-  const T t287 = t196*t285;
-  const T t288 = -k4a99e1de*t196;
-  const T t289 = k5612693a + t196*t288;
-  const T t290 = 1.0/t151;
-  const T t291 = t192*t290;
-  const T t292 = -t192*t291 + t264;
-  const T t293 = t191*t291 + t265;
-  const T t294 = t190*t291 + t266;
-  const T t295 = t154*t291 + t268;
-  const T t296 = t186*t291 + t269;
-  const T t297 = -t191*t290;
-  const T t298 = t191*t297 + t271;
-  const T t299 = t190*t297 + t272;
-  const T t300 = t154*t297 + t274;
-  const T t301 = t186*t297 + t275;
-  const T t302 = -t190*t290;
-  const T t303 = t190*t302 + t277;
-  const T t304 = t154*t302 + t279;
-  const T t305 = t186*t302 + t280;
-  const T t306 = -t154*t290;
-  const T t307 = t154*t306 + t286;
-  const T t308 = t186*t306 + t287;
-  const T t309 = -t186*t290;
-  const T t310 = t186*t309 + t289;
-  const T t311 = 1.0/t292;
-  const T t312 = t293*t311;
-  const T t313 = -t293*t312 + t298;
-  const T t314 = -t294*t312 + t299;
-  const T t315 = -t267*t312 + t273;
-  const T t316 = -t295*t312 + t300;
-  const T t317 = -t296*t312 + t301;
-  const T t318 = t294*t311;
-  const T t319 = -t294*t318 + t303;
-  const T t320 = -t267*t318 + t278;
-  const T t321 = -t295*t318 + t304;
-  const T t322 = -t296*t318 + t305;
-  const T t323 = t267*t311;
-  const T t324 = -t267*t323 + t282;
-  const T t325 = t283 - t295*t323;
-  const T t326 = t284 - t296*t323;
-  const T t327 = t295*t311;
-  const T t328 = -t295*t327 + t307;
-  const T t329 = -t296*t327 + t308;
-  const T t330 = t296*t311;
-  const T t331 = -t296*t330 + t310;
-  const T t332 = 1.0/t313;
-  const T t333 = t314*t332;
-  const T t334 = -t314*t333 + t319;
-  const T t335 = -t315*t333 + t320;
-  const T t336 = -t316*t333 + t321;
-  const T t337 = -t317*t333 + t322;
-  const T t338 = t315*t332;
-  const T t339 = -t315*t338 + t324;
-  const T t340 = -t316*t338 + t325;
-  const T t341 = -t317*t338 + t326;
-  const T t342 = t316*t332;
-  const T t343 = -t316*t342 + t328;
-  const T t344 = -t317*t342 + t329;
-  const T t345 = t317*t332;
-  const T t346 = -t317*t345 + t331;
-  const T t347 = 1.0/t334;
-  const T t348 = t335*t347;
-  const T t349 = -t335*t348 + t339;
-  const T t350 = -t336*t348 + t340;
-  const T t351 = -t337*t348 + t341;
-  const T t352 = t336*t347;
-  const T t353 = -t336*t352 + t343;
-  const T t354 = -t337*t352 + t344;
-  const T t355 = t337*t347;
-  const T t356 = -t337*t355 + t346;
-  const T t357 = 1.0/t349;
-  const T t358 = t350*t357;
-  const T t359 = -t350*t358 + t353;
-  const T t360 = -t351*t358 + t354;
-  const T t361 = t351*t357;
-  const T t362 = -t351*t361 + t356;
-  const T t363 = 1.0/t359;
-  const T t364 = t360*t363;
-  const T t365 = -t360*t364 + t362;
-  const T t367 = -t224*t263 + t262;
-  const T t368 = -t224*t270 + t261;
-  const T t369 = -t224*t276 + t260;
-  const T t370 = -t224*t281 + t259;
-  const T t371 = -t224*t285 + t258;
-  const T t372 = -t224*t288 + t257;
-  const T t373 = -t240*t291 + t367;
-  const T t374 = -t240*t297 + t368;
-  const T t375 = -t240*t302 + t369;
-  const T t376 = -t240*t306 + t371;
-  const T t377 = -t240*t309 + t372;
-  const T t378 = -t312*t373 + t374;
-  const T t379 = -t318*t373 + t375;
-  const T t380 = -t323*t373 + t370;
-  const T t381 = -t327*t373 + t376;
-  const T t382 = -t330*t373 + t377;
-  const T t383 = -t333*t378 + t379;
-  const T t384 = -t338*t378 + t380;
-  const T t385 = -t342*t378 + t381;
-  const T t386 = -t345*t378 + t382;
-  const T t387 = -t348*t383 + t384;
-  const T t388 = -t352*t383 + t385;
-  const T t389 = -t355*t383 + t386;
-  const T t390 = -t358*t387 + t388;
-  const T t391 = -t361*t387 + t389;
-  const T t392 = -t364*t390 + t391;
-  const T t393 = t392/t365;
-  const T t394 = t390/t359;
-  const T t395 = t387/t349;
-  const T t396 = t383/t334;
-  const T t397 = t378/t313;
-  const T t398 = t373/t292;
-  const T t399 = t240/t151;
-  const T t400 = k4a99e1de*t224;
-  const T t401 = -t364*t393 + t394;
-  const T t402 = -t358*t401 + t395;
-  const T t403 = -t361*t393 + t402;
-  const T t404 = -t348*t403 + t396;
-  const T t405 = -t352*t401 + t404;
-  const T t406 = -t355*t393 + t405;
-  const T t407 = -t333*t406 + t397;
-  const T t408 = -t338*t403 + t407;
-  const T t409 = -t342*t401 + t408;
-  const T t410 = -t345*t393 + t409;
-  const T t411 = -t312*t410 + t398;
-  const T t412 = -t318*t406 + t411;
-  const T t413 = -t323*t403 + t412;
-  const T t414 = -t327*t401 + t413;
-  const T t415 = -t330*t393 + t414;
-  const T t416 = -t291*t415 + t399;
-  const T t417 = -t297*t410 + t416;
-  const T t418 = -t302*t406 + t417;
-  const T t419 = -t306*t401 + t418;
-  const T t420 = -t309*t393 + t419;
-  const T t421 = -t263*t415 + t400;
-  const T t422 = -t270*t410 + t421;
-  const T t423 = -t276*t406 + t422;
-  const T t424 = -t281*t403 + t423;
-  const T t425 = -t285*t401 + t424;
-  const T t426 = -t288*t393 + t425;
-  if (!(t365 > 1e-14*k5612693a)) return 1;
-  if (!(t359 > 1e-14*k5612693a)) return 2;
-  if (!(t349 > 1e-14*k5612693a)) return 3;
-  if (!(t334 > 1e-14*t174)) return 4;
-  if (!(t313 > 1e-14*t177)) return 5;
-  if (!(t292 > 1e-14*t179)) return 6;
-  if (!(t151 > 0.0)) return 7;
+  const T t259 = k4a99e1de*t196;
+  const T t260 = t175 - t196*t259;
+  const T t261 = t174 + t200*t259;
+  const T t262 = t172 + t199*t259;
+  const T t263 = -t132*t259;
+  const T t264 = t181 + t193*t259;
+  const T t265 = t180 + t192*t259;
+  const T t266 = -k4a99e1de*t200;
+  const T t267 = t173 + t200*t266;
+  const T t268 = t171 + t199*t266;
+  const T t269 = -t132*t266 + t179;
+  const T t270 = t193*t266;
+  const T t271 = t178 + t192*t266;
+  const T t272 = -k4a99e1de*t199;
+  const T t273 = t170 + t199*t272;
+  const T t274 = -t132*t272 + t177;
+  const T t275 = t176 + t193*t272;
+  const T t276 = t192*t272;
+  const T t277 = k4a99e1de*t132;
+  const T t278 = k5612693a - t132*t277;
+  const T t279 = t193*t277;
+  const T t280 = t192*t277;
+  const T t281 = -k4a99e1de*t193;
+  const T t282 = k5612693a + t193*t281;
+  const T t283 = t192*t281;
+  const T t284 = -k4a99e1de*t192;
+  const T t285 = k5612693a + t192*t284;
+  const T t286 = 1.0/t147;
+  const T t287 = t188*t286;
+  const T t288 = -t188*t287 + t260;
+  const T t289 = t187*t287 + t261;
+  const T t290 = t186*t287 + t262;
+  const T t291 = t150*t287 + t264;
+  const T t292 = t182*t287 + t265;
+  const T t293 = -t187*t286;
+  const T t294 = t187*t293 + t267;
+  const T t295 = t186*t293 + t268;
+  const T t296 = t150*t293 + t270;
+  const T t297 = t182*t293 + t271;
+  const T t298 = -t186*t286;
+  const T t299 = t186*t298 + t273;
+  const T t300 = t150*t298 + t275;
+  const T t301 = t182*t298 + t276;
+  const T t302 = -t150*t286;
+  const T t303 = t150*t302 + t282;
+  const T t304 = t182*t302 + t283;
+  const T t305 = -t182*t286;
+  const T t306 = t182*t305 + t285;
+  const T t307 = 1.0/t288;
+  const T t308 = t289*t307;
+  const T t309 = -t289*t308 + t294;
+  const T t310 = -t290*t308 + t295;
+  const T t311 = -t263*t308 + t269;
+  const T t312 = -t291*t308 + t296;
+  const T t313 = -t292*t308 + t297;
+  const T t314 = t290*t307;
+  const T t315 = -t290*t314 + t299;
+  const T t316 = -t263*t314 + t274;
+  const T t317 = -t291*t314 + t300;
+  const T t318 = -t292*t314 + t301;
+  const T t319 = t263*t307;
+  const T t320 = -t263*t319 + t278;
+  const T t321 = t279 - t291*t319;
+  const T t322 = t280 - t292*t319;
+  const T t323 = t291*t307;
+  const T t324 = -t291*t323 + t303;
+  const T t325 = -t292*t323 + t304;
+  const T t326 = t292*t307;
+  const T t327 = -t292*t326 + t306;
+  const T t328 = 1.0/t309;
+  const T t329 = t310*t328;
+  const T t330 = -t310*t329 + t315;
+  const T t331 = -t311*t329 + t316;
+  const T t332 = -t312*t329 + t317;
+  const T t333 = -t313*t329 + t318;
+  const T t334 = t311*t328;
+  const T t335 = -t311*t334 + t320;
+  const T t336 = -t312*t334 + t321;
+  const T t337 = -t313*t334 + t322;
+  const T t338 = t312*t328;
+  const T t339 = -t312*t338 + t324;
+  const T t340 = -t313*t338 + t325;
+  const T t341 = t313*t328;
+  const T t342 = -t313*t341 + t327;
+  const T t343 = 1.0/t330;
+  const T t344 = t331*t343;
+  const T t345 = -t331*t344 + t335;
+  const T t346 = -t332*t344 + t336;
+  const T t347 = -t333*t344 + t337;
+  const T t348 = t332*t343;
+  const T t349 = -t332*t348 + t339;
+  const T t350 = -t333*t348 + t340;
+  const T t351 = t333*t343;
+  const T t352 = -t333*t351 + t342;
+  const T t353 = 1.0/t345;
+  const T t354 = t346*t353;
+  const T t355 = -t346*t354 + t349;
+  const T t356 = -t347*t354 + t350;
+  const T t357 = t347*t353;
+  const T t358 = -t347*t357 + t352;
+  const T t359 = 1.0/t355;
+  const T t360 = t356*t359;
+  const T t361 = -t356*t360 + t358;
+  const T t363 = -t220*t259 + t258;
+  const T t364 = -t220*t266 + t257;
+  const T t365 = -t220*t272 + t256;
+  const T t366 = -t220*t277 + t255;
+  const T t367 = -t220*t281 + t254;
+  const T t368 = -t220*t284 + t253;
+  const T t369 = -t236*t287 + t363;
+  const T t370 = -t236*t293 + t364;
+  const T t371 = -t236*t298 + t365;
+  const T t372 = -t236*t302 + t367;
+  const T t373 = -t236*t305 + t368;
+  const T t374 = -t308*t369 + t370;
+  const T t375 = -t314*t369 + t371;
+  const T t376 = -t319*t369 + t366;
+  const T t377 = -t323*t369 + t372;
+  const T t378 = -t326*t369 + t373;
+  const T t379 = -t329*t374 + t375;
+  const T t380 = -t334*t374 + t376;
+  const T t381 = -t338*t374 + t377;
+  const T t382 = -t341*t374 + t378;
+  const T t383 = -t344*t379 + t380;
+  const T t384 = -t348*t379 + t381;
+  const T t385 = -t351*t379 + t382;
+  const T t386 = -t354*t383 + t384;
+  const T t387 = -t357*t383 + t385;
+  const T t388 = -t360*t386 + t387;
+  const T t389 = t388/t361;
+  const T t390 = t386/t355;
+  const T t391 = t383/t345;
+  const T t392 = t379/t330;
+  const T t393 = t374/t309;
+  const T t394 = t369/t288;
+  const T t395 = t236/t147;
+  const T t396 = k4a99e1de*t220;
+  const T t397 = -t360*t389 + t390;
+  const T t398 = -t354*t397 + t391;
+  const T t399 = -t357*t389 + t398;
+  const T t400 = -t344*t399 + t392;
+  const T t401 = -t348*t397 + t400;
+  const T t402 = -t351*t389 + t401;
+  const T t403 = -t329*t402 + t393;
+  const T t404 = -t334*t399 + t403;
+  const T t405 = -t338*t397 + t404;
+  const T t406 = -t341*t389 + t405;
+  const T t407 = -t308*t406 + t394;
+  const T t408 = -t314*t402 + t407;
+  const T t409 = -t319*t399 + t408;
+  const T t410 = -t323*t397 + t409;
+  const T t411 = -t326*t389 + t410;
+  const T t412 = -t287*t411 + t395;
+  const T t413 = -t293*t406 + t412;
+  const T t414 = -t298*t402 + t413;
+  const T t415 = -t302*t397 + t414;
+  const T t416 = -t305*t389 + t415;
+  const T t417 = -t259*t411 + t396;
+  const T t418 = -t266*t406 + t417;
+  const T t419 = -t272*t402 + t418;
+  const T t420 = -t277*t399 + t419;
+  const T t421 = -t281*t397 + t420;
+  const T t422 = -t284*t389 + t421;
+  if (!(t361 > 1e-14*k5612693a)) return 1;
+  if (!(t355 > 1e-14*k5612693a)) return 2;
+  if (!(t345 > 1e-14*k5612693a)) return 3;
+  if (!(t330 > 1e-14*t170)) return 4;
+  if (!(t309 > 1e-14*t173)) return 5;
+  if (!(t288 > 1e-14*t175)) return 6;
+  if (!(t147 > 0.0)) return 7;
   if (!(sensor_J0_zz > 0.0)) return 8;
-  udot[0] = t393;
-  udot[1] = t401;
-  udot[2] = t403;
-  udot[3] = t406;
-  udot[4] = t410;
-  udot[5] = t415;
-  udot[6] = t420;
-  udot[7] = t426;
+  udot[0] = t389;
+  udot[1] = t397;
+  udot[2] = t399;
+  udot[3] = t402;
+  udot[4] = t406;
+  udot[5] = t411;
+  udot[6] = t416;
+  udot[7] = t422;
   return 0;
 }
 
@@ -897,60 +1024,60 @@ template <class T>
 void energy(const T* q, const T* u, T* TV) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8] + sensor_angle_offset};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body arm: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = -arm_p_J_z*u[4];
-  const T t41 = arm_p_J_x*u[5] + arm_p_J_z*u[3];
-  const T t42 = arm_p_J_x*u[4];
-  const T t43 = t40 - u[0];
-  const T t44 = t41 - u[1];
-  const T t45 = t42 + u[2];
-  const T t52 = -t26*u[3] - t27*u[4];
-  const T t53 = -t26*u[4] + t27*u[3];
+  const T t38 = -arm_p_J_z*u[4];
+  const T t39 = arm_p_J_x*u[5] + arm_p_J_z*u[3];
+  const T t40 = arm_p_J_x*u[4];
+  const T t41 = t38 - u[0];
+  const T t42 = t39 - u[1];
+  const T t43 = t40 + u[2];
+  const T t50 = -angle_c[0]*u[3] - angle_s[0]*u[4];
+  const T t51 = -angle_c[0]*u[4] + angle_s[0]*u[3];
   const T w_B_arm_z = u[5] + u[6];
-  const T t55 = t26*t43 + t27*t44;
-  const T t56 = t26*t44 - t27*t43;
+  const T t53 = angle_c[0]*t41 + angle_s[0]*t42;
+  const T t54 = angle_c[0]*t42 - angle_s[0]*t41;
   // ---- body sensor: outward pass (velocities)
-  const T t62 = cos(q[8] + sensor_angle_offset);
-  const T t63 = sin(q[8] + sensor_angle_offset);
-  const T t76 = -sensor_p_J_x*t53;
-  const T t77 = -sensor_p_J_x*w_B_arm_z;
-  const T t78 = t45 + t76;
-  const T t79 = -t56 + t77;
-  const T t88 = t52*t62 + t63*w_B_arm_z;
-  const T t89 = -t52*t63 + t62*w_B_arm_z;
-  const T w_B_sensor_z = -t53 + u[7];
-  const T t91 = t55*t62 + t63*t78;
-  const T t92 = -t55*t63 + t62*t78;
+  const T t72 = -sensor_p_J_x*t51;
+  const T t73 = -sensor_p_J_x*w_B_arm_z;
+  const T t74 = t43 + t72;
+  const T t75 = -t54 + t73;
+  const T t84 = angle_c[1]*t50 + angle_s[1]*w_B_arm_z;
+  const T t85 = angle_c[1]*w_B_arm_z - angle_s[1]*t50;
+  const T w_B_sensor_z = -t51 + u[7];
+  const T t87 = angle_c[1]*t53 + angle_s[1]*t74;
+  const T t88 = angle_c[1]*t74 - angle_s[1]*t53;
   // ---- body arm: mass and velocity terms
-  const T t119 = arm_J0_xx*t52;
+  const T t115 = arm_J0_xx*t50;
   // ---- body sensor: mass and velocity terms
-  const T t130 = sensor_J0_xx*t88;
-  const T t136 = -station_S0_y*u[5] + station_S0_z*u[4] + station_mass*u[0];
-  const T t137 = station_S0_x*u[5] - station_S0_z*u[3] + station_mass*u[1];
-  const T t138 = -station_S0_x*u[4] + station_S0_y*u[3] + station_mass*u[2];
-  const T t139 = ((station_J0_xx*u[3] + station_J0_xy*u[4]) + (station_J0_xz*u[5] + station_S0_y*u[2])) - station_S0_z*u[1];
-  const T t140 = ((station_J0_xy*u[3] + station_J0_yy*u[4]) + (station_J0_yz*u[5] + station_S0_z*u[0])) - station_S0_x*u[2];
-  const T t141 = ((station_J0_xz*u[3] + station_J0_yz*u[4]) + (station_J0_zz*u[5] + station_S0_x*u[1])) - station_S0_y*u[0];
-  const T t142 = ((t136*u[0] + t137*u[1]) + t138*u[2]) + ((t139*u[3] + t140*u[4]) + t141*u[5]);
-  const T t143 = arm_mass*t55;
-  const T t144 = arm_S0_x*w_B_arm_z + arm_mass*t56;
-  const T t145 = -arm_S0_x*t53 + arm_mass*t45;
-  const T t146 = arm_J0_yy*t53 - arm_S0_x*t45;
-  const T t147 = arm_J0_zz*w_B_arm_z + arm_S0_x*t56;
-  const T t148 = ((t119*t52 + t143*t55) + t144*t56) + ((t145*t45 + t146*t53) + t147*w_B_arm_z);
-  const T t149 = sensor_mass*t91;
-  const T t150 = sensor_S0_x*w_B_sensor_z + sensor_mass*t92;
-  const T t151 = -sensor_S0_x*t89 + sensor_mass*t79;
-  const T t152 = sensor_J0_yy*t89 - sensor_S0_x*t79;
-  const T t153 = sensor_J0_zz*w_B_sensor_z + sensor_S0_x*t92;
-  const T t154 = ((t130*t88 + t149*t91) + t150*t92) + ((t151*t79 + t152*t89) + t153*w_B_sensor_z);
-  const T t155 = t142/2.0 + t148/2.0 + t154/2.0;
-  const T t156 = arm_k*q[7]*q[7]/2.0;
-  const T t157 = q[8]*q[8]*sensor_k/2.0 + t156;
-  TV[0] = t155;
-  TV[1] = t157;
+  const T t126 = sensor_J0_xx*t84;
+  const T t132 = -station_S0_y*u[5] + station_S0_z*u[4] + station_mass*u[0];
+  const T t133 = station_S0_x*u[5] - station_S0_z*u[3] + station_mass*u[1];
+  const T t134 = -station_S0_x*u[4] + station_S0_y*u[3] + station_mass*u[2];
+  const T t135 = ((station_J0_xx*u[3] + station_J0_xy*u[4]) + (station_J0_xz*u[5] + station_S0_y*u[2])) - station_S0_z*u[1];
+  const T t136 = ((station_J0_xy*u[3] + station_J0_yy*u[4]) + (station_J0_yz*u[5] + station_S0_z*u[0])) - station_S0_x*u[2];
+  const T t137 = ((station_J0_xz*u[3] + station_J0_yz*u[4]) + (station_J0_zz*u[5] + station_S0_x*u[1])) - station_S0_y*u[0];
+  const T t138 = ((t132*u[0] + t133*u[1]) + t134*u[2]) + ((t135*u[3] + t136*u[4]) + t137*u[5]);
+  const T t139 = arm_mass*t53;
+  const T t140 = arm_S0_x*w_B_arm_z + arm_mass*t54;
+  const T t141 = -arm_S0_x*t51 + arm_mass*t43;
+  const T t142 = arm_J0_yy*t51 - arm_S0_x*t43;
+  const T t143 = arm_J0_zz*w_B_arm_z + arm_S0_x*t54;
+  const T t144 = ((t115*t50 + t139*t53) + t140*t54) + ((t141*t43 + t142*t51) + t143*w_B_arm_z);
+  const T t145 = sensor_mass*t87;
+  const T t146 = sensor_S0_x*w_B_sensor_z + sensor_mass*t88;
+  const T t147 = -sensor_S0_x*t85 + sensor_mass*t75;
+  const T t148 = sensor_J0_yy*t85 - sensor_S0_x*t75;
+  const T t149 = sensor_J0_zz*w_B_sensor_z + sensor_S0_x*t88;
+  const T t150 = ((t126*t84 + t145*t87) + t146*t88) + ((t147*t75 + t148*t85) + t149*w_B_sensor_z);
+  const T t151 = t138/2.0 + t144/2.0 + t150/2.0;
+  const T t152 = arm_k*q[7]*q[7]/2.0;
+  const T t153 = q[8]*q[8]*sensor_k/2.0 + t152;
+  TV[0] = t151;
+  TV[1] = t153;
 }
 
 // ---- momentum: p_N[3], H_N[3] about N's origin ---------------------------------
@@ -958,6 +1085,10 @@ template <class T>
 void momentum(const T* q, const T* u, T* pH) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[2], angle_c[2];
+  const T angle_x[2] = {q[7], q[8] + sensor_angle_offset};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body station: outward pass (velocities)
   const T t0 = (1.0/sqrt((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
   const T t1 = q[3]*t0;
@@ -983,129 +1114,125 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t21 = 2.0*t10 + 2.0*t11;
   const T t22 = 1.0 - 2.0*t5 - 2.0*t6;
   // ---- body arm: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T R_NB_arm_xx = -t14*t26 - t15*t27;
-  const T R_NB_arm_xy = t14*t27 - t15*t26;
-  const T R_NB_arm_yx = -t17*t26 - t18*t27;
-  const T R_NB_arm_yy = t17*t27 - t18*t26;
-  const T R_NB_arm_zx = -t20*t26 - t21*t27;
-  const T R_NB_arm_zy = t20*t27 - t21*t26;
-  const T t34 = arm_p_PJ_x*t14 + arm_p_PJ_z*t16;
-  const T t35 = arm_p_PJ_x*t17 + arm_p_PJ_z*t19;
-  const T t36 = arm_p_PJ_x*t20 + arm_p_PJ_z*t22;
-  const T r_NO_N_arm_x = q[0] + t34;
-  const T r_NO_N_arm_y = q[1] + t35;
-  const T r_NO_N_arm_z = q[2] + t36;
-  const T t40 = -arm_p_J_z*u[4];
-  const T t41 = arm_p_J_x*u[5] + arm_p_J_z*u[3];
-  const T t42 = arm_p_J_x*u[4];
-  const T t43 = t40 - u[0];
-  const T t44 = t41 - u[1];
-  const T t45 = t42 + u[2];
-  const T t52 = -t26*u[3] - t27*u[4];
-  const T t53 = -t26*u[4] + t27*u[3];
+  const T R_NB_arm_xx = -angle_c[0]*t14 - angle_s[0]*t15;
+  const T R_NB_arm_xy = -angle_c[0]*t15 + angle_s[0]*t14;
+  const T R_NB_arm_yx = -angle_c[0]*t17 - angle_s[0]*t18;
+  const T R_NB_arm_yy = -angle_c[0]*t18 + angle_s[0]*t17;
+  const T R_NB_arm_zx = -angle_c[0]*t20 - angle_s[0]*t21;
+  const T R_NB_arm_zy = -angle_c[0]*t21 + angle_s[0]*t20;
+  const T t32 = arm_p_PJ_x*t14 + arm_p_PJ_z*t16;
+  const T t33 = arm_p_PJ_x*t17 + arm_p_PJ_z*t19;
+  const T t34 = arm_p_PJ_x*t20 + arm_p_PJ_z*t22;
+  const T r_NO_N_arm_x = q[0] + t32;
+  const T r_NO_N_arm_y = q[1] + t33;
+  const T r_NO_N_arm_z = q[2] + t34;
+  const T t38 = -arm_p_J_z*u[4];
+  const T t39 = arm_p_J_x*u[5] + arm_p_J_z*u[3];
+  const T t40 = arm_p_J_x*u[4];
+  const T t41 = t38 - u[0];
+  const T t42 = t39 - u[1];
+  const T t43 = t40 + u[2];
+  const T t50 = -angle_c[0]*u[3] - angle_s[0]*u[4];
+  const T t51 = -angle_c[0]*u[4] + angle_s[0]*u[3];
   const T w_B_arm_z = u[5] + u[6];
-  const T t55 = t26*t43 + t27*t44;
-  const T t56 = t26*t44 - t27*t43;
+  const T t53 = angle_c[0]*t41 + angle_s[0]*t42;
+  const T t54 = angle_c[0]*t42 - angle_s[0]*t41;
   // ---- body sensor: outward pass (velocities)
-  const T t62 = cos(q[8] + sensor_angle_offset);
-  const T t63 = sin(q[8] + sensor_angle_offset);
-  const T R_NB_sensor_xx = R_NB_arm_xx*t62 + t16*t63;
-  const T R_NB_sensor_xy = -R_NB_arm_xx*t63 + t16*t62;
-  const T R_NB_sensor_yx = R_NB_arm_yx*t62 + t19*t63;
-  const T R_NB_sensor_yy = -R_NB_arm_yx*t63 + t19*t62;
-  const T R_NB_sensor_zx = R_NB_arm_zx*t62 + t22*t63;
-  const T R_NB_sensor_zy = -R_NB_arm_zx*t63 + t22*t62;
-  const T t70 = R_NB_arm_xx*sensor_p_PJ_x;
-  const T t71 = R_NB_arm_yx*sensor_p_PJ_x;
-  const T t72 = R_NB_arm_zx*sensor_p_PJ_x;
-  const T r_NO_N_sensor_x = r_NO_N_arm_x + t70;
-  const T r_NO_N_sensor_y = r_NO_N_arm_y + t71;
-  const T r_NO_N_sensor_z = r_NO_N_arm_z + t72;
-  const T t76 = -sensor_p_J_x*t53;
-  const T t77 = -sensor_p_J_x*w_B_arm_z;
-  const T t78 = t45 + t76;
-  const T t79 = -t56 + t77;
-  const T t88 = t52*t62 + t63*w_B_arm_z;
-  const T t89 = -t52*t63 + t62*w_B_arm_z;
-  const T w_B_sensor_z = -t53 + u[7];
-  const T t91 = t55*t62 + t63*t78;
-  const T t92 = -t55*t63 + t62*t78;
+  const T R_NB_sensor_xx = R_NB_arm_xx*angle_c[1] + angle_s[1]*t16;
+  const T R_NB_sensor_xy = -R_NB_arm_xx*angle_s[1] + angle_c[1]*t16;
+  const T R_NB_sensor_yx = R_NB_arm_yx*angle_c[1] + angle_s[1]*t19;
+  const T R_NB_sensor_yy = -R_NB_arm_yx*angle_s[1] + angle_c[1]*t19;
+  const T R_NB_sensor_zx = R_NB_arm_zx*angle_c[1] + angle_s[1]*t22;
+  const T R_NB_sensor_zy = -R_NB_arm_zx*angle_s[1] + angle_c[1]*t22;
+  const T t66 = R_NB_arm_xx*sensor_p_PJ_x;
+  const T t67 = R_NB_arm_yx*sensor_p_PJ_x;
+  const T t68 = R_NB_arm_zx*sensor_p_PJ_x;
+  const T r_NO_N_sensor_x = r_NO_N_arm_x + t66;
+  const T r_NO_N_sensor_y = r_NO_N_arm_y + t67;
+  const T r_NO_N_sensor_z = r_NO_N_arm_z + t68;
+  const T t72 = -sensor_p_J_x*t51;
+  const T t73 = -sensor_p_J_x*w_B_arm_z;
+  const T t74 = t43 + t72;
+  const T t75 = -t54 + t73;
+  const T t84 = angle_c[1]*t50 + angle_s[1]*w_B_arm_z;
+  const T t85 = angle_c[1]*w_B_arm_z - angle_s[1]*t50;
+  const T w_B_sensor_z = -t51 + u[7];
+  const T t87 = angle_c[1]*t53 + angle_s[1]*t74;
+  const T t88 = angle_c[1]*t74 - angle_s[1]*t53;
   // ---- body arm: mass and velocity terms
-  const T t119 = arm_J0_xx*t52;
+  const T t115 = arm_J0_xx*t50;
   // ---- body sensor: mass and velocity terms
-  const T t130 = sensor_J0_xx*t88;
-  const T t136 = -station_S0_y*u[5] + station_S0_z*u[4] + station_mass*u[0];
-  const T t137 = station_S0_x*u[5] - station_S0_z*u[3] + station_mass*u[1];
-  const T t138 = -station_S0_x*u[4] + station_S0_y*u[3] + station_mass*u[2];
-  const T t139 = ((station_J0_xx*u[3] + station_J0_xy*u[4]) + (station_J0_xz*u[5] + station_S0_y*u[2])) - station_S0_z*u[1];
-  const T t140 = ((station_J0_xy*u[3] + station_J0_yy*u[4]) + (station_J0_yz*u[5] + station_S0_z*u[0])) - station_S0_x*u[2];
-  const T t141 = ((station_J0_xz*u[3] + station_J0_yz*u[4]) + (station_J0_zz*u[5] + station_S0_x*u[1])) - station_S0_y*u[0];
-  const T t142 = t136*t14 + t137*t15 + t138*t16;
-  const T t143 = t136*t17 + t137*t18 + t138*t19;
-  const T t144 = t136*t20 + t137*t21 + t138*t22;
-  const T t145 = t139*t14 + t140*t15 + t141*t16;
-  const T t146 = t139*t17 + t140*t18 + t141*t19;
-  const T t147 = t139*t20 + t140*t21 + t141*t22;
-  const T t148 = q[1]*t144 - q[2]*t143;
-  const T t149 = -q[0]*t144 + q[2]*t142;
-  const T t150 = q[0]*t143 - q[1]*t142;
-  const T t151 = t145 + t148;
-  const T t152 = t146 + t149;
-  const T t153 = t147 + t150;
-  const T t154 = arm_mass*t55;
-  const T t155 = arm_S0_x*w_B_arm_z + arm_mass*t56;
-  const T t156 = -arm_S0_x*t53 + arm_mass*t45;
-  const T t157 = arm_J0_yy*t53 - arm_S0_x*t45;
-  const T t158 = arm_J0_zz*w_B_arm_z + arm_S0_x*t56;
-  const T t159 = R_NB_arm_xx*t154 + R_NB_arm_xy*t155 + t156*t16;
-  const T t160 = R_NB_arm_yx*t154 + R_NB_arm_yy*t155 + t156*t19;
-  const T t161 = R_NB_arm_zx*t154 + R_NB_arm_zy*t155 + t156*t22;
-  const T t162 = R_NB_arm_xx*t119 + R_NB_arm_xy*t157 + t158*t16;
-  const T t163 = R_NB_arm_yx*t119 + R_NB_arm_yy*t157 + t158*t19;
-  const T t164 = R_NB_arm_zx*t119 + R_NB_arm_zy*t157 + t158*t22;
-  const T t165 = r_NO_N_arm_y*t161 - r_NO_N_arm_z*t160;
-  const T t166 = -r_NO_N_arm_x*t161 + r_NO_N_arm_z*t159;
-  const T t167 = r_NO_N_arm_x*t160 - r_NO_N_arm_y*t159;
-  const T t168 = t162 + t165;
-  const T t169 = t163 + t166;
-  const T t170 = t164 + t167;
-  const T t171 = t142 + t159;
-  const T t172 = t143 + t160;
-  const T t173 = t144 + t161;
-  const T t174 = t151 + t168;
-  const T t175 = t152 + t169;
-  const T t176 = t153 + t170;
-  const T t177 = sensor_mass*t91;
-  const T t178 = sensor_S0_x*w_B_sensor_z + sensor_mass*t92;
-  const T t179 = -sensor_S0_x*t89 + sensor_mass*t79;
-  const T t180 = sensor_J0_yy*t89 - sensor_S0_x*t79;
-  const T t181 = sensor_J0_zz*w_B_sensor_z + sensor_S0_x*t92;
-  const T t182 = -R_NB_arm_xy*t179 + R_NB_sensor_xx*t177 + R_NB_sensor_xy*t178;
-  const T t183 = -R_NB_arm_yy*t179 + R_NB_sensor_yx*t177 + R_NB_sensor_yy*t178;
-  const T t184 = -R_NB_arm_zy*t179 + R_NB_sensor_zx*t177 + R_NB_sensor_zy*t178;
-  const T t185 = -R_NB_arm_xy*t181 + R_NB_sensor_xx*t130 + R_NB_sensor_xy*t180;
-  const T t186 = -R_NB_arm_yy*t181 + R_NB_sensor_yx*t130 + R_NB_sensor_yy*t180;
-  const T t187 = -R_NB_arm_zy*t181 + R_NB_sensor_zx*t130 + R_NB_sensor_zy*t180;
-  const T t188 = r_NO_N_sensor_y*t184 - r_NO_N_sensor_z*t183;
-  const T t189 = -r_NO_N_sensor_x*t184 + r_NO_N_sensor_z*t182;
-  const T t190 = r_NO_N_sensor_x*t183 - r_NO_N_sensor_y*t182;
-  const T t191 = t185 + t188;
-  const T t192 = t186 + t189;
-  const T t193 = t187 + t190;
-  const T t194 = t171 + t182;
-  const T t195 = t172 + t183;
-  const T t196 = t173 + t184;
-  const T t197 = t174 + t191;
-  const T t198 = t175 + t192;
-  const T t199 = t176 + t193;
-  pH[0] = t194;
-  pH[1] = t195;
-  pH[2] = t196;
-  pH[3] = t197;
-  pH[4] = t198;
-  pH[5] = t199;
+  const T t126 = sensor_J0_xx*t84;
+  const T t132 = -station_S0_y*u[5] + station_S0_z*u[4] + station_mass*u[0];
+  const T t133 = station_S0_x*u[5] - station_S0_z*u[3] + station_mass*u[1];
+  const T t134 = -station_S0_x*u[4] + station_S0_y*u[3] + station_mass*u[2];
+  const T t135 = ((station_J0_xx*u[3] + station_J0_xy*u[4]) + (station_J0_xz*u[5] + station_S0_y*u[2])) - station_S0_z*u[1];
+  const T t136 = ((station_J0_xy*u[3] + station_J0_yy*u[4]) + (station_J0_yz*u[5] + station_S0_z*u[0])) - station_S0_x*u[2];
+  const T t137 = ((station_J0_xz*u[3] + station_J0_yz*u[4]) + (station_J0_zz*u[5] + station_S0_x*u[1])) - station_S0_y*u[0];
+  const T t138 = t132*t14 + t133*t15 + t134*t16;
+  const T t139 = t132*t17 + t133*t18 + t134*t19;
+  const T t140 = t132*t20 + t133*t21 + t134*t22;
+  const T t141 = t135*t14 + t136*t15 + t137*t16;
+  const T t142 = t135*t17 + t136*t18 + t137*t19;
+  const T t143 = t135*t20 + t136*t21 + t137*t22;
+  const T t144 = q[1]*t140 - q[2]*t139;
+  const T t145 = -q[0]*t140 + q[2]*t138;
+  const T t146 = q[0]*t139 - q[1]*t138;
+  const T t147 = t141 + t144;
+  const T t148 = t142 + t145;
+  const T t149 = t143 + t146;
+  const T t150 = arm_mass*t53;
+  const T t151 = arm_S0_x*w_B_arm_z + arm_mass*t54;
+  const T t152 = -arm_S0_x*t51 + arm_mass*t43;
+  const T t153 = arm_J0_yy*t51 - arm_S0_x*t43;
+  const T t154 = arm_J0_zz*w_B_arm_z + arm_S0_x*t54;
+  const T t155 = R_NB_arm_xx*t150 + R_NB_arm_xy*t151 + t152*t16;
+  const T t156 = R_NB_arm_yx*t150 + R_NB_arm_yy*t151 + t152*t19;
+  const T t157 = R_NB_arm_zx*t150 + R_NB_arm_zy*t151 + t152*t22;
+  const T t158 = R_NB_arm_xx*t115 + R_NB_arm_xy*t153 + t154*t16;
+  const T t159 = R_NB_arm_yx*t115 + R_NB_arm_yy*t153 + t154*t19;
+  const T t160 = R_NB_arm_zx*t115 + R_NB_arm_zy*t153 + t154*t22;
+  const T t161 = r_NO_N_arm_y*t157 - r_NO_N_arm_z*t156;
+  const T t162 = -r_NO_N_arm_x*t157 + r_NO_N_arm_z*t155;
+  const T t163 = r_NO_N_arm_x*t156 - r_NO_N_arm_y*t155;
+  const T t164 = t158 + t161;
+  const T t165 = t159 + t162;
+  const T t166 = t160 + t163;
+  const T t167 = t138 + t155;
+  const T t168 = t139 + t156;
+  const T t169 = t140 + t157;
+  const T t170 = t147 + t164;
+  const T t171 = t148 + t165;
+  const T t172 = t149 + t166;
+  const T t173 = sensor_mass*t87;
+  const T t174 = sensor_S0_x*w_B_sensor_z + sensor_mass*t88;
+  const T t175 = -sensor_S0_x*t85 + sensor_mass*t75;
+  const T t176 = sensor_J0_yy*t85 - sensor_S0_x*t75;
+  const T t177 = sensor_J0_zz*w_B_sensor_z + sensor_S0_x*t88;
+  const T t178 = -R_NB_arm_xy*t175 + R_NB_sensor_xx*t173 + R_NB_sensor_xy*t174;
+  const T t179 = -R_NB_arm_yy*t175 + R_NB_sensor_yx*t173 + R_NB_sensor_yy*t174;
+  const T t180 = -R_NB_arm_zy*t175 + R_NB_sensor_zx*t173 + R_NB_sensor_zy*t174;
+  const T t181 = -R_NB_arm_xy*t177 + R_NB_sensor_xx*t126 + R_NB_sensor_xy*t176;
+  const T t182 = -R_NB_arm_yy*t177 + R_NB_sensor_yx*t126 + R_NB_sensor_yy*t176;
+  const T t183 = -R_NB_arm_zy*t177 + R_NB_sensor_zx*t126 + R_NB_sensor_zy*t176;
+  const T t184 = r_NO_N_sensor_y*t180 - r_NO_N_sensor_z*t179;
+  const T t185 = -r_NO_N_sensor_x*t180 + r_NO_N_sensor_z*t178;
+  const T t186 = r_NO_N_sensor_x*t179 - r_NO_N_sensor_y*t178;
+  const T t187 = t181 + t184;
+  const T t188 = t182 + t185;
+  const T t189 = t183 + t186;
+  const T t190 = t167 + t178;
+  const T t191 = t168 + t179;
+  const T t192 = t169 + t180;
+  const T t193 = t170 + t187;
+  const T t194 = t171 + t188;
+  const T t195 = t172 + t189;
+  pH[0] = t190;
+  pH[1] = t191;
+  pH[2] = t192;
+  pH[3] = t193;
+  pH[4] = t194;
+  pH[5] = t195;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

@@ -16,12 +16,12 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
-//   mass_matrix       98 (44 add, 48 mul, 0 div, 6 func)
-//   forcing          280 (116 add, 158 mul, 0 div, 6 func)
-//   udot             718 (305 add, 392 mul, 15 div, 6 func) -- composite form; composite 718, articulated 820
-//     udot by pass: outward pass (velocities) 86; mass and velocity terms 77; composite inertia (inward) 66; its columns of M (walked to the root) 22; bias force 50; generalized forces (inward) 67; M u_dot = F: L^T D L along the dof tree 350
-//   energy           160 (60 add, 90 mul, 4 div, 6 func)
-//   momentum         407 (163 add, 236 mul, 1 div, 7 func)
+//   mass_matrix       96 (42 add, 48 mul, 0 div, 6 func)
+//   forcing          278 (114 add, 158 mul, 0 div, 6 func)
+//   udot             716 (303 add, 392 mul, 15 div, 6 func) -- composite form; composite 716, articulated 818
+//     udot by pass: joint angles' sin and cos 8; outward pass (velocities) 76; mass and velocity terms 77; composite inertia (inward) 66; its columns of M (walked to the root) 22; bias force 50; generalized forces (inward) 67; M u_dot = F: L^T D L along the dof tree 350
+//   energy           158 (58 add, 90 mul, 4 div, 6 func)
+//   momentum         405 (161 add, 236 mul, 1 div, 7 func)
 
 #pragma once
 
@@ -131,6 +131,135 @@ template <int W> inline bool operator>(double a, const Dual<W>& b) { return a > 
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }
+// ---- joint angles' sin and cos (templates/joint_sincos.inc) -------------------
+// Every joint angle's sin and cos, computed in one batch before the rest of a
+// function (issue 38, item 3: one evaluation per angle, shared by every use),
+// two angles at a time in SSE2 pairs (GCC/clang vector extensions, no header).
+// Accuracy (tests/codegen/test_joint_sincos.cpp, against sinl/cosl): at most
+// 0.51 ulp, the library's sin and cos 0.52-0.56 on the same arguments; beyond
+// |x| = 1e5 rad (and for inf and NaN) the library's sin and cos. (-ffast-math,
+// which reorders the exact sums, voids the bound.)
+// Method: x = k pi/32 + r, |r| <= pi/64, with pi/32 in four parts (three of 33
+// bits, exact products for |k| < 2^20) and r carried as r + rlo; sin and cos
+// of k pi/32 from a table as double-doubles (hi, lo, and hi split in 26-bit
+// halves for Dekker's exact product); sin r - r and cos r - 1 by their Taylor
+// series to r^9 and r^8 (truncation below 1e-20 on |r| <= pi/64);
+// sin x = S + C r + (S (cos r - 1) + C (sin r - r) + C rlo + S_lo), the sum
+// S + C r exact (TwoSum of the exact product), likewise cos x.
+
+// sin(j pi/32), j = 0..63: hi, lo (hi + lo to ~2^-106), and hi in two halves of 26 bits
+inline constexpr double kanegen_sin_table[64][4] = {
+    {0.0, 0.0, 0.0, 0.0},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.0000000000000p+0, 0.0, 0x1.0000000000000p+0, 0.0},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0.0, 0.0, 0.0, 0.0},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.0000000000000p+0, 0.0, -0x1.0000000000000p+0, 0.0},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+};
+
+typedef double kanegen_v2d __attribute__((vector_size(16)));
+
+/// sin and cos of x[0..n), in s and c.
+inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
+  for (int i = 0; i < n; i += 2) {
+    const int b = i + 1 < n ? i + 1 : i;  // an odd count's last angle twice
+    // beyond 1e5 rad (and inf, NaN) the library's, below; 0 meanwhile keeps the integer conversion defined
+    const double xi = x[i] <= 1.0e5 && x[i] >= -1.0e5 ? x[i] : 0.0, xb = x[b] <= 1.0e5 && x[b] >= -1.0e5 ? x[b] : 0.0;
+    const kanegen_v2d xv = {xi, xb};
+    const kanegen_v2d kn = (xv * 0x1.45f306dc9c883p+3 + 0x1.8p52) - 0x1.8p52;  // round(x 32/pi)
+    const kanegen_v2d t = xv - kn * 0x1.921fb54400000p-4, u2 = kn * 0x1.0b4611a600000p-38,
+                      u3 = kn * 0x1.3198a2e000000p-73;
+    const kanegen_v2d r1 = t - u2, e1 = (t - r1) - u2;
+    const kanegen_v2d r = r1 - u3, b3 = r - r1, e2 = (r1 - (r - b3)) - (u3 + b3);
+    const kanegen_v2d rlo = (e1 + e2) - kn * 0x1.b839a252049c1p-108;
+    const kanegen_v2d z = r * r;
+    const kanegen_v2d sr = (r * z) * (-1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 + z * (1.0 / 362880))));
+    const kanegen_v2d cm = z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320))));
+    const long k0 = static_cast<long>(kn[0]), k1 = static_cast<long>(kn[1]);
+    const double* Sa = kanegen_sin_table[k0 & 63];
+    const double* Sb = kanegen_sin_table[k1 & 63];
+    const double* Ca = kanegen_sin_table[(k0 + 16) & 63];
+    const double* Cb = kanegen_sin_table[(k1 + 16) & 63];
+    const kanegen_v2d S0 = {Sa[0], Sb[0]}, S1 = {Sa[1], Sb[1]}, S2 = {Sa[2], Sb[2]}, S3 = {Sa[3], Sb[3]};
+    const kanegen_v2d C0 = {Ca[0], Cb[0]}, C1 = {Ca[1], Cb[1]}, C2 = {Ca[2], Cb[2]}, C3 = {Ca[3], Cb[3]};
+    const kanegen_v2d g = 134217729.0 * r, rh = g - (g - r), rl = r - rh;  // r in 26-bit halves
+    const kanegen_v2d p = C0 * r, pe = (((C2 * rh - p) + C2 * rl) + C3 * rh) + C3 * rl;  // C r = p + pe
+    const kanegen_v2d s1 = S0 + p, bs = s1 - S0, se = (S0 - (s1 - bs)) + (p - bs);    // S + p = s1 + se
+    const kanegen_v2d sv = s1 + ((se + pe) + (S1 + C1 * r + C0 * rlo + S0 * cm + C0 * sr));
+    const kanegen_v2d q = S0 * r, qe = (((S2 * rh - q) + S2 * rl) + S3 * rh) + S3 * rl;  // S r = q + qe
+    const kanegen_v2d c1 = C0 - q, bc = c1 - C0, ce = (C0 - (c1 - bc)) + (-q - bc);      // C - q = c1 + ce
+    const kanegen_v2d cv = c1 + ((ce - qe) + (C1 - S1 * r - S0 * rlo + C0 * cm - S0 * sr));
+    s[i] = sv[0], c[i] = cv[0], s[b] = sv[1], c[b] = cv[1];
+    if (!(x[i] <= 1.0e5 && x[i] >= -1.0e5)) s[i] = std::sin(x[i]), c[i] = std::cos(x[i]);
+    if (!(x[b] <= 1.0e5 && x[b] >= -1.0e5)) s[b] = std::sin(x[b]), c[b] = std::cos(x[b]);
+  }
+}
+
+/// The same for any other number type (the dual numbers of the Jacobians): its own sin and cos.
+template <class T>
+inline void kanegen_sincos_n(const T* x, T* s, T* c, int n) {
+  using std::cos;
+  using std::sin;
+  for (int i = 0; i < n; ++i) s[i] = sin(x[i]), c[i] = cos(x[i]);
+}
 
 // ---- q_dot = W(q) u ------------------------------------------------------------
 template <class T>
@@ -171,166 +300,161 @@ template <class T>
 void mass_matrix(const T* q, T* M) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q;
-  // ---- body outer: outward pass (positions)
-  const T t23 = cos(q[7]);
-  const T t24 = sin(q[7]);
-  // ---- body middle: outward pass (positions)
-  const T t37 = cos(middle_angle_offset + q[8]);
-  const T t38 = sin(middle_angle_offset + q[8]);
-  // ---- body platform: outward pass (positions)
-  const T t45 = cos(platform_angle_offset + q[9]);
-  const T t46 = sin(platform_angle_offset + q[9]);
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[3], angle_c[3];
+  const T angle_x[3] = {q[7], middle_angle_offset + q[8], platform_angle_offset + q[9]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 3);
   // ---- body platform: composite inertia (inward)
-  const T t53 = t46*t46;
-  const T t54 = t45*t46;
-  const T t56 = k90de9f79*t53;
-  const T t57 = platform_J0_xx - t56;
-  const T t58 = platform_J0_yy + t56;
-  const T t59 = k90de9f79*t54;
-  const T t60 = middle_J0_xx + t57;
-  const T t61 = middle_J0_zz + t58;
+  const T t47 = angle_s[2]*angle_s[2];
+  const T t48 = angle_c[2]*angle_s[2];
+  const T t50 = k90de9f79*t47;
+  const T t51 = platform_J0_xx - t50;
+  const T t52 = platform_J0_yy + t50;
+  const T t53 = k90de9f79*t48;
+  const T t54 = middle_J0_xx + t51;
+  const T t55 = middle_J0_zz + t52;
   // ---- body middle: composite inertia (inward)
-  const T t62 = platform_S0_z*t38;
-  const T t63 = -platform_S0_z*t37;
-  const T t64 = t38*t38;
-  const T t65 = t37*t38;
-  const T t67 = -k066c2bd9 + t60;
-  const T t68 = t64*t67;
-  const T t69 = t60 - t68;
-  const T t70 = k066c2bd9 + t68;
-  const T t71 = t65*t67;
-  const T t72 = t37*t59;
-  const T t73 = t38*t59;
-  const T t74 = outer_J0_xx + t69;
-  const T t75 = outer_J0_yy + t61;
-  const T t76 = outer_J0_zz + t70;
+  const T t56 = angle_s[1]*platform_S0_z;
+  const T t57 = -angle_c[1]*platform_S0_z;
+  const T t58 = angle_s[1]*angle_s[1];
+  const T t59 = angle_c[1]*angle_s[1];
+  const T t61 = -k066c2bd9 + t54;
+  const T t62 = t58*t61;
+  const T t63 = t54 - t62;
+  const T t64 = k066c2bd9 + t62;
+  const T t65 = t59*t61;
+  const T t66 = angle_c[1]*t53;
+  const T t67 = angle_s[1]*t53;
+  const T t68 = outer_J0_xx + t63;
+  const T t69 = outer_J0_yy + t55;
+  const T t70 = outer_J0_zz + t64;
   // ---- body outer: composite inertia (inward)
-  const T t77 = t23*t62;
-  const T t78 = t24*t62;
-  const T t79 = t24*t24;
-  const T t80 = t23*t24;
-  const T t81 = 1.0 - 2.0*t79;
-  const T t82 = t74 - t75;
-  const T t83 = -2.0*t72*t80 + t79*t82;
-  const T t84 = t74 - t83;
-  const T t85 = t75 + t83;
-  const T t86 = -t72*t81 + t80*t82;
-  const T t87 = t23*t71 + t24*t73;
-  const T t88 = -t23*t73 + t24*t71;
-  const T t89 = 2.0*outer_p_J_z*t63 + kd6a1eb15 + t84;
-  const T t90 = -outer_p_J_z*t77 + t87;
-  const T t91 = 2.0*outer_p_J_z*t63 + kd6a1eb15 + t85;
-  const T t92 = -outer_p_J_z*t78 + t88;
-  const T t93 = kd681c1b9 + t63;
-  const T t94 = bus_J0_xx + t89;
-  const T t95 = bus_J0_xy + t86;
-  const T t96 = bus_J0_yy + t91;
-  const T t97 = bus_J0_yz - t92;
-  const T t98 = bus_J0_zz + t76;
-  const T t99 = -bus_S0_z - t93;
-  const T t100 = bus_S0_z + t93;
-  const T t101 = -bus_S0_x + t77;
-  const T t102 = bus_S0_x - t77;
+  const T t71 = angle_c[0]*t56;
+  const T t72 = angle_s[0]*t56;
+  const T t73 = angle_s[0]*angle_s[0];
+  const T t74 = angle_c[0]*angle_s[0];
+  const T t75 = 1.0 - 2.0*t73;
+  const T t76 = t68 - t69;
+  const T t77 = -2.0*t66*t74 + t73*t76;
+  const T t78 = t68 - t77;
+  const T t79 = t69 + t77;
+  const T t80 = -t66*t75 + t74*t76;
+  const T t81 = angle_c[0]*t65 + angle_s[0]*t67;
+  const T t82 = -angle_c[0]*t67 + angle_s[0]*t65;
+  const T t83 = 2.0*outer_p_J_z*t57 + kd6a1eb15 + t78;
+  const T t84 = -outer_p_J_z*t71 + t81;
+  const T t85 = 2.0*outer_p_J_z*t57 + kd6a1eb15 + t79;
+  const T t86 = -outer_p_J_z*t72 + t82;
+  const T t87 = kd681c1b9 + t57;
+  const T t88 = bus_J0_xx + t83;
+  const T t89 = bus_J0_xy + t80;
+  const T t90 = bus_J0_yy + t85;
+  const T t91 = bus_J0_yz - t86;
+  const T t92 = bus_J0_zz + t70;
+  const T t93 = -bus_S0_z - t87;
+  const T t94 = bus_S0_z + t87;
+  const T t95 = -bus_S0_x + t71;
+  const T t96 = bus_S0_x - t71;
   // ---- body outer: its columns of M (walked to the root)
-  const T t103 = -t24*t62;
-  const T t104 = -outer_p_J_z*t77;
-  const T t105 = outer_p_J_z*t103;
-  const T t106 = t104 + t87;
-  const T t107 = t105 + t88;
+  const T t97 = -angle_s[0]*t56;
+  const T t98 = -outer_p_J_z*t71;
+  const T t99 = outer_p_J_z*t97;
+  const T t100 = t81 + t98;
+  const T t101 = t82 + t99;
   // ---- body middle: its columns of M (walked to the root)
-  const T t108 = platform_S0_z*t37;
-  const T t109 = t108*t23;
-  const T t110 = t108*t24;
-  const T t111 = -outer_p_J_z*t110;
-  const T t112 = outer_p_J_z*t109;
-  const T t113 = t23*t72 + t24*t61;
-  const T t114 = -t23*t61 + t24*t72;
-  const T t115 = t111 + t113;
-  const T t116 = t112 + t114;
+  const T t102 = angle_c[1]*platform_S0_z;
+  const T t103 = angle_c[0]*t102;
+  const T t104 = angle_s[0]*t102;
+  const T t105 = -outer_p_J_z*t104;
+  const T t106 = outer_p_J_z*t103;
+  const T t107 = angle_c[0]*t66 + angle_s[0]*t55;
+  const T t108 = -angle_c[0]*t55 + angle_s[0]*t66;
+  const T t109 = t105 + t107;
+  const T t110 = t106 + t108;
   // ---- body platform: its columns of M (walked to the root)
-  const T t117 = platform_J0_zz*t38;
-  const T t118 = -platform_J0_zz*t37;
-  const T t119 = t117*t23;
-  const T t120 = t117*t24;
+  const T t111 = angle_s[1]*platform_J0_zz;
+  const T t112 = -angle_c[1]*platform_J0_zz;
+  const T t113 = angle_c[0]*t111;
+  const T t114 = angle_s[0]*t111;
   M[0] = kf72fdc70;
   M[1] = 0.0;
   M[2] = 0.0;
   M[3] = 0.0;
-  M[4] = t100;
-  M[5] = t78;
-  M[6] = -t103;
-  M[7] = -t109;
+  M[4] = t94;
+  M[5] = t72;
+  M[6] = -t97;
+  M[7] = -t103;
   M[8] = 0.0;
   M[9] = 0.0;
   M[10] = kf72fdc70;
   M[11] = 0.0;
-  M[12] = t99;
+  M[12] = t93;
   M[13] = 0.0;
-  M[14] = t102;
-  M[15] = -t77;
-  M[16] = -t110;
+  M[14] = t96;
+  M[15] = -t71;
+  M[16] = -t104;
   M[17] = 0.0;
   M[18] = 0.0;
   M[19] = 0.0;
   M[20] = kf72fdc70;
-  M[21] = -t78;
-  M[22] = t101;
+  M[21] = -t72;
+  M[22] = t95;
   M[23] = 0.0;
   M[24] = 0.0;
-  M[25] = t62;
+  M[25] = t56;
   M[26] = 0.0;
   M[27] = 0.0;
-  M[28] = t99;
-  M[29] = -t78;
-  M[30] = t94;
-  M[31] = t95;
-  M[32] = -t90;
-  M[33] = -t106;
-  M[34] = -t115;
-  M[35] = -t119;
-  M[36] = t100;
+  M[28] = t93;
+  M[29] = -t72;
+  M[30] = t88;
+  M[31] = t89;
+  M[32] = -t84;
+  M[33] = -t100;
+  M[34] = -t109;
+  M[35] = -t113;
+  M[36] = t94;
   M[37] = 0.0;
-  M[38] = t101;
-  M[39] = t95;
-  M[40] = t96;
-  M[41] = t97;
-  M[42] = -t107;
-  M[43] = -t116;
-  M[44] = -t120;
-  M[45] = t78;
-  M[46] = t102;
+  M[38] = t95;
+  M[39] = t89;
+  M[40] = t90;
+  M[41] = t91;
+  M[42] = -t101;
+  M[43] = -t110;
+  M[44] = -t114;
+  M[45] = t72;
+  M[46] = t96;
   M[47] = 0.0;
-  M[48] = -t90;
-  M[49] = t97;
-  M[50] = t98;
-  M[51] = t76;
-  M[52] = t73;
-  M[53] = t118;
-  M[54] = -t103;
-  M[55] = -t77;
+  M[48] = -t84;
+  M[49] = t91;
+  M[50] = t92;
+  M[51] = t70;
+  M[52] = t67;
+  M[53] = t112;
+  M[54] = -t97;
+  M[55] = -t71;
   M[56] = 0.0;
-  M[57] = -t106;
-  M[58] = -t107;
-  M[59] = t76;
-  M[60] = t76;
-  M[61] = t73;
-  M[62] = t118;
-  M[63] = -t109;
-  M[64] = -t110;
-  M[65] = t62;
-  M[66] = -t115;
-  M[67] = -t116;
-  M[68] = t73;
-  M[69] = t73;
-  M[70] = t61;
+  M[57] = -t100;
+  M[58] = -t101;
+  M[59] = t70;
+  M[60] = t70;
+  M[61] = t67;
+  M[62] = t112;
+  M[63] = -t103;
+  M[64] = -t104;
+  M[65] = t56;
+  M[66] = -t109;
+  M[67] = -t110;
+  M[68] = t67;
+  M[69] = t67;
+  M[70] = t55;
   M[71] = 0.0;
   M[72] = 0.0;
   M[73] = 0.0;
   M[74] = 0.0;
-  M[75] = -t119;
-  M[76] = -t120;
-  M[77] = t118;
-  M[78] = t118;
+  M[75] = -t113;
+  M[76] = -t114;
+  M[77] = t112;
+  M[78] = t112;
   M[79] = 0.0;
   M[80] = platform_J0_zz;
 }
@@ -340,178 +464,176 @@ template <class T>
 void forcing(const T* q, const T* u, const T* tau, T* F) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[3], angle_c[3];
+  const T angle_x[3] = {q[7], middle_angle_offset + q[8], platform_angle_offset + q[9]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 3);
   // ---- body bus: outward pass (velocities)
   const T t23 = -u[1]*u[5] + u[2]*u[4];
   const T t24 = u[0]*u[5] - u[2]*u[3];
   const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body outer: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = -outer_p_J_z*u[4];
-  const T t41 = outer_p_J_z*u[3];
-  const T t44 = -t41*u[5];
-  const T t45 = t40*u[5];
-  const T t46 = t40*u[4] - t41*u[3];
-  const T t47 = -t23 + t44;
-  const T t48 = -t24 + t45;
-  const T t49 = t25 + t46;
-  const T t50 = -t26*u[3] - t27*u[4];
-  const T t51 = -t26*u[4] + t27*u[3];
+  const T t38 = -outer_p_J_z*u[4];
+  const T t39 = outer_p_J_z*u[3];
+  const T t42 = -t39*u[5];
+  const T t43 = t38*u[5];
+  const T t44 = t38*u[4] - t39*u[3];
+  const T t45 = -t23 + t42;
+  const T t46 = -t24 + t43;
+  const T t47 = t25 + t44;
+  const T t48 = -angle_c[0]*u[3] - angle_s[0]*u[4];
+  const T t49 = -angle_c[0]*u[4] + angle_s[0]*u[3];
   const T w_B_outer_z = u[5] + u[6];
-  const T t55 = t51*u[6];
-  const T t56 = -t50*u[6];
-  const T t58 = t26*t47 + t27*t48;
-  const T t59 = t26*t48 - t27*t47;
+  const T t53 = t49*u[6];
+  const T t54 = -t48*u[6];
+  const T t56 = angle_c[0]*t45 + angle_s[0]*t46;
+  const T t57 = angle_c[0]*t46 - angle_s[0]*t45;
   // ---- body middle: outward pass (velocities)
-  const T t60 = cos(middle_angle_offset + q[8]);
-  const T t61 = sin(middle_angle_offset + q[8]);
-  const T t68 = t50*t60 + t61*w_B_outer_z;
-  const T t69 = -t50*t61 + t60*w_B_outer_z;
-  const T w_B_middle_z = -t51 + u[7];
-  const T t73 = t69*u[7];
-  const T t74 = -t68*u[7];
-  const T t75 = t55*t60;
-  const T t76 = -t55*t61;
-  const T alpha_R_B_middle_x = t73 + t75;
-  const T alpha_R_B_middle_y = t74 + t76;
-  const T t80 = t49*t61 + t58*t60;
-  const T t81 = t49*t60 - t58*t61;
+  const T t64 = angle_c[1]*t48 + angle_s[1]*w_B_outer_z;
+  const T t65 = angle_c[1]*w_B_outer_z - angle_s[1]*t48;
+  const T w_B_middle_z = -t49 + u[7];
+  const T t69 = t65*u[7];
+  const T t70 = -t64*u[7];
+  const T t71 = angle_c[1]*t53;
+  const T t72 = -angle_s[1]*t53;
+  const T alpha_R_B_middle_x = t69 + t71;
+  const T alpha_R_B_middle_y = t70 + t72;
+  const T t76 = angle_c[1]*t56 + angle_s[1]*t47;
+  const T t77 = angle_c[1]*t47 - angle_s[1]*t56;
   // ---- body platform: outward pass (velocities)
-  const T t82 = cos(platform_angle_offset + q[9]);
-  const T t83 = sin(platform_angle_offset + q[9]);
-  const T t90 = t68*t82 + t83*w_B_middle_z;
-  const T t91 = -t68*t83 + t82*w_B_middle_z;
-  const T w_B_platform_z = -t69 + u[8];
-  const T t95 = t91*u[8];
-  const T t96 = -t90*u[8];
-  const T t97 = alpha_R_B_middle_x*t82 - t56*t83;
-  const T t98 = -alpha_R_B_middle_x*t83 - t56*t82;
-  const T alpha_R_B_platform_x = t95 + t97;
-  const T alpha_R_B_platform_y = t96 + t98;
-  const T t102 = -t59*t83 + t80*t82;
-  const T t103 = -t59*t82 - t80*t83;
+  const T t84 = angle_c[2]*t64 + angle_s[2]*w_B_middle_z;
+  const T t85 = angle_c[2]*w_B_middle_z - angle_s[2]*t64;
+  const T w_B_platform_z = -t65 + u[8];
+  const T t89 = t85*u[8];
+  const T t90 = -t84*u[8];
+  const T t91 = alpha_R_B_middle_x*angle_c[2] - angle_s[2]*t54;
+  const T t92 = -alpha_R_B_middle_x*angle_s[2] - angle_c[2]*t54;
+  const T alpha_R_B_platform_x = t89 + t91;
+  const T alpha_R_B_platform_y = t90 + t92;
+  const T t96 = angle_c[2]*t76 - angle_s[2]*t57;
+  const T t97 = -angle_c[2]*t57 - angle_s[2]*t76;
   // ---- body bus: mass and velocity terms
-  const T t104 = bus_S0_z*u[4];
-  const T t105 = bus_S0_x*u[5] - bus_S0_z*u[3];
-  const T t106 = -bus_S0_x*u[4];
+  const T t98 = bus_S0_z*u[4];
+  const T t99 = bus_S0_x*u[5] - bus_S0_z*u[3];
+  const T t100 = -bus_S0_x*u[4];
+  const T t101 = t100*u[4] - t99*u[5];
+  const T t102 = -t100*u[3] + t98*u[5];
+  const T t103 = -t98*u[4] + t99*u[3];
+  const T t104 = bus_J0_xx*u[3] + bus_J0_xy*u[4];
+  const T t105 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
+  const T t106 = bus_J0_yz*u[4] + bus_J0_zz*u[5];
   const T t107 = -t105*u[5] + t106*u[4];
   const T t108 = t104*u[5] - t106*u[3];
   const T t109 = -t104*u[4] + t105*u[3];
-  const T t110 = bus_J0_xx*u[3] + bus_J0_xy*u[4];
-  const T t111 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
-  const T t112 = bus_J0_yz*u[4] + bus_J0_zz*u[5];
-  const T t113 = -t111*u[5] + t112*u[4];
-  const T t114 = t110*u[5] - t112*u[3];
-  const T t115 = -t110*u[4] + t111*u[3];
   // ---- body outer: mass and velocity terms
-  const T t116 = outer_J0_xx*t50;
-  const T t117 = outer_J0_yy*t51;
-  const T t118 = outer_J0_zz*w_B_outer_z;
-  const T t119 = -t117*w_B_outer_z + t118*t51;
-  const T t120 = t116*w_B_outer_z - t118*t50;
-  const T t121 = -t116*t51 + t117*t50;
+  const T t110 = outer_J0_xx*t48;
+  const T t111 = outer_J0_yy*t49;
+  const T t112 = outer_J0_zz*w_B_outer_z;
+  const T t113 = -t111*w_B_outer_z + t112*t49;
+  const T t114 = t110*w_B_outer_z - t112*t48;
+  const T t115 = -t110*t49 + t111*t48;
   // ---- body middle: mass and velocity terms
-  const T t122 = middle_J0_xx*t68;
-  const T t123 = middle_J0_yy*t69;
-  const T t124 = middle_J0_zz*w_B_middle_z;
-  const T t125 = -t123*w_B_middle_z + t124*t69;
-  const T t126 = t122*w_B_middle_z - t124*t68;
-  const T t127 = -t122*t69 + t123*t68;
+  const T t116 = middle_J0_xx*t64;
+  const T t117 = middle_J0_yy*t65;
+  const T t118 = middle_J0_zz*w_B_middle_z;
+  const T t119 = -t117*w_B_middle_z + t118*t65;
+  const T t120 = t116*w_B_middle_z - t118*t64;
+  const T t121 = -t116*t65 + t117*t64;
   // ---- body platform: mass and velocity terms
-  const T t128 = platform_S0_z*t91;
-  const T t129 = -platform_S0_z*t90;
-  const T t130 = -t129*w_B_platform_z;
-  const T t131 = t128*w_B_platform_z;
-  const T t132 = -t128*t91 + t129*t90;
-  const T t133 = platform_J0_xx*t90;
-  const T t134 = platform_J0_yy*t91;
-  const T t135 = platform_J0_zz*w_B_platform_z;
-  const T t136 = -t134*w_B_platform_z + t135*t91;
-  const T t137 = t133*w_B_platform_z - t135*t90;
-  const T t138 = -t133*t91 + t134*t90;
+  const T t122 = platform_S0_z*t85;
+  const T t123 = -platform_S0_z*t84;
+  const T t124 = -t123*w_B_platform_z;
+  const T t125 = t122*w_B_platform_z;
+  const T t126 = -t122*t85 + t123*t84;
+  const T t127 = platform_J0_xx*t84;
+  const T t128 = platform_J0_yy*t85;
+  const T t129 = platform_J0_zz*w_B_platform_z;
+  const T t130 = -t128*w_B_platform_z + t129*t85;
+  const T t131 = t127*w_B_platform_z - t129*t84;
+  const T t132 = -t127*t85 + t128*t84;
   // ---- body bus: bias force
-  const T t139 = -bus_mass*t23 - t107;
-  const T t140 = -bus_mass*t24 - t108;
-  const T t141 = -bus_mass*t25 - t109;
-  const T t142 = bus_S0_z*t24 - t113;
-  const T t143 = bus_S0_x*t25 - bus_S0_z*t23 - t114;
-  const T t144 = -bus_S0_x*t24 - t115;
+  const T t133 = -bus_mass*t23 - t101;
+  const T t134 = -bus_mass*t24 - t102;
+  const T t135 = -bus_mass*t25 - t103;
+  const T t136 = bus_S0_z*t24 - t107;
+  const T t137 = bus_S0_x*t25 - bus_S0_z*t23 - t108;
+  const T t138 = -bus_S0_x*t24 - t109;
   // ---- body outer: bias force
-  const T t145 = -outer_mass*t58;
-  const T t146 = -outer_mass*t59;
-  const T t147 = -outer_mass*t49;
-  const T t148 = -outer_J0_xx*t55 - t119;
-  const T t149 = -outer_J0_yy*t56 - t120;
+  const T t139 = -outer_mass*t56;
+  const T t140 = -outer_mass*t57;
+  const T t141 = -outer_mass*t47;
+  const T t142 = -outer_J0_xx*t53 - t113;
+  const T t143 = -outer_J0_yy*t54 - t114;
   // ---- body middle: bias force
-  const T t150 = -middle_mass*t80;
-  const T t151 = -middle_mass*t81;
-  const T t152 = middle_mass*t59;
-  const T t153 = -alpha_R_B_middle_x*middle_J0_xx - t125;
-  const T t154 = -alpha_R_B_middle_y*middle_J0_yy - t126;
-  const T t155 = middle_J0_zz*t56 - t127;
+  const T t144 = -middle_mass*t76;
+  const T t145 = -middle_mass*t77;
+  const T t146 = middle_mass*t57;
+  const T t147 = -alpha_R_B_middle_x*middle_J0_xx - t119;
+  const T t148 = -alpha_R_B_middle_y*middle_J0_yy - t120;
+  const T t149 = middle_J0_zz*t54 - t121;
   // ---- body platform: bias force
-  const T t156 = -alpha_R_B_platform_y*platform_S0_z - platform_mass*t102 - t130;
-  const T t157 = alpha_R_B_platform_x*platform_S0_z - platform_mass*t103 - t131;
-  const T t158 = platform_mass*t81 - t132;
-  const T t159 = -alpha_R_B_platform_x*platform_J0_xx + platform_S0_z*t103 - t136;
-  const T t160 = -alpha_R_B_platform_y*platform_J0_yy - platform_S0_z*t102 - t137;
-  const T t161 = alpha_R_B_middle_y*platform_J0_zz - t138;
+  const T t150 = -alpha_R_B_platform_y*platform_S0_z - platform_mass*t96 - t124;
+  const T t151 = alpha_R_B_platform_x*platform_S0_z - platform_mass*t97 - t125;
+  const T t152 = platform_mass*t77 - t126;
+  const T t153 = -alpha_R_B_platform_x*platform_J0_xx + platform_S0_z*t97 - t130;
+  const T t154 = -alpha_R_B_platform_y*platform_J0_yy - platform_S0_z*t96 - t131;
+  const T t155 = alpha_R_B_middle_y*platform_J0_zz - t132;
   // ---- body platform: generalized forces (inward)
-  const T t162 = t161 + tau[8];
-  const T t163 = t156*t82 - t157*t83;
-  const T t164 = t156*t83 + t157*t82;
-  const T t165 = t159*t82 - t160*t83;
-  const T t166 = t159*t83 + t160*t82;
-  const T t167 = t150 + t163;
-  const T t168 = t151 - t158;
-  const T t169 = t152 + t164;
-  const T t170 = t153 + t165;
-  const T t171 = t154 - t161;
-  const T t172 = t155 + t166;
+  const T t156 = t155 + tau[8];
+  const T t157 = angle_c[2]*t150 - angle_s[2]*t151;
+  const T t158 = angle_c[2]*t151 + angle_s[2]*t150;
+  const T t159 = angle_c[2]*t153 - angle_s[2]*t154;
+  const T t160 = angle_c[2]*t154 + angle_s[2]*t153;
+  const T t161 = t144 + t157;
+  const T t162 = t145 - t152;
+  const T t163 = t146 + t158;
+  const T t164 = t147 + t159;
+  const T t165 = t148 - t155;
+  const T t166 = t149 + t160;
   // ---- body middle: generalized forces (inward)
-  const T t173 = t172 + tau[7];
-  const T t174 = t167*t60 - t168*t61;
-  const T t175 = t167*t61 + t168*t60;
-  const T t176 = t170*t60 - t171*t61;
-  const T t177 = t170*t61 + t171*t60;
-  const T t178 = t145 + t174;
-  const T t179 = t146 - t169;
-  const T t180 = t147 + t175;
-  const T t181 = t148 + t176;
-  const T t182 = t149 - t172;
-  const T t183 = -t121 + t177;
+  const T t167 = t166 + tau[7];
+  const T t168 = angle_c[1]*t161 - angle_s[1]*t162;
+  const T t169 = angle_c[1]*t162 + angle_s[1]*t161;
+  const T t170 = angle_c[1]*t164 - angle_s[1]*t165;
+  const T t171 = angle_c[1]*t165 + angle_s[1]*t164;
+  const T t172 = t139 + t168;
+  const T t173 = t140 - t163;
+  const T t174 = t141 + t169;
+  const T t175 = t142 + t170;
+  const T t176 = t143 - t166;
+  const T t177 = -t115 + t171;
   // ---- body outer: generalized forces (inward)
-  const T t184 = t183 + tau[6];
-  const T t185 = t178*t26 - t179*t27;
-  const T t186 = t178*t27 + t179*t26;
-  const T t187 = -outer_p_J_z*t186;
-  const T t188 = outer_p_J_z*t185;
-  const T t189 = t181*t26 - t182*t27;
-  const T t190 = t181*t27 + t182*t26;
-  const T t191 = t187 + t189;
-  const T t192 = t188 + t190;
-  const T t193 = t139 - t185;
-  const T t194 = t140 - t186;
-  const T t195 = t141 + t180;
-  const T t196 = t142 - t191;
-  const T t197 = t143 - t192;
-  const T t198 = t144 + t183;
+  const T t178 = t177 + tau[6];
+  const T t179 = angle_c[0]*t172 - angle_s[0]*t173;
+  const T t180 = angle_c[0]*t173 + angle_s[0]*t172;
+  const T t181 = -outer_p_J_z*t180;
+  const T t182 = outer_p_J_z*t179;
+  const T t183 = angle_c[0]*t175 - angle_s[0]*t176;
+  const T t184 = angle_c[0]*t176 + angle_s[0]*t175;
+  const T t185 = t181 + t183;
+  const T t186 = t182 + t184;
+  const T t187 = t133 - t179;
+  const T t188 = t134 - t180;
+  const T t189 = t135 + t174;
+  const T t190 = t136 - t185;
+  const T t191 = t137 - t186;
+  const T t192 = t138 + t177;
   // ---- body bus: generalized forces (inward)
-  const T t199 = t193 + tau[0];
-  const T t200 = t194 + tau[1];
-  const T t201 = t195 + tau[2];
-  const T t202 = t196 + tau[3];
-  const T t203 = t197 + tau[4];
-  const T t204 = t198 + tau[5];
-  F[0] = t199;
-  F[1] = t200;
-  F[2] = t201;
-  F[3] = t202;
-  F[4] = t203;
-  F[5] = t204;
-  F[6] = t184;
-  F[7] = t173;
-  F[8] = t162;
+  const T t193 = t187 + tau[0];
+  const T t194 = t188 + tau[1];
+  const T t195 = t189 + tau[2];
+  const T t196 = t190 + tau[3];
+  const T t197 = t191 + tau[4];
+  const T t198 = t192 + tau[5];
+  F[0] = t193;
+  F[1] = t194;
+  F[2] = t195;
+  F[3] = t196;
+  F[4] = t197;
+  F[5] = t198;
+  F[6] = t178;
+  F[7] = t167;
+  F[8] = t156;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
@@ -520,461 +642,459 @@ template <class T>
 int udot(const T* q, const T* u, const T* tau, T* udot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[3], angle_c[3];
+  const T angle_x[3] = {q[7], middle_angle_offset + q[8], platform_angle_offset + q[9]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 3);
   // ---- body bus: outward pass (velocities)
   const T t23 = -u[1]*u[5] + u[2]*u[4];
   const T t24 = u[0]*u[5] - u[2]*u[3];
   const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body outer: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = -outer_p_J_z*u[4];
-  const T t41 = outer_p_J_z*u[3];
-  const T t44 = -t41*u[5];
-  const T t45 = t40*u[5];
-  const T t46 = t40*u[4] - t41*u[3];
-  const T t47 = -t23 + t44;
-  const T t48 = -t24 + t45;
-  const T t49 = t25 + t46;
-  const T t50 = -t26*u[3] - t27*u[4];
-  const T t51 = -t26*u[4] + t27*u[3];
+  const T t38 = -outer_p_J_z*u[4];
+  const T t39 = outer_p_J_z*u[3];
+  const T t42 = -t39*u[5];
+  const T t43 = t38*u[5];
+  const T t44 = t38*u[4] - t39*u[3];
+  const T t45 = -t23 + t42;
+  const T t46 = -t24 + t43;
+  const T t47 = t25 + t44;
+  const T t48 = -angle_c[0]*u[3] - angle_s[0]*u[4];
+  const T t49 = -angle_c[0]*u[4] + angle_s[0]*u[3];
   const T w_B_outer_z = u[5] + u[6];
-  const T t55 = t51*u[6];
-  const T t56 = -t50*u[6];
-  const T t58 = t26*t47 + t27*t48;
-  const T t59 = t26*t48 - t27*t47;
+  const T t53 = t49*u[6];
+  const T t54 = -t48*u[6];
+  const T t56 = angle_c[0]*t45 + angle_s[0]*t46;
+  const T t57 = angle_c[0]*t46 - angle_s[0]*t45;
   // ---- body middle: outward pass (velocities)
-  const T t60 = cos(middle_angle_offset + q[8]);
-  const T t61 = sin(middle_angle_offset + q[8]);
-  const T t68 = t50*t60 + t61*w_B_outer_z;
-  const T t69 = -t50*t61 + t60*w_B_outer_z;
-  const T w_B_middle_z = -t51 + u[7];
-  const T t73 = t69*u[7];
-  const T t74 = -t68*u[7];
-  const T t75 = t55*t60;
-  const T t76 = -t55*t61;
-  const T alpha_R_B_middle_x = t73 + t75;
-  const T alpha_R_B_middle_y = t74 + t76;
-  const T t80 = t49*t61 + t58*t60;
-  const T t81 = t49*t60 - t58*t61;
+  const T t64 = angle_c[1]*t48 + angle_s[1]*w_B_outer_z;
+  const T t65 = angle_c[1]*w_B_outer_z - angle_s[1]*t48;
+  const T w_B_middle_z = -t49 + u[7];
+  const T t69 = t65*u[7];
+  const T t70 = -t64*u[7];
+  const T t71 = angle_c[1]*t53;
+  const T t72 = -angle_s[1]*t53;
+  const T alpha_R_B_middle_x = t69 + t71;
+  const T alpha_R_B_middle_y = t70 + t72;
+  const T t76 = angle_c[1]*t56 + angle_s[1]*t47;
+  const T t77 = angle_c[1]*t47 - angle_s[1]*t56;
   // ---- body platform: outward pass (velocities)
-  const T t82 = cos(platform_angle_offset + q[9]);
-  const T t83 = sin(platform_angle_offset + q[9]);
-  const T t90 = t68*t82 + t83*w_B_middle_z;
-  const T t91 = -t68*t83 + t82*w_B_middle_z;
-  const T w_B_platform_z = -t69 + u[8];
-  const T t95 = t91*u[8];
-  const T t96 = -t90*u[8];
-  const T t97 = alpha_R_B_middle_x*t82 - t56*t83;
-  const T t98 = -alpha_R_B_middle_x*t83 - t56*t82;
-  const T alpha_R_B_platform_x = t95 + t97;
-  const T alpha_R_B_platform_y = t96 + t98;
-  const T t102 = -t59*t83 + t80*t82;
-  const T t103 = -t59*t82 - t80*t83;
+  const T t84 = angle_c[2]*t64 + angle_s[2]*w_B_middle_z;
+  const T t85 = angle_c[2]*w_B_middle_z - angle_s[2]*t64;
+  const T w_B_platform_z = -t65 + u[8];
+  const T t89 = t85*u[8];
+  const T t90 = -t84*u[8];
+  const T t91 = alpha_R_B_middle_x*angle_c[2] - angle_s[2]*t54;
+  const T t92 = -alpha_R_B_middle_x*angle_s[2] - angle_c[2]*t54;
+  const T alpha_R_B_platform_x = t89 + t91;
+  const T alpha_R_B_platform_y = t90 + t92;
+  const T t96 = angle_c[2]*t76 - angle_s[2]*t57;
+  const T t97 = -angle_c[2]*t57 - angle_s[2]*t76;
   // ---- body bus: mass and velocity terms
-  const T t104 = bus_S0_z*u[4];
-  const T t105 = bus_S0_x*u[5] - bus_S0_z*u[3];
-  const T t106 = -bus_S0_x*u[4];
+  const T t98 = bus_S0_z*u[4];
+  const T t99 = bus_S0_x*u[5] - bus_S0_z*u[3];
+  const T t100 = -bus_S0_x*u[4];
+  const T t101 = t100*u[4] - t99*u[5];
+  const T t102 = -t100*u[3] + t98*u[5];
+  const T t103 = -t98*u[4] + t99*u[3];
+  const T t104 = bus_J0_xx*u[3] + bus_J0_xy*u[4];
+  const T t105 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
+  const T t106 = bus_J0_yz*u[4] + bus_J0_zz*u[5];
   const T t107 = -t105*u[5] + t106*u[4];
   const T t108 = t104*u[5] - t106*u[3];
   const T t109 = -t104*u[4] + t105*u[3];
-  const T t110 = bus_J0_xx*u[3] + bus_J0_xy*u[4];
-  const T t111 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
-  const T t112 = bus_J0_yz*u[4] + bus_J0_zz*u[5];
-  const T t113 = -t111*u[5] + t112*u[4];
-  const T t114 = t110*u[5] - t112*u[3];
-  const T t115 = -t110*u[4] + t111*u[3];
   // ---- body outer: mass and velocity terms
-  const T t116 = outer_J0_xx*t50;
-  const T t117 = outer_J0_yy*t51;
-  const T t118 = outer_J0_zz*w_B_outer_z;
-  const T t119 = -t117*w_B_outer_z + t118*t51;
-  const T t120 = t116*w_B_outer_z - t118*t50;
-  const T t121 = -t116*t51 + t117*t50;
+  const T t110 = outer_J0_xx*t48;
+  const T t111 = outer_J0_yy*t49;
+  const T t112 = outer_J0_zz*w_B_outer_z;
+  const T t113 = -t111*w_B_outer_z + t112*t49;
+  const T t114 = t110*w_B_outer_z - t112*t48;
+  const T t115 = -t110*t49 + t111*t48;
   // ---- body middle: mass and velocity terms
-  const T t122 = middle_J0_xx*t68;
-  const T t123 = middle_J0_yy*t69;
-  const T t124 = middle_J0_zz*w_B_middle_z;
-  const T t125 = -t123*w_B_middle_z + t124*t69;
-  const T t126 = t122*w_B_middle_z - t124*t68;
-  const T t127 = -t122*t69 + t123*t68;
+  const T t116 = middle_J0_xx*t64;
+  const T t117 = middle_J0_yy*t65;
+  const T t118 = middle_J0_zz*w_B_middle_z;
+  const T t119 = -t117*w_B_middle_z + t118*t65;
+  const T t120 = t116*w_B_middle_z - t118*t64;
+  const T t121 = -t116*t65 + t117*t64;
   // ---- body platform: mass and velocity terms
-  const T t128 = platform_S0_z*t91;
-  const T t129 = -platform_S0_z*t90;
-  const T t130 = -t129*w_B_platform_z;
-  const T t131 = t128*w_B_platform_z;
-  const T t132 = -t128*t91 + t129*t90;
-  const T t133 = platform_J0_xx*t90;
-  const T t134 = platform_J0_yy*t91;
-  const T t135 = platform_J0_zz*w_B_platform_z;
-  const T t136 = -t134*w_B_platform_z + t135*t91;
-  const T t137 = t133*w_B_platform_z - t135*t90;
-  const T t138 = -t133*t91 + t134*t90;
+  const T t122 = platform_S0_z*t85;
+  const T t123 = -platform_S0_z*t84;
+  const T t124 = -t123*w_B_platform_z;
+  const T t125 = t122*w_B_platform_z;
+  const T t126 = -t122*t85 + t123*t84;
+  const T t127 = platform_J0_xx*t84;
+  const T t128 = platform_J0_yy*t85;
+  const T t129 = platform_J0_zz*w_B_platform_z;
+  const T t130 = -t128*w_B_platform_z + t129*t85;
+  const T t131 = t127*w_B_platform_z - t129*t84;
+  const T t132 = -t127*t85 + t128*t84;
   // ---- body platform: composite inertia (inward)
-  const T t139 = t83*t83;
-  const T t140 = t82*t83;
-  const T t142 = k90de9f79*t139;
-  const T t143 = platform_J0_xx - t142;
-  const T t144 = platform_J0_yy + t142;
-  const T t145 = k90de9f79*t140;
-  const T t146 = middle_J0_xx + t143;
-  const T t147 = middle_J0_zz + t144;
+  const T t133 = angle_s[2]*angle_s[2];
+  const T t134 = angle_c[2]*angle_s[2];
+  const T t136 = k90de9f79*t133;
+  const T t137 = platform_J0_xx - t136;
+  const T t138 = platform_J0_yy + t136;
+  const T t139 = k90de9f79*t134;
+  const T t140 = middle_J0_xx + t137;
+  const T t141 = middle_J0_zz + t138;
   // ---- body middle: composite inertia (inward)
-  const T t148 = platform_S0_z*t61;
-  const T t149 = -platform_S0_z*t60;
-  const T t150 = t61*t61;
-  const T t151 = t60*t61;
-  const T t153 = -k066c2bd9 + t146;
-  const T t154 = t150*t153;
-  const T t155 = t146 - t154;
-  const T t156 = k066c2bd9 + t154;
-  const T t157 = t151*t153;
-  const T t158 = t145*t60;
-  const T t159 = t145*t61;
-  const T t160 = outer_J0_xx + t155;
-  const T t161 = outer_J0_yy + t147;
-  const T t162 = outer_J0_zz + t156;
+  const T t142 = angle_s[1]*platform_S0_z;
+  const T t143 = -angle_c[1]*platform_S0_z;
+  const T t144 = angle_s[1]*angle_s[1];
+  const T t145 = angle_c[1]*angle_s[1];
+  const T t147 = -k066c2bd9 + t140;
+  const T t148 = t144*t147;
+  const T t149 = t140 - t148;
+  const T t150 = k066c2bd9 + t148;
+  const T t151 = t145*t147;
+  const T t152 = angle_c[1]*t139;
+  const T t153 = angle_s[1]*t139;
+  const T t154 = outer_J0_xx + t149;
+  const T t155 = outer_J0_yy + t141;
+  const T t156 = outer_J0_zz + t150;
   // ---- body outer: composite inertia (inward)
-  const T t163 = t148*t26;
-  const T t164 = t148*t27;
-  const T t165 = t27*t27;
-  const T t166 = t26*t27;
-  const T t167 = 1.0 - 2.0*t165;
-  const T t168 = t160 - t161;
-  const T t169 = -2.0*t158*t166 + t165*t168;
-  const T t170 = t160 - t169;
-  const T t171 = t161 + t169;
-  const T t172 = -t158*t167 + t166*t168;
-  const T t173 = t157*t26 + t159*t27;
-  const T t174 = t157*t27 - t159*t26;
-  const T t175 = 2.0*outer_p_J_z*t149 + kd6a1eb15 + t170;
-  const T t176 = -outer_p_J_z*t163 + t173;
-  const T t177 = 2.0*outer_p_J_z*t149 + kd6a1eb15 + t171;
-  const T t178 = -outer_p_J_z*t164 + t174;
-  const T t179 = kd681c1b9 + t149;
-  const T t180 = bus_J0_xx + t175;
-  const T t181 = bus_J0_xy + t172;
-  const T t182 = bus_J0_yy + t177;
-  const T t183 = bus_J0_yz - t178;
-  const T t184 = bus_J0_zz + t162;
-  const T t185 = -bus_S0_z - t179;
-  const T t186 = bus_S0_z + t179;
-  const T t187 = -bus_S0_x + t163;
-  const T t188 = bus_S0_x - t163;
+  const T t157 = angle_c[0]*t142;
+  const T t158 = angle_s[0]*t142;
+  const T t159 = angle_s[0]*angle_s[0];
+  const T t160 = angle_c[0]*angle_s[0];
+  const T t161 = 1.0 - 2.0*t159;
+  const T t162 = t154 - t155;
+  const T t163 = -2.0*t152*t160 + t159*t162;
+  const T t164 = t154 - t163;
+  const T t165 = t155 + t163;
+  const T t166 = -t152*t161 + t160*t162;
+  const T t167 = angle_c[0]*t151 + angle_s[0]*t153;
+  const T t168 = -angle_c[0]*t153 + angle_s[0]*t151;
+  const T t169 = 2.0*outer_p_J_z*t143 + kd6a1eb15 + t164;
+  const T t170 = -outer_p_J_z*t157 + t167;
+  const T t171 = 2.0*outer_p_J_z*t143 + kd6a1eb15 + t165;
+  const T t172 = -outer_p_J_z*t158 + t168;
+  const T t173 = kd681c1b9 + t143;
+  const T t174 = bus_J0_xx + t169;
+  const T t175 = bus_J0_xy + t166;
+  const T t176 = bus_J0_yy + t171;
+  const T t177 = bus_J0_yz - t172;
+  const T t178 = bus_J0_zz + t156;
+  const T t179 = -bus_S0_z - t173;
+  const T t180 = bus_S0_z + t173;
+  const T t181 = -bus_S0_x + t157;
+  const T t182 = bus_S0_x - t157;
   // ---- body outer: its columns of M (walked to the root)
-  const T t189 = -t148*t27;
-  const T t190 = -outer_p_J_z*t163;
-  const T t191 = outer_p_J_z*t189;
-  const T t192 = t173 + t190;
-  const T t193 = t174 + t191;
+  const T t183 = -angle_s[0]*t142;
+  const T t184 = -outer_p_J_z*t157;
+  const T t185 = outer_p_J_z*t183;
+  const T t186 = t167 + t184;
+  const T t187 = t168 + t185;
   // ---- body middle: its columns of M (walked to the root)
-  const T t194 = platform_S0_z*t60;
-  const T t195 = t194*t26;
-  const T t196 = t194*t27;
-  const T t197 = -outer_p_J_z*t196;
-  const T t198 = outer_p_J_z*t195;
-  const T t199 = t147*t27 + t158*t26;
-  const T t200 = -t147*t26 + t158*t27;
-  const T t201 = t197 + t199;
-  const T t202 = t198 + t200;
+  const T t188 = angle_c[1]*platform_S0_z;
+  const T t189 = angle_c[0]*t188;
+  const T t190 = angle_s[0]*t188;
+  const T t191 = -outer_p_J_z*t190;
+  const T t192 = outer_p_J_z*t189;
+  const T t193 = angle_c[0]*t152 + angle_s[0]*t141;
+  const T t194 = -angle_c[0]*t141 + angle_s[0]*t152;
+  const T t195 = t191 + t193;
+  const T t196 = t192 + t194;
   // ---- body platform: its columns of M (walked to the root)
-  const T t203 = platform_J0_zz*t61;
-  const T t204 = -platform_J0_zz*t60;
-  const T t205 = t203*t26;
-  const T t206 = t203*t27;
+  const T t197 = angle_s[1]*platform_J0_zz;
+  const T t198 = -angle_c[1]*platform_J0_zz;
+  const T t199 = angle_c[0]*t197;
+  const T t200 = angle_s[0]*t197;
   // ---- body bus: bias force
-  const T t207 = -bus_mass*t23 - t107;
-  const T t208 = -bus_mass*t24 - t108;
-  const T t209 = -bus_mass*t25 - t109;
-  const T t210 = bus_S0_z*t24 - t113;
-  const T t211 = bus_S0_x*t25 - bus_S0_z*t23 - t114;
-  const T t212 = -bus_S0_x*t24 - t115;
+  const T t201 = -bus_mass*t23 - t101;
+  const T t202 = -bus_mass*t24 - t102;
+  const T t203 = -bus_mass*t25 - t103;
+  const T t204 = bus_S0_z*t24 - t107;
+  const T t205 = bus_S0_x*t25 - bus_S0_z*t23 - t108;
+  const T t206 = -bus_S0_x*t24 - t109;
   // ---- body outer: bias force
-  const T t213 = -outer_mass*t58;
-  const T t214 = -outer_mass*t59;
-  const T t215 = -outer_mass*t49;
-  const T t216 = -outer_J0_xx*t55 - t119;
-  const T t217 = -outer_J0_yy*t56 - t120;
+  const T t207 = -outer_mass*t56;
+  const T t208 = -outer_mass*t57;
+  const T t209 = -outer_mass*t47;
+  const T t210 = -outer_J0_xx*t53 - t113;
+  const T t211 = -outer_J0_yy*t54 - t114;
   // ---- body middle: bias force
-  const T t218 = -middle_mass*t80;
-  const T t219 = -middle_mass*t81;
-  const T t220 = middle_mass*t59;
-  const T t221 = -alpha_R_B_middle_x*middle_J0_xx - t125;
-  const T t222 = -alpha_R_B_middle_y*middle_J0_yy - t126;
-  const T t223 = middle_J0_zz*t56 - t127;
+  const T t212 = -middle_mass*t76;
+  const T t213 = -middle_mass*t77;
+  const T t214 = middle_mass*t57;
+  const T t215 = -alpha_R_B_middle_x*middle_J0_xx - t119;
+  const T t216 = -alpha_R_B_middle_y*middle_J0_yy - t120;
+  const T t217 = middle_J0_zz*t54 - t121;
   // ---- body platform: bias force
-  const T t224 = -alpha_R_B_platform_y*platform_S0_z - platform_mass*t102 - t130;
-  const T t225 = alpha_R_B_platform_x*platform_S0_z - platform_mass*t103 - t131;
-  const T t226 = platform_mass*t81 - t132;
-  const T t227 = -alpha_R_B_platform_x*platform_J0_xx + platform_S0_z*t103 - t136;
-  const T t228 = -alpha_R_B_platform_y*platform_J0_yy - platform_S0_z*t102 - t137;
-  const T t229 = alpha_R_B_middle_y*platform_J0_zz - t138;
+  const T t218 = -alpha_R_B_platform_y*platform_S0_z - platform_mass*t96 - t124;
+  const T t219 = alpha_R_B_platform_x*platform_S0_z - platform_mass*t97 - t125;
+  const T t220 = platform_mass*t77 - t126;
+  const T t221 = -alpha_R_B_platform_x*platform_J0_xx + platform_S0_z*t97 - t130;
+  const T t222 = -alpha_R_B_platform_y*platform_J0_yy - platform_S0_z*t96 - t131;
+  const T t223 = alpha_R_B_middle_y*platform_J0_zz - t132;
   // ---- body platform: generalized forces (inward)
-  const T t230 = t229 + tau[8];
-  const T t231 = t224*t82 - t225*t83;
-  const T t232 = t224*t83 + t225*t82;
-  const T t233 = t227*t82 - t228*t83;
-  const T t234 = t227*t83 + t228*t82;
-  const T t235 = t218 + t231;
-  const T t236 = t219 - t226;
-  const T t237 = t220 + t232;
-  const T t238 = t221 + t233;
-  const T t239 = t222 - t229;
-  const T t240 = t223 + t234;
+  const T t224 = t223 + tau[8];
+  const T t225 = angle_c[2]*t218 - angle_s[2]*t219;
+  const T t226 = angle_c[2]*t219 + angle_s[2]*t218;
+  const T t227 = angle_c[2]*t221 - angle_s[2]*t222;
+  const T t228 = angle_c[2]*t222 + angle_s[2]*t221;
+  const T t229 = t212 + t225;
+  const T t230 = t213 - t220;
+  const T t231 = t214 + t226;
+  const T t232 = t215 + t227;
+  const T t233 = t216 - t223;
+  const T t234 = t217 + t228;
   // ---- body middle: generalized forces (inward)
-  const T t241 = t240 + tau[7];
-  const T t242 = t235*t60 - t236*t61;
-  const T t243 = t235*t61 + t236*t60;
-  const T t244 = t238*t60 - t239*t61;
-  const T t245 = t238*t61 + t239*t60;
-  const T t246 = t213 + t242;
-  const T t247 = t214 - t237;
-  const T t248 = t215 + t243;
-  const T t249 = t216 + t244;
-  const T t250 = t217 - t240;
-  const T t251 = -t121 + t245;
+  const T t235 = t234 + tau[7];
+  const T t236 = angle_c[1]*t229 - angle_s[1]*t230;
+  const T t237 = angle_c[1]*t230 + angle_s[1]*t229;
+  const T t238 = angle_c[1]*t232 - angle_s[1]*t233;
+  const T t239 = angle_c[1]*t233 + angle_s[1]*t232;
+  const T t240 = t207 + t236;
+  const T t241 = t208 - t231;
+  const T t242 = t209 + t237;
+  const T t243 = t210 + t238;
+  const T t244 = t211 - t234;
+  const T t245 = -t115 + t239;
   // ---- body outer: generalized forces (inward)
-  const T t252 = t251 + tau[6];
-  const T t253 = t246*t26 - t247*t27;
-  const T t254 = t246*t27 + t247*t26;
-  const T t255 = -outer_p_J_z*t254;
-  const T t256 = outer_p_J_z*t253;
-  const T t257 = t249*t26 - t250*t27;
-  const T t258 = t249*t27 + t250*t26;
-  const T t259 = t255 + t257;
-  const T t260 = t256 + t258;
-  const T t261 = t207 - t253;
-  const T t262 = t208 - t254;
-  const T t263 = t209 + t248;
-  const T t264 = t210 - t259;
-  const T t265 = t211 - t260;
-  const T t266 = t212 + t251;
+  const T t246 = t245 + tau[6];
+  const T t247 = angle_c[0]*t240 - angle_s[0]*t241;
+  const T t248 = angle_c[0]*t241 + angle_s[0]*t240;
+  const T t249 = -outer_p_J_z*t248;
+  const T t250 = outer_p_J_z*t247;
+  const T t251 = angle_c[0]*t243 - angle_s[0]*t244;
+  const T t252 = angle_c[0]*t244 + angle_s[0]*t243;
+  const T t253 = t249 + t251;
+  const T t254 = t250 + t252;
+  const T t255 = t201 - t247;
+  const T t256 = t202 - t248;
+  const T t257 = t203 + t242;
+  const T t258 = t204 - t253;
+  const T t259 = t205 - t254;
+  const T t260 = t206 + t245;
   // ---- body bus: generalized forces (inward)
-  const T t267 = t261 + tau[0];
-  const T t268 = t262 + tau[1];
-  const T t269 = t263 + tau[2];
-  const T t270 = t264 + tau[3];
-  const T t271 = t265 + tau[4];
-  const T t272 = t266 + tau[5];
+  const T t261 = t255 + tau[0];
+  const T t262 = t256 + tau[1];
+  const T t263 = t257 + tau[2];
+  const T t264 = t258 + tau[3];
+  const T t265 = t259 + tau[4];
+  const T t266 = t260 + tau[5];
   // ---- M u_dot = F: L^T D L along the dof tree
-  const T t273 = k027b32c0*t204;
-  const T t274 = t162 - t204*t273;
-  const T t275 = -t193 + t206*t273;
-  const T t276 = -t192 + t205*t273;
-  const T t277 = t184 - t204*t273;
-  const T t278 = t183 + t206*t273;
-  const T t279 = -t176 + t205*t273;
-  const T t280 = -k027b32c0*t206;
-  const T t281 = t182 + t206*t280;
-  const T t282 = t181 + t205*t280;
-  const T t283 = -k027b32c0*t205;
-  const T t284 = t180 + t205*t283;
-  const T t285 = 1.0/t147;
-  const T t286 = t159*t285;
-  const T t287 = -t159*t286 + t274;
-  const T t288 = t202*t286 + t275;
-  const T t289 = t201*t286 + t276;
-  const T t290 = -t148*t286;
-  const T t291 = -t163 + t196*t286;
-  const T t292 = -t189 + t195*t286;
-  const T t293 = -t159*t286 + t277;
-  const T t294 = t202*t286 + t278;
-  const T t295 = t201*t286 + t279;
-  const T t296 = t188 + t196*t286;
-  const T t297 = t164 + t195*t286;
-  const T t298 = -t202*t285;
-  const T t299 = t202*t298 + t281;
-  const T t300 = t201*t298 + t282;
-  const T t301 = -t148*t298 + t187;
-  const T t302 = t196*t298;
-  const T t303 = t186 + t195*t298;
-  const T t304 = -t201*t285;
-  const T t305 = t201*t304 + t284;
-  const T t306 = -t148*t304 - t164;
-  const T t307 = t185 + t196*t304;
-  const T t308 = t195*t304;
-  const T t309 = t148*t285;
-  const T t310 = kf72fdc70 - t148*t309;
-  const T t311 = t196*t309;
-  const T t312 = t195*t309;
-  const T t313 = -t196*t285;
-  const T t314 = kf72fdc70 + t196*t313;
-  const T t315 = t195*t313;
-  const T t316 = -t195*t285;
-  const T t317 = kf72fdc70 + t195*t316;
-  const T t318 = 1.0/t287;
-  const T t319 = t287*t318;
-  const T t320 = -t287*t319 + t293;
-  const T t321 = -t288*t319 + t294;
-  const T t322 = -t289*t319 + t295;
-  const T t323 = t290 - t290*t319;
-  const T t324 = -t291*t319 + t296;
-  const T t325 = -t292*t319 + t297;
-  const T t326 = t288*t318;
-  const T t327 = -t288*t326 + t299;
-  const T t328 = -t289*t326 + t300;
-  const T t329 = -t290*t326 + t301;
-  const T t330 = -t291*t326 + t302;
-  const T t331 = -t292*t326 + t303;
-  const T t332 = t289*t318;
-  const T t333 = -t289*t332 + t305;
-  const T t334 = -t290*t332 + t306;
-  const T t335 = -t291*t332 + t307;
-  const T t336 = -t292*t332 + t308;
-  const T t337 = t290*t318;
-  const T t338 = -t290*t337 + t310;
-  const T t339 = -t291*t337 + t311;
-  const T t340 = -t292*t337 + t312;
-  const T t341 = t291*t318;
-  const T t342 = -t291*t341 + t314;
-  const T t343 = -t292*t341 + t315;
-  const T t344 = t292*t318;
-  const T t345 = -t292*t344 + t317;
-  const T t346 = 1.0/t320;
-  const T t347 = t321*t346;
-  const T t348 = -t321*t347 + t327;
-  const T t349 = -t322*t347 + t328;
-  const T t350 = -t323*t347 + t329;
-  const T t351 = -t324*t347 + t330;
-  const T t352 = -t325*t347 + t331;
-  const T t353 = t322*t346;
-  const T t354 = -t322*t353 + t333;
-  const T t355 = -t323*t353 + t334;
-  const T t356 = -t324*t353 + t335;
-  const T t357 = -t325*t353 + t336;
-  const T t358 = t323*t346;
-  const T t359 = -t323*t358 + t338;
-  const T t360 = -t324*t358 + t339;
-  const T t361 = -t325*t358 + t340;
-  const T t362 = t324*t346;
-  const T t363 = -t324*t362 + t342;
-  const T t364 = -t325*t362 + t343;
-  const T t365 = t325*t346;
-  const T t366 = -t325*t365 + t345;
-  const T t367 = 1.0/t348;
-  const T t368 = t349*t367;
-  const T t369 = -t349*t368 + t354;
-  const T t370 = -t350*t368 + t355;
-  const T t371 = -t351*t368 + t356;
-  const T t372 = -t352*t368 + t357;
-  const T t373 = t350*t367;
-  const T t374 = -t350*t373 + t359;
-  const T t375 = -t351*t373 + t360;
-  const T t376 = -t352*t373 + t361;
-  const T t377 = t351*t367;
-  const T t378 = -t351*t377 + t363;
-  const T t379 = -t352*t377 + t364;
-  const T t380 = t352*t367;
-  const T t381 = -t352*t380 + t366;
-  const T t382 = 1.0/t369;
-  const T t383 = t370*t382;
-  const T t384 = -t370*t383 + t374;
-  const T t385 = -t371*t383 + t375;
-  const T t386 = -t372*t383 + t376;
-  const T t387 = t371*t382;
-  const T t388 = -t371*t387 + t378;
-  const T t389 = -t372*t387 + t379;
-  const T t390 = t372*t382;
-  const T t391 = -t372*t390 + t381;
-  const T t392 = 1.0/t384;
-  const T t393 = t385*t392;
-  const T t394 = -t385*t393 + t388;
-  const T t395 = -t386*t393 + t389;
-  const T t396 = t386*t392;
-  const T t397 = -t386*t396 + t391;
-  const T t398 = 1.0/t394;
-  const T t399 = t395*t398;
-  const T t400 = -t395*t399 + t397;
-  const T t402 = -t230*t273 + t252;
-  const T t403 = -t230*t273 + t272;
-  const T t404 = -t230*t280 + t271;
-  const T t405 = -t230*t283 + t270;
-  const T t406 = -t241*t286 + t402;
-  const T t407 = -t241*t286 + t403;
-  const T t408 = -t241*t298 + t404;
-  const T t409 = -t241*t304 + t405;
-  const T t410 = -t241*t309 + t269;
-  const T t411 = -t241*t313 + t268;
-  const T t412 = -t241*t316 + t267;
-  const T t413 = -t319*t406 + t407;
-  const T t414 = -t326*t406 + t408;
-  const T t415 = -t332*t406 + t409;
-  const T t416 = -t337*t406 + t410;
-  const T t417 = -t341*t406 + t411;
-  const T t418 = -t344*t406 + t412;
-  const T t419 = -t347*t413 + t414;
-  const T t420 = -t353*t413 + t415;
-  const T t421 = -t358*t413 + t416;
-  const T t422 = -t362*t413 + t417;
-  const T t423 = -t365*t413 + t418;
-  const T t424 = -t368*t419 + t420;
-  const T t425 = -t373*t419 + t421;
-  const T t426 = -t377*t419 + t422;
-  const T t427 = -t380*t419 + t423;
-  const T t428 = -t383*t424 + t425;
-  const T t429 = -t387*t424 + t426;
-  const T t430 = -t390*t424 + t427;
-  const T t431 = -t393*t428 + t429;
-  const T t432 = -t396*t428 + t430;
-  const T t433 = -t399*t431 + t432;
-  const T t434 = t433/t400;
-  const T t435 = t431/t394;
-  const T t436 = t428/t384;
-  const T t437 = t424/t369;
-  const T t438 = t419/t348;
-  const T t439 = t413/t320;
-  const T t440 = t406/t287;
-  const T t441 = t241/t147;
-  const T t442 = k027b32c0*t230;
-  const T t443 = -t399*t434 + t435;
-  const T t444 = -t393*t443 + t436;
-  const T t445 = -t396*t434 + t444;
-  const T t446 = -t383*t445 + t437;
-  const T t447 = -t387*t443 + t446;
-  const T t448 = -t390*t434 + t447;
-  const T t449 = -t368*t448 + t438;
-  const T t450 = -t373*t445 + t449;
-  const T t451 = -t377*t443 + t450;
-  const T t452 = -t380*t434 + t451;
-  const T t453 = -t347*t452 + t439;
-  const T t454 = -t353*t448 + t453;
-  const T t455 = -t358*t445 + t454;
-  const T t456 = -t362*t443 + t455;
-  const T t457 = -t365*t434 + t456;
-  const T t458 = -t319*t457 + t440;
-  const T t459 = -t326*t452 + t458;
-  const T t460 = -t332*t448 + t459;
-  const T t461 = -t337*t445 + t460;
-  const T t462 = -t341*t443 + t461;
-  const T t463 = -t344*t434 + t462;
-  const T t464 = -t286*t463 + t441;
-  const T t465 = -t286*t457 + t464;
-  const T t466 = -t298*t452 + t465;
-  const T t467 = -t304*t448 + t466;
-  const T t468 = -t309*t445 + t467;
-  const T t469 = -t313*t443 + t468;
-  const T t470 = -t316*t434 + t469;
-  const T t471 = -t273*t463 + t442;
-  const T t472 = -t273*t457 + t471;
-  const T t473 = -t280*t452 + t472;
-  const T t474 = -t283*t448 + t473;
-  if (!(t400 > 1e-14*kf72fdc70)) return 1;
-  if (!(t394 > 1e-14*kf72fdc70)) return 2;
-  if (!(t384 > 1e-14*kf72fdc70)) return 3;
-  if (!(t369 > 1e-14*t180)) return 4;
-  if (!(t348 > 1e-14*t182)) return 5;
-  if (!(t320 > 1e-14*t184)) return 6;
-  if (!(t287 > 1e-14*t162)) return 7;
-  if (!(t147 > 0.0)) return 8;
+  const T t267 = k027b32c0*t198;
+  const T t268 = t156 - t198*t267;
+  const T t269 = -t187 + t200*t267;
+  const T t270 = -t186 + t199*t267;
+  const T t271 = t178 - t198*t267;
+  const T t272 = t177 + t200*t267;
+  const T t273 = -t170 + t199*t267;
+  const T t274 = -k027b32c0*t200;
+  const T t275 = t176 + t200*t274;
+  const T t276 = t175 + t199*t274;
+  const T t277 = -k027b32c0*t199;
+  const T t278 = t174 + t199*t277;
+  const T t279 = 1.0/t141;
+  const T t280 = t153*t279;
+  const T t281 = -t153*t280 + t268;
+  const T t282 = t196*t280 + t269;
+  const T t283 = t195*t280 + t270;
+  const T t284 = -t142*t280;
+  const T t285 = -t157 + t190*t280;
+  const T t286 = -t183 + t189*t280;
+  const T t287 = -t153*t280 + t271;
+  const T t288 = t196*t280 + t272;
+  const T t289 = t195*t280 + t273;
+  const T t290 = t182 + t190*t280;
+  const T t291 = t158 + t189*t280;
+  const T t292 = -t196*t279;
+  const T t293 = t196*t292 + t275;
+  const T t294 = t195*t292 + t276;
+  const T t295 = -t142*t292 + t181;
+  const T t296 = t190*t292;
+  const T t297 = t180 + t189*t292;
+  const T t298 = -t195*t279;
+  const T t299 = t195*t298 + t278;
+  const T t300 = -t142*t298 - t158;
+  const T t301 = t179 + t190*t298;
+  const T t302 = t189*t298;
+  const T t303 = t142*t279;
+  const T t304 = kf72fdc70 - t142*t303;
+  const T t305 = t190*t303;
+  const T t306 = t189*t303;
+  const T t307 = -t190*t279;
+  const T t308 = kf72fdc70 + t190*t307;
+  const T t309 = t189*t307;
+  const T t310 = -t189*t279;
+  const T t311 = kf72fdc70 + t189*t310;
+  const T t312 = 1.0/t281;
+  const T t313 = t281*t312;
+  const T t314 = -t281*t313 + t287;
+  const T t315 = -t282*t313 + t288;
+  const T t316 = -t283*t313 + t289;
+  const T t317 = t284 - t284*t313;
+  const T t318 = -t285*t313 + t290;
+  const T t319 = -t286*t313 + t291;
+  const T t320 = t282*t312;
+  const T t321 = -t282*t320 + t293;
+  const T t322 = -t283*t320 + t294;
+  const T t323 = -t284*t320 + t295;
+  const T t324 = -t285*t320 + t296;
+  const T t325 = -t286*t320 + t297;
+  const T t326 = t283*t312;
+  const T t327 = -t283*t326 + t299;
+  const T t328 = -t284*t326 + t300;
+  const T t329 = -t285*t326 + t301;
+  const T t330 = -t286*t326 + t302;
+  const T t331 = t284*t312;
+  const T t332 = -t284*t331 + t304;
+  const T t333 = -t285*t331 + t305;
+  const T t334 = -t286*t331 + t306;
+  const T t335 = t285*t312;
+  const T t336 = -t285*t335 + t308;
+  const T t337 = -t286*t335 + t309;
+  const T t338 = t286*t312;
+  const T t339 = -t286*t338 + t311;
+  const T t340 = 1.0/t314;
+  const T t341 = t315*t340;
+  const T t342 = -t315*t341 + t321;
+  const T t343 = -t316*t341 + t322;
+  const T t344 = -t317*t341 + t323;
+  const T t345 = -t318*t341 + t324;
+  const T t346 = -t319*t341 + t325;
+  const T t347 = t316*t340;
+  const T t348 = -t316*t347 + t327;
+  const T t349 = -t317*t347 + t328;
+  const T t350 = -t318*t347 + t329;
+  const T t351 = -t319*t347 + t330;
+  const T t352 = t317*t340;
+  const T t353 = -t317*t352 + t332;
+  const T t354 = -t318*t352 + t333;
+  const T t355 = -t319*t352 + t334;
+  const T t356 = t318*t340;
+  const T t357 = -t318*t356 + t336;
+  const T t358 = -t319*t356 + t337;
+  const T t359 = t319*t340;
+  const T t360 = -t319*t359 + t339;
+  const T t361 = 1.0/t342;
+  const T t362 = t343*t361;
+  const T t363 = -t343*t362 + t348;
+  const T t364 = -t344*t362 + t349;
+  const T t365 = -t345*t362 + t350;
+  const T t366 = -t346*t362 + t351;
+  const T t367 = t344*t361;
+  const T t368 = -t344*t367 + t353;
+  const T t369 = -t345*t367 + t354;
+  const T t370 = -t346*t367 + t355;
+  const T t371 = t345*t361;
+  const T t372 = -t345*t371 + t357;
+  const T t373 = -t346*t371 + t358;
+  const T t374 = t346*t361;
+  const T t375 = -t346*t374 + t360;
+  const T t376 = 1.0/t363;
+  const T t377 = t364*t376;
+  const T t378 = -t364*t377 + t368;
+  const T t379 = -t365*t377 + t369;
+  const T t380 = -t366*t377 + t370;
+  const T t381 = t365*t376;
+  const T t382 = -t365*t381 + t372;
+  const T t383 = -t366*t381 + t373;
+  const T t384 = t366*t376;
+  const T t385 = -t366*t384 + t375;
+  const T t386 = 1.0/t378;
+  const T t387 = t379*t386;
+  const T t388 = -t379*t387 + t382;
+  const T t389 = -t380*t387 + t383;
+  const T t390 = t380*t386;
+  const T t391 = -t380*t390 + t385;
+  const T t392 = 1.0/t388;
+  const T t393 = t389*t392;
+  const T t394 = -t389*t393 + t391;
+  const T t396 = -t224*t267 + t246;
+  const T t397 = -t224*t267 + t266;
+  const T t398 = -t224*t274 + t265;
+  const T t399 = -t224*t277 + t264;
+  const T t400 = -t235*t280 + t396;
+  const T t401 = -t235*t280 + t397;
+  const T t402 = -t235*t292 + t398;
+  const T t403 = -t235*t298 + t399;
+  const T t404 = -t235*t303 + t263;
+  const T t405 = -t235*t307 + t262;
+  const T t406 = -t235*t310 + t261;
+  const T t407 = -t313*t400 + t401;
+  const T t408 = -t320*t400 + t402;
+  const T t409 = -t326*t400 + t403;
+  const T t410 = -t331*t400 + t404;
+  const T t411 = -t335*t400 + t405;
+  const T t412 = -t338*t400 + t406;
+  const T t413 = -t341*t407 + t408;
+  const T t414 = -t347*t407 + t409;
+  const T t415 = -t352*t407 + t410;
+  const T t416 = -t356*t407 + t411;
+  const T t417 = -t359*t407 + t412;
+  const T t418 = -t362*t413 + t414;
+  const T t419 = -t367*t413 + t415;
+  const T t420 = -t371*t413 + t416;
+  const T t421 = -t374*t413 + t417;
+  const T t422 = -t377*t418 + t419;
+  const T t423 = -t381*t418 + t420;
+  const T t424 = -t384*t418 + t421;
+  const T t425 = -t387*t422 + t423;
+  const T t426 = -t390*t422 + t424;
+  const T t427 = -t393*t425 + t426;
+  const T t428 = t427/t394;
+  const T t429 = t425/t388;
+  const T t430 = t422/t378;
+  const T t431 = t418/t363;
+  const T t432 = t413/t342;
+  const T t433 = t407/t314;
+  const T t434 = t400/t281;
+  const T t435 = t235/t141;
+  const T t436 = k027b32c0*t224;
+  const T t437 = -t393*t428 + t429;
+  const T t438 = -t387*t437 + t430;
+  const T t439 = -t390*t428 + t438;
+  const T t440 = -t377*t439 + t431;
+  const T t441 = -t381*t437 + t440;
+  const T t442 = -t384*t428 + t441;
+  const T t443 = -t362*t442 + t432;
+  const T t444 = -t367*t439 + t443;
+  const T t445 = -t371*t437 + t444;
+  const T t446 = -t374*t428 + t445;
+  const T t447 = -t341*t446 + t433;
+  const T t448 = -t347*t442 + t447;
+  const T t449 = -t352*t439 + t448;
+  const T t450 = -t356*t437 + t449;
+  const T t451 = -t359*t428 + t450;
+  const T t452 = -t313*t451 + t434;
+  const T t453 = -t320*t446 + t452;
+  const T t454 = -t326*t442 + t453;
+  const T t455 = -t331*t439 + t454;
+  const T t456 = -t335*t437 + t455;
+  const T t457 = -t338*t428 + t456;
+  const T t458 = -t280*t457 + t435;
+  const T t459 = -t280*t451 + t458;
+  const T t460 = -t292*t446 + t459;
+  const T t461 = -t298*t442 + t460;
+  const T t462 = -t303*t439 + t461;
+  const T t463 = -t307*t437 + t462;
+  const T t464 = -t310*t428 + t463;
+  const T t465 = -t267*t457 + t436;
+  const T t466 = -t267*t451 + t465;
+  const T t467 = -t274*t446 + t466;
+  const T t468 = -t277*t442 + t467;
+  if (!(t394 > 1e-14*kf72fdc70)) return 1;
+  if (!(t388 > 1e-14*kf72fdc70)) return 2;
+  if (!(t378 > 1e-14*kf72fdc70)) return 3;
+  if (!(t363 > 1e-14*t174)) return 4;
+  if (!(t342 > 1e-14*t176)) return 5;
+  if (!(t314 > 1e-14*t178)) return 6;
+  if (!(t281 > 1e-14*t156)) return 7;
+  if (!(t141 > 0.0)) return 8;
   if (!(platform_J0_zz > 0.0)) return 9;
-  udot[0] = t434;
-  udot[1] = t443;
-  udot[2] = t445;
-  udot[3] = t448;
-  udot[4] = t452;
-  udot[5] = t457;
-  udot[6] = t463;
-  udot[7] = t470;
-  udot[8] = t474;
+  udot[0] = t428;
+  udot[1] = t437;
+  udot[2] = t439;
+  udot[3] = t442;
+  udot[4] = t446;
+  udot[5] = t451;
+  udot[6] = t457;
+  udot[7] = t464;
+  udot[8] = t468;
   return 0;
 }
 
@@ -983,67 +1103,65 @@ template <class T>
 void energy(const T* q, const T* u, T* TV) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[3], angle_c[3];
+  const T angle_x[3] = {q[7], middle_angle_offset + q[8], platform_angle_offset + q[9]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 3);
   // ---- body outer: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t40 = -outer_p_J_z*u[4];
-  const T t41 = outer_p_J_z*u[3];
-  const T t42 = t40 - u[0];
-  const T t43 = t41 - u[1];
-  const T t50 = -t26*u[3] - t27*u[4];
-  const T t51 = -t26*u[4] + t27*u[3];
+  const T t38 = -outer_p_J_z*u[4];
+  const T t39 = outer_p_J_z*u[3];
+  const T t40 = t38 - u[0];
+  const T t41 = t39 - u[1];
+  const T t48 = -angle_c[0]*u[3] - angle_s[0]*u[4];
+  const T t49 = -angle_c[0]*u[4] + angle_s[0]*u[3];
   const T w_B_outer_z = u[5] + u[6];
-  const T t53 = t26*t42 + t27*t43;
-  const T t54 = t26*t43 - t27*t42;
+  const T t51 = angle_c[0]*t40 + angle_s[0]*t41;
+  const T t52 = angle_c[0]*t41 - angle_s[0]*t40;
   // ---- body middle: outward pass (velocities)
-  const T t60 = cos(middle_angle_offset + q[8]);
-  const T t61 = sin(middle_angle_offset + q[8]);
-  const T t68 = t50*t60 + t61*w_B_outer_z;
-  const T t69 = -t50*t61 + t60*w_B_outer_z;
-  const T w_B_middle_z = -t51 + u[7];
-  const T t71 = t53*t60 + t61*u[2];
-  const T t72 = -t53*t61 + t60*u[2];
+  const T t64 = angle_c[1]*t48 + angle_s[1]*w_B_outer_z;
+  const T t65 = angle_c[1]*w_B_outer_z - angle_s[1]*t48;
+  const T w_B_middle_z = -t49 + u[7];
+  const T t67 = angle_c[1]*t51 + angle_s[1]*u[2];
+  const T t68 = angle_c[1]*u[2] - angle_s[1]*t51;
   // ---- body platform: outward pass (velocities)
-  const T t82 = cos(platform_angle_offset + q[9]);
-  const T t83 = sin(platform_angle_offset + q[9]);
-  const T t90 = t68*t82 + t83*w_B_middle_z;
-  const T t91 = -t68*t83 + t82*w_B_middle_z;
-  const T w_B_platform_z = -t69 + u[8];
-  const T t93 = -t54*t83 + t71*t82;
-  const T t94 = -t54*t82 - t71*t83;
+  const T t84 = angle_c[2]*t64 + angle_s[2]*w_B_middle_z;
+  const T t85 = angle_c[2]*w_B_middle_z - angle_s[2]*t64;
+  const T w_B_platform_z = -t65 + u[8];
+  const T t87 = angle_c[2]*t67 - angle_s[2]*t52;
+  const T t88 = -angle_c[2]*t52 - angle_s[2]*t67;
   // ---- body outer: mass and velocity terms
-  const T t116 = outer_J0_xx*t50;
-  const T t117 = outer_J0_yy*t51;
-  const T t118 = outer_J0_zz*w_B_outer_z;
+  const T t110 = outer_J0_xx*t48;
+  const T t111 = outer_J0_yy*t49;
+  const T t112 = outer_J0_zz*w_B_outer_z;
   // ---- body middle: mass and velocity terms
-  const T t122 = middle_J0_xx*t68;
-  const T t123 = middle_J0_yy*t69;
-  const T t124 = middle_J0_zz*w_B_middle_z;
+  const T t116 = middle_J0_xx*t64;
+  const T t117 = middle_J0_yy*t65;
+  const T t118 = middle_J0_zz*w_B_middle_z;
   // ---- body platform: mass and velocity terms
-  const T t135 = platform_J0_zz*w_B_platform_z;
-  const T t139 = bus_S0_z*u[4] + bus_mass*u[0];
-  const T t140 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
-  const T t141 = -bus_S0_x*u[4] + bus_mass*u[2];
-  const T t142 = bus_J0_xx*u[3] + bus_J0_xy*u[4] - bus_S0_z*u[1];
-  const T t143 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
-  const T t144 = bus_J0_yz*u[4] + bus_J0_zz*u[5] + bus_S0_x*u[1];
-  const T t145 = ((t139*u[0] + t140*u[1]) + t141*u[2]) + ((t142*u[3] + t143*u[4]) + t144*u[5]);
-  const T t146 = outer_mass*t53;
-  const T t147 = outer_mass*t54;
-  const T t148 = outer_mass*u[2];
-  const T t149 = ((t116*t50 + t117*t51) + t118*w_B_outer_z) + ((t146*t53 + t147*t54) + t148*u[2]);
-  const T t150 = middle_mass*t71;
-  const T t151 = middle_mass*t72;
-  const T t152 = -middle_mass*t54;
-  const T t153 = (((t122*t68 + t123*t69) + t124*w_B_middle_z) + (t150*t71 + t151*t72)) - t152*t54;
-  const T t154 = platform_S0_z*t91 + platform_mass*t93;
-  const T t155 = -platform_S0_z*t90 + platform_mass*t94;
-  const T t156 = -platform_mass*t72;
-  const T t157 = platform_J0_xx*t90 - platform_S0_z*t94;
-  const T t158 = platform_J0_yy*t91 + platform_S0_z*t93;
-  const T t159 = (((t135*w_B_platform_z + t154*t93) + t155*t94) + (t157*t90 + t158*t91)) - t156*t72;
-  const T t160 = (t145/2.0 + t149/2.0) + (t153/2.0 + t159/2.0);
-  TV[0] = t160;
+  const T t129 = platform_J0_zz*w_B_platform_z;
+  const T t133 = bus_S0_z*u[4] + bus_mass*u[0];
+  const T t134 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
+  const T t135 = -bus_S0_x*u[4] + bus_mass*u[2];
+  const T t136 = bus_J0_xx*u[3] + bus_J0_xy*u[4] - bus_S0_z*u[1];
+  const T t137 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
+  const T t138 = bus_J0_yz*u[4] + bus_J0_zz*u[5] + bus_S0_x*u[1];
+  const T t139 = ((t133*u[0] + t134*u[1]) + t135*u[2]) + ((t136*u[3] + t137*u[4]) + t138*u[5]);
+  const T t140 = outer_mass*t51;
+  const T t141 = outer_mass*t52;
+  const T t142 = outer_mass*u[2];
+  const T t143 = ((t110*t48 + t111*t49) + t112*w_B_outer_z) + ((t140*t51 + t141*t52) + t142*u[2]);
+  const T t144 = middle_mass*t67;
+  const T t145 = middle_mass*t68;
+  const T t146 = -middle_mass*t52;
+  const T t147 = (((t116*t64 + t117*t65) + t118*w_B_middle_z) + (t144*t67 + t145*t68)) - t146*t52;
+  const T t148 = platform_S0_z*t85 + platform_mass*t87;
+  const T t149 = -platform_S0_z*t84 + platform_mass*t88;
+  const T t150 = -platform_mass*t68;
+  const T t151 = platform_J0_xx*t84 - platform_S0_z*t88;
+  const T t152 = platform_J0_yy*t85 + platform_S0_z*t87;
+  const T t153 = (((t129*w_B_platform_z + t148*t87) + t149*t88) + (t151*t84 + t152*t85)) - t150*t68;
+  const T t154 = (t139/2.0 + t143/2.0) + (t147/2.0 + t153/2.0);
+  TV[0] = t154;
   TV[1] = 0.0;
 }
 
@@ -1052,6 +1170,10 @@ template <class T>
 void momentum(const T* q, const T* u, T* pH) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[3], angle_c[3];
+  const T angle_x[3] = {q[7], middle_angle_offset + q[8], platform_angle_offset + q[9]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 3);
   // ---- body bus: outward pass (velocities)
   const T t0 = (1.0/sqrt((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
   const T t1 = q[3]*t0;
@@ -1077,156 +1199,150 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t21 = 2.0*t10 + 2.0*t11;
   const T t22 = 1.0 - 2.0*t5 - 2.0*t6;
   // ---- body outer: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T R_NB_outer_xx = -t14*t26 - t15*t27;
-  const T R_NB_outer_xy = t14*t27 - t15*t26;
-  const T R_NB_outer_yx = -t17*t26 - t18*t27;
-  const T R_NB_outer_yy = t17*t27 - t18*t26;
-  const T R_NB_outer_zx = -t20*t26 - t21*t27;
-  const T R_NB_outer_zy = t20*t27 - t21*t26;
-  const T t34 = outer_p_PJ_z*t16;
-  const T t35 = outer_p_PJ_z*t19;
-  const T t36 = outer_p_PJ_z*t22;
-  const T r_NO_N_outer_x = q[0] + t34;
-  const T r_NO_N_outer_y = q[1] + t35;
-  const T r_NO_N_outer_z = q[2] + t36;
-  const T t40 = -outer_p_J_z*u[4];
-  const T t41 = outer_p_J_z*u[3];
-  const T t42 = t40 - u[0];
-  const T t43 = t41 - u[1];
-  const T t50 = -t26*u[3] - t27*u[4];
-  const T t51 = -t26*u[4] + t27*u[3];
+  const T R_NB_outer_xx = -angle_c[0]*t14 - angle_s[0]*t15;
+  const T R_NB_outer_xy = -angle_c[0]*t15 + angle_s[0]*t14;
+  const T R_NB_outer_yx = -angle_c[0]*t17 - angle_s[0]*t18;
+  const T R_NB_outer_yy = -angle_c[0]*t18 + angle_s[0]*t17;
+  const T R_NB_outer_zx = -angle_c[0]*t20 - angle_s[0]*t21;
+  const T R_NB_outer_zy = -angle_c[0]*t21 + angle_s[0]*t20;
+  const T t32 = outer_p_PJ_z*t16;
+  const T t33 = outer_p_PJ_z*t19;
+  const T t34 = outer_p_PJ_z*t22;
+  const T r_NO_N_outer_x = q[0] + t32;
+  const T r_NO_N_outer_y = q[1] + t33;
+  const T r_NO_N_outer_z = q[2] + t34;
+  const T t38 = -outer_p_J_z*u[4];
+  const T t39 = outer_p_J_z*u[3];
+  const T t40 = t38 - u[0];
+  const T t41 = t39 - u[1];
+  const T t48 = -angle_c[0]*u[3] - angle_s[0]*u[4];
+  const T t49 = -angle_c[0]*u[4] + angle_s[0]*u[3];
   const T w_B_outer_z = u[5] + u[6];
-  const T t53 = t26*t42 + t27*t43;
-  const T t54 = t26*t43 - t27*t42;
+  const T t51 = angle_c[0]*t40 + angle_s[0]*t41;
+  const T t52 = angle_c[0]*t41 - angle_s[0]*t40;
   // ---- body middle: outward pass (velocities)
-  const T t60 = cos(middle_angle_offset + q[8]);
-  const T t61 = sin(middle_angle_offset + q[8]);
-  const T R_NB_middle_xx = R_NB_outer_xx*t60 + t16*t61;
-  const T R_NB_middle_xy = -R_NB_outer_xx*t61 + t16*t60;
-  const T R_NB_middle_yx = R_NB_outer_yx*t60 + t19*t61;
-  const T R_NB_middle_yy = -R_NB_outer_yx*t61 + t19*t60;
-  const T R_NB_middle_zx = R_NB_outer_zx*t60 + t22*t61;
-  const T R_NB_middle_zy = -R_NB_outer_zx*t61 + t22*t60;
-  const T t68 = t50*t60 + t61*w_B_outer_z;
-  const T t69 = -t50*t61 + t60*w_B_outer_z;
-  const T w_B_middle_z = -t51 + u[7];
-  const T t71 = t53*t60 + t61*u[2];
-  const T t72 = -t53*t61 + t60*u[2];
+  const T R_NB_middle_xx = R_NB_outer_xx*angle_c[1] + angle_s[1]*t16;
+  const T R_NB_middle_xy = -R_NB_outer_xx*angle_s[1] + angle_c[1]*t16;
+  const T R_NB_middle_yx = R_NB_outer_yx*angle_c[1] + angle_s[1]*t19;
+  const T R_NB_middle_yy = -R_NB_outer_yx*angle_s[1] + angle_c[1]*t19;
+  const T R_NB_middle_zx = R_NB_outer_zx*angle_c[1] + angle_s[1]*t22;
+  const T R_NB_middle_zy = -R_NB_outer_zx*angle_s[1] + angle_c[1]*t22;
+  const T t64 = angle_c[1]*t48 + angle_s[1]*w_B_outer_z;
+  const T t65 = angle_c[1]*w_B_outer_z - angle_s[1]*t48;
+  const T w_B_middle_z = -t49 + u[7];
+  const T t67 = angle_c[1]*t51 + angle_s[1]*u[2];
+  const T t68 = angle_c[1]*u[2] - angle_s[1]*t51;
   // ---- body platform: outward pass (velocities)
-  const T t82 = cos(platform_angle_offset + q[9]);
-  const T t83 = sin(platform_angle_offset + q[9]);
-  const T R_NB_platform_xx = R_NB_middle_xx*t82 - R_NB_outer_xy*t83;
-  const T R_NB_platform_xy = -R_NB_middle_xx*t83 - R_NB_outer_xy*t82;
-  const T R_NB_platform_yx = R_NB_middle_yx*t82 - R_NB_outer_yy*t83;
-  const T R_NB_platform_yy = -R_NB_middle_yx*t83 - R_NB_outer_yy*t82;
-  const T R_NB_platform_zx = R_NB_middle_zx*t82 - R_NB_outer_zy*t83;
-  const T R_NB_platform_zy = -R_NB_middle_zx*t83 - R_NB_outer_zy*t82;
-  const T t90 = t68*t82 + t83*w_B_middle_z;
-  const T t91 = -t68*t83 + t82*w_B_middle_z;
-  const T w_B_platform_z = -t69 + u[8];
-  const T t93 = -t54*t83 + t71*t82;
-  const T t94 = -t54*t82 - t71*t83;
+  const T R_NB_platform_xx = R_NB_middle_xx*angle_c[2] - R_NB_outer_xy*angle_s[2];
+  const T R_NB_platform_xy = -R_NB_middle_xx*angle_s[2] - R_NB_outer_xy*angle_c[2];
+  const T R_NB_platform_yx = R_NB_middle_yx*angle_c[2] - R_NB_outer_yy*angle_s[2];
+  const T R_NB_platform_yy = -R_NB_middle_yx*angle_s[2] - R_NB_outer_yy*angle_c[2];
+  const T R_NB_platform_zx = R_NB_middle_zx*angle_c[2] - R_NB_outer_zy*angle_s[2];
+  const T R_NB_platform_zy = -R_NB_middle_zx*angle_s[2] - R_NB_outer_zy*angle_c[2];
+  const T t84 = angle_c[2]*t64 + angle_s[2]*w_B_middle_z;
+  const T t85 = angle_c[2]*w_B_middle_z - angle_s[2]*t64;
+  const T w_B_platform_z = -t65 + u[8];
+  const T t87 = angle_c[2]*t67 - angle_s[2]*t52;
+  const T t88 = -angle_c[2]*t52 - angle_s[2]*t67;
   // ---- body outer: mass and velocity terms
-  const T t116 = outer_J0_xx*t50;
-  const T t117 = outer_J0_yy*t51;
-  const T t118 = outer_J0_zz*w_B_outer_z;
+  const T t110 = outer_J0_xx*t48;
+  const T t111 = outer_J0_yy*t49;
+  const T t112 = outer_J0_zz*w_B_outer_z;
   // ---- body middle: mass and velocity terms
-  const T t122 = middle_J0_xx*t68;
-  const T t123 = middle_J0_yy*t69;
-  const T t124 = middle_J0_zz*w_B_middle_z;
+  const T t116 = middle_J0_xx*t64;
+  const T t117 = middle_J0_yy*t65;
+  const T t118 = middle_J0_zz*w_B_middle_z;
   // ---- body platform: mass and velocity terms
-  const T t135 = platform_J0_zz*w_B_platform_z;
-  const T t139 = bus_S0_z*u[4] + bus_mass*u[0];
-  const T t140 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
-  const T t141 = -bus_S0_x*u[4] + bus_mass*u[2];
-  const T t142 = bus_J0_xx*u[3] + bus_J0_xy*u[4] - bus_S0_z*u[1];
-  const T t143 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
-  const T t144 = bus_J0_yz*u[4] + bus_J0_zz*u[5] + bus_S0_x*u[1];
-  const T t145 = t139*t14 + t140*t15 + t141*t16;
-  const T t146 = t139*t17 + t140*t18 + t141*t19;
-  const T t147 = t139*t20 + t140*t21 + t141*t22;
-  const T t148 = t14*t142 + t143*t15 + t144*t16;
-  const T t149 = t142*t17 + t143*t18 + t144*t19;
-  const T t150 = t142*t20 + t143*t21 + t144*t22;
-  const T t151 = q[1]*t147 - q[2]*t146;
-  const T t152 = -q[0]*t147 + q[2]*t145;
-  const T t153 = q[0]*t146 - q[1]*t145;
-  const T t154 = t148 + t151;
-  const T t155 = t149 + t152;
-  const T t156 = t150 + t153;
-  const T t157 = outer_mass*t53;
-  const T t158 = outer_mass*t54;
-  const T t159 = outer_mass*u[2];
-  const T t160 = R_NB_outer_xx*t157 + R_NB_outer_xy*t158 + t159*t16;
-  const T t161 = R_NB_outer_yx*t157 + R_NB_outer_yy*t158 + t159*t19;
-  const T t162 = R_NB_outer_zx*t157 + R_NB_outer_zy*t158 + t159*t22;
-  const T t163 = R_NB_outer_xx*t116 + R_NB_outer_xy*t117 + t118*t16;
-  const T t164 = R_NB_outer_yx*t116 + R_NB_outer_yy*t117 + t118*t19;
-  const T t165 = R_NB_outer_zx*t116 + R_NB_outer_zy*t117 + t118*t22;
-  const T t166 = r_NO_N_outer_y*t162 - r_NO_N_outer_z*t161;
-  const T t167 = -r_NO_N_outer_x*t162 + r_NO_N_outer_z*t160;
-  const T t168 = r_NO_N_outer_x*t161 - r_NO_N_outer_y*t160;
-  const T t169 = t163 + t166;
-  const T t170 = t164 + t167;
-  const T t171 = t165 + t168;
-  const T t172 = t145 + t160;
-  const T t173 = t146 + t161;
-  const T t174 = t147 + t162;
-  const T t175 = t154 + t169;
-  const T t176 = t155 + t170;
-  const T t177 = t156 + t171;
-  const T t178 = middle_mass*t71;
-  const T t179 = middle_mass*t72;
-  const T t180 = -middle_mass*t54;
-  const T t181 = R_NB_middle_xx*t178 + R_NB_middle_xy*t179 - R_NB_outer_xy*t180;
-  const T t182 = R_NB_middle_yx*t178 + R_NB_middle_yy*t179 - R_NB_outer_yy*t180;
-  const T t183 = R_NB_middle_zx*t178 + R_NB_middle_zy*t179 - R_NB_outer_zy*t180;
-  const T t184 = R_NB_middle_xx*t122 + R_NB_middle_xy*t123 - R_NB_outer_xy*t124;
-  const T t185 = R_NB_middle_yx*t122 + R_NB_middle_yy*t123 - R_NB_outer_yy*t124;
-  const T t186 = R_NB_middle_zx*t122 + R_NB_middle_zy*t123 - R_NB_outer_zy*t124;
-  const T t187 = r_NO_N_outer_y*t183 - r_NO_N_outer_z*t182;
-  const T t188 = -r_NO_N_outer_x*t183 + r_NO_N_outer_z*t181;
-  const T t189 = r_NO_N_outer_x*t182 - r_NO_N_outer_y*t181;
-  const T t190 = t184 + t187;
-  const T t191 = t185 + t188;
-  const T t192 = t186 + t189;
-  const T t193 = t172 + t181;
-  const T t194 = t173 + t182;
-  const T t195 = t174 + t183;
-  const T t196 = t175 + t190;
-  const T t197 = t176 + t191;
-  const T t198 = t177 + t192;
-  const T t199 = platform_S0_z*t91 + platform_mass*t93;
-  const T t200 = -platform_S0_z*t90 + platform_mass*t94;
-  const T t201 = -platform_mass*t72;
-  const T t202 = platform_J0_xx*t90 - platform_S0_z*t94;
-  const T t203 = platform_J0_yy*t91 + platform_S0_z*t93;
-  const T t204 = -R_NB_middle_xy*t201 + R_NB_platform_xx*t199 + R_NB_platform_xy*t200;
-  const T t205 = -R_NB_middle_yy*t201 + R_NB_platform_yx*t199 + R_NB_platform_yy*t200;
-  const T t206 = -R_NB_middle_zy*t201 + R_NB_platform_zx*t199 + R_NB_platform_zy*t200;
-  const T t207 = -R_NB_middle_xy*t135 + R_NB_platform_xx*t202 + R_NB_platform_xy*t203;
-  const T t208 = -R_NB_middle_yy*t135 + R_NB_platform_yx*t202 + R_NB_platform_yy*t203;
-  const T t209 = -R_NB_middle_zy*t135 + R_NB_platform_zx*t202 + R_NB_platform_zy*t203;
-  const T t210 = r_NO_N_outer_y*t206 - r_NO_N_outer_z*t205;
-  const T t211 = -r_NO_N_outer_x*t206 + r_NO_N_outer_z*t204;
-  const T t212 = r_NO_N_outer_x*t205 - r_NO_N_outer_y*t204;
-  const T t213 = t207 + t210;
-  const T t214 = t208 + t211;
-  const T t215 = t209 + t212;
-  const T t216 = t193 + t204;
-  const T t217 = t194 + t205;
-  const T t218 = t195 + t206;
-  const T t219 = t196 + t213;
-  const T t220 = t197 + t214;
-  const T t221 = t198 + t215;
-  pH[0] = t216;
-  pH[1] = t217;
-  pH[2] = t218;
-  pH[3] = t219;
-  pH[4] = t220;
-  pH[5] = t221;
+  const T t129 = platform_J0_zz*w_B_platform_z;
+  const T t133 = bus_S0_z*u[4] + bus_mass*u[0];
+  const T t134 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
+  const T t135 = -bus_S0_x*u[4] + bus_mass*u[2];
+  const T t136 = bus_J0_xx*u[3] + bus_J0_xy*u[4] - bus_S0_z*u[1];
+  const T t137 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
+  const T t138 = bus_J0_yz*u[4] + bus_J0_zz*u[5] + bus_S0_x*u[1];
+  const T t139 = t133*t14 + t134*t15 + t135*t16;
+  const T t140 = t133*t17 + t134*t18 + t135*t19;
+  const T t141 = t133*t20 + t134*t21 + t135*t22;
+  const T t142 = t136*t14 + t137*t15 + t138*t16;
+  const T t143 = t136*t17 + t137*t18 + t138*t19;
+  const T t144 = t136*t20 + t137*t21 + t138*t22;
+  const T t145 = q[1]*t141 - q[2]*t140;
+  const T t146 = -q[0]*t141 + q[2]*t139;
+  const T t147 = q[0]*t140 - q[1]*t139;
+  const T t148 = t142 + t145;
+  const T t149 = t143 + t146;
+  const T t150 = t144 + t147;
+  const T t151 = outer_mass*t51;
+  const T t152 = outer_mass*t52;
+  const T t153 = outer_mass*u[2];
+  const T t154 = R_NB_outer_xx*t151 + R_NB_outer_xy*t152 + t153*t16;
+  const T t155 = R_NB_outer_yx*t151 + R_NB_outer_yy*t152 + t153*t19;
+  const T t156 = R_NB_outer_zx*t151 + R_NB_outer_zy*t152 + t153*t22;
+  const T t157 = R_NB_outer_xx*t110 + R_NB_outer_xy*t111 + t112*t16;
+  const T t158 = R_NB_outer_yx*t110 + R_NB_outer_yy*t111 + t112*t19;
+  const T t159 = R_NB_outer_zx*t110 + R_NB_outer_zy*t111 + t112*t22;
+  const T t160 = r_NO_N_outer_y*t156 - r_NO_N_outer_z*t155;
+  const T t161 = -r_NO_N_outer_x*t156 + r_NO_N_outer_z*t154;
+  const T t162 = r_NO_N_outer_x*t155 - r_NO_N_outer_y*t154;
+  const T t163 = t157 + t160;
+  const T t164 = t158 + t161;
+  const T t165 = t159 + t162;
+  const T t166 = t139 + t154;
+  const T t167 = t140 + t155;
+  const T t168 = t141 + t156;
+  const T t169 = t148 + t163;
+  const T t170 = t149 + t164;
+  const T t171 = t150 + t165;
+  const T t172 = middle_mass*t67;
+  const T t173 = middle_mass*t68;
+  const T t174 = -middle_mass*t52;
+  const T t175 = R_NB_middle_xx*t172 + R_NB_middle_xy*t173 - R_NB_outer_xy*t174;
+  const T t176 = R_NB_middle_yx*t172 + R_NB_middle_yy*t173 - R_NB_outer_yy*t174;
+  const T t177 = R_NB_middle_zx*t172 + R_NB_middle_zy*t173 - R_NB_outer_zy*t174;
+  const T t178 = R_NB_middle_xx*t116 + R_NB_middle_xy*t117 - R_NB_outer_xy*t118;
+  const T t179 = R_NB_middle_yx*t116 + R_NB_middle_yy*t117 - R_NB_outer_yy*t118;
+  const T t180 = R_NB_middle_zx*t116 + R_NB_middle_zy*t117 - R_NB_outer_zy*t118;
+  const T t181 = r_NO_N_outer_y*t177 - r_NO_N_outer_z*t176;
+  const T t182 = -r_NO_N_outer_x*t177 + r_NO_N_outer_z*t175;
+  const T t183 = r_NO_N_outer_x*t176 - r_NO_N_outer_y*t175;
+  const T t184 = t178 + t181;
+  const T t185 = t179 + t182;
+  const T t186 = t180 + t183;
+  const T t187 = t166 + t175;
+  const T t188 = t167 + t176;
+  const T t189 = t168 + t177;
+  const T t190 = t169 + t184;
+  const T t191 = t170 + t185;
+  const T t192 = t171 + t186;
+  const T t193 = platform_S0_z*t85 + platform_mass*t87;
+  const T t194 = -platform_S0_z*t84 + platform_mass*t88;
+  const T t195 = -platform_mass*t68;
+  const T t196 = platform_J0_xx*t84 - platform_S0_z*t88;
+  const T t197 = platform_J0_yy*t85 + platform_S0_z*t87;
+  const T t198 = -R_NB_middle_xy*t195 + R_NB_platform_xx*t193 + R_NB_platform_xy*t194;
+  const T t199 = -R_NB_middle_yy*t195 + R_NB_platform_yx*t193 + R_NB_platform_yy*t194;
+  const T t200 = -R_NB_middle_zy*t195 + R_NB_platform_zx*t193 + R_NB_platform_zy*t194;
+  const T t201 = -R_NB_middle_xy*t129 + R_NB_platform_xx*t196 + R_NB_platform_xy*t197;
+  const T t202 = -R_NB_middle_yy*t129 + R_NB_platform_yx*t196 + R_NB_platform_yy*t197;
+  const T t203 = -R_NB_middle_zy*t129 + R_NB_platform_zx*t196 + R_NB_platform_zy*t197;
+  const T t204 = r_NO_N_outer_y*t200 - r_NO_N_outer_z*t199;
+  const T t205 = -r_NO_N_outer_x*t200 + r_NO_N_outer_z*t198;
+  const T t206 = r_NO_N_outer_x*t199 - r_NO_N_outer_y*t198;
+  const T t207 = t201 + t204;
+  const T t208 = t202 + t205;
+  const T t209 = t203 + t206;
+  const T t210 = t187 + t198;
+  const T t211 = t188 + t199;
+  const T t212 = t189 + t200;
+  const T t213 = t190 + t207;
+  const T t214 = t191 + t208;
+  const T t215 = t192 + t209;
+  pH[0] = t210;
+  pH[1] = t211;
+  pH[2] = t212;
+  pH[3] = t213;
+  pH[4] = t214;
+  pH[5] = t215;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

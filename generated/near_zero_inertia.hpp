@@ -19,7 +19,7 @@
 //   mass_matrix        0 (0 add, 0 mul, 0 div, 0 func)
 //   forcing          199 (82 add, 115 mul, 0 div, 2 func)
 //   udot             270 (114 add, 154 mul, 0 div, 2 func) -- composite form; composite 270, articulated 273
-//     udot by pass: outward pass (velocities) 55; mass and velocity terms 61; bias force 36; generalized forces (inward) 47; M u_dot = F: L^T D L along the dof tree 71
+//     udot by pass: joint angles' sin and cos 2; outward pass (velocities) 53; mass and velocity terms 61; bias force 36; generalized forces (inward) 47; M u_dot = F: L^T D L along the dof tree 71
 //   energy           119 (46 add, 68 mul, 3 div, 2 func)
 //   momentum         288 (113 add, 171 mul, 1 div, 3 func)
 
@@ -284,6 +284,135 @@ template <int W> inline bool operator>(double a, const Dual<W>& b) { return a > 
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }
+// ---- joint angles' sin and cos (templates/joint_sincos.inc) -------------------
+// Every joint angle's sin and cos, computed in one batch before the rest of a
+// function (issue 38, item 3: one evaluation per angle, shared by every use),
+// two angles at a time in SSE2 pairs (GCC/clang vector extensions, no header).
+// Accuracy (tests/codegen/test_joint_sincos.cpp, against sinl/cosl): at most
+// 0.51 ulp, the library's sin and cos 0.52-0.56 on the same arguments; beyond
+// |x| = 1e5 rad (and for inf and NaN) the library's sin and cos. (-ffast-math,
+// which reorders the exact sums, voids the bound.)
+// Method: x = k pi/32 + r, |r| <= pi/64, with pi/32 in four parts (three of 33
+// bits, exact products for |k| < 2^20) and r carried as r + rlo; sin and cos
+// of k pi/32 from a table as double-doubles (hi, lo, and hi split in 26-bit
+// halves for Dekker's exact product); sin r - r and cos r - 1 by their Taylor
+// series to r^9 and r^8 (truncation below 1e-20 on |r| <= pi/64);
+// sin x = S + C r + (S (cos r - 1) + C (sin r - r) + C rlo + S_lo), the sum
+// S + C r exact (TwoSum of the exact product), likewise cos x.
+
+// sin(j pi/32), j = 0..63: hi, lo (hi + lo to ~2^-106), and hi in two halves of 26 bits
+inline constexpr double kanegen_sin_table[64][4] = {
+    {0.0, 0.0, 0.0, 0.0},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.0000000000000p+0, 0.0, 0x1.0000000000000p+0, 0.0},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0.0, 0.0, 0.0, 0.0},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.0000000000000p+0, 0.0, -0x1.0000000000000p+0, 0.0},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+};
+
+typedef double kanegen_v2d __attribute__((vector_size(16)));
+
+/// sin and cos of x[0..n), in s and c.
+inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
+  for (int i = 0; i < n; i += 2) {
+    const int b = i + 1 < n ? i + 1 : i;  // an odd count's last angle twice
+    // beyond 1e5 rad (and inf, NaN) the library's, below; 0 meanwhile keeps the integer conversion defined
+    const double xi = x[i] <= 1.0e5 && x[i] >= -1.0e5 ? x[i] : 0.0, xb = x[b] <= 1.0e5 && x[b] >= -1.0e5 ? x[b] : 0.0;
+    const kanegen_v2d xv = {xi, xb};
+    const kanegen_v2d kn = (xv * 0x1.45f306dc9c883p+3 + 0x1.8p52) - 0x1.8p52;  // round(x 32/pi)
+    const kanegen_v2d t = xv - kn * 0x1.921fb54400000p-4, u2 = kn * 0x1.0b4611a600000p-38,
+                      u3 = kn * 0x1.3198a2e000000p-73;
+    const kanegen_v2d r1 = t - u2, e1 = (t - r1) - u2;
+    const kanegen_v2d r = r1 - u3, b3 = r - r1, e2 = (r1 - (r - b3)) - (u3 + b3);
+    const kanegen_v2d rlo = (e1 + e2) - kn * 0x1.b839a252049c1p-108;
+    const kanegen_v2d z = r * r;
+    const kanegen_v2d sr = (r * z) * (-1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 + z * (1.0 / 362880))));
+    const kanegen_v2d cm = z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320))));
+    const long k0 = static_cast<long>(kn[0]), k1 = static_cast<long>(kn[1]);
+    const double* Sa = kanegen_sin_table[k0 & 63];
+    const double* Sb = kanegen_sin_table[k1 & 63];
+    const double* Ca = kanegen_sin_table[(k0 + 16) & 63];
+    const double* Cb = kanegen_sin_table[(k1 + 16) & 63];
+    const kanegen_v2d S0 = {Sa[0], Sb[0]}, S1 = {Sa[1], Sb[1]}, S2 = {Sa[2], Sb[2]}, S3 = {Sa[3], Sb[3]};
+    const kanegen_v2d C0 = {Ca[0], Cb[0]}, C1 = {Ca[1], Cb[1]}, C2 = {Ca[2], Cb[2]}, C3 = {Ca[3], Cb[3]};
+    const kanegen_v2d g = 134217729.0 * r, rh = g - (g - r), rl = r - rh;  // r in 26-bit halves
+    const kanegen_v2d p = C0 * r, pe = (((C2 * rh - p) + C2 * rl) + C3 * rh) + C3 * rl;  // C r = p + pe
+    const kanegen_v2d s1 = S0 + p, bs = s1 - S0, se = (S0 - (s1 - bs)) + (p - bs);    // S + p = s1 + se
+    const kanegen_v2d sv = s1 + ((se + pe) + (S1 + C1 * r + C0 * rlo + S0 * cm + C0 * sr));
+    const kanegen_v2d q = S0 * r, qe = (((S2 * rh - q) + S2 * rl) + S3 * rh) + S3 * rl;  // S r = q + qe
+    const kanegen_v2d c1 = C0 - q, bc = c1 - C0, ce = (C0 - (c1 - bc)) + (-q - bc);      // C - q = c1 + ce
+    const kanegen_v2d cv = c1 + ((ce - qe) + (C1 - S1 * r - S0 * rlo + C0 * cm - S0 * sr));
+    s[i] = sv[0], c[i] = cv[0], s[b] = sv[1], c[b] = cv[1];
+    if (!(x[i] <= 1.0e5 && x[i] >= -1.0e5)) s[i] = std::sin(x[i]), c[i] = std::cos(x[i]);
+    if (!(x[b] <= 1.0e5 && x[b] >= -1.0e5)) s[b] = std::sin(x[b]), c[b] = std::cos(x[b]);
+  }
+}
+
+/// The same for any other number type (the dual numbers of the Jacobians): its own sin and cos.
+template <class T>
+inline void kanegen_sincos_n(const T* x, T* s, T* c, int n) {
+  using std::cos;
+  using std::sin;
+  for (int i = 0; i < n; ++i) s[i] = sin(x[i]), c[i] = cos(x[i]);
+}
 
 // ---- q_dot = W(q) u ------------------------------------------------------------
 template <class T>
@@ -378,108 +507,110 @@ template <class T>
 void forcing(const T* q, const T* u, const T* tau, T* F) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[1], angle_c[1];
+  const T angle_x[1] = {q[7]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 1);
   // ---- body bus: outward pass (velocities)
   const T t23 = -u[1]*u[5] + u[2]*u[4];
   const T t24 = u[0]*u[5] - u[2]*u[3];
   const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body probe: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t47 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
-  const T t48 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
-  const T t49 = -probe_p_J_y*t48 + probe_p_J_z*t47;
-  const T t50 = -probe_p_J_z*u[5];
-  const T t51 = probe_p_J_y*u[5];
-  const T t57 = t47*t51 - t48*t50;
-  const T t58 = t48*t49 - t51*u[5];
-  const T t59 = -t47*t49 + t50*u[5];
-  const T t60 = probe_R_PJ_xy*t23 + probe_R_PJ_yy*t24;
-  const T t61 = probe_R_PJ_xz*t23 + probe_R_PJ_yz*t24;
-  const T t62 = t25 + t57;
-  const T t63 = t58 + t60;
-  const T t64 = t59 + t61;
-  const T t65 = t26*u[5] + t27*t47;
-  const T t66 = t26*t47 - t27*u[5];
-  const T w_B_probe_z = t48 + u[6];
-  const T t70 = t66*u[6];
-  const T t71 = -t65*u[6];
-  const T t73 = t26*t62 + t27*t63;
-  const T t74 = t26*t63 - t27*t62;
+  const T t45 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
+  const T t46 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
+  const T t47 = -probe_p_J_y*t46 + probe_p_J_z*t45;
+  const T t48 = -probe_p_J_z*u[5];
+  const T t49 = probe_p_J_y*u[5];
+  const T t55 = t45*t49 - t46*t48;
+  const T t56 = t46*t47 - t49*u[5];
+  const T t57 = -t45*t47 + t48*u[5];
+  const T t58 = probe_R_PJ_xy*t23 + probe_R_PJ_yy*t24;
+  const T t59 = probe_R_PJ_xz*t23 + probe_R_PJ_yz*t24;
+  const T t60 = t25 + t55;
+  const T t61 = t56 + t58;
+  const T t62 = t57 + t59;
+  const T t63 = angle_c[0]*u[5] + angle_s[0]*t45;
+  const T t64 = angle_c[0]*t45 - angle_s[0]*u[5];
+  const T w_B_probe_z = t46 + u[6];
+  const T t68 = t64*u[6];
+  const T t69 = -t63*u[6];
+  const T t71 = angle_c[0]*t60 + angle_s[0]*t61;
+  const T t72 = angle_c[0]*t61 - angle_s[0]*t60;
   // ---- body bus: mass and velocity terms
-  const T t75 = -bus_S0_y*u[5] + bus_S0_z*u[4];
-  const T t76 = bus_S0_x*u[5] - bus_S0_z*u[3];
-  const T t77 = -bus_S0_x*u[4] + bus_S0_y*u[3];
-  const T t78 = -t76*u[5] + t77*u[4];
-  const T t79 = t75*u[5] - t77*u[3];
-  const T t80 = -t75*u[4] + t76*u[3];
-  const T t81 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5];
-  const T t82 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
-  const T t83 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5];
-  const T t84 = -t82*u[5] + t83*u[4];
-  const T t85 = t81*u[5] - t83*u[3];
-  const T t86 = -t81*u[4] + t82*u[3];
+  const T t73 = -bus_S0_y*u[5] + bus_S0_z*u[4];
+  const T t74 = bus_S0_x*u[5] - bus_S0_z*u[3];
+  const T t75 = -bus_S0_x*u[4] + bus_S0_y*u[3];
+  const T t76 = -t74*u[5] + t75*u[4];
+  const T t77 = t73*u[5] - t75*u[3];
+  const T t78 = -t73*u[4] + t74*u[3];
+  const T t79 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5];
+  const T t80 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
+  const T t81 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5];
+  const T t82 = -t80*u[5] + t81*u[4];
+  const T t83 = t79*u[5] - t81*u[3];
+  const T t84 = -t79*u[4] + t80*u[3];
   // ---- body probe: mass and velocity terms
-  const T t87 = probe_S0_z*t66;
-  const T t88 = -probe_S0_z*t65;
-  const T t89 = -t88*w_B_probe_z;
-  const T t90 = t87*w_B_probe_z;
-  const T t91 = t65*t88 - t66*t87;
-  const T t92 = probe_J0_xx*t65;
-  const T t93 = probe_J0_yy*t66;
-  const T t94 = probe_J0_zz*w_B_probe_z;
-  const T t95 = t66*t94 - t93*w_B_probe_z;
-  const T t96 = -t65*t94 + t92*w_B_probe_z;
-  const T t97 = t65*t93 - t66*t92;
+  const T t85 = probe_S0_z*t64;
+  const T t86 = -probe_S0_z*t63;
+  const T t87 = -t86*w_B_probe_z;
+  const T t88 = t85*w_B_probe_z;
+  const T t89 = t63*t86 - t64*t85;
+  const T t90 = probe_J0_xx*t63;
+  const T t91 = probe_J0_yy*t64;
+  const T t92 = probe_J0_zz*w_B_probe_z;
+  const T t93 = t64*t92 - t91*w_B_probe_z;
+  const T t94 = -t63*t92 + t90*w_B_probe_z;
+  const T t95 = t63*t91 - t64*t90;
   // ---- body bus: bias force
-  const T t98 = -bus_mass*t23 - t78;
-  const T t99 = -bus_mass*t24 - t79;
-  const T t100 = -bus_mass*t25 - t80;
-  const T t101 = -bus_S0_y*t25 + bus_S0_z*t24 - t84;
-  const T t102 = bus_S0_x*t25 - bus_S0_z*t23 - t85;
-  const T t103 = -bus_S0_x*t24 + bus_S0_y*t23 - t86;
+  const T t96 = -bus_mass*t23 - t76;
+  const T t97 = -bus_mass*t24 - t77;
+  const T t98 = -bus_mass*t25 - t78;
+  const T t99 = -bus_S0_y*t25 + bus_S0_z*t24 - t82;
+  const T t100 = bus_S0_x*t25 - bus_S0_z*t23 - t83;
+  const T t101 = -bus_S0_x*t24 + bus_S0_y*t23 - t84;
   // ---- body probe: bias force
-  const T t104 = -probe_S0_z*t71 - probe_mass*t73 - t89;
-  const T t105 = probe_S0_z*t70 - probe_mass*t74 - t90;
-  const T t106 = -probe_mass*t64 - t91;
-  const T t107 = -probe_J0_xx*t70 + probe_S0_z*t74 - t95;
-  const T t108 = -probe_J0_yy*t71 - probe_S0_z*t73 - t96;
+  const T t102 = -probe_S0_z*t69 - probe_mass*t71 - t87;
+  const T t103 = probe_S0_z*t68 - probe_mass*t72 - t88;
+  const T t104 = -probe_mass*t62 - t89;
+  const T t105 = -probe_J0_xx*t68 + probe_S0_z*t72 - t93;
+  const T t106 = -probe_J0_yy*t69 - probe_S0_z*t71 - t94;
   // ---- body probe: generalized forces (inward)
-  const T t109 = -probe_k*q[7] + tau[6];
-  const T t110 = t109 - t97;
-  const T t111 = t104*t26 - t105*t27;
-  const T t112 = t104*t27 + t105*t26;
-  const T t113 = probe_p_J_y*t106 - probe_p_J_z*t112;
-  const T t114 = probe_p_J_z*t111;
-  const T t115 = -probe_p_J_y*t111;
-  const T t116 = t107*t26 - t108*t27;
-  const T t117 = t107*t27 + t108*t26;
-  const T t118 = t113 + t116;
-  const T t119 = t114 + t117;
-  const T t120 = t115 - t97;
-  const T t121 = probe_R_PJ_xy*t112 + probe_R_PJ_xz*t106;
-  const T t122 = probe_R_PJ_yy*t112 + probe_R_PJ_yz*t106;
-  const T t123 = probe_R_PJ_xy*t119 + probe_R_PJ_xz*t120;
-  const T t124 = probe_R_PJ_yy*t119 + probe_R_PJ_yz*t120;
-  const T t125 = t121 + t98;
-  const T t126 = t122 + t99;
-  const T t127 = t100 + t111;
-  const T t128 = t101 + t123;
-  const T t129 = t102 + t124;
-  const T t130 = t103 + t118;
+  const T t107 = -probe_k*q[7] + tau[6];
+  const T t108 = t107 - t95;
+  const T t109 = angle_c[0]*t102 - angle_s[0]*t103;
+  const T t110 = angle_c[0]*t103 + angle_s[0]*t102;
+  const T t111 = probe_p_J_y*t104 - probe_p_J_z*t110;
+  const T t112 = probe_p_J_z*t109;
+  const T t113 = -probe_p_J_y*t109;
+  const T t114 = angle_c[0]*t105 - angle_s[0]*t106;
+  const T t115 = angle_c[0]*t106 + angle_s[0]*t105;
+  const T t116 = t111 + t114;
+  const T t117 = t112 + t115;
+  const T t118 = t113 - t95;
+  const T t119 = probe_R_PJ_xy*t110 + probe_R_PJ_xz*t104;
+  const T t120 = probe_R_PJ_yy*t110 + probe_R_PJ_yz*t104;
+  const T t121 = probe_R_PJ_xy*t117 + probe_R_PJ_xz*t118;
+  const T t122 = probe_R_PJ_yy*t117 + probe_R_PJ_yz*t118;
+  const T t123 = t119 + t96;
+  const T t124 = t120 + t97;
+  const T t125 = t109 + t98;
+  const T t126 = t121 + t99;
+  const T t127 = t100 + t122;
+  const T t128 = t101 + t116;
   // ---- body bus: generalized forces (inward)
-  const T t131 = t125 + tau[0];
-  const T t132 = t126 + tau[1];
-  const T t133 = t127 + tau[2];
-  const T t134 = t128 + tau[3];
-  const T t135 = t129 + tau[4];
-  const T t136 = t130 + tau[5];
-  F[0] = t131;
-  F[1] = t132;
-  F[2] = t133;
-  F[3] = t134;
-  F[4] = t135;
-  F[5] = t136;
-  F[6] = t110;
+  const T t129 = t123 + tau[0];
+  const T t130 = t124 + tau[1];
+  const T t131 = t125 + tau[2];
+  const T t132 = t126 + tau[3];
+  const T t133 = t127 + tau[4];
+  const T t134 = t128 + tau[5];
+  F[0] = t129;
+  F[1] = t130;
+  F[2] = t131;
+  F[3] = t132;
+  F[4] = t133;
+  F[5] = t134;
+  F[6] = t108;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
@@ -488,141 +619,143 @@ template <class T>
 int udot(const T* q, const T* u, const T* tau, T* udot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[1], angle_c[1];
+  const T angle_x[1] = {q[7]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 1);
   // ---- body bus: outward pass (velocities)
   const T t23 = -u[1]*u[5] + u[2]*u[4];
   const T t24 = u[0]*u[5] - u[2]*u[3];
   const T t25 = -u[0]*u[4] + u[1]*u[3];
   // ---- body probe: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t47 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
-  const T t48 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
-  const T t49 = -probe_p_J_y*t48 + probe_p_J_z*t47;
-  const T t50 = -probe_p_J_z*u[5];
-  const T t51 = probe_p_J_y*u[5];
-  const T t57 = t47*t51 - t48*t50;
-  const T t58 = t48*t49 - t51*u[5];
-  const T t59 = -t47*t49 + t50*u[5];
-  const T t60 = probe_R_PJ_xy*t23 + probe_R_PJ_yy*t24;
-  const T t61 = probe_R_PJ_xz*t23 + probe_R_PJ_yz*t24;
-  const T t62 = t25 + t57;
-  const T t63 = t58 + t60;
-  const T t64 = t59 + t61;
-  const T t65 = t26*u[5] + t27*t47;
-  const T t66 = t26*t47 - t27*u[5];
-  const T w_B_probe_z = t48 + u[6];
-  const T t70 = t66*u[6];
-  const T t71 = -t65*u[6];
-  const T t73 = t26*t62 + t27*t63;
-  const T t74 = t26*t63 - t27*t62;
+  const T t45 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
+  const T t46 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
+  const T t47 = -probe_p_J_y*t46 + probe_p_J_z*t45;
+  const T t48 = -probe_p_J_z*u[5];
+  const T t49 = probe_p_J_y*u[5];
+  const T t55 = t45*t49 - t46*t48;
+  const T t56 = t46*t47 - t49*u[5];
+  const T t57 = -t45*t47 + t48*u[5];
+  const T t58 = probe_R_PJ_xy*t23 + probe_R_PJ_yy*t24;
+  const T t59 = probe_R_PJ_xz*t23 + probe_R_PJ_yz*t24;
+  const T t60 = t25 + t55;
+  const T t61 = t56 + t58;
+  const T t62 = t57 + t59;
+  const T t63 = angle_c[0]*u[5] + angle_s[0]*t45;
+  const T t64 = angle_c[0]*t45 - angle_s[0]*u[5];
+  const T w_B_probe_z = t46 + u[6];
+  const T t68 = t64*u[6];
+  const T t69 = -t63*u[6];
+  const T t71 = angle_c[0]*t60 + angle_s[0]*t61;
+  const T t72 = angle_c[0]*t61 - angle_s[0]*t60;
   // ---- body bus: mass and velocity terms
-  const T t75 = -bus_S0_y*u[5] + bus_S0_z*u[4];
-  const T t76 = bus_S0_x*u[5] - bus_S0_z*u[3];
-  const T t77 = -bus_S0_x*u[4] + bus_S0_y*u[3];
-  const T t78 = -t76*u[5] + t77*u[4];
-  const T t79 = t75*u[5] - t77*u[3];
-  const T t80 = -t75*u[4] + t76*u[3];
-  const T t81 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5];
-  const T t82 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
-  const T t83 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5];
-  const T t84 = -t82*u[5] + t83*u[4];
-  const T t85 = t81*u[5] - t83*u[3];
-  const T t86 = -t81*u[4] + t82*u[3];
+  const T t73 = -bus_S0_y*u[5] + bus_S0_z*u[4];
+  const T t74 = bus_S0_x*u[5] - bus_S0_z*u[3];
+  const T t75 = -bus_S0_x*u[4] + bus_S0_y*u[3];
+  const T t76 = -t74*u[5] + t75*u[4];
+  const T t77 = t73*u[5] - t75*u[3];
+  const T t78 = -t73*u[4] + t74*u[3];
+  const T t79 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5];
+  const T t80 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
+  const T t81 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5];
+  const T t82 = -t80*u[5] + t81*u[4];
+  const T t83 = t79*u[5] - t81*u[3];
+  const T t84 = -t79*u[4] + t80*u[3];
   // ---- body probe: mass and velocity terms
-  const T t87 = probe_S0_z*t66;
-  const T t88 = -probe_S0_z*t65;
-  const T t89 = -t88*w_B_probe_z;
-  const T t90 = t87*w_B_probe_z;
-  const T t91 = t65*t88 - t66*t87;
-  const T t92 = probe_J0_xx*t65;
-  const T t93 = probe_J0_yy*t66;
-  const T t94 = probe_J0_zz*w_B_probe_z;
-  const T t95 = t66*t94 - t93*w_B_probe_z;
-  const T t96 = -t65*t94 + t92*w_B_probe_z;
-  const T t97 = t65*t93 - t66*t92;
+  const T t85 = probe_S0_z*t64;
+  const T t86 = -probe_S0_z*t63;
+  const T t87 = -t86*w_B_probe_z;
+  const T t88 = t85*w_B_probe_z;
+  const T t89 = t63*t86 - t64*t85;
+  const T t90 = probe_J0_xx*t63;
+  const T t91 = probe_J0_yy*t64;
+  const T t92 = probe_J0_zz*w_B_probe_z;
+  const T t93 = t64*t92 - t91*w_B_probe_z;
+  const T t94 = -t63*t92 + t90*w_B_probe_z;
+  const T t95 = t63*t91 - t64*t90;
   // ---- body bus: bias force
-  const T t101 = -bus_mass*t23 - t78;
-  const T t102 = -bus_mass*t24 - t79;
-  const T t103 = -bus_mass*t25 - t80;
-  const T t104 = -bus_S0_y*t25 + bus_S0_z*t24 - t84;
-  const T t105 = bus_S0_x*t25 - bus_S0_z*t23 - t85;
-  const T t106 = -bus_S0_x*t24 + bus_S0_y*t23 - t86;
+  const T t99 = -bus_mass*t23 - t76;
+  const T t100 = -bus_mass*t24 - t77;
+  const T t101 = -bus_mass*t25 - t78;
+  const T t102 = -bus_S0_y*t25 + bus_S0_z*t24 - t82;
+  const T t103 = bus_S0_x*t25 - bus_S0_z*t23 - t83;
+  const T t104 = -bus_S0_x*t24 + bus_S0_y*t23 - t84;
   // ---- body probe: bias force
-  const T t107 = -probe_S0_z*t71 - probe_mass*t73 - t89;
-  const T t108 = probe_S0_z*t70 - probe_mass*t74 - t90;
-  const T t109 = -probe_mass*t64 - t91;
-  const T t110 = -probe_J0_xx*t70 + probe_S0_z*t74 - t95;
-  const T t111 = -probe_J0_yy*t71 - probe_S0_z*t73 - t96;
+  const T t105 = -probe_S0_z*t69 - probe_mass*t71 - t87;
+  const T t106 = probe_S0_z*t68 - probe_mass*t72 - t88;
+  const T t107 = -probe_mass*t62 - t89;
+  const T t108 = -probe_J0_xx*t68 + probe_S0_z*t72 - t93;
+  const T t109 = -probe_J0_yy*t69 - probe_S0_z*t71 - t94;
   // ---- body probe: generalized forces (inward)
-  const T t112 = -probe_k*q[7] + tau[6];
-  const T t113 = t112 - t97;
-  const T t114 = t107*t26 - t108*t27;
-  const T t115 = t107*t27 + t108*t26;
-  const T t116 = probe_p_J_y*t109 - probe_p_J_z*t115;
-  const T t117 = probe_p_J_z*t114;
-  const T t118 = -probe_p_J_y*t114;
-  const T t119 = t110*t26 - t111*t27;
-  const T t120 = t110*t27 + t111*t26;
-  const T t121 = t116 + t119;
-  const T t122 = t117 + t120;
-  const T t123 = t118 - t97;
-  const T t124 = probe_R_PJ_xy*t115 + probe_R_PJ_xz*t109;
-  const T t125 = probe_R_PJ_yy*t115 + probe_R_PJ_yz*t109;
-  const T t126 = probe_R_PJ_xy*t122 + probe_R_PJ_xz*t123;
-  const T t127 = probe_R_PJ_yy*t122 + probe_R_PJ_yz*t123;
-  const T t128 = t101 + t124;
-  const T t129 = t102 + t125;
-  const T t130 = t103 + t114;
-  const T t131 = t104 + t126;
-  const T t132 = t105 + t127;
-  const T t133 = t106 + t121;
+  const T t110 = -probe_k*q[7] + tau[6];
+  const T t111 = t110 - t95;
+  const T t112 = angle_c[0]*t105 - angle_s[0]*t106;
+  const T t113 = angle_c[0]*t106 + angle_s[0]*t105;
+  const T t114 = probe_p_J_y*t107 - probe_p_J_z*t113;
+  const T t115 = probe_p_J_z*t112;
+  const T t116 = -probe_p_J_y*t112;
+  const T t117 = angle_c[0]*t108 - angle_s[0]*t109;
+  const T t118 = angle_c[0]*t109 + angle_s[0]*t108;
+  const T t119 = t114 + t117;
+  const T t120 = t115 + t118;
+  const T t121 = t116 - t95;
+  const T t122 = probe_R_PJ_xy*t113 + probe_R_PJ_xz*t107;
+  const T t123 = probe_R_PJ_yy*t113 + probe_R_PJ_yz*t107;
+  const T t124 = probe_R_PJ_xy*t120 + probe_R_PJ_xz*t121;
+  const T t125 = probe_R_PJ_yy*t120 + probe_R_PJ_yz*t121;
+  const T t126 = t122 + t99;
+  const T t127 = t100 + t123;
+  const T t128 = t101 + t112;
+  const T t129 = t102 + t124;
+  const T t130 = t103 + t125;
+  const T t131 = t104 + t119;
   // ---- body bus: generalized forces (inward)
-  const T t134 = t128 + tau[0];
-  const T t135 = t129 + tau[1];
-  const T t136 = t130 + tau[2];
-  const T t137 = t131 + tau[3];
-  const T t138 = t132 + tau[4];
-  const T t139 = t133 + tau[5];
+  const T t132 = t126 + tau[0];
+  const T t133 = t127 + tau[1];
+  const T t134 = t128 + tau[2];
+  const T t135 = t129 + tau[3];
+  const T t136 = t130 + tau[4];
+  const T t137 = t131 + tau[5];
   // ---- M u_dot = F: L^T D L along the dof tree
-  const T t140 = -kcf881ceb*t113 + t138;
-  const T t141 = -k4ab06a8f*t113 + t137;
-  const T t142 = -kbdb64d6e*t139 + t140;
-  const T t143 = -k1bdc33d2*t139 + t141;
-  const T t144 = -k4799cce7*t139 + t135;
-  const T t145 = kd447e126*t139 + t134;
-  const T t146 = -kec9ce579*t142 + t143;
-  const T t147 = k14fbf280*t142 + t136;
-  const T t148 = k7a50ebb4*t142 + t144;
-  const T t149 = k1d77e7da*t142 + t145;
-  const T t150 = -kd3e4ee15*t146 + t147;
-  const T t151 = -kc2a315ce*t146 + t148;
-  const T t152 = k8a1d27a2*t146 + t149;
-  const T t153 = k4d1afa91*t150 + t151;
-  const T t154 = k1dd8b291*t150 + t152;
-  const T t155 = -k42c83df6*t153 + t154;
-  const T t156 = kf00a5655*t155;
-  const T t157 = k531ff1b5*t153;
-  const T t158 = kf1b96bf6*t150;
-  const T t159 = k71c4f190*t146;
-  const T t160 = k4a3c96b2*t142;
-  const T t161 = k9e4c8ac7*t139;
-  const T t162 = k70ce114d*t113;
-  const T t163 = -k42c83df6*t156 + t157;
-  const T t164 = k4d1afa91*t163 + t158;
-  const T t165 = k1dd8b291*t156 + t164;
-  const T t166 = -kd3e4ee15*t165 + t159;
-  const T t167 = -kc2a315ce*t163 + t166;
-  const T t168 = k8a1d27a2*t156 + t167;
-  const T t169 = -kec9ce579*t168 + t160;
-  const T t170 = k14fbf280*t165 + t169;
-  const T t171 = k7a50ebb4*t163 + t170;
-  const T t172 = k1d77e7da*t156 + t171;
-  const T t173 = -kbdb64d6e*t172 + t161;
-  const T t174 = -k1bdc33d2*t168 + t173;
-  const T t175 = -k4799cce7*t163 + t174;
-  const T t176 = kd447e126*t156 + t175;
-  const T t177 = -kcf881ceb*t172 + t162;
-  const T t178 = -k4ab06a8f*t168 + t177;
+  const T t138 = -kcf881ceb*t111 + t136;
+  const T t139 = -k4ab06a8f*t111 + t135;
+  const T t140 = -kbdb64d6e*t137 + t138;
+  const T t141 = -k1bdc33d2*t137 + t139;
+  const T t142 = -k4799cce7*t137 + t133;
+  const T t143 = kd447e126*t137 + t132;
+  const T t144 = -kec9ce579*t140 + t141;
+  const T t145 = k14fbf280*t140 + t134;
+  const T t146 = k7a50ebb4*t140 + t142;
+  const T t147 = k1d77e7da*t140 + t143;
+  const T t148 = -kd3e4ee15*t144 + t145;
+  const T t149 = -kc2a315ce*t144 + t146;
+  const T t150 = k8a1d27a2*t144 + t147;
+  const T t151 = k4d1afa91*t148 + t149;
+  const T t152 = k1dd8b291*t148 + t150;
+  const T t153 = -k42c83df6*t151 + t152;
+  const T t154 = kf00a5655*t153;
+  const T t155 = k531ff1b5*t151;
+  const T t156 = kf1b96bf6*t148;
+  const T t157 = k71c4f190*t144;
+  const T t158 = k4a3c96b2*t140;
+  const T t159 = k9e4c8ac7*t137;
+  const T t160 = k70ce114d*t111;
+  const T t161 = -k42c83df6*t154 + t155;
+  const T t162 = k4d1afa91*t161 + t156;
+  const T t163 = k1dd8b291*t154 + t162;
+  const T t164 = -kd3e4ee15*t163 + t157;
+  const T t165 = -kc2a315ce*t161 + t164;
+  const T t166 = k8a1d27a2*t154 + t165;
+  const T t167 = -kec9ce579*t166 + t158;
+  const T t168 = k14fbf280*t163 + t167;
+  const T t169 = k7a50ebb4*t161 + t168;
+  const T t170 = k1d77e7da*t154 + t169;
+  const T t171 = -kbdb64d6e*t170 + t159;
+  const T t172 = -k1bdc33d2*t166 + t171;
+  const T t173 = -k4799cce7*t161 + t172;
+  const T t174 = kd447e126*t154 + t173;
+  const T t175 = -kcf881ceb*t170 + t160;
+  const T t176 = -k4ab06a8f*t166 + t175;
   if (!(k0117888d > 1e-14*kfd32cd94)) return 1;
   if (!(k5579ef2f > 1e-14*kfd32cd94)) return 2;
   if (!(kd3553756 > 1e-14*kfd32cd94)) return 3;
@@ -630,13 +763,13 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   if (!(k3688a0d6 > 1e-14*k25891712)) return 5;
   if (!(kc929d4ee > 0.0)) return 6;
   if (!(probe_J0_zz > 0.0)) return 7;
-  udot[0] = t156;
-  udot[1] = t163;
-  udot[2] = t165;
-  udot[3] = t168;
-  udot[4] = t172;
-  udot[5] = t176;
-  udot[6] = t178;
+  udot[0] = t154;
+  udot[1] = t161;
+  udot[2] = t163;
+  udot[3] = t166;
+  udot[4] = t170;
+  udot[5] = t174;
+  udot[6] = t176;
   return 0;
 }
 
@@ -645,43 +778,45 @@ template <class T>
 void energy(const T* q, const T* u, T* TV) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[1], angle_c[1];
+  const T angle_x[1] = {q[7]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 1);
   // ---- body probe: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T t47 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
-  const T t48 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
-  const T t49 = -probe_p_J_y*t48 + probe_p_J_z*t47;
-  const T t50 = -probe_p_J_z*u[5];
-  const T t51 = probe_p_J_y*u[5];
-  const T t52 = probe_R_PJ_xy*u[0] + probe_R_PJ_yy*u[1];
-  const T t53 = probe_R_PJ_xz*u[0] + probe_R_PJ_yz*u[1];
-  const T t54 = t49 + u[2];
-  const T t55 = t50 + t52;
-  const T t56 = t51 + t53;
-  const T t65 = t26*u[5] + t27*t47;
-  const T t66 = t26*t47 - t27*u[5];
-  const T w_B_probe_z = t48 + u[6];
-  const T t68 = t26*t54 + t27*t55;
-  const T t69 = t26*t55 - t27*t54;
+  const T t45 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
+  const T t46 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
+  const T t47 = -probe_p_J_y*t46 + probe_p_J_z*t45;
+  const T t48 = -probe_p_J_z*u[5];
+  const T t49 = probe_p_J_y*u[5];
+  const T t50 = probe_R_PJ_xy*u[0] + probe_R_PJ_yy*u[1];
+  const T t51 = probe_R_PJ_xz*u[0] + probe_R_PJ_yz*u[1];
+  const T t52 = t47 + u[2];
+  const T t53 = t48 + t50;
+  const T t54 = t49 + t51;
+  const T t63 = angle_c[0]*u[5] + angle_s[0]*t45;
+  const T t64 = angle_c[0]*t45 - angle_s[0]*u[5];
+  const T w_B_probe_z = t46 + u[6];
+  const T t66 = angle_c[0]*t52 + angle_s[0]*t53;
+  const T t67 = angle_c[0]*t53 - angle_s[0]*t52;
   // ---- body probe: mass and velocity terms
-  const T t94 = probe_J0_zz*w_B_probe_z;
-  const T t98 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
-  const T t99 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
-  const T t100 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
-  const T t101 = ((bus_J0_xx*u[3] + bus_J0_xy*u[4]) + (bus_J0_xz*u[5] + bus_S0_y*u[2])) - bus_S0_z*u[1];
-  const T t102 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
-  const T t103 = ((bus_J0_xz*u[3] + bus_J0_yz*u[4]) + (bus_J0_zz*u[5] + bus_S0_x*u[1])) - bus_S0_y*u[0];
-  const T t104 = ((t100*u[2] + t101*u[3]) + t102*u[4]) + ((t103*u[5] + t98*u[0]) + t99*u[1]);
-  const T t105 = probe_S0_z*t66 + probe_mass*t68;
-  const T t106 = -probe_S0_z*t65 + probe_mass*t69;
-  const T t107 = probe_mass*t56;
-  const T t108 = probe_J0_xx*t65 - probe_S0_z*t69;
-  const T t109 = probe_J0_yy*t66 + probe_S0_z*t68;
-  const T t110 = ((t105*t68 + t106*t69) + t107*t56) + ((t108*t65 + t109*t66) + t94*w_B_probe_z);
-  const T t111 = t104/2.0 + t110/2.0;
-  const T t112 = probe_k*q[7]*q[7]/2.0;
-  TV[0] = t111;
-  TV[1] = t112;
+  const T t92 = probe_J0_zz*w_B_probe_z;
+  const T t96 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
+  const T t97 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
+  const T t98 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
+  const T t99 = ((bus_J0_xx*u[3] + bus_J0_xy*u[4]) + (bus_J0_xz*u[5] + bus_S0_y*u[2])) - bus_S0_z*u[1];
+  const T t100 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
+  const T t101 = ((bus_J0_xz*u[3] + bus_J0_yz*u[4]) + (bus_J0_zz*u[5] + bus_S0_x*u[1])) - bus_S0_y*u[0];
+  const T t102 = ((t100*u[4] + t101*u[5]) + t96*u[0]) + ((t97*u[1] + t98*u[2]) + t99*u[3]);
+  const T t103 = probe_S0_z*t64 + probe_mass*t66;
+  const T t104 = -probe_S0_z*t63 + probe_mass*t67;
+  const T t105 = probe_mass*t54;
+  const T t106 = probe_J0_xx*t63 - probe_S0_z*t67;
+  const T t107 = probe_J0_yy*t64 + probe_S0_z*t66;
+  const T t108 = ((t103*t66 + t104*t67) + t105*t54) + ((t106*t63 + t107*t64) + t92*w_B_probe_z);
+  const T t109 = t102/2.0 + t108/2.0;
+  const T t110 = probe_k*q[7]*q[7]/2.0;
+  TV[0] = t109;
+  TV[1] = t110;
 }
 
 // ---- momentum: p_N[3], H_N[3] about N's origin ---------------------------------
@@ -689,6 +824,10 @@ template <class T>
 void momentum(const T* q, const T* u, T* pH) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[1], angle_c[1];
+  const T angle_x[1] = {q[7]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 1);
   // ---- body bus: outward pass (velocities)
   const T t0 = (1.0/sqrt((q[3]*q[3] + q[4]*q[4]) + (q[5]*q[5] + q[6]*q[6])));
   const T t1 = q[3]*t0;
@@ -714,91 +853,89 @@ void momentum(const T* q, const T* u, T* pH) {
   const T t21 = 2.0*t10 + 2.0*t11;
   const T t22 = 1.0 - 2.0*t5 - 2.0*t6;
   // ---- body probe: outward pass (velocities)
-  const T t26 = cos(q[7]);
-  const T t27 = sin(q[7]);
-  const T R_PB_probe_xx = probe_R_PJ_xy*t27;
-  const T R_PB_probe_xy = probe_R_PJ_xy*t26;
-  const T R_PB_probe_yx = probe_R_PJ_yy*t27;
-  const T R_PB_probe_yy = probe_R_PJ_yy*t26;
-  const T R_NB_probe_xx = R_PB_probe_xx*t14 + R_PB_probe_yx*t15 + t16*t26;
-  const T R_NB_probe_xy = R_PB_probe_xy*t14 + R_PB_probe_yy*t15 - t16*t27;
+  const T R_PB_probe_xx = angle_s[0]*probe_R_PJ_xy;
+  const T R_PB_probe_xy = angle_c[0]*probe_R_PJ_xy;
+  const T R_PB_probe_yx = angle_s[0]*probe_R_PJ_yy;
+  const T R_PB_probe_yy = angle_c[0]*probe_R_PJ_yy;
+  const T R_NB_probe_xx = R_PB_probe_xx*t14 + R_PB_probe_yx*t15 + angle_c[0]*t16;
+  const T R_NB_probe_xy = R_PB_probe_xy*t14 + R_PB_probe_yy*t15 - angle_s[0]*t16;
   const T R_NB_probe_xz = probe_R_PJ_xz*t14 + probe_R_PJ_yz*t15;
-  const T R_NB_probe_yx = R_PB_probe_xx*t17 + R_PB_probe_yx*t18 + t19*t26;
-  const T R_NB_probe_yy = R_PB_probe_xy*t17 + R_PB_probe_yy*t18 - t19*t27;
+  const T R_NB_probe_yx = R_PB_probe_xx*t17 + R_PB_probe_yx*t18 + angle_c[0]*t19;
+  const T R_NB_probe_yy = R_PB_probe_xy*t17 + R_PB_probe_yy*t18 - angle_s[0]*t19;
   const T R_NB_probe_yz = probe_R_PJ_xz*t17 + probe_R_PJ_yz*t18;
-  const T R_NB_probe_zx = R_PB_probe_xx*t20 + R_PB_probe_yx*t21 + t22*t26;
-  const T R_NB_probe_zy = R_PB_probe_xy*t20 + R_PB_probe_yy*t21 - t22*t27;
+  const T R_NB_probe_zx = R_PB_probe_xx*t20 + R_PB_probe_yx*t21 + angle_c[0]*t22;
+  const T R_NB_probe_zy = R_PB_probe_xy*t20 + R_PB_probe_yy*t21 - angle_s[0]*t22;
   const T R_NB_probe_zz = probe_R_PJ_xz*t20 + probe_R_PJ_yz*t21;
-  const T t41 = probe_p_PJ_x*t14 + probe_p_PJ_y*t15;
-  const T t42 = probe_p_PJ_x*t17 + probe_p_PJ_y*t18;
-  const T t43 = probe_p_PJ_x*t20 + probe_p_PJ_y*t21;
-  const T r_NO_N_probe_x = q[0] + t41;
-  const T r_NO_N_probe_y = q[1] + t42;
-  const T r_NO_N_probe_z = q[2] + t43;
-  const T t47 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
-  const T t48 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
-  const T t49 = -probe_p_J_y*t48 + probe_p_J_z*t47;
-  const T t50 = -probe_p_J_z*u[5];
-  const T t51 = probe_p_J_y*u[5];
-  const T t52 = probe_R_PJ_xy*u[0] + probe_R_PJ_yy*u[1];
-  const T t53 = probe_R_PJ_xz*u[0] + probe_R_PJ_yz*u[1];
-  const T t54 = t49 + u[2];
-  const T t55 = t50 + t52;
-  const T t56 = t51 + t53;
-  const T t65 = t26*u[5] + t27*t47;
-  const T t66 = t26*t47 - t27*u[5];
-  const T w_B_probe_z = t48 + u[6];
-  const T t68 = t26*t54 + t27*t55;
-  const T t69 = t26*t55 - t27*t54;
+  const T t39 = probe_p_PJ_x*t14 + probe_p_PJ_y*t15;
+  const T t40 = probe_p_PJ_x*t17 + probe_p_PJ_y*t18;
+  const T t41 = probe_p_PJ_x*t20 + probe_p_PJ_y*t21;
+  const T r_NO_N_probe_x = q[0] + t39;
+  const T r_NO_N_probe_y = q[1] + t40;
+  const T r_NO_N_probe_z = q[2] + t41;
+  const T t45 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
+  const T t46 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
+  const T t47 = -probe_p_J_y*t46 + probe_p_J_z*t45;
+  const T t48 = -probe_p_J_z*u[5];
+  const T t49 = probe_p_J_y*u[5];
+  const T t50 = probe_R_PJ_xy*u[0] + probe_R_PJ_yy*u[1];
+  const T t51 = probe_R_PJ_xz*u[0] + probe_R_PJ_yz*u[1];
+  const T t52 = t47 + u[2];
+  const T t53 = t48 + t50;
+  const T t54 = t49 + t51;
+  const T t63 = angle_c[0]*u[5] + angle_s[0]*t45;
+  const T t64 = angle_c[0]*t45 - angle_s[0]*u[5];
+  const T w_B_probe_z = t46 + u[6];
+  const T t66 = angle_c[0]*t52 + angle_s[0]*t53;
+  const T t67 = angle_c[0]*t53 - angle_s[0]*t52;
   // ---- body probe: mass and velocity terms
-  const T t94 = probe_J0_zz*w_B_probe_z;
-  const T t98 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
-  const T t99 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
-  const T t100 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
-  const T t101 = ((bus_J0_xx*u[3] + bus_J0_xy*u[4]) + (bus_J0_xz*u[5] + bus_S0_y*u[2])) - bus_S0_z*u[1];
-  const T t102 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
-  const T t103 = ((bus_J0_xz*u[3] + bus_J0_yz*u[4]) + (bus_J0_zz*u[5] + bus_S0_x*u[1])) - bus_S0_y*u[0];
-  const T t104 = t100*t16 + t14*t98 + t15*t99;
-  const T t105 = t100*t19 + t17*t98 + t18*t99;
-  const T t106 = t100*t22 + t20*t98 + t21*t99;
-  const T t107 = t101*t14 + t102*t15 + t103*t16;
-  const T t108 = t101*t17 + t102*t18 + t103*t19;
-  const T t109 = t101*t20 + t102*t21 + t103*t22;
-  const T t110 = q[1]*t106 - q[2]*t105;
-  const T t111 = -q[0]*t106 + q[2]*t104;
-  const T t112 = q[0]*t105 - q[1]*t104;
+  const T t92 = probe_J0_zz*w_B_probe_z;
+  const T t96 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
+  const T t97 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
+  const T t98 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
+  const T t99 = ((bus_J0_xx*u[3] + bus_J0_xy*u[4]) + (bus_J0_xz*u[5] + bus_S0_y*u[2])) - bus_S0_z*u[1];
+  const T t100 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
+  const T t101 = ((bus_J0_xz*u[3] + bus_J0_yz*u[4]) + (bus_J0_zz*u[5] + bus_S0_x*u[1])) - bus_S0_y*u[0];
+  const T t102 = t14*t96 + t15*t97 + t16*t98;
+  const T t103 = t17*t96 + t18*t97 + t19*t98;
+  const T t104 = t20*t96 + t21*t97 + t22*t98;
+  const T t105 = t100*t15 + t101*t16 + t14*t99;
+  const T t106 = t100*t18 + t101*t19 + t17*t99;
+  const T t107 = t100*t21 + t101*t22 + t20*t99;
+  const T t108 = q[1]*t104 - q[2]*t103;
+  const T t109 = -q[0]*t104 + q[2]*t102;
+  const T t110 = q[0]*t103 - q[1]*t102;
+  const T t111 = t105 + t108;
+  const T t112 = t106 + t109;
   const T t113 = t107 + t110;
-  const T t114 = t108 + t111;
-  const T t115 = t109 + t112;
-  const T t116 = probe_S0_z*t66 + probe_mass*t68;
-  const T t117 = -probe_S0_z*t65 + probe_mass*t69;
-  const T t118 = probe_mass*t56;
-  const T t119 = probe_J0_xx*t65 - probe_S0_z*t69;
-  const T t120 = probe_J0_yy*t66 + probe_S0_z*t68;
-  const T t121 = R_NB_probe_xx*t116 + R_NB_probe_xy*t117 + R_NB_probe_xz*t118;
-  const T t122 = R_NB_probe_yx*t116 + R_NB_probe_yy*t117 + R_NB_probe_yz*t118;
-  const T t123 = R_NB_probe_zx*t116 + R_NB_probe_zy*t117 + R_NB_probe_zz*t118;
-  const T t124 = R_NB_probe_xx*t119 + R_NB_probe_xy*t120 + R_NB_probe_xz*t94;
-  const T t125 = R_NB_probe_yx*t119 + R_NB_probe_yy*t120 + R_NB_probe_yz*t94;
-  const T t126 = R_NB_probe_zx*t119 + R_NB_probe_zy*t120 + R_NB_probe_zz*t94;
-  const T t127 = r_NO_N_probe_y*t123 - r_NO_N_probe_z*t122;
-  const T t128 = -r_NO_N_probe_x*t123 + r_NO_N_probe_z*t121;
-  const T t129 = r_NO_N_probe_x*t122 - r_NO_N_probe_y*t121;
+  const T t114 = probe_S0_z*t64 + probe_mass*t66;
+  const T t115 = -probe_S0_z*t63 + probe_mass*t67;
+  const T t116 = probe_mass*t54;
+  const T t117 = probe_J0_xx*t63 - probe_S0_z*t67;
+  const T t118 = probe_J0_yy*t64 + probe_S0_z*t66;
+  const T t119 = R_NB_probe_xx*t114 + R_NB_probe_xy*t115 + R_NB_probe_xz*t116;
+  const T t120 = R_NB_probe_yx*t114 + R_NB_probe_yy*t115 + R_NB_probe_yz*t116;
+  const T t121 = R_NB_probe_zx*t114 + R_NB_probe_zy*t115 + R_NB_probe_zz*t116;
+  const T t122 = R_NB_probe_xx*t117 + R_NB_probe_xy*t118 + R_NB_probe_xz*t92;
+  const T t123 = R_NB_probe_yx*t117 + R_NB_probe_yy*t118 + R_NB_probe_yz*t92;
+  const T t124 = R_NB_probe_zx*t117 + R_NB_probe_zy*t118 + R_NB_probe_zz*t92;
+  const T t125 = r_NO_N_probe_y*t121 - r_NO_N_probe_z*t120;
+  const T t126 = -r_NO_N_probe_x*t121 + r_NO_N_probe_z*t119;
+  const T t127 = r_NO_N_probe_x*t120 - r_NO_N_probe_y*t119;
+  const T t128 = t122 + t125;
+  const T t129 = t123 + t126;
   const T t130 = t124 + t127;
-  const T t131 = t125 + t128;
-  const T t132 = t126 + t129;
+  const T t131 = t102 + t119;
+  const T t132 = t103 + t120;
   const T t133 = t104 + t121;
-  const T t134 = t105 + t122;
-  const T t135 = t106 + t123;
+  const T t134 = t111 + t128;
+  const T t135 = t112 + t129;
   const T t136 = t113 + t130;
-  const T t137 = t114 + t131;
-  const T t138 = t115 + t132;
-  pH[0] = t133;
-  pH[1] = t134;
-  pH[2] = t135;
-  pH[3] = t136;
-  pH[4] = t137;
-  pH[5] = t138;
+  pH[0] = t131;
+  pH[1] = t132;
+  pH[2] = t133;
+  pH[3] = t134;
+  pH[4] = t135;
+  pH[5] = t136;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

@@ -17,10 +17,10 @@
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot               0 (0 add, 0 mul, 0 div, 0 func)
 //   mass_matrix        0 (0 add, 0 mul, 0 div, 0 func)
-//   forcing            3 (1 add, 1 mul, 0 div, 1 func)
-//   udot               3 (1 add, 1 mul, 0 div, 1 func) -- composite form; composite 3, articulated 3
-//     udot by pass: outward pass (velocities) 2; generalized forces (inward) 1
-//   energy             4 (0 add, 2 mul, 1 div, 1 func)
+//   forcing            4 (1 add, 1 mul, 0 div, 2 func)
+//   udot               4 (1 add, 1 mul, 0 div, 2 func) -- composite form; composite 4, articulated 4
+//     udot by pass: joint angles' sin and cos 2; outward pass (velocities) 1; generalized forces (inward) 1
+//   energy             5 (0 add, 2 mul, 1 div, 2 func)
 //   momentum           4 (0 add, 2 mul, 0 div, 2 func)
 //   reactions          7 (2 add, 3 mul, 0 div, 2 func)
 
@@ -92,6 +92,135 @@ template <int W> inline bool operator>(double a, const Dual<W>& b) { return a > 
 template <int W> inline Dual<W> sin(const Dual<W>& a) { Dual<W> r; r.v = std::sin(a.v); const double c = std::cos(a.v); for (int i = 0; i < W; ++i) r.d[i] = c * a.d[i]; return r; }
 template <int W> inline Dual<W> cos(const Dual<W>& a) { Dual<W> r; r.v = std::cos(a.v); const double s = -std::sin(a.v); for (int i = 0; i < W; ++i) r.d[i] = s * a.d[i]; return r; }
 template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::sqrt(a.v); const double f = 0.5 / r.v; for (int i = 0; i < W; ++i) r.d[i] = f * a.d[i]; return r; }
+// ---- joint angles' sin and cos (templates/joint_sincos.inc) -------------------
+// Every joint angle's sin and cos, computed in one batch before the rest of a
+// function (issue 38, item 3: one evaluation per angle, shared by every use),
+// two angles at a time in SSE2 pairs (GCC/clang vector extensions, no header).
+// Accuracy (tests/codegen/test_joint_sincos.cpp, against sinl/cosl): at most
+// 0.51 ulp, the library's sin and cos 0.52-0.56 on the same arguments; beyond
+// |x| = 1e5 rad (and for inf and NaN) the library's sin and cos. (-ffast-math,
+// which reorders the exact sums, voids the bound.)
+// Method: x = k pi/32 + r, |r| <= pi/64, with pi/32 in four parts (three of 33
+// bits, exact products for |k| < 2^20) and r carried as r + rlo; sin and cos
+// of k pi/32 from a table as double-doubles (hi, lo, and hi split in 26-bit
+// halves for Dekker's exact product); sin r - r and cos r - 1 by their Taylor
+// series to r^9 and r^8 (truncation below 1e-20 on |r| <= pi/64);
+// sin x = S + C r + (S (cos r - 1) + C (sin r - r) + C rlo + S_lo), the sum
+// S + C r exact (TwoSum of the exact product), likewise cos x.
+
+// sin(j pi/32), j = 0..63: hi, lo (hi + lo to ~2^-106), and hi in two halves of 26 bits
+inline constexpr double kanegen_sin_table[64][4] = {
+    {0.0, 0.0, 0.0, 0.0},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.0000000000000p+0, 0.0, 0x1.0000000000000p+0, 0.0},
+    {0x1.fd88da3d12526p-1, -0x1.87df6378811c7p-55, 0x1.fd88da0000000p-1, 0x1.e892930000000p-28},
+    {0x1.f6297cff75cb0p-1, 0x1.562172a361fd3p-56, 0x1.f6297d0000000p-1, -0x1.146a000000000p-34},
+    {0x1.e9f4156c62ddap-1, 0x1.760b1e2e3f81ep-55, 0x1.e9f4158000000p-1, -0x1.39d2260000000p-29},
+    {0x1.d906bcf328d46p-1, 0x1.457e610231ac2p-56, 0x1.d906bd0000000p-1, -0x1.9ae5740000000p-30},
+    {0x1.c38b2f180bdb1p-1, -0x1.6e0b1757c8d07p-56, 0x1.c38b2f0000000p-1, 0x1.80bdb10000000p-29},
+    {0x1.a9b66290ea1a3p-1, 0x1.9f630e8b6dac8p-60, 0x1.a9b6628000000p-1, 0x1.0ea1a30000000p-29},
+    {0x1.8bc806b151741p-1, -0x1.2c5e12ed1336dp-55, 0x1.8bc8068000000p-1, 0x1.8a8ba08000000p-28},
+    {0x1.6a09e667f3bcdp-1, -0x1.bdd3413b26456p-55, 0x1.6a09e68000000p-1, -0x1.80c4330000000p-29},
+    {0x1.44cf325091dd6p-1, 0x1.8076a2cfdc6b3p-57, 0x1.44cf328000000p-1, -0x1.7b71150000000p-28},
+    {0x1.1c73b39ae68c8p-1, 0x1.b25dd267f6600p-55, 0x1.1c73b38000000p-1, 0x1.ae68c80000000p-29},
+    {0x1.e2b5d3806f63bp-2, 0x1.e0d891d3c6841p-58, 0x1.e2b5d38000000p-2, 0x1.bd8ec00000000p-36},
+    {0x1.87de2a6aea963p-2, -0x1.72cedd3d5a610p-57, 0x1.87de2a8000000p-2, -0x1.51569d0000000p-30},
+    {0x1.294062ed59f06p-2, -0x1.5d28da2c4612dp-56, 0x1.2940630000000p-2, -0x1.2a60fa0000000p-30},
+    {0x1.8f8b83c69a60bp-3, -0x1.26d19b9ff8d82p-57, 0x1.8f8b840000000p-3, -0x1.cb2cfa8000000p-30},
+    {0x1.917a6bc29b42cp-4, -0x1.e2718d26ed688p-60, 0x1.917a6c0000000p-4, -0x1.eb25ea0000000p-31},
+    {0.0, 0.0, 0.0, 0.0},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.0000000000000p+0, 0.0, -0x1.0000000000000p+0, 0.0},
+    {-0x1.fd88da3d12526p-1, 0x1.87df6378811c7p-55, -0x1.fd88da0000000p-1, -0x1.e892930000000p-28},
+    {-0x1.f6297cff75cb0p-1, -0x1.562172a361fd3p-56, -0x1.f6297d0000000p-1, 0x1.146a000000000p-34},
+    {-0x1.e9f4156c62ddap-1, -0x1.760b1e2e3f81ep-55, -0x1.e9f4158000000p-1, 0x1.39d2260000000p-29},
+    {-0x1.d906bcf328d46p-1, -0x1.457e610231ac2p-56, -0x1.d906bd0000000p-1, 0x1.9ae5740000000p-30},
+    {-0x1.c38b2f180bdb1p-1, 0x1.6e0b1757c8d07p-56, -0x1.c38b2f0000000p-1, -0x1.80bdb10000000p-29},
+    {-0x1.a9b66290ea1a3p-1, -0x1.9f630e8b6dac8p-60, -0x1.a9b6628000000p-1, -0x1.0ea1a30000000p-29},
+    {-0x1.8bc806b151741p-1, 0x1.2c5e12ed1336dp-55, -0x1.8bc8068000000p-1, -0x1.8a8ba08000000p-28},
+    {-0x1.6a09e667f3bcdp-1, 0x1.bdd3413b26456p-55, -0x1.6a09e68000000p-1, 0x1.80c4330000000p-29},
+    {-0x1.44cf325091dd6p-1, -0x1.8076a2cfdc6b3p-57, -0x1.44cf328000000p-1, 0x1.7b71150000000p-28},
+    {-0x1.1c73b39ae68c8p-1, -0x1.b25dd267f6600p-55, -0x1.1c73b38000000p-1, -0x1.ae68c80000000p-29},
+    {-0x1.e2b5d3806f63bp-2, -0x1.e0d891d3c6841p-58, -0x1.e2b5d38000000p-2, -0x1.bd8ec00000000p-36},
+    {-0x1.87de2a6aea963p-2, 0x1.72cedd3d5a610p-57, -0x1.87de2a8000000p-2, 0x1.51569d0000000p-30},
+    {-0x1.294062ed59f06p-2, 0x1.5d28da2c4612dp-56, -0x1.2940630000000p-2, 0x1.2a60fa0000000p-30},
+    {-0x1.8f8b83c69a60bp-3, 0x1.26d19b9ff8d82p-57, -0x1.8f8b840000000p-3, 0x1.cb2cfa8000000p-30},
+    {-0x1.917a6bc29b42cp-4, 0x1.e2718d26ed688p-60, -0x1.917a6c0000000p-4, 0x1.eb25ea0000000p-31},
+};
+
+typedef double kanegen_v2d __attribute__((vector_size(16)));
+
+/// sin and cos of x[0..n), in s and c.
+inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
+  for (int i = 0; i < n; i += 2) {
+    const int b = i + 1 < n ? i + 1 : i;  // an odd count's last angle twice
+    // beyond 1e5 rad (and inf, NaN) the library's, below; 0 meanwhile keeps the integer conversion defined
+    const double xi = x[i] <= 1.0e5 && x[i] >= -1.0e5 ? x[i] : 0.0, xb = x[b] <= 1.0e5 && x[b] >= -1.0e5 ? x[b] : 0.0;
+    const kanegen_v2d xv = {xi, xb};
+    const kanegen_v2d kn = (xv * 0x1.45f306dc9c883p+3 + 0x1.8p52) - 0x1.8p52;  // round(x 32/pi)
+    const kanegen_v2d t = xv - kn * 0x1.921fb54400000p-4, u2 = kn * 0x1.0b4611a600000p-38,
+                      u3 = kn * 0x1.3198a2e000000p-73;
+    const kanegen_v2d r1 = t - u2, e1 = (t - r1) - u2;
+    const kanegen_v2d r = r1 - u3, b3 = r - r1, e2 = (r1 - (r - b3)) - (u3 + b3);
+    const kanegen_v2d rlo = (e1 + e2) - kn * 0x1.b839a252049c1p-108;
+    const kanegen_v2d z = r * r;
+    const kanegen_v2d sr = (r * z) * (-1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 + z * (1.0 / 362880))));
+    const kanegen_v2d cm = z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320))));
+    const long k0 = static_cast<long>(kn[0]), k1 = static_cast<long>(kn[1]);
+    const double* Sa = kanegen_sin_table[k0 & 63];
+    const double* Sb = kanegen_sin_table[k1 & 63];
+    const double* Ca = kanegen_sin_table[(k0 + 16) & 63];
+    const double* Cb = kanegen_sin_table[(k1 + 16) & 63];
+    const kanegen_v2d S0 = {Sa[0], Sb[0]}, S1 = {Sa[1], Sb[1]}, S2 = {Sa[2], Sb[2]}, S3 = {Sa[3], Sb[3]};
+    const kanegen_v2d C0 = {Ca[0], Cb[0]}, C1 = {Ca[1], Cb[1]}, C2 = {Ca[2], Cb[2]}, C3 = {Ca[3], Cb[3]};
+    const kanegen_v2d g = 134217729.0 * r, rh = g - (g - r), rl = r - rh;  // r in 26-bit halves
+    const kanegen_v2d p = C0 * r, pe = (((C2 * rh - p) + C2 * rl) + C3 * rh) + C3 * rl;  // C r = p + pe
+    const kanegen_v2d s1 = S0 + p, bs = s1 - S0, se = (S0 - (s1 - bs)) + (p - bs);    // S + p = s1 + se
+    const kanegen_v2d sv = s1 + ((se + pe) + (S1 + C1 * r + C0 * rlo + S0 * cm + C0 * sr));
+    const kanegen_v2d q = S0 * r, qe = (((S2 * rh - q) + S2 * rl) + S3 * rh) + S3 * rl;  // S r = q + qe
+    const kanegen_v2d c1 = C0 - q, bc = c1 - C0, ce = (C0 - (c1 - bc)) + (-q - bc);      // C - q = c1 + ce
+    const kanegen_v2d cv = c1 + ((ce - qe) + (C1 - S1 * r - S0 * rlo + C0 * cm - S0 * sr));
+    s[i] = sv[0], c[i] = cv[0], s[b] = sv[1], c[b] = cv[1];
+    if (!(x[i] <= 1.0e5 && x[i] >= -1.0e5)) s[i] = std::sin(x[i]), c[i] = std::cos(x[i]);
+    if (!(x[b] <= 1.0e5 && x[b] >= -1.0e5)) s[b] = std::sin(x[b]), c[b] = std::cos(x[b]);
+  }
+}
+
+/// The same for any other number type (the dual numbers of the Jacobians): its own sin and cos.
+template <class T>
+inline void kanegen_sincos_n(const T* x, T* s, T* c, int n) {
+  using std::cos;
+  using std::sin;
+  for (int i = 0; i < n; ++i) s[i] = sin(x[i]), c[i] = cos(x[i]);
+}
 
 // ---- q_dot = W(q) u ------------------------------------------------------------
 template <class T>
@@ -114,12 +243,15 @@ template <class T>
 void forcing(const T* q, const T* u, const T* tau, T* F) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[1], angle_c[1];
+  const T angle_x[1] = {q[0]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 1);
   // ---- body bob: outward pass (velocities)
-  const T t0 = cos(q[0]);
-  const T t3 = -minus_gravity_z*t0;
+  const T t1 = -angle_c[0]*minus_gravity_z;
   // ---- body bob: generalized forces (inward)
-  const T t6 = -t3 + tau[0];
-  F[0] = t6;
+  const T t4 = -t1 + tau[0];
+  F[0] = t4;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
@@ -128,12 +260,15 @@ template <class T>
 int udot(const T* q, const T* u, const T* tau, T* udot) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)tau;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[1], angle_c[1];
+  const T angle_x[1] = {q[0]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 1);
   // ---- body bob: outward pass (velocities)
-  const T t0 = cos(q[0]);
-  const T t3 = -minus_gravity_z*t0;
+  const T t1 = -angle_c[0]*minus_gravity_z;
   // ---- body bob: generalized forces (inward)
-  const T t6 = -t3 + tau[0];
-  udot[0] = t6;
+  const T t4 = -t1 + tau[0];
+  udot[0] = t4;
   return 0;
 }
 
@@ -142,13 +277,15 @@ template <class T>
 void energy(const T* q, const T* u, T* TV) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
-  // ---- body bob: outward pass (velocities)
-  const T t1 = sin(q[0]);
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[1], angle_c[1];
+  const T angle_x[1] = {q[0]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 1);
   // ---- body bob: mass and velocity terms
-  const T t5 = u[0]*u[0];
-  const T t6 = gravity_z*t1;
-  TV[0] = t5/2.0;
-  TV[1] = t6;
+  const T t3 = u[0]*u[0];
+  const T t4 = angle_s[0]*gravity_z;
+  TV[0] = t3/2.0;
+  TV[1] = t4;
 }
 
 // ---- momentum: p_N[3], H_N[3] about N's origin ---------------------------------
@@ -156,15 +293,16 @@ template <class T>
 void momentum(const T* q, const T* u, T* pH) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u;
-  // ---- body bob: outward pass (velocities)
-  const T t0 = cos(q[0]);
-  const T t1 = sin(q[0]);
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[1], angle_c[1];
+  const T angle_x[1] = {q[0]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 1);
   // ---- body bob: mass and velocity terms
-  const T t5 = -t1*u[0];
-  const T t6 = -t0*u[0];
-  pH[0] = t5;
+  const T t3 = -angle_s[0]*u[0];
+  const T t4 = -angle_c[0]*u[0];
+  pH[0] = t3;
   pH[1] = 0.0;
-  pH[2] = t6;
+  pH[2] = t4;
   pH[3] = 0.0;
   pH[4] = u[0];
   pH[5] = 0.0;
@@ -175,20 +313,22 @@ template <class T>
 void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   using std::cos; using std::sin; using std::sqrt;
   (void)q; (void)u; (void)udot_in;
+  // ---- joint angles' sin and cos, in one batch (joint_sincos.inc)
+  T angle_s[1], angle_c[1];
+  const T angle_x[1] = {q[0]};
+  kanegen_sincos_n(angle_x, angle_s, angle_c, 1);
   // ---- body bob: outward pass (velocities)
-  const T t0 = cos(q[0]);
-  const T t1 = sin(q[0]);
-  const T t2 = -minus_gravity_z*t1;
-  const T t3 = -minus_gravity_z*t0;
+  const T t0 = -angle_s[0]*minus_gravity_z;
+  const T t1 = -angle_c[0]*minus_gravity_z;
   // ---- body bob: mass and velocity terms
-  const T t4 = -u[0]*u[0];
-  const T t5 = t2 + t4;
-  const T t6 = t3 + udot_in[0];
-  wrenches[0] = t5;
+  const T t2 = -u[0]*u[0];
+  const T t3 = t0 + t2;
+  const T t4 = t1 + udot_in[0];
+  wrenches[0] = t3;
   wrenches[3] = 0.0;
   wrenches[1] = 0.0;
-  wrenches[4] = t6;
-  wrenches[2] = -t6;
+  wrenches[4] = t4;
+  wrenches[2] = -t4;
   wrenches[5] = 0.0;
 }
 

@@ -96,16 +96,18 @@ TEST_CASE("generated headers compile standalone with only <cmath>, every functio
 
 TEST_CASE("generated code takes one sin and one cos per joint angle in each function and shares them among every use",
           "[generated][generator]") {
-  // Each generated function evaluates sin(a) and cos(a) of an angle a once, into a temporary every use reads
-  // (GCC then fuses the pair into one sincos call at -O1 and above); the values are the library's, so their
-  // accuracy is std::sin's and std::cos's. Checked on every committed header (generated/, which
-  // "headers regenerate" keeps equal to the generator's output).
+  // Each generated function evaluates sin(a) and cos(a) of an angle a once: the joint angles in one batch,
+  // kanegen_sincos_n (templates/joint_sincos.inc; its accuracy: test_joint_sincos.cpp), into arrays every use
+  // reads; any other angle into a temporary every use reads (GCC then fuses the pair into one sincos call at
+  // -O1 and above). Checked on every committed header (generated/, which "headers regenerate" keeps equal to
+  // the generator's output).
   // functions, split parts (KANEGEN_NOINLINE ... void udot_part0(...)) too; a function and its parts are one
   // evaluation, so an angle's sin is taken once among them
   const std::regex fn_re(R"(\n(?:template <class T>\n)?(?:[A-Z_]+ )*(?:void|int) ([a-z_0-9]+)\([^)]*\) \{\n)");
   const std::regex part_re(R"(_part[0-9]+$)");
   const std::regex any_call_re(R"(\b(sin|cos)\()");
   const std::regex call_re(R"(\b(sin|cos)\(([^()]*(?:\([^()]*\))?[^()]*)\))");
+  const std::regex batch_re(R"(kanegen_sincos_n\(angle_x, angle_s, angle_c, ([0-9]+)\);)");
   int headers = 0, calls = 0;
   for (const auto& m : kanegen::test::model_files()) {
     const std::string name = fs::path(m).stem().string();
@@ -115,6 +117,7 @@ TEST_CASE("generated code takes one sin and one cos per joint angle in each func
     for (std::sregex_iterator it(text.begin(), text.end(), fn_re), end; it != end; ++it)
       starts.emplace_back((*it)[1].str(), static_cast<std::size_t>(it->position() + it->length()));
     std::map<std::string, std::map<std::string, int>> seen;  // function (parts joined) -> call -> count
+    std::map<std::string, int> batches;                      // function (parts joined) -> batches
     for (std::size_t f = 0; f < starts.size(); ++f) {
       const std::size_t stop = text.find("\n}\n", starts[f].second);
       const std::string body = text.substr(starts[f].second, stop - starts[f].second);
@@ -128,11 +131,19 @@ TEST_CASE("generated code takes one sin and one cos per joint angle in each func
       }
       for (std::sregex_iterator it(body.begin(), body.end(), any_call_re), end; it != end; ++it)
         if (it->position() == 0 || body[static_cast<std::size_t>(it->position()) - 1] != ':') ++all;
+      for (std::sregex_iterator it(body.begin(), body.end(), batch_re), end; it != end; ++it) {
+        ++batches[std::regex_replace(starts[f].first, part_re, "")];
+        calls += 2 * std::stoi((*it)[1].str());
+      }
       INFO(name << ": " << starts[f].first);
       CHECK(matched == all);  // no call the pattern above could not read
       calls += matched;
     }
     CHECK(seen.count("udot") == 1);
+    for (const auto& [function, n] : batches) {
+      INFO(name << ": " << function);
+      CHECK(n == 1);  // one batch per function, its parts included (the first part computes it)
+    }
     for (const auto& [function, in_function] : seen)
       for (const auto& [call, count] : in_function) {
         INFO(name << ": " << function << ": " << call);
@@ -140,5 +151,5 @@ TEST_CASE("generated code takes one sin and one cos per joint angle in each func
       }
   }
   CHECK(headers >= 20);
-  CHECK(calls >= 500);  // the headers do call them (1,037 calls in 26 headers on 2026-12-06)
+  CHECK(calls >= 500);  // the headers do evaluate them (1,037 sin and cos in 26 headers on 2026-12-06)
 }
