@@ -4,7 +4,6 @@
 //   v_O_B = R_BP (v_P + w_P x p_PO_P + v_rel),  and the remainder accelerations.
 #include <fmt/format.h>
 
-#include <set>
 #include <tuple>
 
 #include "codegen/kane_context.hpp"
@@ -17,15 +16,6 @@ using namespace GiNaC;
 static const char* kAxis[3] = {"x", "y", "z"};
 
 namespace {
-
-/// Whether `e` reads no temporary of `P` (only state, time, parameters, constants and preludes' values).
-bool reads_no_temporary(const Program& P, const ex& e) {
-  std::set<std::string> syms;
-  collect_symbols(e, syms);
-  for (const std::string& n : syms)
-    if (P.names().count(n)) return false;
-  return true;
-}
 
 /// Q^T Rz(z) Ry(y) Rx(x) Q: the misalignment of body j's joint frame (runtime
 /// parameters, model axes) in the generator's frame B' (Q = R_BB').
@@ -310,7 +300,7 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
         // one batch of every joint angle's sin and cos (Program::sincos), where the angle is a function of
         // the state (a prescribed angle's prelude value too); otherwise the library's, bound here
         ex cq, sq;
-        if (reads_no_temporary(ctx.P, angle)) {
+        if (!ctx.P.reads_temporary(angle)) {
           std::tie(sq, cq) = ctx.P.sincos(angle);
         } else {
           cq = A.let(cos(angle)), sq = A.let(sin(angle));

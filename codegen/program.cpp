@@ -49,12 +49,17 @@ void Program::prelude(const std::string& text, const std::vector<std::string>& d
   preludes_.push_back({text, defines});
 }
 
+bool Program::reads_temporary(const ex& e) const {
+  std::set<std::string> syms;
+  collect_symbols(e, syms);
+  for (const std::string& n : syms)
+    if (names_.count(n)) return true;
+  return false;
+}
+
 std::pair<ex, ex> Program::sincos(const ex& angle_in) {
   const ex angle = fold ? fold(angle_in) : angle_in;
-  std::set<std::string> syms;
-  collect_symbols(angle, syms);
-  for (const std::string& n : syms)
-    if (names_.count(n)) throw std::logic_error("Program::sincos: the angle reads the temporary " + n);
+  if (reads_temporary(angle)) throw std::logic_error("Program::sincos: the angle reads a temporary");
   auto it = angle_index_.find(angle);
   if (it == angle_index_.end()) {
     const std::size_t i = angles_.size();

@@ -64,6 +64,9 @@ class Program {
   /// in one batch after the preludes (kanegen_sincos_n, templates/joint_sincos.inc); the same angle
   /// gives the same symbols.
   std::pair<ex, ex> sincos(const ex& angle);
+  /// Whether `e` reads a temporary of this program (else only the state, time, parameters, constants and
+  /// preludes' values: what sincos() takes).
+  bool reads_temporary(const ex& e) const;
   /// Whether some angle's sin and cos were asked for (the header then needs templates/joint_sincos.inc).
   bool has_sincos() const { return !angles_.empty(); }
 
@@ -108,8 +111,8 @@ class Program {
  private:
   /// Which temporaries some statement needs; `needed` gets their symbols.
   std::vector<bool> liveness(std::set<std::string>& needed) const;
-  /// The preludes that define a symbol in `needed`, one line each, then the angles' batch when one of its
-  /// symbols is needed; `ops` counts the batch's operations.
+  /// Fills `out`'s preludes: those that define a symbol in `needed`, one line each, then the angles' batch
+  /// when one of its symbols is needed (its operations in out.prelude_ops).
   void used_preludes(const std::set<std::string>& needed, const std::string& indent, Listing& out) const;
   struct Temp {
     GiNaC::symbol sym;

@@ -69,8 +69,8 @@ struct OtherCodeNames {
   std::string tag, name, second_tag, second_name_prefix;
 };
 
-OtherCodeNames other_code_names(const std::string& code, const JitOptions& o) {
-  const std::string v3 = second_at_v3(o) ? "-v3" : "";
+OtherCodeNames other_code_names(const std::string& code, bool second_v3) {
+  const std::string v3 = second_v3 ? "-v3" : "";
   if (code == "compact") return {"compact", "compact", "compact-second" + v3, "compact by "};
   return {"straight", "straight-line", "straight-second" + v3, "straight-line by "};
 }
@@ -144,7 +144,7 @@ std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const 
   if (!second.empty()) by_second(second, second_tag(o), manifest.udot_form, entry, tmp / "udot-second.so");
   const std::string other = other_udot_code(manifest, o);
   if (!other_entry.empty() && !other.empty()) {
-    const OtherCodeNames n = other_code_names(other, o);
+    const OtherCodeNames n = other_code_names(other, second_at_v3(o));
     // the main compiler at the main library's flags (its AVX2 clone too)
     UdotCandidate c{n.name, n.tag, other_form, split_words(o.compiler), tmp / ("udot-" + n.tag + ".so")};
     for (const std::string& f : split_words(o.flags)) c.argv.push_back(f);
@@ -166,8 +166,14 @@ std::string udot_candidate_path(const std::string& so_path, const std::string& t
 }
 
 void remove_udot_candidates(const std::string& so_path) {
-  for (const char* tag : {"second", "second-v3", "compact", "compact-second", "compact-second-v3", "straight",
-                          "straight-second", "straight-second-v3"}) {
+  std::vector<std::string> tags{"second", "second-v3"};
+  for (const char* code : {"compact", "straight-line"})
+    for (const bool v3 : {false, true}) {
+      const OtherCodeNames n = other_code_names(code, v3);
+      if (!v3) tags.push_back(n.tag);
+      tags.push_back(n.second_tag);
+    }
+  for (const std::string& tag : tags) {
     const std::string path = udot_candidate_path(so_path, tag);
     std::error_code ec;
     fs::remove(jit_cache::record_path(path), ec);  // the record first: a library without one is never loaded
@@ -187,7 +193,7 @@ void attach_udot_candidates(GeneratedEngine& e, const Model& model, const std::s
   const std::string second = second_compiler(o);
   std::vector<std::pair<std::string, std::string>> candidates = {{second_tag(o), second}};
   for (const char* code : {"compact", "straight-line"}) {
-    const OtherCodeNames n = other_code_names(code, o);
+    const OtherCodeNames n = other_code_names(code, second_at_v3(o));
     candidates.emplace_back(n.tag, n.name);
     candidates.emplace_back(n.second_tag, second.empty() ? "" : n.second_name_prefix + second);
   }
