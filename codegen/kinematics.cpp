@@ -4,7 +4,7 @@
 //   v_O_B = R_BP (v_P + w_P x p_PO_P + v_rel),  and the remainder accelerations.
 #include <fmt/format.h>
 
-#include <tuple>
+#include <utility>
 
 #include "codegen/kane_context.hpp"
 #include "model/joints/joint_kinematics.hpp"
@@ -16,6 +16,13 @@ using namespace GiNaC;
 static const char* kAxis[3] = {"x", "y", "z"};
 
 namespace {
+
+/// sin and cos of a joint coordinate or angle: from the function's batch of joint angles (Program::sincos) when
+/// it reads no temporary (the state, a prescribed angle's prelude value); otherwise the library's, bound here.
+std::pair<ex, ex> joint_sin_cos(KaneContext& ctx, const ex& angle) {
+  if (!ctx.P.reads_temporary(angle)) return ctx.P.sincos(angle);
+  return {ctx.A.let(sin(angle)), ctx.A.let(cos(angle))};
+}
 
 /// Q^T Rz(z) Ry(y) Rx(x) Q: the misalignment of body j's joint frame (runtime
 /// parameters, model axes) in the generator's frame B' (Q = R_BB').
@@ -297,14 +304,7 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
         const double offset = i < ctx.angle_offset.size() ? ctx.angle_offset[i] : 0.0;
         const ex angle = q_j + ctx.c(offset, n + "_angle_offset", "rad",
                                      "joint angle offset of the generator's body frame (joint_frames.hpp)");
-        // one batch of every joint angle's sin and cos (Program::sincos), where the angle is a function of
-        // the state (a prescribed angle's prelude value too); otherwise the library's, bound here
-        ex cq, sq;
-        if (!ctx.P.reads_temporary(angle)) {
-          std::tie(sq, cq) = ctx.P.sincos(angle);
-        } else {
-          cq = A.let(cos(angle)), sq = A.let(sin(angle));
-        }
+        const auto [sq, cq] = joint_sin_cos(ctx, angle);
         // Rot(a, th) = a a^T + cos th (I - a a^T) + sin th a^x
         const Eigen::Matrix3d aa = b.joint.axis_J * b.joint.axis_J.transpose();
         const SM3 Ax = Alg::skew(axis);
@@ -339,7 +339,8 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
           axes.push_back({a[0], a[1], a[2]});
         }
         const auto jm = joints::joint_motion<ex>(b.primitives, axes, jt.nu(), qj.data(), uj.data(), with_velocity,
-                                                 [&](const ex& x) { return A.let(x); });
+                                                 [&](const ex& x) { return A.let(x); },
+                                                 [&](const ex& x) { return joint_sin_cos(ctx, x); });
         for (int r = 0; r < 3; ++r) {
           for (int cc = 0; cc < 3; ++cc) R_JB(r, cc) = jm.R_JB[r][cc];
           e_J[r] = jm.e_J[r];

@@ -23,6 +23,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include "model/joints/joint_primitive.hpp"
@@ -103,13 +104,24 @@ Mat<S> quaternion_rotation(const S& w, const S& x, const S& y, const S& z) {
 
 }  // namespace detail
 
+/// sin and cos of a rotation's coordinate: the number type's own.
+struct OwnSinCos {
+  template <class S>
+  std::pair<S, S> operator()(const S& x) const {
+    using std::cos;
+    using std::sin;
+    return {sin(x), cos(x)};
+  }
+};
+
 /// The joint's kinematics (see the header comment). `axes[i]` is primitive i's
 /// axis converted to S; q and u point at the joint's own coordinates and
 /// speeds (u may be null when with_velocity is false); `let` names an
-/// intermediate value (identity for numbers).
-template <class S, class Let>
+/// intermediate value (identity for numbers); `sin_cos(x)` gives {sin x, cos x}
+/// (the generator's: from its batch of joint angles, Program::sincos).
+template <class S, class Let, class SinCos = OwnSinCos>
 JointMotion<S> joint_motion(const std::vector<JointPrimitive>& prims, const std::vector<Vec<S>>& axes, int nu,
-                            const S* q, const S* u, bool with_velocity, Let&& let) {
+                            const S* q, const S* u, bool with_velocity, Let&& let, SinCos sin_cos = {}) {
   using namespace detail;
   using std::cos;
   using std::sin;
@@ -138,7 +150,8 @@ JointMotion<S> joint_motion(const std::vector<JointPrimitive>& prims, const std:
     const Vec<S>& a = axes[i];
     switch (p.kind) {
       case JointPrimitive::Kind::rotation: {
-        const S c = let(cos(q[p.q])), s = let(sin(q[p.q]));
+        const auto [s_q, c_q] = sin_cos(q[p.q]);
+        const S c = let(c_q), s = let(s_q);
         turn(let_m(axis_rotation(a, c, s)));
         jm.Sw[p.u] = add(jm.Sw[p.u], a);
         if (with_velocity) {
