@@ -19,9 +19,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// Straight-line u-dot below this many operations fits the instruction cache: GCC's code is then as fast as
-/// clang's (chain_4: faster) and as compact code (docs/decisions.md).
+/// Below this many operations straight-line u-dot fits the instruction cache and is faster than compact code
+/// (docs/decisions.md): no other code is raced.
 constexpr long kCandidateMinOps = 2000;
+
+/// From this many operations the second compiler's build of u-dot is raced too: at the baseline ISA clang++'s
+/// straight-line u-dot ran 198 ns against g++'s 239 on bus_4 (1,665 operations) and 137 against 145 on chain_4
+/// (900), as fast on chain_2 (187), and 1.5x slower on gravity_gradient_boom: measured per model, not assumed.
+constexpr long kSecondCompilerMinOps = 500;
 
 /// Compact u-dot of at most this many operations is raced against straight-line code: near the generator's
 /// threshold (codegen/generator.hpp), AVX2 straight-line code can be faster (chain_8's by clang++ 408 ns against
@@ -58,11 +63,14 @@ bool second_at_v3(const JitOptions& o) {
 /// never served, on a CPU without it (a cache shared between machines).
 std::string second_tag(const JitOptions& o) { return second_at_v3(o) ? "second-v3" : "second"; }
 
-/// Whether u-dot is long enough to race candidates of it (straight-line or compact code).
-bool long_udot(const Manifest& manifest) {
+/// Whether u-dot has at least `min_ops` operations.
+bool udot_of_at_least(const Manifest& manifest, long min_ops) {
   const ManifestFunction* udot = manifest.find("udot");
-  return udot && udot->ops >= kCandidateMinOps;
+  return udot && udot->ops >= min_ops;
 }
+
+/// Whether u-dot is long enough to race it in the other code (straight-line or compact).
+bool long_udot(const Manifest& manifest) { return udot_of_at_least(manifest, kCandidateMinOps); }
 
 /// The other code's candidates, by the main compiler and the second: tags and names.
 struct OtherCodeNames {
@@ -128,7 +136,7 @@ std::vector<UdotCandidate> plan_udot_candidates(const Manifest& manifest, const 
                                                 const fs::path& entry, const fs::path& other_entry,
                                                 const std::string& other_form) {
   std::vector<UdotCandidate> out;
-  if (!optimized_default_build(o) || !long_udot(manifest)) return out;
+  if (!optimized_default_build(o) || !udot_of_at_least(manifest, kSecondCompilerMinOps)) return out;
   const std::string second = second_compiler(o);
   // the second compiler, for the instruction set the main library's u-dot runs at on this CPU
   auto by_second = [&](std::string name, std::string tag, const std::string& form, const fs::path& from,

@@ -2,11 +2,12 @@
 // against the library's own u-dot at the initial state (udot_race.hpp) and
 // serves when measured faster (docs/decisions.md, "u-dot candidates"):
 //   - u-dot by a second compiler (clang++ where installed), for u-dot of
-//     2,000 operations and more, straight-line or compact: GCC and clang
-//     differ most on long straight-line code (clang packs pairs of like
-//     operations into SSE2 instructions, its code is smaller), and which is
-//     faster varies by model (on compact code too: chain_8's ran 5 % faster
-//     by clang++, chain_16's 4 % slower);
+//     500 operations and more, straight-line or compact: GCC and clang
+//     differ most on straight-line code (clang packs pairs of like
+//     operations into SSE2 instructions: without it, its tree_15 ran 1.6x
+//     slower), and which is faster varies by model (bus_4's by clang++ 1.2x
+//     faster, gravity_gradient_boom's 1.5x slower; on compact code chain_8's
+//     5 % faster, chain_16's 4 % slower);
 //   - u-dot as the other code, by each compiler, in the main code's form:
 //     compact code (kernels shared by bodies of one shape,
 //     codegen/outlined_code.hpp) where the generator's cost model chose

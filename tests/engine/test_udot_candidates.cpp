@@ -154,7 +154,7 @@ TEST_CASE("no u-dot candidates for short u-dot, no second compiler when told non
   const SecondCompilerCache cache;
   {
     const SecondCompilerEnv env("clang++");
-    // 186 operations: fits the instruction cache, the main compiler's code is as fast
+    // 175 operations: under 500 both compilers' code is as fast (chain_2)
     const Model small = load_model(test::source_path("models/double_pendulum.yaml"));
     auto e = jit_load(small, codegen::jit_code_generator(), cache.options());
     CHECK_FALSE(fs::exists(udot_candidate_path(e->library_path(), "second")));
@@ -389,9 +389,16 @@ TEST_CASE("the candidates planned: which code, which compiler, which entry file"
     const auto cl = plan_udot_candidates(ml, o, tmp, entry, straight, "articulated");
     REQUIRE(tags(cl) == std::vector<std::string>{"second"});
     CHECK(builds(cl[0], entry));
+    // shorter straight-line u-dot (500 to 2,000 operations): clang++'s build of it only
+    Manifest mm = m;
+    mm.functions = {{"udot", 1500}};
+    CHECK(other_udot_code(mm, o).empty());
+    const auto cm = plan_udot_candidates(mm, o, tmp, entry, compact, "composite");
+    REQUIRE(tags(cm) == std::vector<std::string>{"second"});
+    CHECK((cm[0].name == "clang++" && builds(cm[0], entry)));
     // short u-dot, or a quick build: none
     Manifest ms = m;
-    ms.functions = {{"udot", 1500}};
+    ms.functions = {{"udot", 499}};
     CHECK(other_udot_code(ms, o).empty());
     CHECK(plan_udot_candidates(ms, o, tmp, entry, compact, "composite").empty());
     JitOptions quick = o;
