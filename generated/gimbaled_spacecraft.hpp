@@ -207,8 +207,9 @@ template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::s
 // of k pi/32 from a table as double-doubles (hi, lo, and hi split in 26-bit
 // halves for Dekker's exact product); sin r - r and cos r - 1 by their Taylor
 // series to r^9 and r^8 (truncation below 1e-20 on |r| <= pi/64);
-// sin x = S + C r + (S (cos r - 1) + C (sin r - r) + C rlo + S_lo), the sum
-// S + C r exact (TwoSum of the exact product), likewise cos x.
+// sin x = S + C r + (S (cos r - 1) + C ((sin r - r) + rlo) + S_lo + C_lo r),
+// the sum S + C r exact (Fast2Sum of Dekker's exact product: |S| >= sin(pi/32)
+// > |C r| or S = 0), likewise cos x.
 
 // sin(j pi/32), j = 0..63: hi, lo (hi + lo to ~2^-106), and hi in two halves of 26 bits
 inline constexpr double kanegen_sin_table[64][4] = {
@@ -284,8 +285,13 @@ typedef double kanegen_v2d __attribute__((vector_size(16)));
 inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
   for (int i = 0; i < n; i += 2) {
     const int b = i + 1 < n ? i + 1 : i;  // an odd count's last angle twice
+    double xi = x[i], xb = x[b];
     // beyond 1e5 rad (and inf, NaN) the library's, below; 0 meanwhile keeps the integer conversion defined
-    const double xi = x[i] <= 1.0e5 && x[i] >= -1.0e5 ? x[i] : 0.0, xb = x[b] <= 1.0e5 && x[b] >= -1.0e5 ? x[b] : 0.0;
+    const bool in_range = xi <= 1.0e5 && xi >= -1.0e5 && xb <= 1.0e5 && xb >= -1.0e5;
+    if (__builtin_expect(!in_range, 0)) {
+      if (!(xi <= 1.0e5 && xi >= -1.0e5)) xi = 0.0;
+      if (!(xb <= 1.0e5 && xb >= -1.0e5)) xb = 0.0;
+    }
     const kanegen_v2d xv = {xi, xb};
     const kanegen_v2d kn = (xv * 0x1.45f306dc9c883p+3 + 0x1.8p52) - 0x1.8p52;  // round(x 32/pi)
     const kanegen_v2d t = xv - kn * 0x1.921fb54400000p-4, u2 = kn * 0x1.0b4611a600000p-38,
@@ -296,6 +302,7 @@ inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
     const kanegen_v2d z = r * r;
     const kanegen_v2d sr = (r * z) * (-1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 + z * (1.0 / 362880))));
     const kanegen_v2d cm = z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320))));
+    const kanegen_v2d wl = sr + rlo;
     const long k0 = static_cast<long>(kn[0]), k1 = static_cast<long>(kn[1]);
     const double* Sa = kanegen_sin_table[k0 & 63];
     const double* Sb = kanegen_sin_table[k1 & 63];
@@ -305,14 +312,16 @@ inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
     const kanegen_v2d C0 = {Ca[0], Cb[0]}, C1 = {Ca[1], Cb[1]}, C2 = {Ca[2], Cb[2]}, C3 = {Ca[3], Cb[3]};
     const kanegen_v2d g = 134217729.0 * r, rh = g - (g - r), rl = r - rh;  // r in 26-bit halves
     const kanegen_v2d p = C0 * r, pe = (((C2 * rh - p) + C2 * rl) + C3 * rh) + C3 * rl;  // C r = p + pe
-    const kanegen_v2d s1 = S0 + p, bs = s1 - S0, se = (S0 - (s1 - bs)) + (p - bs);    // S + p = s1 + se
-    const kanegen_v2d sv = s1 + ((se + pe) + (S1 + C1 * r + C0 * rlo + S0 * cm + C0 * sr));
+    const kanegen_v2d s1 = S0 + p, se = p - (s1 - S0);  // S + p = s1 + se (|S| >= |p| or S = 0)
+    const kanegen_v2d sv = s1 + ((se + pe) + (S1 + C1 * r + S0 * cm + C0 * wl));
     const kanegen_v2d q = S0 * r, qe = (((S2 * rh - q) + S2 * rl) + S3 * rh) + S3 * rl;  // S r = q + qe
-    const kanegen_v2d c1 = C0 - q, bc = c1 - C0, ce = (C0 - (c1 - bc)) + (-q - bc);      // C - q = c1 + ce
-    const kanegen_v2d cv = c1 + ((ce - qe) + (C1 - S1 * r - S0 * rlo + C0 * cm - S0 * sr));
+    const kanegen_v2d c1 = C0 - q, ce = (C0 - c1) - q;  // C - q = c1 + ce (|C| >= |q| or C = 0)
+    const kanegen_v2d cv = c1 + ((ce - qe) + (C1 - S1 * r + C0 * cm - S0 * wl));
     s[i] = sv[0], c[i] = cv[0], s[b] = sv[1], c[b] = cv[1];
-    if (!(x[i] <= 1.0e5 && x[i] >= -1.0e5)) s[i] = std::sin(x[i]), c[i] = std::cos(x[i]);
-    if (!(x[b] <= 1.0e5 && x[b] >= -1.0e5)) s[b] = std::sin(x[b]), c[b] = std::cos(x[b]);
+    if (__builtin_expect(!in_range, 0)) {
+      if (!(x[i] <= 1.0e5 && x[i] >= -1.0e5)) s[i] = std::sin(x[i]), c[i] = std::cos(x[i]);
+      if (!(x[b] <= 1.0e5 && x[b] >= -1.0e5)) s[b] = std::sin(x[b]), c[b] = std::cos(x[b]);
+    }
   }
 }
 
