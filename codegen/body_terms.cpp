@@ -1,7 +1,13 @@
 // Symbolic per-body inertia, velocity and gravity terms in the body's own
 // velocity coordinates z = [v_O_B, w_B, eta_dot], from its mass integrals
 // (dynamics/body_inertia.hpp derives them; the same formulas in numbers).
+// Unlike the generic engine, the rich nodes' sums of degree 1 and 2 in eta
+// (mass, first moment, participation, modal mass: RichNodeSums) are formed
+// once per body from coefficients summed at load, and a rich node adds only
+// its terms of degree 3 and 4 and its rotary inertia.
 #include <fmt/format.h>
+
+#include <array>
 
 #include "codegen/kane_context.hpp"
 
@@ -65,7 +71,8 @@ void add_integrated_velocity_terms(KaneContext& ctx, int j, const SV3& S, const 
 
 /// A rich node's terms, one by one (dynamics/body_inertia.hpp, add_node_terms).
 /// With `element`, also the node's mass element for the central field (its position also when massless).
-void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV3& g_B, bool with_velocity,
+/// `modal_mass`: also its m_k Phi~_i . Phi~_l (where the body does not sum them: modal_mass_summed).
+void add_node_terms(KaneContext& ctx, int j, int k, bool with_velocity, bool modal_mass,
                     SymMassElement* element) {
   Alg& A = ctx.A;
   const Body& b = ctx.model.bodies[j];
@@ -115,30 +122,17 @@ void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV
     sk = A.let(sk, ctx.name("s_B", j) + fmt::format("_node{}", node.id));
     if (element) element->mass = mk, element->s_B = sk, element->Pt = Pt;
     if (node.mass != 0.0) {
-    const SM3 sx = Alg::skew(sk);
-    for (int a = 0; a < 3; ++a) {
-      M(a, a) = M(a, a) + mk;
-      for (int c = 0; c < 3; ++c) {
-        M(a, 3 + c) = M(a, 3 + c) - mk * sx(a, c);
-        M(3 + a, c) = M(3 + a, c) + mk * sx(a, c);
+    // Only the sums of degree 3 and 4 in eta here: the mass, first moment, participation, modal mass and
+    // gravity of the node, and the translational part of its remainder force, are in the body's sums
+    // (RichNodeSums, compute_body_terms).
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c < 3; ++c)
         M(3 + a, 3 + c) = M(3 + a, 3 + c) + mk * ((a == c ? A.dot(sk, sk) : ex(0)) - sk[a] * sk[c]);
-      }
-    }
     for (int i = 0; i < m; ++i) {
       const SV3 sxP = A.cross(sk, Pt[i]);
-      for (int a = 0; a < 3; ++a) {
-        M(a, 6 + i) = M(6 + i, a) = M(a, 6 + i) + mk * Pt[i][a];
-        M(3 + a, 6 + i) = M(6 + i, 3 + a) = M(3 + a, 6 + i) + mk * sxP[a];
-      }
-      for (int l = i; l < m; ++l) M(6 + i, 6 + l) = M(6 + l, 6 + i) = M(6 + i, 6 + l) + mk * A.dot(Pt[i], Pt[l]);
-    }
-    if (gravity_terms) {
-      const SV3 sg = A.cross(sk, g_B);
-      for (int a = 0; a < 3; ++a) {
-        s.g_body[a] = s.g_body[a] + mk * g_B[a];
-        s.g_body[3 + a] = s.g_body[3 + a] + mk * sg[a];
-      }
-      for (int i = 0; i < m; ++i) s.g_body[6 + i] = s.g_body[6 + i] + mk * A.dot(Pt[i], g_B);
+      for (int a = 0; a < 3; ++a) M(3 + a, 6 + i) = M(6 + i, 3 + a) = M(3 + a, 6 + i) + mk * sxP[a];
+      if (modal_mass)
+        for (int l = i; l < m; ++l) M(6 + i, 6 + l) = M(6 + l, 6 + i) = M(6 + i, 6 + l) + mk * A.dot(Pt[i], Pt[l]);
     }
     if (with_velocity) {
       SV3 v_rel;
@@ -150,10 +144,7 @@ void add_node_terms(KaneContext& ctx, int j, int k, bool gravity_terms, const SV
       SV3 bk = A.add(A.cross(w, A.cross(w, sk)), A.scale(2, A.cross(w, v_rel)));
       bk = A.add(bk, gamma_dd);
       const SV3 sb = A.cross(sk, bk);
-      for (int a = 0; a < 3; ++a) {
-        s.h_body[a] = s.h_body[a] + mk * bk[a];
-        s.h_body[3 + a] = s.h_body[3 + a] + mk * sb[a];
-      }
+      for (int a = 0; a < 3; ++a) s.h_body[3 + a] = s.h_body[3 + a] + mk * sb[a];
       for (int i = 0; i < m; ++i) s.h_body[6 + i] = s.h_body[6 + i] + mk * A.dot(Pt[i], bk);
     }
     }  // node.mass != 0
@@ -261,16 +252,54 @@ void runtime_rigid_part(KaneContext& ctx, int j, ex& mass, SV3& S0, SM3& J0, Sym
     const double r = total - rigid;
     return std::abs(r) <= 1e-14 * std::max(std::abs(total), std::abs(rigid)) ? 0.0 : r;
   };
-  mass = A.P.let(m + ctx.c(rest(I.mass, m0), n + "_nodes_mass", "kg", "mass of the plain nodes"));
+  mass = A.P.let(m + ctx.c(rest(I.mass + I.rich.mass, m0), n + "_nodes_mass", "kg", "mass of the nodes"));
   const ex c2 = A.P.let(cp[0] * cp[0] + cp[1] * cp[1] + cp[2] * cp[2]);
   for (int a = 0; a < 3; ++a) {
-    S0[a] = A.P.let(m * cp[a] + ctx.c(rest(I.S0(a), m0 * c0(a)), fmt::format("{}_nodes_S0_{}", n, "xyz"[a]), "kg m",
-                                      "first moment of the plain nodes"));
+    S0[a] = A.P.let(m * cp[a] + ctx.c(rest(I.S0(a) + I.rich.S0(a), m0 * c0(a)), fmt::format("{}_nodes_S0_{}", n, "xyz"[a]),
+                                      "kg m", "first moment of the nodes (undeformed)"));
     for (int cc = 0; cc < 3; ++cc)
       J0(a, cc) = A.P.let(Icp(a, cc) + m * ((a == cc ? c2 : ex(0)) - cp[a] * cp[cc]) +
                           ctx.c(rest(I.J0(a, cc), Jr0(a, cc)), fmt::format("{}_nodes_J0_{}{}", n, "xyz"[std::min(a, cc)], "xyz"[std::max(a, cc)]),
                                 "kg m^2", "inertia of the plain nodes about O"));
   }
+}
+
+/// Whether the rich nodes' modal mass block costs fewer operations from its coefficients (RichNodeSums: an
+/// add and a multiply per non-zero coefficient of degree 1 and 2) than node by node (per node and pair of
+/// modes the products of the components of Phi~_i and Phi~_l that can be non-zero, their sum, the mass's
+/// multiply and an add). A beam's modes bend in one plane each, so Phi~ has two components: 8 modes on 7
+/// nodes cost more summed, 4 modes on 13 nodes less (docs/flexible_ops.md).
+bool rich_modal_mass_cheaper(const FlexibleData& flex, const std::vector<int>& rich, const RichNodeSums& R) {
+  const int m = static_cast<int>(R.Y.rows());
+  long coefficients = 0;
+  for (int i = 0; i < m; ++i)
+    for (int l = i; l < m; ++l) {
+      const std::size_t il = static_cast<std::size_t>(i * m + l);
+      for (int p = 0; p < m; ++p) {
+        coefficients += R.Y1[il](p) != 0.0;
+        for (int r = p; r < m; ++r) coefficients += R.Y2[il](p, r) != 0.0;
+      }
+    }
+  long by_node = 0;
+  for (int k : rich) {
+    if (flex.nodes[static_cast<std::size_t>(k)].mass == 0.0) continue;
+    // component a of Phi~_i can be non-zero: Phi[a,i] or row i of Gamma^a
+    std::vector<std::array<bool, 3>> nz(static_cast<std::size_t>(m));
+    for (int i = 0; i < m; ++i)
+      for (int a = 0; a < 3; ++a) {
+        bool v = flex.Phi(3 * k + a, i) != 0.0;
+        if (flex.has_second_order(k) && flex.Gamma[k][a].size())
+          for (int l = 0; l < m; ++l) v = v || flex.Gamma[k][a](std::min(i, l), std::max(i, l)) != 0.0;
+        nz[static_cast<std::size_t>(i)][a] = v;
+      }
+    for (int i = 0; i < m; ++i)
+      for (int l = i; l < m; ++l) {
+        int products = 0;
+        for (int a = 0; a < 3; ++a) products += nz[static_cast<std::size_t>(i)][a] && nz[static_cast<std::size_t>(l)][a];
+        if (products) by_node += 2 * products + 1;
+      }
+  }
+  return 2 * coefficients < by_node;
 }
 
 }  // namespace
@@ -310,13 +339,30 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
         if (rigid.has_inertia) rigid.I_B = ctx.cmat(b.rigid.I_c_B, n + "_rigid_I", "kg m^2", "rigid part's inertia about its com", true);
         s.elements.push_back(rigid);
       }
-      mass = ctx.c(I.mass, n + "_mass", "kg", "mass (rigid part and plain nodes)");
-      S0 = ctx.cvec(I.S0, n + "_S0", "kg m", "first mass moment about O (undeformed)");
+      mass = ctx.c(I.mass + I.rich.mass, n + "_mass", "kg", "mass (rigid part and nodes)");
+      S0 = ctx.cvec(I.S0 + I.rich.S0, n + "_S0", "kg m", "first mass moment about O (undeformed)");
       J0 = ctx.cmat(I.J0, n + "_J0", "kg m^2", "inertia about O (undeformed)", true);
     }
     // Modal integrals.
     std::vector<SV3> Bc(m);
-    for (int i = 0; i < m; ++i) Bc[i] = ctx.cvec(I.B.col(i), fmt::format("{}_B{}", n, i + 1), "kg m", "modal participation");
+    for (int i = 0; i < m; ++i)
+      Bc[i] = ctx.cvec(I.B.col(i) + I.rich.B.col(i), fmt::format("{}_B{}", n, i + 1), "kg m", "modal participation");
+    // The rich nodes' sums of degree 1 and 2 in eta (RichNodeSums, model/modal_integrals.hpp): added here
+    // once, not node by node (add_node_terms adds their terms of degree 3 and 4 and their rotary inertia).
+    const RichNodeSums& R = I.rich;
+    auto Gs = [&](int a, int i, int l) {
+      return ctx.c(R.G[a](std::min(i, l), std::max(i, l)),
+                   fmt::format("{}_rich_Gamma{}_{}_{}", n, kAxis[a], std::min(i, l) + 1, std::max(i, l) + 1), "kg/m",
+                   "Sum m Gamma over the rich nodes");
+    };
+    // Bt[i] = Sum m Phi~_i over every node: B_i + [G[a] eta]_i (plain nodes: B_i)
+    std::vector<SV3> Bt = Bc;
+    for (int i = 0; i < m && R.nodes > 0; ++i)
+      for (int a = 0; a < 3; ++a) {
+        ex sum = Bc[i][a];
+        for (int l = 0; l < m; ++l) sum += Gs(a, i, l) * s.eta[l];
+        Bt[i][a] = A.let(sum);
+      }
     auto Yc = [&](int i, int l) {
       return ctx.c(I.Y(std::min(i, l), std::max(i, l)), fmt::format("{}_Y_{}_{}", n, std::min(i, l) + 1, std::max(i, l) + 1),
                "kg m^2", "modal mass");
@@ -331,9 +377,11 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
     };
     SV3 S = S0;
     for (int a = 0; a < 3; ++a) {
-      ex sum = S0[a];
+      ex sum = S0[a], quad = 0;
       for (int i = 0; i < m; ++i) sum += Bc[i][a] * s.eta[i];
-      S[a] = A.let(sum, Alg::component(ctx.name("S_B", static_cast<int>(j)), a));
+      for (int i = 0; i < m && R.nodes > 0; ++i)
+        for (int l = 0; l < m; ++l) quad += Gs(a, i, l) * s.eta[i] * s.eta[l];
+      S[a] = A.let(sum + quad / 2, Alg::component(ctx.name("S_B", static_cast<int>(j)), a));
     }
     SM3 J = J0;
     // Q[a][c][i] = Sum m s_a Phi_c,i
@@ -371,7 +419,7 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
       }
     for (int i = 0; i < m; ++i) {
       for (int a = 0; a < 3; ++a) {
-        s.M_body(a, 6 + i) = s.M_body(6 + i, a) = Bc[i][a];
+        s.M_body(a, 6 + i) = s.M_body(6 + i, a) = Bt[i][a];
         ex Cai = 0;  // C[a,i] = eps_abc Q[b][c]_i
         for (int bb = 0; bb < 3; ++bb)
           for (int cc = 0; cc < 3; ++cc)
@@ -380,6 +428,23 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
       }
       for (int l = 0; l < m; ++l) s.M_body(6 + i, 6 + l) = Yc(i, l);
     }
+    // the rich nodes' Sum m Phi~_i . Phi~_l = Y + Y1 . eta + eta^T Y2 eta, where its coefficients cost
+    // fewer operations than the nodes' products (m^2 (m + 1)^2 / 4 of degree 2 against ~7 m (m + 1) / 2
+    // per node: 8 modes on 7 nodes cost more summed)
+    const bool modal_mass_summed = R.nodes > 0 && rich_modal_mass_cheaper(*b.flex, b.rich_nodes, R);
+    for (int i = 0; i < m && modal_mass_summed; ++i)
+      for (int l = i; l < m; ++l) {
+        const std::size_t il = static_cast<std::size_t>(i * m + l);
+        ex sum = ctx.c(R.Y(i, l), fmt::format("{}_rich_Y_{}_{}", n, i + 1, l + 1), "kg m^2", "rich nodes' modal mass");
+        for (int p = 0; p < m; ++p) {
+          sum += ctx.c(R.Y1[il](p), fmt::format("{}_rich_Y1_{}_{}_{}", n, i + 1, l + 1, p + 1), "kg m",
+                       "rich nodes' Phi~.Phi~, degree 1") * s.eta[p];
+          for (int r = p; r < m; ++r)
+            sum += ctx.c((r == p ? 1.0 : 2.0) * R.Y2[il](p, r), fmt::format("{}_rich_Y2_{}_{}_{}_{}", n, i + 1, l + 1, p + 1, r + 1),
+                         "kg", "rich nodes' Phi~.Phi~, degree 2") * s.eta[p] * s.eta[r];
+        }
+        s.M_body(6 + i, 6 + l) = s.M_body(6 + l, 6 + i) = A.let(s.M_body(6 + i, 6 + l) + sum);
+      }
     // Gravity: g_B = R_NB^T g_N; [m g_B; S x g_B; B^T g_B]
     s.g_body.assign(6 + m, ex(0));
     SV3 g_B;
@@ -388,12 +453,21 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
       g_B = A.mul_t(s.R_NB, g_N, ctx.name("g_B", static_cast<int>(j)));
       const SV3 mg = A.scale(mass, g_B), Sg = A.cross(S, g_B);
       for (int a = 0; a < 3; ++a) s.g_body[a] = mg[a], s.g_body[3 + a] = Sg[a];
-      for (int i = 0; i < m; ++i) s.g_body[6 + i] = A.dot(Bc[i], g_B);
+      for (int i = 0; i < m; ++i) s.g_body[6 + i] = A.dot(Bt[i], g_B);
     }
     s.h_body.assign(6 + m, ex(0));
-    if (with_velocity) add_integrated_velocity_terms(ctx, static_cast<int>(j), S, J, Bc, Q, Pff);
+    if (with_velocity) {
+      add_integrated_velocity_terms(ctx, static_cast<int>(j), S, J, Bt, Q, Pff);
+      // the rich nodes' Sum m eta_dot^T Gamma^a eta_dot (their remainder acceleration's second-order part)
+      for (int a = 0; a < 3 && R.nodes > 0; ++a) {
+        ex sum = 0;
+        for (int i = 0; i < m; ++i)
+          for (int l = 0; l < m; ++l) sum += Gs(a, i, l) * s.eta_dot[i] * s.eta_dot[l];
+        s.h_body[a] = A.let(s.h_body[a] + sum);
+      }
+    }
     if (!central) {
-      for (int k : b.rich_nodes) add_node_terms(ctx, static_cast<int>(j), k, gravity_terms, g_B, with_velocity, nullptr);
+      for (int k : b.rich_nodes) add_node_terms(ctx, static_cast<int>(j), k, with_velocity, !modal_mass_summed, nullptr);
       continue;
     }
     // every node is an element: rich nodes as their terms form them, plain ones at rho + Phi eta
@@ -403,7 +477,7 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
       const ModalNode& node = flex.nodes[k];
       if (flex.node_is_rich(k)) {
         SymMassElement e;
-        add_node_terms(ctx, static_cast<int>(j), k, false, g_B, with_velocity, &e);
+        add_node_terms(ctx, static_cast<int>(j), k, with_velocity, !modal_mass_summed, &e);
         s.elements.push_back(e);
         continue;
       }

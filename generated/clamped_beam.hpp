@@ -61,7 +61,7 @@ inline constexpr char model_hash[] = "8c4fa49666fed41c";
 
 // ---- model constants (SI units) ---------------------------------------------
 // body beam: fixed joint to ground, mass 0.5 kg, flexible: 4 modes from beam
-inline constexpr double beam_mass = 0.5000000000000001;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double beam_mass = 0.5000000000000001;  // mass (rigid part and nodes) [kg]
 inline constexpr double beam_S0_x = 0.25;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double beam_J0_yy = 0.16687500000000005;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double beam_J0_zz = 0.16687500000000005;  // inertia about O (undeformed) [kg m^2]

@@ -62,7 +62,7 @@ inline constexpr char model_hash[] = "ccfb0ba6328367c2";
 // body boom_a: revolute joint to drum, mass 0.5 kg
 inline constexpr double boom_a_p_PJ_x = 0.4;  // joint frame origin in the parent x [m]
 inline constexpr double boom_a_p_J_x = 0.4;  // joint origin from the parent's origin, joint axes x [m]
-inline constexpr double boom_a_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double boom_a_mass = 0.5;  // mass (rigid part and nodes) [kg]
 inline constexpr double boom_a_S0_x = 0.25;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double boom_a_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double boom_a_J0_yy = 0.16670000000000001;  // inertia about O (undeformed) [kg m^2]
@@ -72,7 +72,7 @@ inline constexpr double boom_a_k = 20;  // joint spring stiffness [N m/rad or N/
 // body boom_b: revolute joint to drum, mass 0.5 kg
 inline constexpr double boom_b_p_PJ_x = -0.4;  // joint frame origin in the parent x [m]
 inline constexpr double boom_b_p_J_x = 0.4;  // joint origin from the parent's origin, joint axes x [m]
-inline constexpr double boom_b_mass = 0.5;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double boom_b_mass = 0.5;  // mass (rigid part and nodes) [kg]
 inline constexpr double boom_b_S0_x = 0.25;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double boom_b_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double boom_b_J0_yy = 0.16670000000000001;  // inertia about O (undeformed) [kg m^2]
@@ -80,7 +80,7 @@ inline constexpr double boom_b_J0_zz = 0.16670000000000001;  // inertia about O 
 inline constexpr double boom_b_k = 20;  // joint spring stiffness [N m/rad or N/m]
 
 // body drum: free joint to ground, mass 30 kg
-inline constexpr double drum_mass = 30;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double drum_mass = 30;  // mass (rigid part and nodes) [kg]
 inline constexpr double drum_S0_x = 0.15;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double drum_S0_z = 0.06;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double drum_J0_xx = 1.8251199999999999;  // inertia about O (undeformed) [kg m^2]

@@ -62,7 +62,7 @@ inline constexpr char model_hash[] = "c0ff47b126d72506";
 // body panel_a: revolute joint to hub, mass 5 kg
 inline constexpr double panel_a_p_PJ_x = 0.5;  // joint frame origin in the parent x [m]
 inline constexpr double panel_a_p_J_x = 0.5;  // joint origin from the parent's origin, joint axes x [m]
-inline constexpr double panel_a_mass = 5;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double panel_a_mass = 5;  // mass (rigid part and nodes) [kg]
 inline constexpr double panel_a_S0_x = 3;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double panel_a_J0_xx = 0.15;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double panel_a_J0_yy = 2.55;  // inertia about O (undeformed) [kg m^2]
@@ -72,7 +72,7 @@ inline constexpr double panel_a_k = 2;  // joint spring stiffness [N m/rad or N/
 // body panel_b: revolute joint to hub, mass 5 kg
 inline constexpr double panel_b_p_PJ_x = -0.5;  // joint frame origin in the parent x [m]
 inline constexpr double panel_b_p_J_z = 0.5;  // joint origin from the parent's origin, joint axes z [m]
-inline constexpr double panel_b_mass = 5;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double panel_b_mass = 5;  // mass (rigid part and nodes) [kg]
 inline constexpr double panel_b_S0_z = 3;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double panel_b_J0_xx = 2.55;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double panel_b_J0_yy = 2.4;  // inertia about O (undeformed) [kg m^2]
@@ -80,7 +80,7 @@ inline constexpr double panel_b_J0_zz = 0.15;  // inertia about O (undeformed) [
 inline constexpr double panel_b_k = 0.5;  // joint spring stiffness [N m/rad or N/m]
 
 // body hub: free joint to ground, mass 100 kg
-inline constexpr double hub_mass = 100;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double hub_mass = 100;  // mass (rigid part and nodes) [kg]
 inline constexpr double hub_S0_x = 2;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double hub_S0_z = 3;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double hub_J0_xx = 10.1;  // inertia about O (undeformed) [kg m^2]

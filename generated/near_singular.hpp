@@ -62,28 +62,28 @@ inline constexpr char model_hash[] = "07693a6e6f9cdcd5";
 // body outer: revolute joint to bus, mass 0.001 kg
 inline constexpr double outer_p_PJ_z = 0.8;  // joint frame origin in the parent z [m]
 inline constexpr double outer_p_J_z = 0.8;  // joint origin from the parent's origin, joint axes z [m]
-inline constexpr double outer_mass = 0.001;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double outer_mass = 0.001;  // mass (rigid part and nodes) [kg]
 inline constexpr double outer_J0_xx = 4.5e-07;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double outer_J0_yy = 4.5e-07;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double outer_J0_zz = 9e-07;  // inertia about O (undeformed) [kg m^2]
 
 // body middle: revolute joint to outer, mass 0.001 kg
 inline constexpr double middle_angle_offset = 3.141592653589793;  // joint angle offset of the generator's body frame (joint_frames.hpp) [rad]
-inline constexpr double middle_mass = 0.001;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double middle_mass = 0.001;  // mass (rigid part and nodes) [kg]
 inline constexpr double middle_J0_xx = 4.5e-07;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double middle_J0_yy = 4.5e-07;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double middle_J0_zz = 9e-07;  // inertia about O (undeformed) [kg m^2]
 
 // body platform: revolute joint to middle, mass 5 kg
 inline constexpr double platform_angle_offset = 1.5707963267948966;  // joint angle offset of the generator's body frame (joint_frames.hpp) [rad]
-inline constexpr double platform_mass = 5;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double platform_mass = 5;  // mass (rigid part and nodes) [kg]
 inline constexpr double platform_S0_z = 0.25;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double platform_J0_xx = 0.1325;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double platform_J0_yy = 0.1125;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double platform_J0_zz = 0.08;  // inertia about O (undeformed) [kg m^2]
 
 // body bus: free joint to ground, mass 300 kg
-inline constexpr double bus_mass = 300;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double bus_mass = 300;  // mass (rigid part and nodes) [kg]
 inline constexpr double bus_S0_x = 6;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double bus_S0_z = -15;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double bus_J0_xx = 50.75;  // inertia about O (undeformed) [kg m^2]

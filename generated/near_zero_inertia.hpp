@@ -68,7 +68,7 @@ inline constexpr double probe_p_PJ_x = 0.3;  // joint frame origin in the parent
 inline constexpr double probe_p_PJ_y = 0.1;  // joint frame origin in the parent y [m]
 inline constexpr double probe_p_J_y = -0.006877586914158754;  // joint origin from the parent's origin, joint axes y [m]
 inline constexpr double probe_p_J_z = 0.3161529674038157;  // joint origin from the parent's origin, joint axes z [m]
-inline constexpr double probe_mass = 0.001;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double probe_mass = 0.001;  // mass (rigid part and nodes) [kg]
 inline constexpr double probe_S0_z = 5e-05;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double probe_J0_xx = 3.3300000000000007e-06;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double probe_J0_yy = 3.3300000000000007e-06;  // inertia about O (undeformed) [kg m^2]
@@ -76,7 +76,7 @@ inline constexpr double probe_J0_zz = 1e-09;  // inertia about O (undeformed) [k
 inline constexpr double probe_k = 1e-06;  // joint spring stiffness [N m/rad or N/m]
 
 // body bus: free joint to ground, mass 20 kg
-inline constexpr double bus_mass = 20;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double bus_mass = 20;  // mass (rigid part and nodes) [kg]
 inline constexpr double bus_S0_x = 0.2;  // first mass moment about O (undeformed) x [kg m]
 inline constexpr double bus_S0_y = 0.4;  // first mass moment about O (undeformed) y [kg m]
 inline constexpr double bus_S0_z = -0.2;  // first mass moment about O (undeformed) z [kg m]

@@ -63,7 +63,7 @@ inline constexpr char model_hash[] = "38c15d79c26104e1";
 // body plate: prismatic joint to bus, mass 2 kg
 inline constexpr double plate_p_PJ_z = 0.8;  // joint frame origin in the parent z [m]
 inline constexpr double plate_p_J_z = 0.8;  // joint origin from the parent's origin, joint axes z [m]
-inline constexpr double plate_mass = 2;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double plate_mass = 2;  // mass (rigid part and nodes) [kg]
 inline constexpr double plate_J0_xx = 0.02;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double plate_J0_yy = 0.02;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double plate_J0_zz = 0.04;  // inertia about O (undeformed) [kg m^2]
@@ -73,14 +73,14 @@ inline constexpr double plate_rest = 0.5;  // spring rest value [rad or m]
 // body probe: free joint to plate, mass 30 kg
 inline constexpr double probe_p_PJ_z = 0.05;  // joint frame origin in the parent z [m]
 inline constexpr double probe_p_J_z = 0.05;  // joint origin from the parent's origin, joint axes z [m]
-inline constexpr double probe_mass = 30;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double probe_mass = 30;  // mass (rigid part and nodes) [kg]
 inline constexpr double probe_S0_z = 7.5;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double probe_J0_xx = 3.075;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double probe_J0_yy = 3.075;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double probe_J0_zz = 0.9;  // inertia about O (undeformed) [kg m^2]
 
 // body bus: free joint to ground, mass 400 kg
-inline constexpr double bus_mass = 400;  // mass (rigid part and plain nodes) [kg]
+inline constexpr double bus_mass = 400;  // mass (rigid part and nodes) [kg]
 inline constexpr double bus_S0_z = -120;  // first mass moment about O (undeformed) z [kg m]
 inline constexpr double bus_J0_xx = 216;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double bus_J0_yy = 206;  // inertia about O (undeformed) [kg m^2]

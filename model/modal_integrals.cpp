@@ -1,5 +1,6 @@
 #include "model/modal_integrals.hpp"
 
+#include <algorithm>
 #include <array>
 #include <vector>
 
@@ -10,6 +11,43 @@ namespace kanegen {
 static Eigen::Matrix3d point_inertia(double m, const Eigen::Vector3d& r) {
   return m * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
 }
+
+namespace {
+
+/// I.rich of compute_mass_integrals (modal_integrals.hpp, RichNodeSums).
+void add_rich_node_sums(const FlexibleData& flex, RichNodeSums& r) {
+  const int m = flex.modes();
+  for (int k = 0; k < static_cast<int>(flex.nodes.size()); ++k) {
+    const ModalNode& node = flex.nodes[static_cast<std::size_t>(k)];
+    if (!flex.node_is_rich(k) || node.mass == 0.0) continue;
+    const double mk = node.mass;
+    const Eigen::MatrixXd Phi = flex.Phi.middleRows(3 * k, 3);  // 3 x m
+    std::array<Eigen::MatrixXd, 3> Gk;                          // Gamma_k^a, upper triangle mirrored
+    for (int a = 0; a < 3; ++a) {
+      Gk[a] = Eigen::MatrixXd::Zero(m, m);
+      if (!flex.has_second_order(k) || flex.Gamma[k][a].size() == 0) continue;
+      for (int i = 0; i < m; ++i)
+        for (int l = 0; l < m; ++l) Gk[a](i, l) = flex.Gamma[k][a](std::min(i, l), std::max(i, l));
+    }
+    ++r.nodes;
+    r.mass += mk;
+    r.S0 += mk * node.rho_B;
+    r.B += mk * Phi;
+    r.Y += mk * Phi.transpose() * Phi;
+    for (int a = 0; a < 3; ++a) {
+      r.G[a] += mk * Gk[a];
+      for (int i = 0; i < m; ++i)
+        for (int l = 0; l < m; ++l) {
+          r.Y1[static_cast<std::size_t>(i * m + l)] +=
+              mk * (Phi(a, i) * Gk[a].row(l).transpose() + Phi(a, l) * Gk[a].row(i).transpose());
+          const Eigen::MatrixXd outer = Gk[a].row(i).transpose() * Gk[a].row(l);
+          r.Y2[static_cast<std::size_t>(i * m + l)] += 0.5 * mk * (outer + outer.transpose());
+        }
+    }
+  }
+}
+
+}  // namespace
 
 BodyMassIntegrals compute_mass_integrals(const RigidPart& rigid, const FlexibleData* flex) {
   BodyMassIntegrals I;
@@ -24,7 +62,14 @@ BodyMassIntegrals compute_mass_integrals(const RigidPart& rigid, const FlexibleD
     for (auto& v : row) v = Eigen::VectorXd::Zero(m);
   for (auto& row : I.Pff)
     for (auto& M : row) M = Eigen::MatrixXd::Zero(m, m);
+  I.rich = RichNodeSums{};
+  I.rich.B = Eigen::MatrixXd::Zero(3, m);
+  for (auto& G : I.rich.G) G = Eigen::MatrixXd::Zero(m, m);
+  I.rich.Y = Eigen::MatrixXd::Zero(m, m);
+  I.rich.Y1.assign(static_cast<std::size_t>(m * m), Eigen::VectorXd::Zero(m));
+  I.rich.Y2.assign(static_cast<std::size_t>(m * m), Eigen::MatrixXd::Zero(m, m));
   if (!flex) return I;
+  add_rich_node_sums(*flex, I.rich);
   // Plain nodes gathered so that the sums over nodes are matrix products
   // (O(nodes m^2) in GEMM rather than node by node: 2,000 nodes x 500 modes
   // in well under a second).
