@@ -270,6 +270,7 @@ void runtime_rigid_part(KaneContext& ctx, int j, ex& mass, SV3& S0, SM3& J0, Sym
 /// multiply and an add). A beam's modes bend in one plane each, so Phi~ has two components: 8 modes on 7
 /// nodes cost more summed, 4 modes on 13 nodes less (docs/flexible_ops.md).
 bool rich_modal_mass_cheaper(const FlexibleData& flex, const std::vector<int>& rich, const RichNodeSums& R) {
+  if (R.Y2.empty()) return false;  // beyond RichNodeSums::kMaxModesModalMass modes
   const int m = static_cast<int>(R.Y.rows());
   long coefficients = 0;
   for (int i = 0; i < m; ++i)
@@ -346,7 +347,8 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
     // Modal integrals.
     std::vector<SV3> Bc(m);
     for (int i = 0; i < m; ++i)
-      Bc[i] = ctx.cvec(I.B.col(i) + I.rich.B.col(i), fmt::format("{}_B{}", n, i + 1), "kg m", "modal participation");
+      Bc[i] = ctx.cvec(I.rich.nodes > 0 ? Vec3(I.B.col(i) + I.rich.B.col(i)) : Vec3(I.B.col(i)),
+                       fmt::format("{}_B{}", n, i + 1), "kg m", "modal participation");
     // The rich nodes' sums of degree 1 and 2 in eta (RichNodeSums, model/modal_integrals.hpp): added here
     // once, not node by node (add_node_terms adds their terms of degree 3 and 4 and their rotary inertia).
     const RichNodeSums& R = I.rich;

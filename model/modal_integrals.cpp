@@ -14,37 +14,52 @@ static Eigen::Matrix3d point_inertia(double m, const Eigen::Vector3d& r) {
 
 namespace {
 
-/// I.rich of compute_mass_integrals (modal_integrals.hpp, RichNodeSums).
+/// I.rich of compute_mass_integrals (modal_integrals.hpp, RichNodeSums): empty (nodes = 0, no storage) for a
+/// body without rich nodes of mass; Y1 and Y2 (m^2 (m + 1) / 2 and m^2 (m + 1)^2 / 4 numbers) only up to
+/// RichNodeSums::kMaxModesModalMass modes (and Y with them), and only their entries i <= l.
 void add_rich_node_sums(const FlexibleData& flex, RichNodeSums& r) {
   const int m = flex.modes();
-  for (int k = 0; k < static_cast<int>(flex.nodes.size()); ++k) {
-    const ModalNode& node = flex.nodes[static_cast<std::size_t>(k)];
-    if (!flex.node_is_rich(k) || node.mass == 0.0) continue;
-    const double mk = node.mass;
-    const Eigen::MatrixXd Phi = flex.Phi.middleRows(3 * k, 3);  // 3 x m
-    std::array<Eigen::MatrixXd, 3> Gk;                          // Gamma_k^a, upper triangle mirrored
-    for (int a = 0; a < 3; ++a) {
-      Gk[a] = Eigen::MatrixXd::Zero(m, m);
-      if (!flex.has_second_order(k) || flex.Gamma[k][a].size() == 0) continue;
-      for (int i = 0; i < m; ++i)
-        for (int l = 0; l < m; ++l) Gk[a](i, l) = flex.Gamma[k][a](std::min(i, l), std::max(i, l));
-    }
+  std::vector<int> rich;
+  for (int k = 0; k < static_cast<int>(flex.nodes.size()); ++k)
+    if (flex.node_is_rich(k) && flex.nodes[static_cast<std::size_t>(k)].mass != 0.0) rich.push_back(k);
+  if (rich.empty()) return;
+  r.B = Eigen::MatrixXd::Zero(3, m);
+  for (auto& G : r.G) G = Eigen::MatrixXd::Zero(m, m);
+  r.Y = Eigen::MatrixXd::Zero(m, m);
+  const bool modal_mass = m <= RichNodeSums::kMaxModesModalMass;
+  if (modal_mass) {
+    r.Y1.assign(static_cast<std::size_t>(m * m), Eigen::VectorXd());
+    r.Y2.assign(static_cast<std::size_t>(m * m), Eigen::MatrixXd());
+    for (int i = 0; i < m; ++i)
+      for (int l = i; l < m; ++l) {
+        r.Y1[static_cast<std::size_t>(i * m + l)] = Eigen::VectorXd::Zero(m);
+        r.Y2[static_cast<std::size_t>(i * m + l)] = Eigen::MatrixXd::Zero(m, m);
+      }
+  }
+  std::array<Eigen::MatrixXd, 3> Gk;  // Gamma_k^a, upper triangle mirrored
+  for (const int k : rich) {
+    const double mk = flex.nodes[static_cast<std::size_t>(k)].mass;
+    const auto Phi = flex.Phi.middleRows(3 * k, 3);  // 3 x m
     ++r.nodes;
     r.mass += mk;
-    r.S0 += mk * node.rho_B;
+    r.S0 += mk * flex.nodes[static_cast<std::size_t>(k)].rho_B;
     r.B += mk * Phi;
-    r.Y += mk * Phi.transpose() * Phi;
+    if (modal_mass) r.Y.noalias() += mk * Phi.transpose() * Phi;
     for (int a = 0; a < 3; ++a) {
-      r.G[a] += mk * Gk[a];
+      if (!flex.has_second_order(k) || flex.Gamma[k][a].size() == 0) continue;
+      r.G[a].triangularView<Eigen::Upper>() += mk * flex.Gamma[k][a];  // mirrored below
+      if (!modal_mass) continue;
+      Gk[a] = flex.Gamma[k][a].selfadjointView<Eigen::Upper>();
       for (int i = 0; i < m; ++i)
-        for (int l = 0; l < m; ++l) {
-          r.Y1[static_cast<std::size_t>(i * m + l)] +=
-              mk * (Phi(a, i) * Gk[a].row(l).transpose() + Phi(a, l) * Gk[a].row(i).transpose());
-          const Eigen::MatrixXd outer = Gk[a].row(i).transpose() * Gk[a].row(l);
-          r.Y2[static_cast<std::size_t>(i * m + l)] += 0.5 * mk * (outer + outer.transpose());
+        for (int l = i; l < m; ++l) {
+          const std::size_t il = static_cast<std::size_t>(i * m + l);
+          r.Y1[il] += mk * (Phi(a, i) * Gk[a].row(l).transpose() + Phi(a, l) * Gk[a].row(i).transpose());
+          r.Y2[il].noalias() += (0.5 * mk) * (Gk[a].row(i).transpose() * Gk[a].row(l) +
+                                              Gk[a].row(l).transpose() * Gk[a].row(i));
         }
     }
   }
+  for (auto& G : r.G) G = G.selfadjointView<Eigen::Upper>();
 }
 
 }  // namespace
@@ -63,11 +78,6 @@ BodyMassIntegrals compute_mass_integrals(const RigidPart& rigid, const FlexibleD
   for (auto& row : I.Pff)
     for (auto& M : row) M = Eigen::MatrixXd::Zero(m, m);
   I.rich = RichNodeSums{};
-  I.rich.B = Eigen::MatrixXd::Zero(3, m);
-  for (auto& G : I.rich.G) G = Eigen::MatrixXd::Zero(m, m);
-  I.rich.Y = Eigen::MatrixXd::Zero(m, m);
-  I.rich.Y1.assign(static_cast<std::size_t>(m * m), Eigen::VectorXd::Zero(m));
-  I.rich.Y2.assign(static_cast<std::size_t>(m * m), Eigen::MatrixXd::Zero(m, m));
   if (!flex) return I;
   add_rich_node_sums(*flex, I.rich);
   // Plain nodes gathered so that the sums over nodes are matrix products

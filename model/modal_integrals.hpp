@@ -41,15 +41,18 @@ namespace kanegen {
 /// Gamma_k^a as the generator reads it: its upper triangle, mirrored. The sums of degree 3 and 4
 /// (Sum m s x Phi~, Sum m s s^T) and the rotary inertia stay node by node; the generic engine keeps every
 /// node's terms one by one (an independent check of these sums).
+/// Empty (nodes = 0, no storage) for a body without rich nodes of mass; Y1 and Y2 (m^4 / 4 numbers) only up to
+/// kMaxModesModalMass modes and only for i <= l (beyond, the generated code forms that block node by node).
 struct RichNodeSums {
+  static constexpr int kMaxModesModalMass = 16;
   int nodes = 0;                                ///< rich nodes with mass
   double mass = 0.0;
   Eigen::Vector3d S0 = Eigen::Vector3d::Zero();
   Eigen::MatrixXd B;                            ///< 3 x m
   std::array<Eigen::MatrixXd, 3> G;             ///< m x m each
-  Eigen::MatrixXd Y;                            ///< m x m
-  std::vector<Eigen::VectorXd> Y1;              ///< m * m entries of m
-  std::vector<Eigen::MatrixXd> Y2;              ///< m * m entries of m x m
+  Eigen::MatrixXd Y;                            ///< m x m (zero beyond kMaxModesModalMass)
+  std::vector<Eigen::VectorXd> Y1;              ///< [i m + l], i <= l: m (empty beyond kMaxModesModalMass)
+  std::vector<Eigen::MatrixXd> Y2;              ///< [i m + l], i <= l: m x m (empty likewise)
 };
 
 struct BodyMassIntegrals {

@@ -157,6 +157,8 @@ TEST_CASE("the rich nodes' sums of degree 2 in eta (RichNodeSums) equal the sums
       INFO(rel << " body " << b.name);
       const FlexibleData& f = *b.flex;
       const RichNodeSums& R = b.integrals.rich;
+      REQUIRE(R.nodes > 0);  // these models' rich nodes have mass
+      REQUIRE_FALSE(R.Y2.empty());
       const int m = f.modes();
       bool second_order = false;
       for (int k : b.rich_nodes) second_order = second_order || f.has_second_order(k);
@@ -196,7 +198,8 @@ TEST_CASE("the rich nodes' sums of degree 2 in eta (RichNodeSums) equal the sums
           dd_sums(a) = eta_dot.dot(R.G[a] * eta_dot);
         }
         for (int i = 0; i < m; ++i)
-          for (int l = 0; l < m; ++l) Y_sums(i, l) += R.Y1[i * m + l].dot(eta) + eta.dot(R.Y2[i * m + l] * eta);
+          for (int l = i; l < m; ++l)  // stored for i <= l
+            Y_sums(l, i) = Y_sums(i, l) += R.Y1[i * m + l].dot(eta) + eta.dot(R.Y2[i * m + l] * eta);
         CHECK(R.mass == Approx(mass).epsilon(1e-14));
         CHECK(test::rel_err(S_sums, S) < 1e-13);
         CHECK(test::rel_err(Bt_sums, Bt) < 1e-13);
@@ -208,4 +211,42 @@ TEST_CASE("the rich nodes' sums of degree 2 in eta (RichNodeSums) equal the sums
     }
   }
   CHECK(bodies_with_foreshortening >= 3);
+}
+
+TEST_CASE("the rich nodes' sums take no storage without rich nodes, and no modal-mass block beyond 16 modes",
+          "[modal][flexible]") {
+  // a body of many modes must load in the memory of its mode shapes, not m^4 (docs/limits.md: 500 modes)
+  for (const char* rel : {"models/spacecraft_arrays.yaml", "models/clamped_beam.yaml"}) {
+    const Model model = load_model(test::source_path(rel));
+    for (const Body& b : model.bodies) {
+      if (!b.flex) continue;
+      INFO(rel << " body " << b.name);
+      const RichNodeSums& R = b.integrals.rich;
+      bool rich_mass = false;
+      for (int k : b.rich_nodes) rich_mass = rich_mass || b.flex->nodes[k].mass != 0.0;
+      CHECK((R.nodes > 0) == rich_mass);
+      if (!rich_mass) CHECK((R.B.size() == 0 && R.Y.size() == 0 && R.Y1.empty() && R.Y2.empty()));
+    }
+  }
+  FlexibleData f;
+  const int m = RichNodeSums::kMaxModesModalMass + 1, nodes = 3;
+  f.Phi = MatX::Random(3 * nodes, m);
+  f.Psi = MatX::Zero(3 * nodes, m);
+  f.Gamma.resize(nodes);
+  for (int k = 0; k < nodes; ++k) {
+    ModalNode n;
+    n.id = k + 1;
+    n.mass = 1.0 + k;
+    n.rho_B = Vec3(0, 0.5 * k, 0);
+    f.nodes.push_back(n);
+    const MatX G = MatX::Random(m, m);
+    f.Gamma[k][1] = G + G.transpose();
+  }
+  RigidPart rigid;
+  const BodyMassIntegrals I = compute_mass_integrals(rigid, &f);
+  CHECK(I.rich.nodes == nodes);
+  CHECK(I.rich.mass == Approx(6.0));
+  CHECK(I.rich.Y1.empty());
+  CHECK(I.rich.Y2.empty());
+  CHECK(test::rel_err(I.rich.G[1], MatX(1.0 * (f.Gamma[0][1]) + 2.0 * f.Gamma[1][1] + 3.0 * f.Gamma[2][1])) < 1e-14);
 }
