@@ -99,7 +99,8 @@ template <int W> inline Dual<W> sqrt(const Dual<W>& a) { Dual<W> r; r.v = std::s
 // Accuracy (tests/codegen/test_joint_sincos.cpp, against sinl/cosl): at most
 // 0.51 ulp, the library's sin and cos 0.52-0.56 on the same arguments; beyond
 // |x| = 1e5 rad (and for inf and NaN) the library's sin and cos. (-ffast-math,
-// which reorders the exact sums, voids the bound.)
+// which reorders the exact sums, voids the bound; contraction into fused
+// multiply-adds does not: kanegen_rounded.)
 // Method: x = k pi/32 + r, |r| <= pi/64, with pi/32 in four parts (three of 33
 // bits, exact products for |k| < 2^20) and r carried as r + rlo; sin and cos
 // of k pi/32 from a table as double-doubles (hi, lo, and hi split in 26-bit
@@ -179,6 +180,11 @@ inline constexpr double kanegen_sin_table[64][4] = {
 
 typedef double kanegen_v2d __attribute__((vector_size(16)));
 
+/// v as rounded, in a register: no fused multiply-add may take its product unrounded. The exact steps
+/// (Veltkamp's split, the sums with the products' errors) rely on it, and GCC contracts by default where FMA
+/// is available (the AVX2 clones: 1.0 ulp instead of 0.51 without this).
+inline void kanegen_rounded(kanegen_v2d& v) { __asm__("" : "+x"(v)); }
+
 /// sin and cos of x[0..n), in s and c.
 inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
   for (int i = 0; i < n; i += 2) {
@@ -208,11 +214,16 @@ inline void kanegen_sincos_n(const double* x, double* s, double* c, int n) {
     const double* Cb = kanegen_sin_table[(k1 + 16) & 63];
     const kanegen_v2d S0 = {Sa[0], Sb[0]}, S1 = {Sa[1], Sb[1]}, S2 = {Sa[2], Sb[2]}, S3 = {Sa[3], Sb[3]};
     const kanegen_v2d C0 = {Ca[0], Cb[0]}, C1 = {Ca[1], Cb[1]}, C2 = {Ca[2], Cb[2]}, C3 = {Ca[3], Cb[3]};
-    const kanegen_v2d g = 134217729.0 * r, rh = g - (g - r), rl = r - rh;  // r in 26-bit halves
-    const kanegen_v2d p = C0 * r, pe = (((C2 * rh - p) + C2 * rl) + C3 * rh) + C3 * rl;  // C r = p + pe
+    kanegen_v2d g = 134217729.0 * r;
+    kanegen_rounded(g);
+    const kanegen_v2d rh = g - (g - r), rl = r - rh;  // r in 26-bit halves
+    kanegen_v2d p = C0 * r, q = S0 * r;
+    kanegen_rounded(p);
+    kanegen_rounded(q);
+    const kanegen_v2d pe = (((C2 * rh - p) + C2 * rl) + C3 * rh) + C3 * rl;  // C r = p + pe
     const kanegen_v2d s1 = S0 + p, se = p - (s1 - S0);  // S + p = s1 + se (|S| >= |p| or S = 0)
     const kanegen_v2d sv = s1 + ((se + pe) + (S1 + C1 * r + S0 * cm + C0 * wl));
-    const kanegen_v2d q = S0 * r, qe = (((S2 * rh - q) + S2 * rl) + S3 * rh) + S3 * rl;  // S r = q + qe
+    const kanegen_v2d qe = (((S2 * rh - q) + S2 * rl) + S3 * rh) + S3 * rl;  // S r = q + qe
     const kanegen_v2d c1 = C0 - q, ce = (C0 - c1) - q;  // C - q = c1 + ce (|C| >= |q| or C = 0)
     const kanegen_v2d cv = c1 + ((ce - qe) + (C1 - S1 * r + C0 * cm - S0 * wl));
     s[i] = sv[0], c[i] = cv[0], s[b] = sv[1], c[b] = cv[1];

@@ -6,6 +6,7 @@
 // decides; beyond 1e5 rad, inf and NaN the library's own values.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -14,6 +15,19 @@
 namespace joint_sincos_test {
 #include "templates/joint_sincos.inc"
 }
+
+// The same batch built for AVX2 with FMA, as the JIT's dispatched clones are: GCC contracts a product and a
+// sum into a fused multiply-add by default, which must not break the exact steps (kanegen_rounded).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define JOINT_SINCOS_TEST_FMA 1
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+#pragma GCC optimize("O2", "fp-contract=fast")  // as the JIT builds it (the suite's own build is -O1)
+namespace joint_sincos_fma {
+#include "templates/joint_sincos.inc"
+}
+#pragma GCC pop_options
+#endif
 
 namespace {
 
@@ -69,7 +83,9 @@ TEST_CASE("joint angles' sin and cos: within 0.51 ulp, no worse than the library
 
 TEST_CASE("joint angles' sin and cos: the library's beyond 1e5 rad, for inf and NaN, any count", "[generator][sincos]") {
   const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
-  const std::vector<double> xs{1e5, -1e5, 1.0000001e5, -3e7, 1e300, inf, -inf, nan, 0.0, -0.0, 1e-300};
+  // in pairs as the batch takes them: both in range, both out, and mixed (1e-300 with 2e5, NaN with 1.2)
+  const std::vector<double> xs{1e5, -1e5, 1.0000001e5, -3e7, 1e300, inf,  -inf, nan,
+                               0.0, -0.0, 1e-300,      2e5,  0.3,   -0.7, nan,  1.2, inf};
   std::vector<double> s(xs.size()), c(xs.size());
   joint_sincos_test::kanegen_sincos_n(xs.data(), s.data(), c.data(), static_cast<int>(xs.size()));
   for (std::size_t i = 0; i < xs.size(); ++i) {
@@ -84,6 +100,17 @@ TEST_CASE("joint angles' sin and cos: the library's beyond 1e5 rad, for inf and 
       CHECK(ulps(s[i], sinl(xs[i])) <= 0.51);
       CHECK(ulps(c[i], cosl(xs[i])) <= 0.51);
     }
+  }
+  // a lane in range gets the same value whether its pair's other lane is in range or not
+  {
+    const double in_pair[2] = {1.2, 0.1}, tiny_pair[2] = {0.2, 1e-300};
+    double sp[2], cp[2], st[2], ct[2];
+    joint_sincos_test::kanegen_sincos_n(in_pair, sp, cp, 2);
+    joint_sincos_test::kanegen_sincos_n(tiny_pair, st, ct, 2);
+    CHECK(s[15] == sp[0]);
+    CHECK(c[15] == cp[0]);
+    CHECK(s[10] == st[1]);
+    CHECK(c[10] == ct[1]);
   }
   // one angle, three: the same values as in a longer batch
   for (const int n : {1, 3}) {
@@ -101,3 +128,25 @@ TEST_CASE("joint angles' sin and cos: the library's beyond 1e5 rad, for inf and 
   CHECK(sl[1] == std::sin(-2.0L));
   CHECK(cl[0] == std::cos(0.5L));
 }
+
+#ifdef JOINT_SINCOS_TEST_FMA
+TEST_CASE("joint angles' sin and cos built with fused multiply-adds: within 0.51 ulp too", "[generator][sincos]") {
+  __builtin_cpu_init();
+  if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) {
+    WARN("this CPU has no AVX2 and FMA: the fused build is not run");
+    return;
+  }
+  std::mt19937_64 rng(2027);
+  std::vector<double> xs;
+  for (const double range : {0.2, 3.2, 1e5}) {
+    std::uniform_real_distribution<double> d(-range, range);
+    for (int k = 0; k < 300000; ++k) xs.push_back(d(rng));
+  }
+  std::vector<double> s(xs.size()), c(xs.size());
+  joint_sincos_fma::kanegen_sincos_n(xs.data(), s.data(), c.data(), static_cast<int>(xs.size()));
+  double worst = 0;
+  for (std::size_t i = 0; i < xs.size(); ++i)
+    worst = std::max({worst, ulps(s[i], sinl(xs[i])), ulps(c[i], cosl(xs[i]))});
+  CHECK(worst <= 0.51);  // 1.0 when a fused multiply-add takes Veltkamp's or Dekker's product unrounded
+}
+#endif
