@@ -357,6 +357,13 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
                    fmt::format("{}_rich_Gamma{}_{}_{}", n, kAxis[a], std::min(i, l) + 1, std::max(i, l) + 1), "kg/m",
                    "Sum m Gamma over the rich nodes");
     };
+    // x^T G[a] x over the modal coordinates x (eta in the first moment, eta_dot in the remainder force)
+    auto gamma_form = [&](int a, const std::vector<ex>& x) {
+      ex sum = 0;
+      for (int i = 0; i < m; ++i)
+        for (int l = 0; l < m; ++l) sum += Gs(a, i, l) * x[i] * x[l];
+      return sum;
+    };
     // Bt[i] = Sum m Phi~_i over every node: B_i + [G[a] eta]_i (plain nodes: B_i)
     std::vector<SV3> Bt = Bc;
     for (int i = 0; i < m && R.nodes > 0; ++i)
@@ -379,11 +386,10 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
     };
     SV3 S = S0;
     for (int a = 0; a < 3; ++a) {
-      ex sum = S0[a], quad = 0;
+      ex sum = S0[a];
       for (int i = 0; i < m; ++i) sum += Bc[i][a] * s.eta[i];
-      for (int i = 0; i < m && R.nodes > 0; ++i)
-        for (int l = 0; l < m; ++l) quad += Gs(a, i, l) * s.eta[i] * s.eta[l];
-      S[a] = A.let(sum + quad / 2, Alg::component(ctx.name("S_B", static_cast<int>(j)), a));
+      if (R.nodes > 0) sum += gamma_form(a, s.eta) / 2;
+      S[a] = A.let(sum, Alg::component(ctx.name("S_B", static_cast<int>(j)), a));
     }
     SM3 J = J0;
     // Q[a][c][i] = Sum m s_a Phi_c,i
@@ -461,12 +467,7 @@ void compute_body_terms(KaneContext& ctx, bool with_velocity) {
     if (with_velocity) {
       add_integrated_velocity_terms(ctx, static_cast<int>(j), S, J, Bt, Q, Pff);
       // the rich nodes' Sum m eta_dot^T Gamma^a eta_dot (their remainder acceleration's second-order part)
-      for (int a = 0; a < 3 && R.nodes > 0; ++a) {
-        ex sum = 0;
-        for (int i = 0; i < m; ++i)
-          for (int l = 0; l < m; ++l) sum += Gs(a, i, l) * s.eta_dot[i] * s.eta_dot[l];
-        s.h_body[a] = A.let(s.h_body[a] + sum);
-      }
+      for (int a = 0; a < 3 && R.nodes > 0; ++a) s.h_body[a] = A.let(s.h_body[a] + gamma_form(a, s.eta_dot));
     }
     if (!central) {
       for (int k : b.rich_nodes) add_node_terms(ctx, static_cast<int>(j), k, with_velocity, !modal_mass_summed, nullptr);
