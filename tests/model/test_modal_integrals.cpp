@@ -27,6 +27,15 @@ struct BruteForce {
   VecX h, g;
 };
 
+/// Node k's displaced position rho_k + Phi_k e + 1/2 gamma_k(e), from dynamics.md's definition.
+Vec3 node_position_at(const FlexibleData& f, std::size_t k, const VecX& e) {
+  Vec3 s = f.nodes[k].rho_B + f.Phi.middleRows(3 * static_cast<Eigen::Index>(k), 3) * e;
+  if (f.has_second_order(static_cast<int>(k)))
+    for (int a = 0; a < 3; ++a)
+      if (f.Gamma[k][a].size()) s(a) += 0.5 * e.dot(f.Gamma[k][a] * e);
+  return s;
+}
+
 BruteForce brute_force(const Body& b, const VecX& eta, const VecX& eta_dot, const Vec3& w, const Vec3& g_B) {
   const FlexibleData& f = *b.flex;
   const int m = f.modes();
@@ -46,13 +55,7 @@ BruteForce brute_force(const Body& b, const VecX& eta, const VecX& eta_dot, cons
   r.M.block(3, 3, 3, 3) += b.rigid.I_c_B;
   r.h.segment<3>(3) += w.cross(b.rigid.I_c_B * w);
   for (std::size_t k = 0; k < f.nodes.size(); ++k) {
-    auto position = [&](const VecX& e) {
-      Vec3 s = f.nodes[k].rho_B + f.Phi.middleRows(3 * k, 3) * e;
-      if (f.has_second_order(static_cast<int>(k)))
-        for (int a = 0; a < 3; ++a)
-          if (f.Gamma[k][a].size()) s(a) += 0.5 * e.dot(f.Gamma[k][a] * e);
-      return s;
-    };
+    auto position = [&](const VecX& e) { return node_position_at(f, k, e); };
     const Vec3 s = position(eta);
     // Phi~ = ds/deta and the second derivative along eta_dot: central differences,
     // exact (to rounding) for the quadratic s(eta).
@@ -170,13 +173,7 @@ TEST_CASE("the rich nodes' sums of degree 2 in eta (RichNodeSums) equal the sums
         Vec3 S = Vec3::Zero(), dd = Vec3::Zero();
         MatX Bt = MatX::Zero(3, m), Y = MatX::Zero(m, m);
         for (int k : b.rich_nodes) {
-          auto position = [&](const VecX& e) {
-            Vec3 s = f.nodes[k].rho_B + f.Phi.middleRows(3 * k, 3) * e;
-            if (f.has_second_order(k))
-              for (int a = 0; a < 3; ++a)
-                if (f.Gamma[k][a].size()) s(a) += 0.5 * e.dot(f.Gamma[k][a] * e);
-            return s;
-          };
+          auto position = [&](const VecX& e) { return node_position_at(f, static_cast<std::size_t>(k), e); };
           const double mk = f.nodes[k].mass;
           MatX Pt(3, m);
           for (int i = 0; i < m; ++i) {
