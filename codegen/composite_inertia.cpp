@@ -25,7 +25,7 @@ SMat compute_mass_matrix(KaneContext& ctx) {
     if (p < 0) continue;
     const SymBodyWorkspace& s = ctx.body[j];
     // Rigid form [m, -S^x; S^x, J]: m' = m, S' = R S + m d, J' = R J R^T - d^x S'^x... done as
-    // a turn by R_JB, a shift by d = O_B - O_P in J components, and a turn by R_PJ.
+    // a turn by R_JB, a shift by d = O_B - O_P in J components, and a turn by R_PJ (then R_PS).
     const ex mass = I(0, 0);
     const SV3 S{{I(5, 1), I(3, 2), I(4, 0)}};  // from I(3..5, 0..2) = S^x
     SM3 J;
@@ -42,8 +42,9 @@ SMat compute_mass_matrix(KaneContext& ctx) {
         for (int t = 0; t < 3; ++t) sum -= dx(a, t) * S1x(t, cc) + S1x(a, t) * dx(t, cc) + mass * dx(a, t) * dx(t, cc);
         J2(a, cc) = J2(cc, a) = ctx.A.let(sum);
       }
-    const SV3 Sp = ctx.A.mul(s.R_PJ, ctx.A.add(S1, ctx.A.scale(mass, s.p_BP_J)));
-    const SM3 Jp = rotate_symmetric(ctx, s.R_PJ, J2);
+    SV3 Sp = ctx.A.mul(s.R_PJ, ctx.A.add(S1, ctx.A.scale(mass, s.p_BP_J)));
+    SM3 Jp = rotate_symmetric(ctx, s.R_PJ, J2);
+    if (s.screw) Sp = ctx.A.mul(s.R_PS, Sp), Jp = rotate_symmetric(ctx, s.R_PS, Jp);
     SMat& Ip = Ic[p];
     for (int a = 0; a < 3; ++a)
       for (int cc = a; cc < 3; ++cc) {

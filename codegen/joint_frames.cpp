@@ -23,13 +23,6 @@ Vec3 perpendicular(const Vec3& z, const Vec3& hint) {
   return z.cross(Vec3::Unit(k)).normalized();
 }
 
-Mat3 rot_x(double a) {
-  Mat3 R = Mat3::Identity();
-  const double c = std::cos(a), s = std::sin(a);
-  R(1, 1) = c, R(1, 2) = -s, R(2, 1) = s, R(2, 2) = c;
-  return R;
-}
-
 /// Where along its axis z (through the origin) body j's frame origin goes: the foot of the common normal
 /// to the child's axis, through p with direction a (unit vectors); for parallel axes, the foot of the
 /// perpendicular from p (the offset is then across the axis alone).
@@ -59,9 +52,24 @@ bool origin_pinned(const Model& m, int j) {
 
 }  // namespace
 
+Mat3 rot_x(double a) {
+  Mat3 R = Mat3::Identity();
+  const double c = std::cos(a), s = std::sin(a);
+  R(1, 1) = c, R(1, 2) = -s, R(2, 1) = s, R(2, 2) = c;
+  return R;
+}
+
+Mat3 rot_z(double a) {
+  Mat3 R = Mat3::Identity();
+  const double c = std::cos(a), s = std::sin(a);
+  R(0, 0) = c, R(0, 1) = -s, R(1, 0) = s, R(1, 1) = c;
+  return R;
+}
+
 FramedModel keep_joint_frames(const Model& model) {
   FramedModel f{model, std::vector<Mat3>(model.bodies.size(), Mat3::Identity()),
-                std::vector<double>(model.bodies.size(), 0.0), std::vector<Vec3>(model.bodies.size(), Vec3::Zero())};
+                std::vector<double>(model.bodies.size(), 0.0), std::vector<Vec3>(model.bodies.size(), Vec3::Zero()),
+                std::vector<double>(model.bodies.size(), 0.0)};
   return f;
 }
 
@@ -119,16 +127,23 @@ FramedModel choose_joint_frames(const Model& in) {
     o.rigid.I_c_B = 0.5 * (o.rigid.I_c_B + o.rigid.I_c_B.transpose()).eval();
     // Denavit-Hartenberg: when the parent's x axis is normal to this revolute
     // axis, R_PJ = Rx(alpha) Rz(delta), and Rz(delta) joins the joint rotation.
-    const Mat3& C = o.joint.R_PJ;
+    // Otherwise (not the main child) the parent's axes turned by beta about z
+    // first have their x axis normal to it: R_PJ = Rz(beta) Rx(alpha) Rz(delta).
+    const Mat3 C = o.joint.R_PJ;
     const bool misaligned = std::any_of(in.parameters.begin(), in.parameters.end(), [j](const RuntimeParameter& p) {
       return p.body == j && p.kind == ParameterKind::misalignment;
     });
     if (reframable(b) && b.joint.type == JointType::revolute && b.parent >= 0 && reframable(in.bodies[b.parent]) &&
-        std::abs(C(0, 2)) < 1e-12 && !misaligned) {
-      const double alpha = std::atan2(-C(1, 2), C(2, 2));
-      const Mat3 Rz = rot_x(alpha).transpose() * C;
+        !misaligned) {
+      // beta puts x along z x axis (the axis is C's last column, in P'), as a main child's common normal
+      const double beta = std::abs(C(0, 2)) < 1e-12 ? 0.0 : std::atan2(C(0, 2), -C(1, 2));
+      Mat3 Cs = rot_z(beta).transpose() * C;
+      Cs(0, 2) = 0.0;  // by construction, to rounding
+      const double alpha = std::atan2(-Cs(1, 2), Cs(2, 2));
+      const Mat3 Rz = rot_x(alpha).transpose() * Cs;
       out.angle_offset[j] = std::atan2(Rz(1, 0), Rz(0, 0));
-      o.joint.R_PJ = rot_x(alpha);
+      out.screw_angle[j] = beta;
+      o.joint.R_PJ = beta == 0.0 ? rot_x(alpha) : Mat3(rot_z(beta) * rot_x(alpha));
     }
     snap_roundoff_residues(o);
   }

@@ -47,7 +47,11 @@ struct SymMassElement {
 
 struct SymBodyWorkspace {
   SM3 R_PB, R_NB;                 ///< orientation of B in its parent, in N
-  SM3 R_PJ, R_JB;                 ///< R_PB = R_PJ R_JB: joint frame in the parent (with a node's turn), B in J
+  SM3 R_PJ, R_JB;                 ///< R_PB = R_PS R_PJ R_JB: joint frame in the parent (with a node's turn), B in J
+  /// The first turn from the parent, about its z axis (a revolute child other than the parent's main child,
+  /// joint_frames.hpp), when `screw`: R_PJ is then the joint frame in these turned axes S (Rx(alpha))
+  SM3 R_PS;
+  bool screw = false;
   SV3 p_PO_P;                     ///< O_B from the parent's origin, parent components
   SV3 p_BP_J;                     ///< O_B from the parent's origin, J components
   SV3 r_NO_N;                     ///< O_B from N's origin, N components
@@ -77,6 +81,7 @@ struct KaneContext {
       : KaneContext(framed.model, program, constants, x) {
     angle_offset = framed.angle_offset;
     R_BBp = framed.R_BBp;
+    screw_angle = framed.screw_angle;
   }
 
   const Model& model;
@@ -88,6 +93,8 @@ struct KaneContext {
   std::map<int, std::array<ex, 3>> motion_symbols;  ///< body -> f, f_dot, f_ddot (see motion())
   /// Per body: a revolute joint turns by q + angle_offset[j] (joint_frames.hpp); empty: no offsets.
   std::vector<double> angle_offset;
+  /// Per body: its joint frame turned from the parent's by Rz(screw_angle[j]) first (joint_frames.hpp); empty: none.
+  std::vector<double> screw_angle;
   /// Per body: axes of the generator's frame B' in the model's frame B
   /// (joint_frames.hpp), for the runtime parameters given in B; empty: identity.
   std::vector<Mat3> R_BBp;

@@ -164,8 +164,20 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     }
     const SV3 aR_P = has_parent ? p->a_R_B : minus_g, alR_P = has_parent ? p->alpha_R_B : zero;
 
-    // Joint frame.
-    SM3 R_PJ = ctx.cmat(b.joint.R_PJ, n + "_R_PJ", "", "joint frame orientation in the parent");
+    // Joint frame; with a screw (joint_frames.hpp) R_PJ is the frame in the parent's axes turned by R_PS.
+    const double beta = i < ctx.screw_angle.size() ? ctx.screw_angle[i] : 0.0;
+    s.screw = beta != 0.0;
+    s.R_PS = SM3::identity();
+    SM3 R_PJ;
+    if (s.screw) {
+      const Mat3 R_SJ = rot_z(beta).transpose() * b.joint.R_PJ;  // Rx(alpha), to rounding
+      s.R_PS = ctx.cmat(rot_z(beta), n + "_R_PS", "",
+                        "the parent's axes turned about their z onto the common normal to the joint axis");
+      R_PJ = ctx.cmat(rot_x(std::atan2(R_SJ(2, 1), R_SJ(1, 1))), n + "_R_SJ", "",
+                      "joint frame orientation in the parent's turned axes (joint_frames.hpp)");
+    } else {
+      R_PJ = ctx.cmat(b.joint.R_PJ, n + "_R_PJ", "", "joint frame orientation in the parent");
+    }
     // runtime parameters of the joint's placement (model/parameters.hpp), given in the model's frames
     const bool misaligned = ctx.param(ParameterKind::misalignment, static_cast<int>(j), 0) ||
                             ctx.param(ParameterKind::misalignment, static_cast<int>(j), 1) ||
@@ -377,14 +389,21 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     }
     s.R_PJ = R_PJ;
     s.R_JB = R_JB;
-    const SM3 R_JP = R_PJ.transpose(), R_BJ = R_JB.transpose();
+    const SM3 R_JP = R_PJ.transpose(), R_BJ = R_JB.transpose(), R_SP = s.R_PS.transpose();
+    // a vector of the parent's (P components) in J components
+    auto to_J = [&](const SV3& x) { return A.mul(R_JP, s.screw ? A.mul(R_SP, x) : x); };
     // O_J from O_P in J components: a model constant unless O_J is a node of a flexible parent
-    const SV3 p_J = b.joint.node >= 0 || misaligned || moved ? A.mul(R_JP, p_PJ)
+    const SV3 p_J = b.joint.node >= 0 || misaligned || moved ? to_J(p_PJ)
                                       : ctx.cvec(snapped(Vec3(b.joint.R_PJ.transpose() * b.joint.p_PJ)), n + "_p_J", "m",
                                                  "joint origin from the parent's origin, joint axes");
     s.p_BP_J = A.add(p_J, e_J);
-    s.R_PB = A.mul(R_PJ, R_JB, ctx.name("R_PB", j));
-    s.p_PO_P = A.add(p_PJ, A.mul(R_PJ, e_J), ctx.name("p_PO_P", j));
+    if (s.screw) {
+      s.R_PB = A.mul(s.R_PS, A.mul(R_PJ, R_JB), ctx.name("R_PB", j));
+      s.p_PO_P = A.add(p_PJ, A.mul(s.R_PS, A.mul(R_PJ, e_J)), ctx.name("p_PO_P", j));
+    } else {
+      s.R_PB = A.mul(R_PJ, R_JB, ctx.name("R_PB", j));
+      s.p_PO_P = A.add(p_PJ, A.mul(R_PJ, e_J), ctx.name("p_PO_P", j));
+    }
     // The transforms between B and P (spatial_transforms.cpp) turn by R_JB, then
     // by R_PJ. When R_PJ is dense and R_JB is not the identity, one turn by the
     // product R_PB is cheaper: then J stands for P (R_PJ = I, R_JB = R_PB).
@@ -400,7 +419,7 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
           if (!(R(r, c) - (r == c ? 1 : 0)).is_zero()) return false;
       return true;
     };
-    if (nonzeros(R_PJ) > 5 && !identity(R_JB)) {
+    if (!s.screw && nonzeros(R_PJ) > 5 && !identity(R_JB)) {
       s.R_PJ = SM3::identity();
       s.R_JB = s.R_PB;
       s.p_BP_J = s.p_PO_P;
@@ -422,12 +441,12 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     }
     if (!with_velocity) continue;
     // The parent's motion at O_J and the node's own, J components.
-    const SV3 wP = A.mul(R_JP, w_P), alP = A.mul(R_JP, alR_P);
+    const SV3 wP = to_J(w_P), alP = to_J(alR_P);
     const SV3 wJ = A.mul(R_JP, w_J), wJdot = A.mul(R_JP, w_J_dot_R);
     const SV3 vnode = A.mul(R_JP, v_node), anode = A.mul(R_JP, a_node_R);
     const SV3 w_in = A.add(wP, wJ);
-    const SV3 vP0 = A.add(A.mul(R_JP, v_P), A.cross(wP, p_J));
-    const SV3 aP0 = A.add(A.add(A.mul(R_JP, aR_P), A.cross(alP, p_J)), A.cross(wP, A.cross(wP, p_J)));
+    const SV3 vP0 = A.add(to_J(v_P), A.cross(wP, p_J));
+    const SV3 aP0 = A.add(A.add(to_J(aR_P), A.cross(alP, p_J)), A.cross(wP, A.cross(wP, p_J)));
     // w_B = R_BJ (w_P + w_J) + w_rel; v_O_B = R_BJ (v_OJ + v_node + (w_P + w_J) x e) + e_dot
     const SV3 wt = A.mul(R_BJ, w_in);
     s.w_B = A.add(wt, w_rel_B, ctx.name("w_B", j));

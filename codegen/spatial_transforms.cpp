@@ -67,10 +67,12 @@ std::vector<ex> transform_motion_from_parent(KaneContext& ctx, int j, const std:
   const SymBodyWorkspace& s = ctx.body[j];
   std::vector<ex> dl(6 + ctx.model.bodies[j].n_modes(), ex(0));
   if (!dp) return dl;
-  // [v; w] of the parent at O_B, in J then in B components: two sparse turns
+  // [v; w] of the parent at O_B, in J then in B components: two sparse turns (three with a screw)
   const SM3 R_JP = s.R_PJ.transpose(), R_BJ = s.R_JB.transpose();
-  const SV3 w_J = ctx.A.mul(R_JP, SV3{{(*dp)[3], (*dp)[4], (*dp)[5]}});
-  const SV3 v_J = ctx.A.add(ctx.A.mul(R_JP, SV3{{(*dp)[0], (*dp)[1], (*dp)[2]}}), ctx.A.cross(w_J, s.p_BP_J));
+  SV3 w_P{{(*dp)[3], (*dp)[4], (*dp)[5]}}, v_P{{(*dp)[0], (*dp)[1], (*dp)[2]}};
+  if (s.screw) w_P = ctx.A.mul(s.R_PS.transpose(), w_P), v_P = ctx.A.mul(s.R_PS.transpose(), v_P);
+  const SV3 w_J = ctx.A.mul(R_JP, w_P);
+  const SV3 v_J = ctx.A.add(ctx.A.mul(R_JP, v_P), ctx.A.cross(w_J, s.p_BP_J));
   const SV3 lin = ctx.A.mul(R_BJ, v_J), ang = ctx.A.mul(R_BJ, w_J);
   for (int a = 0; a < 3; ++a) dl[a] = lin[a], dl[3 + a] = ang[a];
   for (int i = 0; i < static_cast<int>(s.P_node.size()); ++i)
@@ -85,7 +87,8 @@ std::vector<ex> transform_wrench_to_parent(KaneContext& ctx, int cidx, const std
   // [f; t about O_B] in J components, moved to the parent's origin, then in P components
   const SV3 f_J = ctx.A.mul(s.R_JB, SV3{{W6[0], W6[1], W6[2]}});
   const SV3 t_J = ctx.A.add(ctx.A.mul(s.R_JB, SV3{{W6[3], W6[4], W6[5]}}), ctx.A.cross(s.p_BP_J, f_J));
-  const SV3 fP = ctx.A.mul(s.R_PJ, f_J), tP = ctx.A.mul(s.R_PJ, t_J);
+  SV3 fP = ctx.A.mul(s.R_PJ, f_J), tP = ctx.A.mul(s.R_PJ, t_J);
+  if (s.screw) fP = ctx.A.mul(s.R_PS, fP), tP = ctx.A.mul(s.R_PS, tP);
   std::vector<ex> out(6 + m_P, ex(0));
   for (int a = 0; a < 3; ++a) out[a] = fP[a], out[3 + a] = tP[a];
   for (int i = 0; i < static_cast<int>(s.P_node.size()); ++i) {
@@ -223,6 +226,11 @@ SMat transform_inertia_to_parent(KaneContext& ctx, int j, const SMat& I) {
   Am = rotate_symmetric(ctx, s.R_PJ, Am);
   B2 = rotate_matrix(ctx, s.R_PJ, B2);
   C2 = rotate_symmetric(ctx, s.R_PJ, C2);
+  if (s.screw) {
+    Am = rotate_symmetric(ctx, s.R_PS, Am);
+    B2 = rotate_matrix(ctx, s.R_PS, B2);
+    C2 = rotate_symmetric(ctx, s.R_PS, C2);
+  }
   SMat out(6, 6);
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) {

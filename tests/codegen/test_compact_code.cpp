@@ -87,6 +87,8 @@ TEST_CASE("compact u-dot code computes the straight-line code's u-dot and Jacobi
       {"random 12-link chain, articulated", chain, "articulated"},
       {"random 12-link chain, composite", chain, "composite"},
       {"branched tree", test::source_path("models/branched_tree.yaml"), "articulated"},
+      {"random 15-body tree (screw turns to its other children), composite",
+       test::write_temp("compact_tree15.yaml", test::random_tree(15, 4)), "composite"},
       {"flexible spacecraft (modes, wheels, a gimbal)", test::source_path("models/flexible_spacecraft.yaml"), "auto"},
       {"Explorer I in orbit (central gravity, free root)", test::source_path("models/explorer1_orbit.yaml"), "auto"},
       {"prescribed motion (a polynomial and a sine: time-dependent code and its preludes)",

@@ -3,7 +3,9 @@
 // has the model's M, F and reactions (these turned and moved back by R_BB'
 // and o_B). And the frames are the ones promised: the offset from a body to
 // its main child, in the child's joint axes, is (a, 0, d) (origins at the
-// feet of the common normals), the turn between them about x alone.
+// feet of the common normals), the turn between them about x alone; to a
+// tree's other revolute children, a turn about z, then about x. A tree's
+// generated code in both u-dot forms against the generic engine.
 #include <catch2/catch.hpp>
 
 #include <random>
@@ -12,6 +14,7 @@
 #include "engine/generic_engine.hpp"
 #include "engine/generated_engine.hpp"
 #include "engine/load_model.hpp"
+#include "sim/crosscheck.hpp"
 #include "tests/support/random_chain.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -50,10 +53,56 @@ TEST_CASE("joint frames: the offset to a main child is (a, 0, d) in its joint ax
   CHECK(shifted == 7);  // every body with a child: random axes are skew
 }
 
+TEST_CASE("joint frames: a tree's other revolute children turn by Rz(beta) Rx(alpha) from the parent",
+          "[generator][joint-frames]") {
+  const Model model = load_model(test::write_temp("frames_tree15.yaml", test::random_tree(15, 4)));
+  const codegen::FramedModel fr = codegen::choose_joint_frames(model);
+  int screws = 0;
+  for (std::size_t c = 1; c < fr.model.bodies.size(); ++c) {
+    const Body& b = fr.model.bodies[c];
+    INFO("body " << b.name << ", screw angle " << fr.screw_angle[c]);
+    // the first (main) child of a parent with two like subtrees is the one listed first: link 2k
+    const bool main_child = c % 2 == 1;  // index c is link c + 1
+    const bool screwed = !main_child && b.joint.type == JointType::revolute;
+    CHECK((fr.screw_angle[c] != 0.0) == screwed);
+    screws += fr.screw_angle[c] != 0.0 ? 1 : 0;
+    const Mat3 R_SJ = codegen::rot_z(fr.screw_angle[c]).transpose() * b.joint.R_PJ;
+    if (b.joint.type == JointType::revolute) {  // Rx(alpha); Rz(delta) joined to the joint angle
+      CHECK(std::abs(R_SJ(0, 0) - 1.0) <= 1e-15);
+      CHECK(std::abs(R_SJ(0, 1)) + std::abs(R_SJ(0, 2)) + std::abs(R_SJ(1, 0)) + std::abs(R_SJ(2, 0)) <= 1e-15);
+      CHECK(std::abs(R_SJ(1, 1) - R_SJ(2, 2)) <= 1e-15);
+    }
+  }
+  CHECK(screws == 6);  // links 3, 7, 9, 11, 13, 15 (link 5, the other child of link 2, is prismatic)
+}
+
+TEST_CASE("joint frames: a tree with screw turns, generated in both u-dot forms, against the generic engine",
+          "[generator][joint-frames][jit]") {
+  // reactions and point sensors on a screwed child (link 3) and on the prismatic one (link 5)
+  const std::string yaml = test::random_tree(9, 8) +
+                           "outputs:\n  - reactions\n"
+                           "  - {name: link3_point_a, type: acceleration, body: link3, point: [0.1, -0.05, 0.2]}\n"
+                           "  - {name: link5_point_v, type: velocity, body: link5, point: [-0.1, 0.05, 0.1]}\n";
+  const Model model = load_model(test::write_temp("frames_tree9.yaml", yaml));
+  REQUIRE(codegen::choose_joint_frames(model).screw_angle[2] != 0.0);
+  GenericEngine generic(model);
+  for (auto& e : test::generated_engines_in_both_forms(model)) {
+    INFO("form " << e->udot_form());
+    const CrosscheckResult r = crosscheck(*e, generic, 6, 17);
+    for (const auto& [q, v] : r.worst) {
+      INFO(q << " " << v);
+      CHECK(v <= CrosscheckResult::tolerance(q));
+    }
+    CHECK(r.worst.count("reactions") == 1);
+    CHECK(r.worst.count("outputs") == 1);
+  }
+}
+
 TEST_CASE("joint frames: the framed model at q + offset has the model's M, F and reactions",
           "[generator][joint-frames]") {
   const std::string chain = test::write_temp("frames_chain6.yaml", test::random_chain(6, 9));
-  for (const std::string& file : {chain, test::source_path("models/extreme/wide_tree.yaml"),
+  const std::string tree = test::write_temp("frames_tree11.yaml", test::random_tree(11, 6));
+  for (const std::string& file : {chain, tree, test::source_path("models/extreme/wide_tree.yaml"),
                                   test::source_path("models/chain5_prismatic.yaml")}) {
     INFO(file);
     const Model model = without_springs(load_model(file));
