@@ -50,6 +50,40 @@ bool origin_pinned(const Model& m, int j) {
   });
 }
 
+/// Exact zeros (to kRoundoffResidue of the largest entry) of v.
+int zeros(const Vec3& v) {
+  const double scale = v.cwiseAbs().maxCoeff();
+  int k = 0;
+  for (int a = 0; a < 3; ++a) k += std::abs(v(a)) <= kRoundoffResidue * scale ? 1 : 0;
+  return k;
+}
+
+/// Where along its axis z a leaf's origin goes (its frame's x axis x; nothing below it depends on the
+/// choice): where the model has it, at the foot of the perpendicular from its parent's new origin (no offset
+/// along the axis; (a, 0, 0) from the parent of a main child) or level with its centre of mass (no first
+/// moment along the axis), whichever leaves most zeros in the offset from the parent (the parent's and the
+/// joint's components) and the first moment, but none of the model's zeros of the first moment (a wheel
+/// keeps its origin at its centre); the model's place on a tie, then the perpendicular's.
+double leaf_origin(const Model& in, const FramedModel& out, int j, const Vec3& z, const Vec3& x) {
+  const Body& b = in.bodies[j];
+  const Vec3 o_P = b.parent >= 0 ? out.o_B[b.parent] : Vec3::Zero();
+  const Mat3 Qp = b.parent >= 0 ? out.R_BBp[b.parent] : Mat3::Identity();
+  const Vec3 y = z.cross(x);
+  const double candidates[3] = {0.0, -(b.joint.R_PJ * z).dot(b.joint.p_PJ - o_P), z.dot(b.rigid.com_B)};
+  double best = 0.0;
+  int most = -1, zeros_S0 = -1;
+  for (const double t : candidates) {
+    const Vec3 d = b.joint.p_PJ + b.joint.R_PJ * (z * t) - o_P;  // O_B' from O_P', the parent's model axes
+    const Vec3 d_J = b.joint.R_PJ.transpose() * d, c = b.rigid.com_B - z * t;
+    const int zeros_S = zeros(Vec3(x.dot(c), y.dot(c), z.dot(c)));
+    if (zeros_S0 < 0) zeros_S0 = zeros_S;
+    if (zeros_S < zeros_S0) continue;  // the first moment enters more products than the offset
+    const int k = zeros(Qp.transpose() * d) + zeros(Vec3(x.dot(d_J), y.dot(d_J), z.dot(d_J))) + zeros_S;
+    if (k > most) most = k, best = t;
+  }
+  return best;
+}
+
 }  // namespace
 
 Mat3 rot_x(double a) {
@@ -102,6 +136,7 @@ FramedModel choose_joint_frames(const Model& in) {
       if (!origin_pinned(in, j)) out.o_B[j] = z * common_normal_foot(z, cb.joint.p_PJ, a_c);
     } else {
       x = perpendicular(z, b.rigid.com_B);
+      if (size[j] == 1 && !origin_pinned(in, j)) out.o_B[j] = z * leaf_origin(in, out, j, z, x);
     }
     Mat3 Q;
     Q.col(0) = x;

@@ -17,7 +17,10 @@
 //     main child's frame is then a along the common normal plus d along the
 //     child's axis, (a, 0, d) in the child's joint axes (McMillan and Orin's
 //     axial screws), so that moving an articulated inertia, a wrench or a
-//     motion to the parent costs fewer products;
+//     motion to the parent costs fewer products; a leaf's origin slides to
+//     the foot of the perpendicular from its parent's origin, so that the
+//     offset has no component along its axis ((a, 0, 0) from the parent of
+//     a main child);
 //   - a revolute child that is not its parent's main child (a tree's other
 //     branches) gets the first of McMillan and Orin's two screws as a turn:
 //     its joint frame is R_PJ = Rz(beta) Rx(alpha) (Rz(delta) joined to the

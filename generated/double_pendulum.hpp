@@ -16,13 +16,13 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot               0 (0 add, 0 mul, 0 div, 0 func)
-//   mass_matrix       40 (15 add, 21 mul, 0 div, 4 func)
-//   forcing          131 (50 add, 77 mul, 0 div, 4 func)
-//   udot             175 (67 add, 103 mul, 1 div, 4 func) -- composite form; composite 175, articulated 214
-//     udot by pass: joint angles' sin and cos 5; outward pass (velocities) 32; mass and velocity terms 38; composite inertia (inward) 27; its columns of M (walked to the root) 8; bias force 35; generalized forces (inward) 21; M u_dot = F: L^T D L along the dof tree 9
-//   energy            94 (32 add, 56 mul, 2 div, 4 func)
-//   momentum         157 (57 add, 96 mul, 0 div, 4 func)
-//   reactions        251 (105 add, 142 mul, 0 div, 4 func)
+//   mass_matrix       34 (13 add, 17 mul, 0 div, 4 func)
+//   forcing          121 (46 add, 71 mul, 0 div, 4 func)
+//   udot             159 (61 add, 93 mul, 1 div, 4 func) -- composite form; composite 159, articulated 179
+//     udot by pass: joint angles' sin and cos 5; outward pass (velocities) 27; mass and velocity terms 38; composite inertia (inward) 24; its columns of M (walked to the root) 5; bias force 35; generalized forces (inward) 16; M u_dot = F: L^T D L along the dof tree 9
+//   energy            87 (29 add, 52 mul, 2 div, 4 func)
+//   momentum         148 (53 add, 91 mul, 0 div, 4 func)
+//   reactions        245 (103 add, 138 mul, 0 div, 4 func)
 
 #pragma once
 
@@ -83,20 +83,17 @@ inline constexpr double link2_R_PJ_yz = -0.9988527010004034;  // joint frame ori
 inline constexpr double link2_R_PJ_zy = 0.9988527010004034;  // joint frame orientation in the parent
 inline constexpr double link2_R_PJ_zz = -0.04788822093374167;  // joint frame orientation in the parent
 inline constexpr double link2_p_PJ_x = 0.8692335601383587;  // joint frame origin in the parent x [m]
-inline constexpr double link2_p_PJ_y = -0.49440167670548435;  // joint frame origin in the parent y [m]
-inline constexpr double link2_p_PJ_z = -0.023703211394805093;  // joint frame origin in the parent z [m]
 inline constexpr double link2_angle_offset = 0.4704898923184695;  // joint angle offset of the generator's body frame (joint_frames.hpp) [rad]
 inline constexpr double link2_p_J_x = 0.8692335601383587;  // joint origin from the parent's origin, joint axes x [m]
-inline constexpr double link2_p_J_z = 0.49496955478051485;  // joint origin from the parent's origin, joint axes z [m]
 inline constexpr double link2_mass = 0.6;  // mass (rigid part and nodes) [kg]
-inline constexpr double link2_S0_x = 0.17441330224498364;  // first mass moment about O (undeformed) x [kg m]
-inline constexpr double link2_S0_z = 0.168;  // first mass moment about O (undeformed) z [kg m]
-inline constexpr double link2_J0_xx = 0.06533145562130178;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link2_S0_x = 0.17441330224498355;  // first mass moment about O (undeformed) x [kg m]
+inline constexpr double link2_S0_z = 0.4649817328683089;  // first mass moment about O (undeformed) z [kg m]
+inline constexpr double link2_J0_xx = 0.37863814212332747;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link2_J0_xy = -0.003766106508875741;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link2_J0_xz = -0.0661071136868038;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link2_J0_yy = 0.13832854437869826;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link2_J0_xz = -0.15243638824680267;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link2_J0_yy = 0.45163523088072394;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link2_J0_yz = -0.00159208039997985;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double link2_J0_zz = 0.08182000000000002;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double link2_J0_zz = 0.08182;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double link2_R_PJ_yy_ss = 0.9977067182958012;  // a turn's sin^2
 inline constexpr double link2_R_PJ_yy_cs = -0.04783327882577192;  // a turn's cos sin
 inline constexpr double link2_R_PJ_yy_S2 = -0.09566655765154385;  // a turn's sin of the double angle
@@ -114,46 +111,38 @@ inline constexpr double link2_R_BBp_yy = 0.9976303284229833;  // the model's bod
 inline constexpr double link2_R_BBp_zx = -0.59857819705379;  // the model's body axes from the generator's (joint_frames.hpp)
 inline constexpr double link2_R_BBp_zy = -0.04128125496922689;  // the model's body axes from the generator's (joint_frames.hpp)
 inline constexpr double link2_R_BBp_zz = 0.8;  // the model's body axes from the generator's (joint_frames.hpp)
+inline constexpr double link2_o_B_x = -0.2969817328683089;  // the generator's origin from the model's x [m]
+inline constexpr double link2_o_B_z = -0.3959756438244119;  // the generator's origin from the model's z [m]
 
 // model
 inline constexpr double gravity_z = -9.81;  // gravity in N z [m/s^2]
 inline constexpr double minus_gravity_z = 9.81;  // -gravity in N: the ground's fictitious acceleration z [m/s^2]
 
 // derived: constant subexpressions, evaluated here exactly
-inline constexpr double k1190128e = 0.22820826203862124;  // = -k59499beb*link2_S0_x + link2_mass
-inline constexpr double k154fd1a6 = 0.05;  // = link1_p_PJ_y + link2_p_PJ_z
-inline constexpr double k1adb1eba = 0.02708139819115127;  // = k59499beb*link2_J0_xz + link2_S0_z
-inline constexpr double k20edf4c2 = 0.00505244041256677;  // = ka903064d*link2_J0_yz - link2_J0_xy
-inline constexpr double k2d09fd55 = 0.28548000000000007;  // = link2_J0_xx + link2_J0_yy + link2_J0_zz
+inline constexpr double k1190128e = 0.22820826203862157;  // = -k59499beb*link2_S0_x + link2_mass
+inline constexpr double k1adb1eba = 0.14003754004964294;  // = k59499beb*link2_J0_xz + link2_S0_z
+inline constexpr double k20edf4c2 = 0.006732263756143564;  // = ka903064d*link2_J0_yz - link2_J0_xy
+inline constexpr double k2d09fd55 = 0.9120933730040515;  // = link2_J0_xx + link2_J0_yy + link2_J0_zz
 inline constexpr double k359ff293 = -4.850080448480802;  // = link1_R_PJ_zx*minus_gravity_z
-inline constexpr double k3a62d85f = 0.14699691609577265;  // = link2_mass*link2_p_J_z*link2_p_J_z
-inline constexpr double k3e46bb28 = 0.1263778729177485;  // = -k912e4bf7 + k9938a779
-inline constexpr double k56a6b3da = -0.022267147953751627;  // = k97f57875*link2_R_PJ_zz
-inline constexpr double k56b964fd = -0.4644482597913584;  // = k97f57875*link2_R_PJ_yz
-inline constexpr double k59499beb = 2.1316707680882865;  // = kb7e5959a*link2_S0_x
-inline constexpr double k59fbd54e = 0.0831548852031265;  // = link2_S0_z*link2_p_J_z
-inline constexpr double k59fbda24 = 0.14603123810324428;  // = link2_S0_z*link2_p_J_x
+inline constexpr double k3e46bb28 = 0.35696577296333587;  // = -k912e4bf7 + k9938a779
+inline constexpr double k59499beb = 2.1316707680882856;  // = kb7e5959a*link2_S0_x
+inline constexpr double k59fbda24 = 0.40417772706042343;  // = link2_S0_z*link2_p_J_x
 inline constexpr double k5bfb74db = -8.5271812249573;  // = link1_R_PJ_zy*minus_gravity_z
-inline constexpr double k61224f02 = 0.37179173796137877;  // = -k1190128e + link2_mass
-inline constexpr double k7584c250 = -0.008045221116868602;  // = link2_R_PJ_zz*link2_S0_z
-inline constexpr double k778d903d = 0.2969817328683089;  // = link2_mass*link2_p_J_z
+inline constexpr double k61224f02 = 0.37179173796137843;  // = -k1190128e + link2_mass
+inline constexpr double k7584c250 = -0.022267147953751627;  // = link2_R_PJ_zz*link2_S0_z
 inline constexpr double k778d9397 = 0.5215401360830152;  // = link2_mass*link2_p_J_x
-inline constexpr double k912e4bf7 = 0.011919692238265832;  // = -ka903064d*link2_J0_xz + link2_J0_xx
-inline constexpr double k97f57875 = 0.4649817328683089;  // = k778d903d + link2_S0_z
+inline constexpr double k912e4bf7 = 0.09463847869470418;  // = -ka903064d*link2_J0_xz + link2_J0_xx
 inline constexpr double k98569865 = 1.6;  // = 1.0 + link2_mass
-inline constexpr double k9938a779 = 0.13829756515601432;  // = -ka904c900*link2_J0_yz + link2_J0_yy
-inline constexpr double ka6ba76ae = 0.7666468757445091;  // = 2.0*k59fbd54e + k3a62d85f + kcd353d42
-inline constexpr double ka7b3ad17 = 0.07299708875739648;  // = -link2_J0_xx + link2_J0_yy
-inline constexpr double ka903064d = -0.8079578793302834;  // = kb7e5959a*link2_J0_xz
+inline constexpr double k9938a779 = 0.45160425165804;  // = -ka904c900*link2_J0_yz + link2_J0_yy
+inline constexpr double k9d0e50fe = -0.4644482597913584;  // = link2_R_PJ_yz*link2_S0_z
+inline constexpr double ka7b3ad17 = 0.07299708875739647;  // = -link2_J0_xx + link2_J0_yy
+inline constexpr double ka903064d = -1.8630700103495803;  // = kb7e5959a*link2_J0_xz
 inline constexpr double ka904c900 = -0.019458328036908456;  // = kb7e5959a*link2_J0_yz
-inline constexpr double kb7e5959a = 12.22195062331948;  // = 1.0/link2_J0_zz
+inline constexpr double kb7e5959a = 12.221950623319481;  // = 1.0/link2_J0_zz
 inline constexpr double kbe5816c7 = 0.5351601892424834;  // = kcd353d42 + link2_J0_zz
-inline constexpr double kc3b8c593 = 0.40417772706042343;  // = k59fbda24 + kcd3534fc
-inline constexpr double kc435ddc0 = -0.0033937912490833535;  // = k59499beb*link2_J0_yz
-inline constexpr double kc7236622 = 0.14091860180884874;  // = -k1adb1eba + link2_S0_z
-inline constexpr double kcd3534fc = 0.2581464889571792;  // = link2_mass*link2_p_J_x*link2_p_J_z
+inline constexpr double kc435ddc0 = -0.0033937912490833518;  // = k59499beb*link2_J0_yz
+inline constexpr double kc7236622 = 0.32494419281866593;  // = -k1adb1eba + link2_S0_z
 inline constexpr double kcd353d42 = 0.4533401892424834;  // = link2_mass*link2_p_J_x*link2_p_J_x
-inline constexpr double kd79b540e = 0.31330668650202564;  // = 2.0*k59fbd54e + k3a62d85f
 
 
 // ---- dual numbers for jacobian() ---------------------------------------------
@@ -353,29 +342,24 @@ void mass_matrix(const T* q, T* M) {
   kanegen_sincos_n(angle_x, angle_s, angle_c, 2);
   // ---- body link2: composite inertia (inward)
   const T t30 = angle_c[1]*link2_S0_x;
-  const T t31 = angle_s[1]*link2_S0_x;
   const T t32 = angle_s[1]*angle_s[1];
   const T t33 = angle_c[1]*angle_s[1];
   const T t35 = 2.0*link2_J0_xy*t33 - ka7b3ad17*t32;
   const T t37 = link2_J0_yy + t35;
   const T t40 = angle_c[1]*link2_J0_yz + angle_s[1]*link2_J0_xz;
-  const T t44 = 2.0*link2_p_J_x*t30 + ka6ba76ae + t37;
-  const T t45 = -link2_p_J_z*t31 + t40;
-  const T t46 = 2.0*link2_p_J_x*t30 + kbe5816c7;
-  const T t50 = t44 - t46;
-  const T t51 = link2_R_PJ_yy_S2*t45 + link2_R_PJ_yy_ss*t50;
-  const T t53 = t46 + t51;
-  const T t62 = link1_J0_zz + t53;
+  const T t43 = 2.0*link2_p_J_x*t30 + kcd353d42 + t37;
+  const T t44 = 2.0*link2_p_J_x*t30 + kbe5816c7;
+  const T t48 = t43 - t44;
+  const T t49 = link2_R_PJ_yy_S2*t40 + link2_R_PJ_yy_ss*t48;
+  const T t51 = t44 + t49;
+  const T t60 = link1_J0_zz + t51;
   // ---- body link2: its columns of M (walked to the root)
-  const T t69 = -angle_s[1]*link2_S0_x;
-  const T t71 = link2_p_J_z*t69;
-  const T t72 = link2_p_J_x*t30;
-  const T t74 = t40 + t71;
-  const T t75 = link2_J0_zz + t72;
-  const T t79 = link2_R_PJ_zy*t74 + link2_R_PJ_zz*t75;
-  M[0] = t62;
-  M[1] = t79;
-  M[2] = t79;
+  const T t68 = link2_p_J_x*t30;
+  const T t69 = link2_J0_zz + t68;
+  const T t73 = link2_R_PJ_zy*t40 + link2_R_PJ_zz*t69;
+  M[0] = t60;
+  M[1] = t73;
+  M[2] = t73;
   M[3] = link2_J0_zz;
 }
 
@@ -394,61 +378,55 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   // ---- body link2: outward pass (velocities)
   const T t18 = link2_R_PJ_zy*u[0];
   const T t19 = link2_R_PJ_zz*u[0];
-  const T t20 = link2_p_J_z*t18;
-  const T t21 = link2_p_J_x*t19;
-  const T t22 = -link2_p_J_x*t18;
-  const T t23 = t18*t22 - t19*t21;
-  const T t24 = t19*t20;
-  const T t25 = -t18*t20;
-  const T t26 = link2_R_PJ_yy*t5;
-  const T t27 = link2_R_PJ_yz*t5;
-  const T t28 = t23 + t4;
-  const T t29 = t24 + t26;
-  const T t30 = t25 + t27;
-  const T t31 = angle_s[1]*t18;
-  const T t32 = angle_c[1]*t18;
+  const T t20 = link2_p_J_x*t19;
+  const T t21 = -link2_p_J_x*t18;
+  const T t22 = t18*t21 - t19*t20;
+  const T t23 = link2_R_PJ_yy*t5;
+  const T t24 = link2_R_PJ_yz*t5;
+  const T t25 = t22 + t4;
+  const T t26 = angle_s[1]*t18;
+  const T t27 = angle_c[1]*t18;
   const T w_B_link2_z = t19 + u[1];
-  const T t36 = t32*u[1];
-  const T t37 = -t31*u[1];
-  const T t39 = angle_c[1]*t28 + angle_s[1]*t29;
-  const T t40 = angle_c[1]*t29 - angle_s[1]*t28;
+  const T t31 = t27*u[1];
+  const T t32 = -t26*u[1];
+  const T t34 = angle_c[1]*t25 + angle_s[1]*t23;
+  const T t35 = angle_c[1]*t23 - angle_s[1]*t25;
   // ---- body link2: mass and velocity terms
-  const T t50 = link2_S0_z*t32;
-  const T t51 = link2_S0_x*w_B_link2_z - link2_S0_z*t31;
-  const T t52 = -link2_S0_x*t32;
-  const T t53 = t32*t52 - t51*w_B_link2_z;
-  const T t54 = -t31*t52 + t50*w_B_link2_z;
-  const T t55 = t31*t51 - t32*t50;
-  const T t56 = link2_J0_xx*t31 + link2_J0_xy*t32 + link2_J0_xz*w_B_link2_z;
-  const T t57 = link2_J0_xy*t31 + link2_J0_yy*t32 + link2_J0_yz*w_B_link2_z;
-  const T t58 = link2_J0_xz*t31 + link2_J0_yz*t32 + link2_J0_zz*w_B_link2_z;
-  const T t59 = t32*t58 - t57*w_B_link2_z;
-  const T t60 = -t31*t58 + t56*w_B_link2_z;
-  const T t61 = t31*t57 - t32*t56;
+  const T t45 = link2_S0_z*t27;
+  const T t46 = link2_S0_x*w_B_link2_z - link2_S0_z*t26;
+  const T t47 = -link2_S0_x*t27;
+  const T t48 = t27*t47 - t46*w_B_link2_z;
+  const T t49 = -t26*t47 + t45*w_B_link2_z;
+  const T t50 = t26*t46 - t27*t45;
+  const T t51 = link2_J0_xx*t26 + link2_J0_xy*t27 + link2_J0_xz*w_B_link2_z;
+  const T t52 = link2_J0_xy*t26 + link2_J0_yy*t27 + link2_J0_yz*w_B_link2_z;
+  const T t53 = link2_J0_xz*t26 + link2_J0_yz*t27 + link2_J0_zz*w_B_link2_z;
+  const T t54 = t27*t53 - t52*w_B_link2_z;
+  const T t55 = -t26*t53 + t51*w_B_link2_z;
+  const T t56 = t26*t52 - t27*t51;
   // ---- body link1: bias force
-  const T t66 = -link1_S0_x*t5 + link1_S0_y*t4;
+  const T t61 = -link1_S0_x*t5 + link1_S0_y*t4;
   // ---- body link2: bias force
-  const T t67 = -link2_S0_z*t37 - link2_mass*t39 - t53;
-  const T t68 = link2_S0_z*t36 - link2_mass*t40 - t54;
-  const T t69 = link2_S0_x*t37 - link2_mass*t30 - t55;
-  const T t70 = link2_S0_z*t40 - ((link2_J0_xx*t36 + link2_J0_xy*t37) + t59);
-  const T t71 = link2_S0_x*t30 - ((link2_J0_xy*t36 + link2_J0_yy*t37) + (link2_S0_z*t39 + t60));
-  const T t72 = -((link2_J0_xz*t36 + link2_J0_yz*t37) + (link2_S0_x*t40 + t61));
+  const T t62 = -link2_S0_z*t32 - link2_mass*t34 - t48;
+  const T t63 = link2_S0_z*t31 - link2_mass*t35 - t49;
+  const T t64 = link2_S0_x*t32 - link2_mass*t24 - t50;
+  const T t65 = link2_S0_z*t35 - ((link2_J0_xx*t31 + link2_J0_xy*t32) + t54);
+  const T t66 = link2_S0_x*t24 - ((link2_J0_xy*t31 + link2_J0_yy*t32) + (link2_S0_z*t34 + t55));
+  const T t67 = -((link2_J0_xz*t31 + link2_J0_yz*t32) + (link2_S0_x*t35 + t56));
   // ---- body link2: generalized forces (inward)
-  const T t73 = t72 + tau[1];
-  const T t74 = angle_c[1]*t67 - angle_s[1]*t68;
-  const T t75 = angle_c[1]*t68 + angle_s[1]*t67;
-  const T t77 = -link2_p_J_x*t69 + link2_p_J_z*t74;
-  const T t78 = link2_p_J_x*t75;
-  const T t80 = angle_c[1]*t71 + angle_s[1]*t70;
-  const T t82 = t77 + t80;
-  const T t83 = t72 + t78;
-  const T t87 = link2_R_PJ_zy*t82 + link2_R_PJ_zz*t83;
-  const T t92 = t66 + t87;
+  const T t68 = t67 + tau[1];
+  const T t70 = angle_c[1]*t63 + angle_s[1]*t62;
+  const T t71 = -link2_p_J_x*t64;
+  const T t72 = link2_p_J_x*t70;
+  const T t74 = angle_c[1]*t66 + angle_s[1]*t65;
+  const T t75 = t71 + t74;
+  const T t76 = t67 + t72;
+  const T t80 = link2_R_PJ_zy*t75 + link2_R_PJ_zz*t76;
+  const T t85 = t61 + t80;
   // ---- body link1: generalized forces (inward)
-  const T t93 = t92 + tau[0];
-  F[0] = t93;
-  F[1] = t73;
+  const T t86 = t85 + tau[0];
+  F[0] = t86;
+  F[1] = t68;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
@@ -467,92 +445,81 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body link2: outward pass (velocities)
   const T t18 = link2_R_PJ_zy*u[0];
   const T t19 = link2_R_PJ_zz*u[0];
-  const T t20 = link2_p_J_z*t18;
-  const T t21 = link2_p_J_x*t19;
-  const T t22 = -link2_p_J_x*t18;
-  const T t23 = t18*t22 - t19*t21;
-  const T t24 = t19*t20;
-  const T t25 = -t18*t20;
-  const T t26 = link2_R_PJ_yy*t5;
-  const T t27 = link2_R_PJ_yz*t5;
-  const T t28 = t23 + t4;
-  const T t29 = t24 + t26;
-  const T t30 = t25 + t27;
-  const T t31 = angle_s[1]*t18;
-  const T t32 = angle_c[1]*t18;
+  const T t20 = link2_p_J_x*t19;
+  const T t21 = -link2_p_J_x*t18;
+  const T t22 = t18*t21 - t19*t20;
+  const T t23 = link2_R_PJ_yy*t5;
+  const T t24 = link2_R_PJ_yz*t5;
+  const T t25 = t22 + t4;
+  const T t26 = angle_s[1]*t18;
+  const T t27 = angle_c[1]*t18;
   const T w_B_link2_z = t19 + u[1];
-  const T t36 = t32*u[1];
-  const T t37 = -t31*u[1];
-  const T t39 = angle_c[1]*t28 + angle_s[1]*t29;
-  const T t40 = angle_c[1]*t29 - angle_s[1]*t28;
+  const T t31 = t27*u[1];
+  const T t32 = -t26*u[1];
+  const T t34 = angle_c[1]*t25 + angle_s[1]*t23;
+  const T t35 = angle_c[1]*t23 - angle_s[1]*t25;
   // ---- body link2: mass and velocity terms
-  const T t50 = link2_S0_z*t32;
-  const T t51 = link2_S0_x*w_B_link2_z - link2_S0_z*t31;
-  const T t52 = -link2_S0_x*t32;
-  const T t53 = t32*t52 - t51*w_B_link2_z;
-  const T t54 = -t31*t52 + t50*w_B_link2_z;
-  const T t55 = t31*t51 - t32*t50;
-  const T t56 = link2_J0_xx*t31 + link2_J0_xy*t32 + link2_J0_xz*w_B_link2_z;
-  const T t57 = link2_J0_xy*t31 + link2_J0_yy*t32 + link2_J0_yz*w_B_link2_z;
-  const T t58 = link2_J0_xz*t31 + link2_J0_yz*t32 + link2_J0_zz*w_B_link2_z;
-  const T t59 = t32*t58 - t57*w_B_link2_z;
-  const T t60 = -t31*t58 + t56*w_B_link2_z;
-  const T t61 = t31*t57 - t32*t56;
+  const T t45 = link2_S0_z*t27;
+  const T t46 = link2_S0_x*w_B_link2_z - link2_S0_z*t26;
+  const T t47 = -link2_S0_x*t27;
+  const T t48 = t27*t47 - t46*w_B_link2_z;
+  const T t49 = -t26*t47 + t45*w_B_link2_z;
+  const T t50 = t26*t46 - t27*t45;
+  const T t51 = link2_J0_xx*t26 + link2_J0_xy*t27 + link2_J0_xz*w_B_link2_z;
+  const T t52 = link2_J0_xy*t26 + link2_J0_yy*t27 + link2_J0_yz*w_B_link2_z;
+  const T t53 = link2_J0_xz*t26 + link2_J0_yz*t27 + link2_J0_zz*w_B_link2_z;
+  const T t54 = t27*t53 - t52*w_B_link2_z;
+  const T t55 = -t26*t53 + t51*w_B_link2_z;
+  const T t56 = t26*t52 - t27*t51;
   // ---- body link2: composite inertia (inward)
-  const T t62 = angle_c[1]*link2_S0_x;
-  const T t63 = angle_s[1]*link2_S0_x;
-  const T t64 = angle_s[1]*angle_s[1];
-  const T t65 = angle_c[1]*angle_s[1];
-  const T t67 = 2.0*link2_J0_xy*t65 - ka7b3ad17*t64;
-  const T t69 = link2_J0_yy + t67;
-  const T t72 = angle_c[1]*link2_J0_yz + angle_s[1]*link2_J0_xz;
-  const T t76 = 2.0*link2_p_J_x*t62 + ka6ba76ae + t69;
-  const T t77 = -link2_p_J_z*t63 + t72;
-  const T t78 = 2.0*link2_p_J_x*t62 + kbe5816c7;
-  const T t82 = t76 - t78;
-  const T t83 = link2_R_PJ_yy_S2*t77 + link2_R_PJ_yy_ss*t82;
-  const T t85 = t78 + t83;
-  const T t94 = link1_J0_zz + t85;
+  const T t57 = angle_c[1]*link2_S0_x;
+  const T t59 = angle_s[1]*angle_s[1];
+  const T t60 = angle_c[1]*angle_s[1];
+  const T t62 = 2.0*link2_J0_xy*t60 - ka7b3ad17*t59;
+  const T t64 = link2_J0_yy + t62;
+  const T t67 = angle_c[1]*link2_J0_yz + angle_s[1]*link2_J0_xz;
+  const T t70 = 2.0*link2_p_J_x*t57 + kcd353d42 + t64;
+  const T t71 = 2.0*link2_p_J_x*t57 + kbe5816c7;
+  const T t75 = t70 - t71;
+  const T t76 = link2_R_PJ_yy_S2*t67 + link2_R_PJ_yy_ss*t75;
+  const T t78 = t71 + t76;
+  const T t87 = link1_J0_zz + t78;
   // ---- body link2: its columns of M (walked to the root)
-  const T t101 = -angle_s[1]*link2_S0_x;
-  const T t103 = link2_p_J_z*t101;
-  const T t104 = link2_p_J_x*t62;
-  const T t106 = t103 + t72;
-  const T t107 = link2_J0_zz + t104;
-  const T t111 = link2_R_PJ_zy*t106 + link2_R_PJ_zz*t107;
+  const T t95 = link2_p_J_x*t57;
+  const T t96 = link2_J0_zz + t95;
+  const T t100 = link2_R_PJ_zy*t67 + link2_R_PJ_zz*t96;
   // ---- body link1: bias force
-  const T t116 = -link1_S0_x*t5 + link1_S0_y*t4;
+  const T t105 = -link1_S0_x*t5 + link1_S0_y*t4;
   // ---- body link2: bias force
-  const T t117 = -link2_S0_z*t37 - link2_mass*t39 - t53;
-  const T t118 = link2_S0_z*t36 - link2_mass*t40 - t54;
-  const T t119 = link2_S0_x*t37 - link2_mass*t30 - t55;
-  const T t120 = link2_S0_z*t40 - ((link2_J0_xx*t36 + link2_J0_xy*t37) + t59);
-  const T t121 = link2_S0_x*t30 - ((link2_J0_xy*t36 + link2_J0_yy*t37) + (link2_S0_z*t39 + t60));
-  const T t122 = -((link2_J0_xz*t36 + link2_J0_yz*t37) + (link2_S0_x*t40 + t61));
+  const T t106 = -link2_S0_z*t32 - link2_mass*t34 - t48;
+  const T t107 = link2_S0_z*t31 - link2_mass*t35 - t49;
+  const T t108 = link2_S0_x*t32 - link2_mass*t24 - t50;
+  const T t109 = link2_S0_z*t35 - ((link2_J0_xx*t31 + link2_J0_xy*t32) + t54);
+  const T t110 = link2_S0_x*t24 - ((link2_J0_xy*t31 + link2_J0_yy*t32) + (link2_S0_z*t34 + t55));
+  const T t111 = -((link2_J0_xz*t31 + link2_J0_yz*t32) + (link2_S0_x*t35 + t56));
   // ---- body link2: generalized forces (inward)
-  const T t123 = t122 + tau[1];
-  const T t124 = angle_c[1]*t117 - angle_s[1]*t118;
-  const T t125 = angle_c[1]*t118 + angle_s[1]*t117;
-  const T t127 = -link2_p_J_x*t119 + link2_p_J_z*t124;
-  const T t128 = link2_p_J_x*t125;
-  const T t130 = angle_c[1]*t121 + angle_s[1]*t120;
-  const T t132 = t127 + t130;
-  const T t133 = t122 + t128;
-  const T t137 = link2_R_PJ_zy*t132 + link2_R_PJ_zz*t133;
-  const T t142 = t116 + t137;
+  const T t112 = t111 + tau[1];
+  const T t114 = angle_c[1]*t107 + angle_s[1]*t106;
+  const T t115 = -link2_p_J_x*t108;
+  const T t116 = link2_p_J_x*t114;
+  const T t118 = angle_c[1]*t110 + angle_s[1]*t109;
+  const T t119 = t115 + t118;
+  const T t120 = t111 + t116;
+  const T t124 = link2_R_PJ_zy*t119 + link2_R_PJ_zz*t120;
+  const T t129 = t105 + t124;
   // ---- body link1: generalized forces (inward)
-  const T t143 = t142 + tau[0];
+  const T t130 = t129 + tau[0];
   // ---- M u_dot = F: L^T D L along the dof tree
-  const T t144 = kb7e5959a*t111;
-  const T t145 = -t111*t144 + t94;
-  const T t147 = -t123*t144 + t143;
-  const T t148 = t147/t145;
-  const T t149 = kb7e5959a*t123;
-  const T t150 = -t144*t148 + t149;
-  if (!(t145 > 1e-14*t94)) return 1;
+  const T t131 = kb7e5959a*t100;
+  const T t132 = -t100*t131 + t87;
+  const T t134 = -t112*t131 + t130;
+  const T t135 = t134/t132;
+  const T t136 = kb7e5959a*t112;
+  const T t137 = -t131*t135 + t136;
+  if (!(t132 > 1e-14*t87)) return 1;
   if (!(link2_J0_zz > 0.0)) return 2;
-  udot[0] = t148;
-  udot[1] = t150;
+  udot[0] = t135;
+  udot[1] = t137;
   return 0;
 }
 
@@ -572,35 +539,34 @@ void energy(const T* q, const T* u, T* TV) {
   const T R_PB_link2_yx = angle_s[1]*link2_R_PJ_yy;
   const T R_NB_link2_zx = R_PB_link1_zx*angle_c[1] + R_PB_link1_zy*R_PB_link2_yx;
   const T R_NB_link2_zz = R_PB_link1_zy*link2_R_PJ_yz;
-  const T t17 = R_PB_link1_zx*link2_p_PJ_x + R_PB_link1_zy*link2_p_PJ_y;
+  const T t17 = R_PB_link1_zx*link2_p_PJ_x;
   const T t18 = link2_R_PJ_zy*u[0];
   const T t19 = link2_R_PJ_zz*u[0];
-  const T t20 = link2_p_J_z*t18;
-  const T t21 = link2_p_J_x*t19;
-  const T t22 = -link2_p_J_x*t18;
-  const T t31 = angle_s[1]*t18;
-  const T t32 = angle_c[1]*t18;
+  const T t20 = link2_p_J_x*t19;
+  const T t21 = -link2_p_J_x*t18;
+  const T t26 = angle_s[1]*t18;
+  const T t27 = angle_c[1]*t18;
   const T w_B_link2_z = t19 + u[1];
-  const T t34 = angle_c[1]*t20 + angle_s[1]*t21;
-  const T t35 = angle_c[1]*t21 - angle_s[1]*t20;
+  const T t29 = angle_s[1]*t20;
+  const T t30 = angle_c[1]*t20;
   // ---- body link1: mass and velocity terms
-  const T t47 = link1_J0_zz*u[0];
+  const T t42 = link1_J0_zz*u[0];
   // ---- body link2: mass and velocity terms
-  const T t62 = t47*u[0];
-  const T t63 = link2_S0_z*t32 + link2_mass*t34;
-  const T t64 = link2_S0_x*w_B_link2_z - link2_S0_z*t31 + link2_mass*t35;
-  const T t65 = -link2_S0_x*t32 + link2_mass*t22;
-  const T t66 = ((link2_J0_xx*t31 + link2_J0_xy*t32) + link2_J0_xz*w_B_link2_z) - link2_S0_z*t35;
-  const T t67 = ((link2_J0_xy*t31 + link2_J0_yy*t32) + (link2_J0_yz*w_B_link2_z + link2_S0_z*t34)) - link2_S0_x*t22;
-  const T t68 = (link2_J0_xz*t31 + link2_J0_yz*t32) + (link2_J0_zz*w_B_link2_z + link2_S0_x*t35);
-  const T t69 = ((t22*t65 + t31*t66) + t32*t67) + ((t34*t63 + t35*t64) + t68*w_B_link2_z);
-  const T t70 = t62/2.0 + t69/2.0;
-  const T t72 = R_PB_link1_zx*link1_S0_x + R_PB_link1_zy*link1_S0_y;
-  const T t73 = -gravity_z*t72;
-  const T t76 = R_NB_link2_zx*link2_S0_x + R_NB_link2_zz*link2_S0_z;
-  const T t77 = -(link2_mass*t17 + t76)*gravity_z + t73;
-  TV[0] = t70;
-  TV[1] = t77;
+  const T t57 = t42*u[0];
+  const T t58 = link2_S0_z*t27 + link2_mass*t29;
+  const T t59 = link2_S0_x*w_B_link2_z - link2_S0_z*t26 + link2_mass*t30;
+  const T t60 = -link2_S0_x*t27 + link2_mass*t21;
+  const T t61 = ((link2_J0_xx*t26 + link2_J0_xy*t27) + link2_J0_xz*w_B_link2_z) - link2_S0_z*t30;
+  const T t62 = ((link2_J0_xy*t26 + link2_J0_yy*t27) + (link2_J0_yz*w_B_link2_z + link2_S0_z*t29)) - link2_S0_x*t21;
+  const T t63 = (link2_J0_xz*t26 + link2_J0_yz*t27) + (link2_J0_zz*w_B_link2_z + link2_S0_x*t30);
+  const T t64 = ((t21*t60 + t26*t61) + t27*t62) + ((t29*t58 + t30*t59) + t63*w_B_link2_z);
+  const T t65 = t57/2.0 + t64/2.0;
+  const T t67 = R_PB_link1_zx*link1_S0_x + R_PB_link1_zy*link1_S0_y;
+  const T t68 = -gravity_z*t67;
+  const T t71 = R_NB_link2_zx*link2_S0_x + R_NB_link2_zz*link2_S0_z;
+  const T t72 = -(link2_mass*t17 + t71)*gravity_z + t68;
+  TV[0] = t65;
+  TV[1] = t72;
 }
 
 // ---- momentum: p_N[3], H_N[3] about N's origin ---------------------------------
@@ -628,62 +594,61 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_link2_zx = R_PB_link1_zx*angle_c[1] + R_PB_link1_zy*R_PB_link2_yx;
   const T R_NB_link2_zy = -R_PB_link1_zx*angle_s[1] + R_PB_link1_zy*R_PB_link2_yy;
   const T R_NB_link2_zz = R_PB_link1_zy*link2_R_PJ_yz;
-  const T t16 = R_PB_link1_xx*link2_p_PJ_x + R_PB_link1_xy*link2_p_PJ_y;
-  const T t17 = R_PB_link1_zx*link2_p_PJ_x + R_PB_link1_zy*link2_p_PJ_y;
+  const T t16 = R_PB_link1_xx*link2_p_PJ_x;
+  const T t17 = R_PB_link1_zx*link2_p_PJ_x;
   const T t18 = link2_R_PJ_zy*u[0];
   const T t19 = link2_R_PJ_zz*u[0];
-  const T t20 = link2_p_J_z*t18;
-  const T t21 = link2_p_J_x*t19;
-  const T t22 = -link2_p_J_x*t18;
-  const T t31 = angle_s[1]*t18;
-  const T t32 = angle_c[1]*t18;
+  const T t20 = link2_p_J_x*t19;
+  const T t21 = -link2_p_J_x*t18;
+  const T t26 = angle_s[1]*t18;
+  const T t27 = angle_c[1]*t18;
   const T w_B_link2_z = t19 + u[1];
-  const T t34 = angle_c[1]*t20 + angle_s[1]*t21;
-  const T t35 = angle_c[1]*t21 - angle_s[1]*t20;
+  const T t29 = angle_s[1]*t20;
+  const T t30 = angle_c[1]*t20;
   // ---- body link1: mass and velocity terms
-  const T t41 = -link1_S0_y*u[0];
-  const T t42 = link1_S0_x*u[0];
-  const T t45 = link1_J0_xz*u[0];
-  const T t46 = link1_J0_yz*u[0];
-  const T t47 = link1_J0_zz*u[0];
+  const T t36 = -link1_S0_y*u[0];
+  const T t37 = link1_S0_x*u[0];
+  const T t40 = link1_J0_xz*u[0];
+  const T t41 = link1_J0_yz*u[0];
+  const T t42 = link1_J0_zz*u[0];
   // ---- body link2: mass and velocity terms
-  const T t62 = R_PB_link1_xx*t41 + R_PB_link1_xy*t42;
-  const T t63 = R_PB_link1_zx*t41 + R_PB_link1_zy*t42;
-  const T t64 = R_PB_link1_xx*t45 + R_PB_link1_xy*t46;
-  const T t65 = R_PB_link1_zx*t45 + R_PB_link1_zy*t46;
-  const T t66 = link1_p_PJ_y*t63;
-  const T t67 = -link1_p_PJ_y*t62;
-  const T t68 = t64 + t66;
-  const T t69 = t65 + t67;
-  const T t70 = link2_S0_z*t32 + link2_mass*t34;
-  const T t71 = link2_S0_x*w_B_link2_z - link2_S0_z*t31 + link2_mass*t35;
-  const T t72 = -link2_S0_x*t32 + link2_mass*t22;
-  const T t73 = ((link2_J0_xx*t31 + link2_J0_xy*t32) + link2_J0_xz*w_B_link2_z) - link2_S0_z*t35;
-  const T t74 = ((link2_J0_xy*t31 + link2_J0_yy*t32) + (link2_J0_yz*w_B_link2_z + link2_S0_z*t34)) - link2_S0_x*t22;
-  const T t75 = (link2_J0_xz*t31 + link2_J0_yz*t32) + (link2_J0_zz*w_B_link2_z + link2_S0_x*t35);
-  const T t76 = R_NB_link2_xx*t70 + R_NB_link2_xy*t71 + R_NB_link2_xz*t72;
-  const T t77 = R_PB_link2_zx*t70 + R_PB_link2_zy*t71 + link2_R_PJ_zz*t72;
-  const T t78 = R_NB_link2_zx*t70 + R_NB_link2_zy*t71 + R_NB_link2_zz*t72;
-  const T t79 = R_NB_link2_xx*t73 + R_NB_link2_xy*t74 + R_NB_link2_xz*t75;
-  const T t80 = R_PB_link2_zx*t73 + R_PB_link2_zy*t74 + link2_R_PJ_zz*t75;
-  const T t81 = R_NB_link2_zx*t73 + R_NB_link2_zy*t74 + R_NB_link2_zz*t75;
-  const T t82 = k154fd1a6*t78 - t17*t77;
-  const T t83 = -t16*t78 + t17*t76;
-  const T t84 = -k154fd1a6*t76 + t16*t77;
-  const T t85 = t79 + t82;
-  const T t86 = t80 + t83;
-  const T t87 = t81 + t84;
-  const T t88 = t62 + t76;
-  const T t89 = t63 + t78;
-  const T t90 = t68 + t85;
-  const T t91 = t47 + t86;
-  const T t92 = t69 + t87;
-  pH[0] = t88;
-  pH[1] = t77;
-  pH[2] = t89;
-  pH[3] = t90;
-  pH[4] = t91;
-  pH[5] = t92;
+  const T t57 = R_PB_link1_xx*t36 + R_PB_link1_xy*t37;
+  const T t58 = R_PB_link1_zx*t36 + R_PB_link1_zy*t37;
+  const T t59 = R_PB_link1_xx*t40 + R_PB_link1_xy*t41;
+  const T t60 = R_PB_link1_zx*t40 + R_PB_link1_zy*t41;
+  const T t61 = link1_p_PJ_y*t58;
+  const T t62 = -link1_p_PJ_y*t57;
+  const T t63 = t59 + t61;
+  const T t64 = t60 + t62;
+  const T t65 = link2_S0_z*t27 + link2_mass*t29;
+  const T t66 = link2_S0_x*w_B_link2_z - link2_S0_z*t26 + link2_mass*t30;
+  const T t67 = -link2_S0_x*t27 + link2_mass*t21;
+  const T t68 = ((link2_J0_xx*t26 + link2_J0_xy*t27) + link2_J0_xz*w_B_link2_z) - link2_S0_z*t30;
+  const T t69 = ((link2_J0_xy*t26 + link2_J0_yy*t27) + (link2_J0_yz*w_B_link2_z + link2_S0_z*t29)) - link2_S0_x*t21;
+  const T t70 = (link2_J0_xz*t26 + link2_J0_yz*t27) + (link2_J0_zz*w_B_link2_z + link2_S0_x*t30);
+  const T t71 = R_NB_link2_xx*t65 + R_NB_link2_xy*t66 + R_NB_link2_xz*t67;
+  const T t72 = R_PB_link2_zx*t65 + R_PB_link2_zy*t66 + link2_R_PJ_zz*t67;
+  const T t73 = R_NB_link2_zx*t65 + R_NB_link2_zy*t66 + R_NB_link2_zz*t67;
+  const T t74 = R_NB_link2_xx*t68 + R_NB_link2_xy*t69 + R_NB_link2_xz*t70;
+  const T t75 = R_PB_link2_zx*t68 + R_PB_link2_zy*t69 + link2_R_PJ_zz*t70;
+  const T t76 = R_NB_link2_zx*t68 + R_NB_link2_zy*t69 + R_NB_link2_zz*t70;
+  const T t77 = link1_p_PJ_y*t73 - t17*t72;
+  const T t78 = -t16*t73 + t17*t71;
+  const T t79 = -link1_p_PJ_y*t71 + t16*t72;
+  const T t80 = t74 + t77;
+  const T t81 = t75 + t78;
+  const T t82 = t76 + t79;
+  const T t83 = t57 + t71;
+  const T t84 = t58 + t73;
+  const T t85 = t63 + t80;
+  const T t86 = t42 + t81;
+  const T t87 = t64 + t82;
+  pH[0] = t83;
+  pH[1] = t72;
+  pH[2] = t84;
+  pH[3] = t85;
+  pH[4] = t86;
+  pH[5] = t87;
 }
 
 // ---- reactions on each body from its parent: [force; torque about O_B], body axes ---
@@ -701,112 +666,110 @@ void reactions(const T* q, const T* u, const T* udot_in, T* wrenches) {
   // ---- body link2: outward pass (velocities)
   const T t18 = link2_R_PJ_zy*u[0];
   const T t19 = link2_R_PJ_zz*u[0];
-  const T t20 = link2_p_J_z*t18;
-  const T t21 = link2_p_J_x*t19;
-  const T t22 = -link2_p_J_x*t18;
-  const T t23 = t18*t22 - t19*t21;
-  const T t24 = t19*t20;
-  const T t25 = -t18*t20;
-  const T t26 = link2_R_PJ_yy*t5;
-  const T t27 = link2_R_PJ_yz*t5;
-  const T t28 = t23 + t4;
-  const T t29 = t24 + t26;
-  const T t30 = t25 + t27;
-  const T t31 = angle_s[1]*t18;
-  const T t32 = angle_c[1]*t18;
+  const T t20 = link2_p_J_x*t19;
+  const T t21 = -link2_p_J_x*t18;
+  const T t22 = t18*t21 - t19*t20;
+  const T t23 = link2_R_PJ_yy*t5;
+  const T t24 = link2_R_PJ_yz*t5;
+  const T t25 = t22 + t4;
+  const T t26 = angle_s[1]*t18;
+  const T t27 = angle_c[1]*t18;
   const T w_B_link2_z = t19 + u[1];
-  const T t36 = t32*u[1];
-  const T t37 = -t31*u[1];
-  const T t39 = angle_c[1]*t28 + angle_s[1]*t29;
-  const T t40 = angle_c[1]*t29 - angle_s[1]*t28;
+  const T t31 = t27*u[1];
+  const T t32 = -t26*u[1];
+  const T t34 = angle_c[1]*t25 + angle_s[1]*t23;
+  const T t35 = angle_c[1]*t23 - angle_s[1]*t25;
   // ---- body link1: mass and velocity terms
-  const T t41 = -link1_S0_y*u[0];
-  const T t42 = link1_S0_x*u[0];
-  const T t43 = -t42*u[0];
-  const T t44 = t41*u[0];
-  const T t45 = link1_J0_xz*u[0];
-  const T t46 = link1_J0_yz*u[0];
-  const T t48 = -t46*u[0];
-  const T t49 = t45*u[0];
+  const T t36 = -link1_S0_y*u[0];
+  const T t37 = link1_S0_x*u[0];
+  const T t38 = -t37*u[0];
+  const T t39 = t36*u[0];
+  const T t40 = link1_J0_xz*u[0];
+  const T t41 = link1_J0_yz*u[0];
+  const T t43 = -t41*u[0];
+  const T t44 = t40*u[0];
   // ---- body link2: mass and velocity terms
-  const T t50 = link2_S0_z*t32;
-  const T t51 = link2_S0_x*w_B_link2_z - link2_S0_z*t31;
-  const T t52 = -link2_S0_x*t32;
-  const T t53 = t32*t52 - t51*w_B_link2_z;
-  const T t54 = -t31*t52 + t50*w_B_link2_z;
-  const T t55 = t31*t51 - t32*t50;
-  const T t56 = link2_J0_xx*t31 + link2_J0_xy*t32 + link2_J0_xz*w_B_link2_z;
-  const T t57 = link2_J0_xy*t31 + link2_J0_yy*t32 + link2_J0_yz*w_B_link2_z;
-  const T t58 = link2_J0_xz*t31 + link2_J0_yz*t32 + link2_J0_zz*w_B_link2_z;
-  const T t59 = t32*t58 - t57*w_B_link2_z;
-  const T t60 = -t31*t58 + t56*w_B_link2_z;
-  const T t61 = t31*t57 - t32*t56;
-  const T t62 = -link1_S0_y*udot_in[0] + t4 + t43;
-  const T t63 = link1_S0_x*udot_in[0] + t44 + t5;
-  const T t64 = link1_J0_xz*udot_in[0] - link1_S0_z*t5 + t48;
-  const T t65 = link1_J0_yz*udot_in[0] + link1_S0_z*t4 + t49;
-  const T t66 = link1_J0_zz*udot_in[0] + link1_S0_x*t5 - link1_S0_y*t4;
-  const T t67 = link2_R_PJ_zy*udot_in[0];
-  const T t68 = link2_R_PJ_zz*udot_in[0];
-  const T t69 = link2_p_J_z*t67;
-  const T t70 = link2_p_J_x*t68;
-  const T t71 = -link2_p_J_x*t67;
-  const T t72 = angle_c[1]*t69 + angle_s[1]*t70;
-  const T t73 = angle_c[1]*t70 - angle_s[1]*t69;
-  const T t74 = angle_s[1]*t67;
-  const T t75 = angle_c[1]*t67;
-  const T t76 = t68 + udot_in[1];
-  const T t77 = (t37 + t75)*link2_S0_z + (t39 + t72)*link2_mass + t53;
-  const T t78 = (((t40 + t73)*link2_mass + link2_S0_x*t76) + t54) - (t36 + t74)*link2_S0_z;
-  const T t79 = (t30 + t71)*link2_mass - (t37 + t75)*link2_S0_x + t55;
-  const T t80 = (((t36 + t74)*link2_J0_xx + (t37 + t75)*link2_J0_xy) + (link2_J0_xz*t76 + t59)) - (t40 + t73)*link2_S0_z;
-  const T t81 = ((((t36 + t74)*link2_J0_xy + (t37 + t75)*link2_J0_yy) + (t39 + t72)*link2_S0_z) + (link2_J0_yz*t76 + t60)) - (t30 + t71)*link2_S0_x;
-  const T t82 = (((t36 + t74)*link2_J0_xz + (t37 + t75)*link2_J0_yz) + (t40 + t73)*link2_S0_x) + (link2_J0_zz*t76 + t61);
-  const T t83 = angle_c[1]*t77 - angle_s[1]*t78;
-  const T t84 = angle_c[1]*t78 + angle_s[1]*t77;
-  const T t85 = -link2_p_J_z*t84;
-  const T t86 = -link2_p_J_x*t79 + link2_p_J_z*t83;
-  const T t87 = link2_p_J_x*t84;
-  const T t88 = angle_c[1]*t80 - angle_s[1]*t81;
-  const T t89 = angle_c[1]*t81 + angle_s[1]*t80;
-  const T t90 = t85 + t88;
-  const T t91 = t86 + t89;
-  const T t92 = t82 + t87;
-  const T t93 = link2_R_PJ_yy*t84 + link2_R_PJ_yz*t79;
-  const T t94 = link2_R_PJ_zy*t84 + link2_R_PJ_zz*t79;
-  const T t95 = link2_R_PJ_yy*t91 + link2_R_PJ_yz*t92;
-  const T t96 = link2_R_PJ_zy*t91 + link2_R_PJ_zz*t92;
-  const T t97 = t62 + t83;
-  const T t98 = t63 + t93;
-  const T t99 = t64 + t90;
-  const T t100 = t65 + t95;
-  const T t101 = t66 + t96;
-  const T t102 = link1_R_BBp_xx*t97 + link1_R_BBp_xy*t98;
-  const T t103 = link1_R_BBp_zx*t97 + link1_R_BBp_zy*t98;
-  const T t104 = link1_R_BBp_xx*t99 + link1_R_BBp_xy*t100;
-  const T t105 = link1_R_BBp_zx*t99 + link1_R_BBp_zy*t100;
-  const T t106 = link1_o_B_y*t103;
-  const T t107 = -link1_o_B_y*t102;
-  const T t108 = t104 + t106;
-  const T t109 = t105 + t107;
-  const T t110 = link2_R_BBp_xx*t77 + link2_R_BBp_xy*t78 + link2_R_BBp_xz*t79;
-  const T t111 = link2_R_BBp_yx*t77 + link2_R_BBp_yy*t78;
-  const T t112 = link2_R_BBp_zx*t77 + link2_R_BBp_zy*t78 + link2_R_BBp_zz*t79;
-  const T t113 = link2_R_BBp_xx*t80 + link2_R_BBp_xy*t81 + link2_R_BBp_xz*t82;
-  const T t114 = link2_R_BBp_yx*t80 + link2_R_BBp_yy*t81;
-  const T t115 = link2_R_BBp_zx*t80 + link2_R_BBp_zy*t81 + link2_R_BBp_zz*t82;
-  wrenches[0] = t102;
-  wrenches[3] = t108;
-  wrenches[1] = t94;
-  wrenches[4] = t101;
-  wrenches[2] = t103;
-  wrenches[5] = t109;
-  wrenches[6] = t110;
-  wrenches[9] = t113;
-  wrenches[7] = t111;
-  wrenches[10] = t114;
-  wrenches[8] = t112;
-  wrenches[11] = t115;
+  const T t45 = link2_S0_z*t27;
+  const T t46 = link2_S0_x*w_B_link2_z - link2_S0_z*t26;
+  const T t47 = -link2_S0_x*t27;
+  const T t48 = t27*t47 - t46*w_B_link2_z;
+  const T t49 = -t26*t47 + t45*w_B_link2_z;
+  const T t50 = t26*t46 - t27*t45;
+  const T t51 = link2_J0_xx*t26 + link2_J0_xy*t27 + link2_J0_xz*w_B_link2_z;
+  const T t52 = link2_J0_xy*t26 + link2_J0_yy*t27 + link2_J0_yz*w_B_link2_z;
+  const T t53 = link2_J0_xz*t26 + link2_J0_yz*t27 + link2_J0_zz*w_B_link2_z;
+  const T t54 = t27*t53 - t52*w_B_link2_z;
+  const T t55 = -t26*t53 + t51*w_B_link2_z;
+  const T t56 = t26*t52 - t27*t51;
+  const T t57 = -link1_S0_y*udot_in[0] + t38 + t4;
+  const T t58 = link1_S0_x*udot_in[0] + t39 + t5;
+  const T t59 = link1_J0_xz*udot_in[0] - link1_S0_z*t5 + t43;
+  const T t60 = link1_J0_yz*udot_in[0] + link1_S0_z*t4 + t44;
+  const T t61 = link1_J0_zz*udot_in[0] + link1_S0_x*t5 - link1_S0_y*t4;
+  const T t62 = link2_R_PJ_zy*udot_in[0];
+  const T t63 = link2_R_PJ_zz*udot_in[0];
+  const T t64 = link2_p_J_x*t63;
+  const T t65 = -link2_p_J_x*t62;
+  const T t66 = angle_s[1]*t64;
+  const T t67 = angle_c[1]*t64;
+  const T t68 = angle_s[1]*t62;
+  const T t69 = angle_c[1]*t62;
+  const T t70 = t63 + udot_in[1];
+  const T t71 = (t32 + t69)*link2_S0_z + (t34 + t66)*link2_mass + t48;
+  const T t72 = (((t35 + t67)*link2_mass + link2_S0_x*t70) + t49) - (t31 + t68)*link2_S0_z;
+  const T t73 = (t24 + t65)*link2_mass - (t32 + t69)*link2_S0_x + t50;
+  const T t74 = (((t31 + t68)*link2_J0_xx + (t32 + t69)*link2_J0_xy) + (link2_J0_xz*t70 + t54)) - (t35 + t67)*link2_S0_z;
+  const T t75 = ((((t31 + t68)*link2_J0_xy + (t32 + t69)*link2_J0_yy) + (t34 + t66)*link2_S0_z) + (link2_J0_yz*t70 + t55)) - (t24 + t65)*link2_S0_x;
+  const T t76 = (((t31 + t68)*link2_J0_xz + (t32 + t69)*link2_J0_yz) + (t35 + t67)*link2_S0_x) + (link2_J0_zz*t70 + t56);
+  const T t77 = angle_c[1]*t71 - angle_s[1]*t72;
+  const T t78 = angle_c[1]*t72 + angle_s[1]*t71;
+  const T t79 = -link2_p_J_x*t73;
+  const T t80 = link2_p_J_x*t78;
+  const T t81 = angle_c[1]*t74 - angle_s[1]*t75;
+  const T t82 = angle_c[1]*t75 + angle_s[1]*t74;
+  const T t83 = t79 + t82;
+  const T t84 = t76 + t80;
+  const T t85 = link2_R_PJ_yy*t78 + link2_R_PJ_yz*t73;
+  const T t86 = link2_R_PJ_zy*t78 + link2_R_PJ_zz*t73;
+  const T t87 = link2_R_PJ_yy*t83 + link2_R_PJ_yz*t84;
+  const T t88 = link2_R_PJ_zy*t83 + link2_R_PJ_zz*t84;
+  const T t89 = t57 + t77;
+  const T t90 = t58 + t85;
+  const T t91 = t59 + t81;
+  const T t92 = t60 + t87;
+  const T t93 = t61 + t88;
+  const T t94 = link1_R_BBp_xx*t89 + link1_R_BBp_xy*t90;
+  const T t95 = link1_R_BBp_zx*t89 + link1_R_BBp_zy*t90;
+  const T t96 = link1_R_BBp_xx*t91 + link1_R_BBp_xy*t92;
+  const T t97 = link1_R_BBp_zx*t91 + link1_R_BBp_zy*t92;
+  const T t98 = link1_o_B_y*t95;
+  const T t99 = -link1_o_B_y*t94;
+  const T t100 = t96 + t98;
+  const T t101 = t97 + t99;
+  const T t102 = link2_R_BBp_xx*t71 + link2_R_BBp_xy*t72 + link2_R_BBp_xz*t73;
+  const T t103 = link2_R_BBp_yx*t71 + link2_R_BBp_yy*t72;
+  const T t104 = link2_R_BBp_zx*t71 + link2_R_BBp_zy*t72 + link2_R_BBp_zz*t73;
+  const T t105 = link2_R_BBp_xx*t74 + link2_R_BBp_xy*t75 + link2_R_BBp_xz*t76;
+  const T t106 = link2_R_BBp_yx*t74 + link2_R_BBp_yy*t75;
+  const T t107 = link2_R_BBp_zx*t74 + link2_R_BBp_zy*t75 + link2_R_BBp_zz*t76;
+  const T t108 = -link2_o_B_z*t103;
+  const T t109 = -link2_o_B_x*t104 + link2_o_B_z*t102;
+  const T t110 = link2_o_B_x*t103;
+  const T t111 = t105 + t108;
+  const T t112 = t106 + t109;
+  const T t113 = t107 + t110;
+  wrenches[0] = t94;
+  wrenches[3] = t100;
+  wrenches[1] = t86;
+  wrenches[4] = t93;
+  wrenches[2] = t95;
+  wrenches[5] = t101;
+  wrenches[6] = t102;
+  wrenches[9] = t111;
+  wrenches[7] = t103;
+  wrenches[10] = t112;
+  wrenches[8] = t104;
+  wrenches[11] = t113;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

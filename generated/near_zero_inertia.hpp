@@ -17,11 +17,11 @@
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
 //   mass_matrix        0 (0 add, 0 mul, 0 div, 0 func)
-//   forcing          199 (82 add, 115 mul, 0 div, 2 func)
-//   udot             270 (114 add, 154 mul, 0 div, 2 func) -- composite form; composite 270, articulated 273
-//     udot by pass: joint angles' sin and cos 2; outward pass (velocities) 53; mass and velocity terms 61; bias force 36; generalized forces (inward) 47; M u_dot = F: L^T D L along the dof tree 71
-//   energy           119 (46 add, 68 mul, 3 div, 2 func)
-//   momentum         288 (113 add, 171 mul, 1 div, 3 func)
+//   forcing          188 (77 add, 109 mul, 0 div, 2 func)
+//   udot             259 (109 add, 148 mul, 0 div, 2 func) -- composite form; composite 259, articulated 262
+//     udot by pass: joint angles' sin and cos 2; outward pass (velocities) 46; mass and velocity terms 61; bias force 36; generalized forces (inward) 43; M u_dot = F: L^T D L along the dof tree 71
+//   energy           115 (44 add, 66 mul, 3 div, 2 func)
+//   momentum         284 (111 add, 169 mul, 1 div, 3 func)
 
 #pragma once
 
@@ -64,14 +64,13 @@ inline constexpr double probe_R_PJ_xy = 0.29552020666133955;  // joint frame ori
 inline constexpr double probe_R_PJ_xz = 0.955336489125606;  // joint frame orientation in the parent
 inline constexpr double probe_R_PJ_yy = -0.955336489125606;  // joint frame orientation in the parent
 inline constexpr double probe_R_PJ_yz = 0.29552020666133955;  // joint frame orientation in the parent
-inline constexpr double probe_p_PJ_x = 0.3;  // joint frame origin in the parent x [m]
-inline constexpr double probe_p_PJ_y = 0.1;  // joint frame origin in the parent y [m]
-inline constexpr double probe_p_J_y = -0.006877586914158754;  // joint origin from the parent's origin, joint axes y [m]
-inline constexpr double probe_p_J_z = 0.3161529674038157;  // joint origin from the parent's origin, joint axes z [m]
+inline constexpr double probe_p_PJ_x = -0.0020324659062034844;  // joint frame origin in the parent x [m]
+inline constexpr double probe_p_PJ_y = 0.006570409736228647;  // joint frame origin in the parent y [m]
+inline constexpr double probe_p_J_y = -0.0068775869141587545;  // joint origin from the parent's origin, joint axes y [m]
 inline constexpr double probe_mass = 0.001;  // mass (rigid part and nodes) [kg]
-inline constexpr double probe_S0_z = 5e-05;  // first mass moment about O (undeformed) z [kg m]
-inline constexpr double probe_J0_xx = 3.3300000000000007e-06;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double probe_J0_yy = 3.3300000000000007e-06;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double probe_S0_z = 0.0003661529674038157;  // first mass moment about O (undeformed) z [kg m]
+inline constexpr double probe_J0_xx = 0.00013489799553861973;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double probe_J0_yy = 0.00013489799553861973;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double probe_J0_zz = 1e-09;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double probe_k = 1e-06;  // joint spring stiffness [N m/rad or N/m]
 
@@ -88,173 +87,161 @@ inline constexpr double bus_J0_yz = 0.014;  // inertia about O (undeformed) [kg 
 inline constexpr double bus_J0_zz = 0.81;  // inertia about O (undeformed) [kg m^2]
 
 // derived: constant subexpressions, evaluated here exactly
-inline constexpr double k0117888d = 19.771880540290038;  // = -k2d383c28*k42c83df6 + k55910245
-inline constexpr double k05032069 = 0.00999950002499875;  // = k144a06fa*k2e47b47e - k184a4b98*kbe764671 - kfb5c4d30
-inline constexpr double k0878fe78 = 0.8336207829891898;  // = 1.0/k50c55f5e + k8b22619e*k8b22619e/k402b2dd7
-inline constexpr double k09c7e7cd = 0.2003477668244563;  // = bus_S0_x + k4923f8de
-inline constexpr double k0adc6025 = 4.730120176180773e-08;  // = k539cd6f4*probe_p_J_y
-inline constexpr double k0adc6090 = -2.174369511488942e-06;  // = k539cd6f4*probe_p_J_z
-inline constexpr double k0bc33935 = 4.014933294251415e-05;  // = -k879742ae*probe_R_PJ_yy - ka1e1120f*probe_R_PJ_yz
+inline constexpr double k01f8e742 = 0.0028758886122065104;  // = k13be8a9b*k8faf47f6
+inline constexpr double k022dbcaa = 0.013371849444835252;  // = k5ed16fa9*k8faf47f6
+inline constexpr double k0420baea = 0.020004738563588472;  // = k0469d77d*ka08e2ce9
+inline constexpr double k0469d77d = 0.4001147760103331;  // = bus_S0_y + k8ff6596d
+inline constexpr double k052e42c3 = 1.2343622575541595;  // = 1.0/kdbbf6c7d
+inline constexpr double k097fb673 = 4.014961526375085e-05;  // = -k91b62dd8*probe_R_PJ_yy - kff2e485f*probe_R_PJ_yz
+inline constexpr double k0adc6025 = 4.7301201761807744e-08;  // = k539cd6f4*probe_p_J_y
+inline constexpr double k0b43e3e4 = -0.009874898060433276;  // = bus_J0_xz*k052e42c3
+inline constexpr double k0c7c1f74 = 19.910689948274854;  // = k245e92e7 - k601e0e53*k77c26862
+inline constexpr double k0ce8b981 = 0.00012812878402524312;  // = k10557130*probe_R_PJ_yz - probe_J0_yy*probe_R_PJ_yy
 inline constexpr double k0df84bc1 = 1.7910450766180863e-20;  // = k25819bb6*probe_R_PJ_yz + kea2434dd*probe_R_PJ_yy
-inline constexpr double k0e90f1e0 = 0.00011477601033306699;  // = k14056fb0*probe_R_PJ_yz + k539cd6f4*probe_R_PJ_yy
-inline constexpr double k10555159 = 1.5807648370190785e-05;  // = probe_S0_z*probe_p_J_z
-inline constexpr double k10557130 = -3.438793457079377e-07;  // = probe_S0_z*probe_p_J_y
-inline constexpr double k12632d37 = 0.020004738563588472;  // = ka08e2ce9*kf5761fb9
-inline constexpr double k13526884 = 0.010016887496847971;  // = (k09c7e7cd + k184a4b98*k5b21c82d*kb8b53809)*k6072e698
-inline constexpr double k14056fb0 = 0.00036615296740381576;  // = k539cd341 + probe_S0_z
+inline constexpr double k10557130 = -2.51824885719688e-06;  // = probe_S0_z*probe_p_J_y
+inline constexpr double k11c214cc = 0.799937126095155;  // = kd3abc6e6 - ((k1335f6d8*k1335f6d8*k5b21c82d + k41883458*k50b58ae0*k50b58ae0) + (k4d031f13*ked6c80...
+inline constexpr double k12148d65 = 0.0013691812141387143;  // = -k022dbcaa*k54d284e0 - k5517855a
+inline constexpr double k1335f6d8 = 0.020004738563588472;  // = k0469d77d*k1e3e25bc
+inline constexpr double k13be8a9b = 0.0034622241045471833;  // = k28af8ec1*k8bc05483
 inline constexpr double k144a06fa = -8.954329927711833e-24;  // = k184a4b98*k98ea08ea
-inline constexpr double k14fbf280 = 0.1664184188235314;  // = k4a3c96b2*kfe1ec95e
 inline constexpr double k184a4b98 = 8.95477764420822e-22;  // = k0df84bc1*k1e3e25bc
-inline constexpr double k19bebda5 = 0.0013691812141387143;  // = -k4ecd60cb*kec9ce579 - kc107fcce
-inline constexpr double k1bdc33d2 = -0.009874898060433276;  // = bus_J0_xz*k9e4c8ac7
-inline constexpr double k1d77e7da = 0.16038610634955258;  // = k4a3c96b2*k4ecd60cb
-inline constexpr double k1dd8b291 = 0.00159473141880304;  // = k82242927*kf1b96bf6
+inline constexpr double k1dc3abe1 = 0.00013494529674038154;  // = probe_J0_xx + probe_mass*probe_p_J_y*probe_p_J_y
 inline constexpr double k1e3e25bc = 0.049997500124993745;  // = 1.0/k5b21c82d
-inline constexpr double k20463360 = 0.010131412944381388;  // = k2e47b47e*kfb8b7a25/k50c55f5e + k78782cea*kf23f55b5/k402b2dd7 - k98ea08ea/kafe9d580
-inline constexpr double k20a2e8a0 = 1.0100132469309355;  // = bus_J0_xx + k352074fc
-inline constexpr double k213c322b = 6.661000000000001e-06;  // = probe_J0_xx + probe_J0_yy + probe_J0_zz
-inline constexpr double k219f08e1 = 0.20202471011349726;  // = k889332d2 + ka6e1530f*kec9ce579
-inline constexpr double k2372934e = 0.00013494529674038154;  // = (2.0*probe_S0_z*probe_p_J_z + probe_J0_xx) + (probe_mass*probe_p_J_y*probe_p_J_y + probe_mass*pro...
+inline constexpr double k1e6b0f41 = 0.0013560022479822016;  // = k12148d65*kc4890bf7
+inline constexpr double k1ffadf40 = 19.771880540290038;  // = -k524c9b42*keb7c4a24 + kb4d8dac2
+inline constexpr double k20b23c7e = 0.016751689098223825;  // = k51d41589/k4d031f13 + k640c4f25*ked6c80d1/k11c214cc
+inline constexpr double k210f0e31 = 0.020181591508823208;  // = k0420baea/k41883458 + k51d41589*k9b6e7658/k4d031f13 + k640c4f25*kbf507a06/k11c214cc
+inline constexpr double k213c322b = 0.00026979699107723947;  // = probe_J0_xx + probe_J0_yy + probe_J0_zz
+inline constexpr double k245e92e7 = 19.911022564233825;  // = -k292f8d31*kd3e17b9b + k70b34510
 inline constexpr double k25819bb6 = 0.000955336489125606;  // = probe_R_PJ_xz*probe_mass
-inline constexpr double k25891712 = 1.2041216993658048;  // = bus_J0_yy + k50841abc
-inline constexpr double k2659c3fe = 0.8101349452967405;  // = bus_J0_zz + kb9dd3689
-inline constexpr double k296c18b0 = 0.010016887496847971;  // = k09c7e7cd*ka08e2ce9
-inline constexpr double k2bb5e4c1 = 19.772420436753904;  // = -k1d77e7da*k4ecd60cb + k5375f7d1
-inline constexpr double k2d383c28 = 0.09853828641655699;  // = -k4d1afa91*k82242927 + kc58fc45f
-inline constexpr double k2e47b47e = 0.019967572288243488;  // = (k12632d37*k296c18b0*kfd32cd94 - k98ea08ea*kbe764671*kc613cfee + k9fa281b7)*kb0a02a3e
-inline constexpr double k2eba675b = 0.09894907300631943;  // = k4799cce7*kda3b4caa
-inline constexpr double k352074fc = 1.3246930935596236e-05;  // = k879742ae*probe_R_PJ_xy + ka1e1120f*probe_R_PJ_xz
-inline constexpr double k3688a0d6 = 1.203879764275992;  // = -bus_J0_yz*kbdb64d6e + k9b27a3cf
-inline constexpr double k39abfd5e = 2.5182488571968797e-06;  // = -probe_S0_z*probe_p_J_y - probe_mass*probe_p_J_y*probe_p_J_z
-inline constexpr double k3b8c946c = 0.09839378036288154;  // = k2eba675b - k4ecd60cb*k7a50ebb4
-inline constexpr double k402b2dd7 = 0.799937126095155;  // = k2659c3fe - ((k13526884*k13526884*kc613cfee + k50c55f5e*k8b22619e*k8b22619e) + (k5b21c82d*kb8b538...
-inline constexpr double k41521e70 = 1.0099342468337844;  // = -bus_J0_xz*k1bdc33d2 + k9320e1d4
-inline constexpr double k42c83df6 = 0.00494901415634242;  // = k2d383c28*k531ff1b5
-inline constexpr double k45aaab02 = 1.0100132460182678;  // = bus_J0_xx + k73670a3b
-inline constexpr double k4799cce7 = 0.2473017217533702;  // = k9e4c8ac7*kfe1ec95e
-inline constexpr double k4923f8de = 0.00034776682445628027;  // = -k14056fb0*probe_R_PJ_yy + k539cd6f4*probe_R_PJ_yz
-inline constexpr double k4a3c96b2 = 0.8306477354915884;  // = 1.0/k3688a0d6
-inline constexpr double k4a879de0 = 19.96765844143025;  // = -k14fbf280*kfe1ec95e + kfd32cd94
+inline constexpr double k26c3978f = 0.00013494529674038154;  // = k0adc6025 + probe_J0_xx
+inline constexpr double k28047973 = 0.03158680894370257;  // = -k12148d65*k5209e803 + kac15f232
+inline constexpr double k28af8ec1 = 0.017281071605758234;  // = bus_J0_yz*k052e42c3
+inline constexpr double k292f8d31 = 0.20202471011349726;  // = k022dbcaa*k13be8a9b + k44f0e077
+inline constexpr double k2b332454 = 0.015959850667057487;  // = bus_J0_xy - kce26d804
+inline constexpr double k2baff61d = 1.2041216993658048;  // = bus_J0_yy + kd909c71c
+inline constexpr double k30425519 = 0.4027937961849187;  // = k022dbcaa*k8bc05483 + k82f5dbb7
+inline constexpr double k30eb361e = 0.00025030568772947996;  // = ((k144a06fa*k98ea08ea/k41883458 + k184a4b98/kc613cfee) + kb80574ad*kdffb5aa1/k11c214cc) - k877e2b...
+inline constexpr double k329ef4f9 = 0.8336207829891898;  // = 1.0/k4d031f13 + ked6c80d1*ked6c80d1/k11c214cc
+inline constexpr double k37a9bd1a = 0.02490162301419597;  // = kb80574ad/k11c214cc
+inline constexpr double k398b851d = 0.09839378036288154;  // = -k01f8e742*k54d284e0 + k63679d03
+inline constexpr double k3de19718 = 1.0097189854781756;  // = -k022dbcaa*k5ed16fa9 + kd7968f9d
+inline constexpr double k41883458 = 1.0000091545237526;  // = -k0420baea*k0420baea*kfd32cd94 + k743dae4e - k98ea08ea*k98ea08ea*kc613cfee
+inline constexpr double k44ace4bf = 19.95145365231487;  // = -k56cfbabb*k8bc05483 + kfd32cd94
+inline constexpr double k44f0e077 = 0.20197841377402698;  // = -bus_S0_z - k0b43e3e4*k8bc05483
+inline constexpr double k48089f82 = 0.00036085640903815795;  // = kbf507a06/k11c214cc
 inline constexpr double k4ab06a8f = 0.9553364891256059;  // = k70ce114d*k80dbd051
-inline constexpr double k4b382fce = 0.010416333560223836;  // = k12632d37*k2e47b47e + k296c18b0
-inline constexpr double k4d1afa91 = 0.004097910226294751;  // = kb87e8e62*kf1b96bf6
-inline constexpr double k4e6825fc = 3.0242698905934806;  // = k2659c3fe + k45aaab02 + k7a44b90c
-inline constexpr double k4ecd60cb = 0.19308558790524352;  // = -bus_S0_z - kbdb64d6e*kda3b4caa
-inline constexpr double k50841abc = 0.00012169936580478528;  // = -k5bb69828*probe_R_PJ_yy - k79d8f120*probe_R_PJ_yz
-inline constexpr double k50c55f5e = 1.1997162306399165;  // = k7a44b90c - ((k296c18b0*k296c18b0*kfd32cd94 + k2e47b47e*k2e47b47e*kafe9d580) + (k5b21c82d*kfb5c4d...
-inline constexpr double k51c731a0 = 0.01595985038473625;  // = -k80dbd051*kcf881ceb + kbe3314ec
-inline constexpr double k531ff1b5 = 0.05022427663721639;  // = 1.0/k5579ef2f
-inline constexpr double k5375f7d1 = 19.803388682390242;  // = -kd447e126*kda3b4caa + kfd32cd94
-inline constexpr double k539cd341 = 0.00031615296740381574;  // = probe_mass*probe_p_J_z
-inline constexpr double k539cd6f4 = -6.877586914158754e-06;  // = probe_mass*probe_p_J_y
-inline constexpr double k5579ef2f = 19.910689948274854;  // = -k4d1afa91*kb87e8e62 + kb3b1c3c4
-inline constexpr double k55910245 = 19.772368207664456;  // = -k1dd8b291*k82242927 + kdc3c5a3d
+inline constexpr double k4ca1f3f0 = 0.9999908455600519;  // = 1.0/k41883458
+inline constexpr double k4cb985bd = 1.2041216992784725;  // = bus_J0_yy + ke99a7cdf
+inline constexpr double k4d031f13 = 1.1997162306399165;  // = k4cb985bd - ((k41883458*k51d41589*k51d41589 + k5b21c82d*kfb5c4d30*kfb5c4d30) + (kbe764671*kbe7646...
+inline constexpr double k4f519b61 = 0.00011477601033306698;  // = k539cd6f4*probe_R_PJ_yy + probe_R_PJ_yz*probe_S0_z
+inline constexpr double k50b58ae0 = 0.010003285924050998;  // = -(bus_J0_xz + k98ea08ea*kb2c40d58*kc613cfee)*k4ca1f3f0
+inline constexpr double k51d41589 = 0.019967572288243488;  // = (k0420baea*kd7079907*kfd32cd94 - k98ea08ea*kbe764671*kc613cfee + kd7d58a71)*k4ca1f3f0
+inline constexpr double k5209e803 = 0.39891673027636143;  // = k30425519*kc4890bf7
+inline constexpr double k524c9b42 = 0.00494901415634242;  // = kbab1e35c*keb7c4a24
+inline constexpr double k53513080 = 0.0986677263239434;  // = k12148d65*kd3e17b9b + k398b851d
+inline constexpr double k539cd6f4 = -6.877586914158755e-06;  // = probe_mass*probe_p_J_y
+inline constexpr double k54d284e0 = 0.19308558790524352;  // = -bus_S0_z - k28af8ec1*k82f5dbb7
+inline constexpr double k5517855a = -0.003951092625575133;  // = k0b43e3e4*k82f5dbb7
+inline constexpr double k56cfbabb = 0.2473017217533702;  // = k052e42c3*k8bc05483
 inline constexpr double k5b21c82d = 20.001;  // = bus_mass + ka7239acb
-inline constexpr double k5b847224 = 0.00036085640903815795;  // = kc99a359a/k402b2dd7
-inline constexpr double k5bb69828 = 0.00012812878402524312;  // = -k39abfd5e*probe_R_PJ_yz - k8d95fafd*probe_R_PJ_yy
-inline constexpr double k5eb42b89 = 0.00012169927847259276;  // = -k5fd87caa*probe_R_PJ_yz - k9bae49ed*probe_R_PJ_yy
-inline constexpr double k5fd87caa = 2.3917965610590575e-06;  // = -k0adc6025*probe_R_PJ_yz - kec373ccc*probe_R_PJ_yy
+inline constexpr double k5ed16fa9 = 0.016098098957582317;  // = -bus_J0_xz*k28af8ec1 + kf753938b
+inline constexpr double k5eeba388 = 0.00159473141880304;  // = k28047973*k813bfd17
+inline constexpr double k5f6d5d68 = 1.2500982481978802;  // = 1.0/k11c214cc
+inline constexpr double k601e0e53 = 0.004097910226294751;  // = k77c26862*k813bfd17
 inline constexpr double k6072e698 = 0.049997500124993745;  // = 1.0/kc613cfee
-inline constexpr double k672a5b3b = 0.019919732749080894;  // = (k13526884*k184a4b98 + kb8b53809) - (k05032069*k8b22619e + k144a06fa*k743ab252)
-inline constexpr double k67b4344c = 0.012717287463727148;  // = k78782cea/k402b2dd7
-inline constexpr double k697d935b = 0.016751689098223825;  // = k2e47b47e/k50c55f5e + k78782cea*k8b22619e/k402b2dd7
-inline constexpr double k6e38b76b = 4.0149615263750854e-05;  // = -k8502c437*probe_R_PJ_yz - kb6c51f26*probe_R_PJ_yy
+inline constexpr double k60e59134 = 0.010131412944381388;  // = k51d41589*ke0fb36af/k4d031f13 + k640c4f25*kdffb5aa1/k11c214cc - k98ea08ea/k41883458
+inline constexpr double k63679d03 = 0.09894907300631943;  // = k56cfbabb*k82f5dbb7
+inline constexpr double k640c4f25 = 0.010173030385459837;  // = k50b58ae0 + k51d41589*ked6c80d1
+inline constexpr double k64453c81 = 19.772420436753904;  // = -k54d284e0*kfa4dd229 + ke752849d
+inline constexpr double k6cc768ec = 1.0100132469309355;  // = bus_J0_xx + kc262282f
+inline constexpr double k6eebe1da = 7.963080698739598e-05;  // = k0420baea*k144a06fa/k41883458 + k877e2bc7*k9b6e7658/k4d031f13 - kb80574ad*kbf507a06/k11c214cc
+inline constexpr double k70496565 = 0.008123198817015384;  // = k877e2bc7/k4d031f13 - kb80574ad*ked6c80d1/k11c214cc
+inline constexpr double k70b34510 = 19.951443695343997;  // = -k01f8e742*k13be8a9b + k44ace4bf
 inline constexpr double k70ce114d = 999999999.9999999;  // = 1.0/probe_J0_zz
-inline constexpr double k71c4f190 = 0.9903745639945821;  // = 1.0/kaca03149
-inline constexpr double k722e46c4 = 0.012649260028516355;  // = kf23f55b5/k402b2dd7
-inline constexpr double k73670a3b = 1.3246018267788783e-05;  // = k8502c437*probe_R_PJ_xz + kb6c51f26*probe_R_PJ_xy
-inline constexpr double k743ab252 = 0.010003285924050998;  // = -(bus_J0_xz + k13526884*k98ea08ea*kc613cfee)*kb0a02a3e
-inline constexpr double k760c4453 = 0.050488228249160515;  // = (1.0/kfd32cd94 + k12632d37*k12632d37/kafe9d580) + (k4b382fce*k4b382fce/k50c55f5e + kc99a359a*kc99...
-inline constexpr double k78782cea = 0.010173030385459837;  // = k2e47b47e*k8b22619e + k743ab252
-inline constexpr double k79d8f120 = 2.391501040852396e-06;  // = -k39abfd5e*probe_R_PJ_yy - kbcb0f926*probe_R_PJ_yz
-inline constexpr double k7a44b90c = 1.2041216992784725;  // = bus_J0_yy + k5eb42b89
-inline constexpr double k7a50ebb4 = 0.0028758886122065104;  // = k4a3c96b2*ka6e1530f
-inline constexpr double k7b565e6b = 0.0005761778610914591;  // = k14fbf280*ka6e1530f
+inline constexpr double k71a6c402 = 1.0100132460182678;  // = -k4ab06a8f*k80dbd051 + k6cc768ec
+inline constexpr double k723ad1e1 = 0.012649260028516355;  // = kdffb5aa1/k11c214cc
+inline constexpr double k741ec73e = 19.96765844143025;  // = -k8bc05483*kef5ddd0e + kfd32cd94
+inline constexpr double k743dae4e = 1.0100132460182678;  // = bus_J0_xx + k7e0d36eb
+inline constexpr double k75b63310 = 19.7724185801411;  // = -k12148d65*k1e6b0f41 + k64453c81
+inline constexpr double k77c26862 = 0.08116721465459756;  // = k292f8d31*k5209e803 + k94823725
+inline constexpr double k77eb7d5e = 19.806977257280558;  // = -k30425519*k5209e803 + k741ec73e
+inline constexpr double k78bdb620 = 0.0003477668244562802;  // = k539cd6f4*probe_R_PJ_yz - probe_R_PJ_yy*probe_S0_z
+inline constexpr double k7b2a00c7 = 0.0505768785099756;  // = 1.0/k1ffadf40
 inline constexpr double k7bea668d = -0.000955336489125606;  // = probe_R_PJ_yy*probe_mass
-inline constexpr double k8094571d = 0.010627093308354731;  // = k8b22619e/k402b2dd7
+inline constexpr double k7d93dcfc = 1.000452550785749;  // = 1.0/k41883458 + k51d41589*k51d41589/k4d031f13 + k640c4f25*k640c4f25/k11c214cc
+inline constexpr double k7e0d36eb = 1.3246018267788781e-05;  // = k91b62dd8*probe_R_PJ_xy + kff2e485f*probe_R_PJ_xz
+inline constexpr double k7ea8b4d2 = 7.903373232151771e-07;  // = -k10557130*probe_R_PJ_xy + kbcb0f926*probe_R_PJ_xz
 inline constexpr double k80dbd051 = 9.55336489125606e-10;  // = probe_J0_zz*probe_R_PJ_xz
 inline constexpr double k80dcbd64 = 2.9552020666133954e-10;  // = probe_J0_zz*probe_R_PJ_yz
-inline constexpr double k82242927 = 0.03158680894370257;  // = -k19bebda5*kd3e4ee15 + kdbc276db
-inline constexpr double k8502c437 = 7.893819867260513e-07;  // = k0adc6025*probe_R_PJ_xz + kec373ccc*probe_R_PJ_xy
-inline constexpr double k879742ae = 4.22708585417524e-05;  // = k39abfd5e*probe_R_PJ_xz + k8d95fafd*probe_R_PJ_xy
-inline constexpr double k87e33c47 = 0.8335304420001137;  // = 1.0/k50c55f5e
-inline constexpr double k889332d2 = 0.20197841377402698;  // = -bus_S0_z - k1bdc33d2*kfe1ec95e
-inline constexpr double k896c0661 = 19.95145365231487;  // = -k4799cce7*kfe1ec95e + kfd32cd94
-inline constexpr double k8a1d27a2 = 0.0013560022479822016;  // = k19bebda5*k71c4f190
-inline constexpr double k8b22619e = 0.008501006479830337;  // = ((bus_J0_yz + k13526884*kbe764671*kc613cfee) + (k2e47b47e*k743ab252*kafe9d580 + k5b21c82d*kb8b538...
-inline constexpr double k8d95fafd = 0.00013489799553861973;  // = 2.0*probe_S0_z*probe_p_J_z + probe_J0_yy + probe_mass*probe_p_J_z*probe_p_J_z
-inline constexpr double k920f6e7a = 0.0002739589136447557;  // = k8b22619e*kf23f55b5/k402b2dd7 + kfb8b7a25/k50c55f5e
-inline constexpr double k9320e1d4 = 1.0100132460182678;  // = k20a2e8a0 - k4ab06a8f*k80dbd051
-inline constexpr double k93a540d0 = 0.016098098957582317;  // = -bus_J0_xz*kbdb64d6e + k51c731a0
+inline constexpr double k813bfd17 = 0.05048725946471336;  // = 1.0/k77eb7d5e
+inline constexpr double k81bfd3f1 = 0.0003477668244562802;  // = k539cd6f4*probe_R_PJ_xy + probe_R_PJ_xz*probe_S0_z
+inline constexpr double k82f5dbb7 = 0.4001147760103331;  // = bus_S0_y + k4f519b61
+inline constexpr double k877e2bc7 = 0.00999950002499875;  // = k144a06fa*k51d41589 - k184a4b98*kbe764671 - kfb5c4d30
+inline constexpr double k8bc05483 = 0.2003477668244563;  // = bus_S0_x + k81bfd3f1
+inline constexpr double k8faf47f6 = 0.8306477354915884;  // = 1.0/ked6184d6
+inline constexpr double k8ff6596d = 0.00011477601033306698;  // = -k539cd6f4*probe_R_PJ_xz + probe_R_PJ_xy*probe_S0_z
+inline constexpr double k91b62dd8 = 4.22708585417524e-05;  // = -k10557130*probe_R_PJ_xz + probe_J0_yy*probe_R_PJ_xy
+inline constexpr double k94823725 = 0.0005761778610914591;  // = k13be8a9b*kef5ddd0e
 inline constexpr double k95368a4e = 20.001;  // = bus_mass + kdb7db7cd
 inline constexpr double k954b958c = 0.9999999999999999;  // = k70ce114d*probe_J0_zz
-inline constexpr double k96d9dd7c = 0.00011576034716842896;  // = k14056fb0*probe_p_J_z
 inline constexpr double k98ea08ea = -0.00999950002499875;  // = bus_S0_z*k6072e698
-inline constexpr double k9b27a3cf = 1.2041216992784727;  // = k25891712 - k80dcbd64*kcf881ceb
-inline constexpr double k9bae49ed = 0.00012812878402524314;  // = -kb7969180*probe_R_PJ_yy - kec373ccc*probe_R_PJ_yz
-inline constexpr double k9e4c8ac7 = 1.2343622575541595;  // = 1.0/kc929d4ee
-inline constexpr double k9fa281b7 = 0.01595985038473625;  // = bus_J0_xy - k6e38b76b
+inline constexpr double k9b6e7658 = 0.010416333560223836;  // = k0420baea*k51d41589 + kd7079907
+inline constexpr double k9c6f00ee = 0.008685398759145514;  // = k9b6e7658/k4d031f13 + kbf507a06*ked6c80d1/k11c214cc
+inline constexpr double k9ca9bf06 = 0.050488228249160515;  // = (1.0/kfd32cd94 + k0420baea*k0420baea/k41883458) + (k9b6e7658*k9b6e7658/k4d031f13 + kbf507a06*kbf5...
 inline constexpr double ka08e2ce9 = 0.049997500124993745;  // = 1.0/kfd32cd94
-inline constexpr double ka16c5185 = 19.951443695343997;  // = -k7a50ebb4*ka6e1530f + k896c0661
-inline constexpr double ka1e1120f = 7.903373232151769e-07;  // = k39abfd5e*probe_R_PJ_xy + kbcb0f926*probe_R_PJ_xz
-inline constexpr double ka6e1530f = 0.0034622241045471833;  // = kbdb64d6e*kfe1ec95e
-inline constexpr double ka6f48908 = 0.008123198817015384;  // = k05032069/k50c55f5e - k672a5b3b*k8b22619e/k402b2dd7
+inline constexpr double ka1619c66 = 0.000205420482848844;  // = -k0420baea*k98ea08ea/k41883458 + k9b6e7658*ke0fb36af/k4d031f13 + kbf507a06*kdffb5aa1/k11c214cc
+inline constexpr double ka33bc8ec = 8.689749539340228e-05;  // = -k144a06fa/k41883458 - k51d41589*k877e2bc7/k4d031f13 + k640c4f25*kb80574ad/k11c214cc
 inline constexpr double ka7239acb = 0.001;  // = k25819bb6*probe_R_PJ_xz + kea2434dd*probe_R_PJ_xy
-inline constexpr double kaca03149 = 1.0097189854781756;  // = k41521e70 - k93a540d0*kec9ce579
-inline constexpr double kaee7bae0 = 0.00011580764837019077;  // = k14056fb0*probe_p_J_z + k539cd6f4*probe_p_J_y
-inline constexpr double kafe9d580 = 1.0000091545237526;  // = -k12632d37*k12632d37*kfd32cd94 + k45aaab02 - k98ea08ea*k98ea08ea*kc613cfee
-inline constexpr double kb0a02a3e = 0.9999908455600519;  // = 1.0/kafe9d580
+inline constexpr double kac15f232 = 0.0321329982368026;  // = k54d284e0*kef5ddd0e
+inline constexpr double kb011343e = 3.0242698905934806;  // = k4cb985bd + k743dae4e + kd3abc6e6
 inline constexpr double kb2a327ab = 0.00029552020666133953;  // = probe_R_PJ_yz*probe_mass
-inline constexpr double kb3b1c3c4 = 19.911022564233825;  // = -k219f08e1*kc2a315ce + ka16c5185
-inline constexpr double kb4c53bab = 0.4027937961849187;  // = kda3b4caa + kec9ce579*kfe1ec95e
-inline constexpr double kb6c51f26 = 4.227085854175241e-05;  // = kb7969180*probe_R_PJ_xy + kec373ccc*probe_R_PJ_xz
-inline constexpr double kb7969180 = 0.00013489799553861976;  // = k10555159 + k96d9dd7c + probe_J0_yy
-inline constexpr double kb87e8e62 = 0.08116721465459756;  // = k219f08e1*kd3e4ee15 + k7b565e6b
-inline constexpr double kb8b53809 = 0.020004738563588472;  // = k1e3e25bc*kf5761fb9
-inline constexpr double kb9dd3689 = 0.00013494529674038156;  // = k10555159 + kaee7bae0 + probe_J0_xx
-inline constexpr double kbcb0f926 = 4.8301201761807726e-08;  // = probe_J0_zz + probe_mass*probe_p_J_y*probe_p_J_y
-inline constexpr double kbdb64d6e = 0.017281071605758234;  // = bus_J0_yz*k9e4c8ac7
-inline constexpr double kbe3314ec = 0.015959850667057487;  // = bus_J0_xy - k0bc33935
-inline constexpr double kbe42abe4 = 0.008685398759145514;  // = k4b382fce/k50c55f5e + k8b22619e*kc99a359a/k402b2dd7
+inline constexpr double kb2c40d58 = 0.010016887496847971;  // = (k1335f6d8*k184a4b98*k5b21c82d + kfa2775da)*k6072e698
+inline constexpr double kb41935d0 = 0.012717287463727148;  // = k640c4f25/k11c214cc
+inline constexpr double kb4d8dac2 = 19.772368207664456;  // = -k28047973*k5eeba388 + k75b63310
+inline constexpr double kb7befdbe = 1.2041216992784727;  // = k2baff61d - k80dcbd64*kcf881ceb
+inline constexpr double kb7de919e = 2.3915010408523966e-06;  // = k10557130*probe_R_PJ_yy - kbcb0f926*probe_R_PJ_yz
+inline constexpr double kb80574ad = 0.019919732749080894;  // = (k1335f6d8 + k184a4b98*kb2c40d58) - (k144a06fa*k50b58ae0 + k877e2bc7*ked6c80d1)
+inline constexpr double kbab1e35c = 0.05022427663721639;  // = 1.0/k0c7c1f74
+inline constexpr double kbcb0f926 = 4.830120176180774e-08;  // = probe_J0_zz + probe_mass*probe_p_J_y*probe_p_J_y
 inline constexpr double kbe764671 = -8.954329927711833e-24;  // = (k184a4b98*k5b21c82d)*(k6072e698*kfb5c4d30)
-inline constexpr double kbff310c2 = 1.2500982481978802;  // = 1.0/k402b2dd7
-inline constexpr double kc107fcce = -0.003951092625575133;  // = k1bdc33d2*kda3b4caa
-inline constexpr double kc2a315ce = 0.2000801341947867;  // = k219f08e1*k71c4f190
-inline constexpr double kc58fc45f = 0.0986677263239434;  // = k19bebda5*kc2a315ce + k3b8c946c
+inline constexpr double kbf507a06 = 0.00028866243877900176;  // = k0420baea*k50b58ae0 + k9b6e7658*ked6c80d1
+inline constexpr double kbf73205d = 0.4938865781968916;  // = k052e42c3*k82f5dbb7
+inline constexpr double kc262282f = 1.3246930935596236e-05;  // = k7ea8b4d2*probe_R_PJ_xz + k91b62dd8*probe_R_PJ_xy
+inline constexpr double kc4890bf7 = 0.9903745639945821;  // = 1.0/k3de19718
 inline constexpr double kc613cfee = 20.001;  // = -k184a4b98*k184a4b98*k5b21c82d + k95368a4e
-inline constexpr double kc929d4ee = 0.8101349452967405;  // = bus_J0_zz + k2372934e
-inline constexpr double kc99a359a = 0.00028866243877900176;  // = k12632d37*k743ab252 + k4b382fce*k8b22619e
-inline constexpr double kc99adbfc = 8.689749539340228e-05;  // = -k05032069*k2e47b47e/k50c55f5e - k144a06fa/kafe9d580 + k672a5b3b*k78782cea/k402b2dd7
-inline constexpr double kcc1935bb = 0.020181591508823208;  // = k12632d37/kafe9d580 + k2e47b47e*k4b382fce/k50c55f5e + k78782cea*kc99a359a/k402b2dd7
-inline constexpr double kce57d488 = 0.05022551540360839;  // = (1.0/kc613cfee + k98ea08ea*k98ea08ea/kafe9d580) + (kf23f55b5*kf23f55b5/k402b2dd7 + kfb8b7a25*kfb8...
+inline constexpr double kce26d804 = 4.014933294251415e-05;  // = -k7ea8b4d2*probe_R_PJ_yz - k91b62dd8*probe_R_PJ_yy
 inline constexpr double kcf881ceb = 0.2955202066613395;  // = k70ce114d*k80dcbd64
-inline constexpr double kd3553756 = 19.806977257280558;  // = k4a879de0 - kb4c53bab*kd3e4ee15
-inline constexpr double kd3e4ee15 = 0.39891673027636143;  // = k71c4f190*kb4c53bab
-inline constexpr double kd447e126 = 0.4938865781968916;  // = k9e4c8ac7*kda3b4caa
-inline constexpr double kda3b4caa = 0.4001147760103331;  // = bus_S0_y + k0e90f1e0
-inline constexpr double kdb08d67b = 0.00034776682445628027;  // = k14056fb0*probe_R_PJ_xz + k539cd6f4*probe_R_PJ_xy
+inline constexpr double kcf920d8e = 2.391796561059058e-06;  // = -k0adc6025*probe_R_PJ_yz + k10557130*probe_R_PJ_yy
+inline constexpr double kd3abc6e6 = 0.8101349452967405;  // = bus_J0_zz + k26c3978f
+inline constexpr double kd3e17b9b = 0.2000801341947867;  // = k292f8d31*kc4890bf7
+inline constexpr double kd7079907 = 0.010016887496847971;  // = ka08e2ce9*kfa2775da
+inline constexpr double kd7968f9d = 1.0099342468337844;  // = -bus_J0_xz*k0b43e3e4 + k71a6c402
+inline constexpr double kd7d58a71 = 0.01595985038473625;  // = bus_J0_xy - k097fb673
+inline constexpr double kd909c71c = 0.00012169936580478528;  // = -k0ce8b981*probe_R_PJ_yy - kb7de919e*probe_R_PJ_yz
 inline constexpr double kdb7db7cd = 0.001;  // = k7bea668d*probe_R_PJ_yy + kb2a327ab*probe_R_PJ_yz
-inline constexpr double kdbc276db = 0.0321329982368026;  // = k14fbf280*k4ecd60cb
-inline constexpr double kdc3c5a3d = 19.7724185801411;  // = -k19bebda5*k8a1d27a2 + k2bb5e4c1
+inline constexpr double kdbbf6c7d = 0.8101349452967405;  // = bus_J0_zz + k1dc3abe1
+inline constexpr double kdea56357 = 0.05022551540360839;  // = (1.0/kc613cfee + k98ea08ea*k98ea08ea/k41883458) + (kdffb5aa1*kdffb5aa1/k11c214cc + ke0fb36af*ke0f...
 inline constexpr double kdfe11949 = 60.003;  // = k5b21c82d + k95368a4e + kfd32cd94
-inline constexpr double ke781aae0 = 0.000205420482848844;  // = -k12632d37*k98ea08ea/kafe9d580 + k4b382fce*kfb8b7a25/k50c55f5e + kc99a359a*kf23f55b5/k402b2dd7
-inline constexpr double ke8516e6d = 1.000452550785749;  // = 1.0/kafe9d580 + k2e47b47e*k2e47b47e/k50c55f5e + k78782cea*k78782cea/k402b2dd7
+inline constexpr double kdffb5aa1 = 0.01011861271444169;  // = -k50b58ae0*k98ea08ea + kb2c40d58 + ke0fb36af*ked6c80d1
+inline constexpr double ke0fb36af = 0.00019966573959545508;  // = -k51d41589*k98ea08ea + kbe764671
+inline constexpr double ke752849d = 19.803388682390242;  // = -k82f5dbb7*kbf73205d + kfd32cd94
+inline constexpr double ke9123bc2 = 0.010627093308354731;  // = ked6c80d1/k11c214cc
+inline constexpr double ke99a7cdf = 0.00012169927847259274;  // = -k0ce8b981*probe_R_PJ_yy - kcf920d8e*probe_R_PJ_yz
 inline constexpr double kea2434dd = 0.00029552020666133953;  // = probe_R_PJ_xy*probe_mass
-inline constexpr double kec373ccc = 2.5182488571968797e-06;  // = -k0adc6090 - k10557130
-inline constexpr double kec9ce579 = 0.013371849444835252;  // = k4a3c96b2*k93a540d0
-inline constexpr double kee5d4586 = 7.963080698739598e-05;  // = k05032069*k4b382fce/k50c55f5e + k12632d37*k144a06fa/kafe9d580 - k672a5b3b*kc99a359a/k402b2dd7
-inline constexpr double kf00a5655 = 0.0505768785099756;  // = 1.0/k0117888d
-inline constexpr double kf1b96bf6 = 0.05048725946471336;  // = 1.0/kd3553756
-inline constexpr double kf23f55b5 = 0.01011861271444169;  // = k13526884 - k743ab252*k98ea08ea + k8b22619e*kfb8b7a25
-inline constexpr double kf5761fb9 = 0.4001147760103331;  // = bus_S0_y + kfeed872f
-inline constexpr double kf905b68b = 0.02490162301419597;  // = k672a5b3b/k402b2dd7
-inline constexpr double kf9f5609b = 0.00025030568772947996;  // = ((k144a06fa*k98ea08ea/kafe9d580 + k184a4b98/kc613cfee) + k672a5b3b*kf23f55b5/k402b2dd7) - k050320...
+inline constexpr double keb7c4a24 = 0.09853828641655699;  // = -k28047973*k601e0e53 + k53513080
+inline constexpr double ked6184d6 = 1.203879764275992;  // = -bus_J0_yz*k28af8ec1 + kb7befdbe
+inline constexpr double ked6c80d1 = 0.008501006479830337;  // = ((bus_J0_yz + k1335f6d8*k5b21c82d*kfb5c4d30) + (k41883458*k50b58ae0*k51d41589 + kb2c40d58*kbe7646...
+inline constexpr double kef1b41a6 = 0.05057687850997559;  // = ((1.0/k5b21c82d + k144a06fa*k144a06fa/k41883458) + k184a4b98*k184a4b98/kc613cfee) + (k877e2bc7*k8...
+inline constexpr double kef5ddd0e = 0.1664184188235314;  // = k8bc05483*k8faf47f6
+inline constexpr double kf33c4598 = 0.8335304420001137;  // = 1.0/k4d031f13
+inline constexpr double kf4b44ffb = 0.0002739589136447557;  // = kdffb5aa1*ked6c80d1/k11c214cc + ke0fb36af/k4d031f13
+inline constexpr double kf753938b = 0.01595985038473625;  // = k2b332454 - k80dbd051*kcf881ceb
+inline constexpr double kfa2775da = 0.2003477668244563;  // = bus_S0_x + k78bdb620
+inline constexpr double kfa4dd229 = 0.16038610634955258;  // = k54d284e0*k8faf47f6
 inline constexpr double kfb5c4d30 = -0.00999950002499875;  // = bus_S0_z*k1e3e25bc
-inline constexpr double kfb84ce57 = 0.05057687850997559;  // = ((1.0/k5b21c82d + k05032069*k05032069/k50c55f5e) + k144a06fa*k144a06fa/kafe9d580) + (k184a4b98*k1...
-inline constexpr double kfb8b7a25 = 0.00019966573959545508;  // = -k2e47b47e*k98ea08ea + kbe764671
 inline constexpr double kfd32cd94 = 20.001;  // = bus_mass + probe_mass
-inline constexpr double kfe1ec95e = 0.2003477668244563;  // = bus_S0_x + kdb08d67b
-inline constexpr double kfeed872f = 0.00011477601033306699;  // = k14056fb0*probe_R_PJ_xy - k539cd6f4*probe_R_PJ_xz
+inline constexpr double kff2e485f = 7.893819867260514e-07;  // = k0adc6025*probe_R_PJ_xz - k10557130*probe_R_PJ_xy
 
 
 // ---- dual numbers for jacobian() ---------------------------------------------
@@ -476,42 +463,42 @@ void mass_matrix(const T* q, T* M) {
   M[2] = 0.0;
   M[3] = 0.0;
   M[4] = bus_S0_z;
-  M[5] = -kda3b4caa;
+  M[5] = -k82f5dbb7;
   M[6] = 0.0;
   M[7] = 0.0;
   M[8] = kfd32cd94;
   M[9] = 0.0;
   M[10] = -bus_S0_z;
   M[11] = 0.0;
-  M[12] = kfe1ec95e;
+  M[12] = k8bc05483;
   M[13] = 0.0;
   M[14] = 0.0;
   M[15] = 0.0;
   M[16] = kfd32cd94;
-  M[17] = kda3b4caa;
-  M[18] = -kfe1ec95e;
+  M[17] = k82f5dbb7;
+  M[18] = -k8bc05483;
   M[19] = 0.0;
   M[20] = 0.0;
   M[21] = 0.0;
   M[22] = -bus_S0_z;
-  M[23] = kda3b4caa;
-  M[24] = k20a2e8a0;
-  M[25] = kbe3314ec;
+  M[23] = k82f5dbb7;
+  M[24] = k6cc768ec;
+  M[25] = k2b332454;
   M[26] = bus_J0_xz;
   M[27] = k80dbd051;
   M[28] = bus_S0_z;
   M[29] = 0.0;
-  M[30] = -kfe1ec95e;
-  M[31] = kbe3314ec;
-  M[32] = k25891712;
+  M[30] = -k8bc05483;
+  M[31] = k2b332454;
+  M[32] = k2baff61d;
   M[33] = bus_J0_yz;
   M[34] = k80dcbd64;
-  M[35] = -kda3b4caa;
-  M[36] = kfe1ec95e;
+  M[35] = -k82f5dbb7;
+  M[36] = k8bc05483;
   M[37] = 0.0;
   M[38] = bus_J0_xz;
   M[39] = bus_J0_yz;
-  M[40] = kc929d4ee;
+  M[40] = kdbbf6c7d;
   M[41] = 0.0;
   M[42] = 0.0;
   M[43] = 0.0;
@@ -538,99 +525,96 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   // ---- body probe: outward pass (velocities)
   const T t45 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
   const T t46 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
-  const T t47 = -probe_p_J_y*t46 + probe_p_J_z*t45;
-  const T t48 = -probe_p_J_z*u[5];
-  const T t49 = probe_p_J_y*u[5];
-  const T t55 = t45*t49 - t46*t48;
-  const T t56 = t46*t47 - t49*u[5];
-  const T t57 = -t45*t47 + t48*u[5];
-  const T t58 = probe_R_PJ_xy*t23 + probe_R_PJ_yy*t24;
-  const T t59 = probe_R_PJ_xz*t23 + probe_R_PJ_yz*t24;
-  const T t60 = t25 + t55;
-  const T t61 = t56 + t58;
-  const T t62 = t57 + t59;
-  const T t63 = angle_c[0]*u[5] + angle_s[0]*t45;
-  const T t64 = angle_c[0]*t45 - angle_s[0]*u[5];
+  const T t47 = -probe_p_J_y*t46;
+  const T t48 = probe_p_J_y*u[5];
+  const T t53 = t45*t48;
+  const T t54 = t46*t47 - t48*u[5];
+  const T t55 = -t45*t47;
+  const T t56 = probe_R_PJ_xy*t23 + probe_R_PJ_yy*t24;
+  const T t57 = probe_R_PJ_xz*t23 + probe_R_PJ_yz*t24;
+  const T t58 = t25 + t53;
+  const T t59 = t54 + t56;
+  const T t60 = t55 + t57;
+  const T t61 = angle_c[0]*u[5] + angle_s[0]*t45;
+  const T t62 = angle_c[0]*t45 - angle_s[0]*u[5];
   const T w_B_probe_z = t46 + u[6];
-  const T t68 = t64*u[6];
-  const T t69 = -t63*u[6];
-  const T t71 = angle_c[0]*t60 + angle_s[0]*t61;
-  const T t72 = angle_c[0]*t61 - angle_s[0]*t60;
+  const T t66 = t62*u[6];
+  const T t67 = -t61*u[6];
+  const T t69 = angle_c[0]*t58 + angle_s[0]*t59;
+  const T t70 = angle_c[0]*t59 - angle_s[0]*t58;
   // ---- body bus: mass and velocity terms
-  const T t73 = -bus_S0_y*u[5] + bus_S0_z*u[4];
-  const T t74 = bus_S0_x*u[5] - bus_S0_z*u[3];
-  const T t75 = -bus_S0_x*u[4] + bus_S0_y*u[3];
-  const T t76 = -t74*u[5] + t75*u[4];
-  const T t77 = t73*u[5] - t75*u[3];
-  const T t78 = -t73*u[4] + t74*u[3];
-  const T t79 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5];
-  const T t80 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
-  const T t81 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5];
-  const T t82 = -t80*u[5] + t81*u[4];
-  const T t83 = t79*u[5] - t81*u[3];
-  const T t84 = -t79*u[4] + t80*u[3];
+  const T t71 = -bus_S0_y*u[5] + bus_S0_z*u[4];
+  const T t72 = bus_S0_x*u[5] - bus_S0_z*u[3];
+  const T t73 = -bus_S0_x*u[4] + bus_S0_y*u[3];
+  const T t74 = -t72*u[5] + t73*u[4];
+  const T t75 = t71*u[5] - t73*u[3];
+  const T t76 = -t71*u[4] + t72*u[3];
+  const T t77 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5];
+  const T t78 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
+  const T t79 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5];
+  const T t80 = -t78*u[5] + t79*u[4];
+  const T t81 = t77*u[5] - t79*u[3];
+  const T t82 = -t77*u[4] + t78*u[3];
   // ---- body probe: mass and velocity terms
-  const T t85 = probe_S0_z*t64;
-  const T t86 = -probe_S0_z*t63;
-  const T t87 = -t86*w_B_probe_z;
-  const T t88 = t85*w_B_probe_z;
-  const T t89 = t63*t86 - t64*t85;
-  const T t90 = probe_J0_xx*t63;
-  const T t91 = probe_J0_yy*t64;
-  const T t92 = probe_J0_zz*w_B_probe_z;
-  const T t93 = t64*t92 - t91*w_B_probe_z;
-  const T t94 = -t63*t92 + t90*w_B_probe_z;
-  const T t95 = t63*t91 - t64*t90;
+  const T t83 = probe_S0_z*t62;
+  const T t84 = -probe_S0_z*t61;
+  const T t85 = -t84*w_B_probe_z;
+  const T t86 = t83*w_B_probe_z;
+  const T t87 = t61*t84 - t62*t83;
+  const T t88 = probe_J0_xx*t61;
+  const T t89 = probe_J0_yy*t62;
+  const T t90 = probe_J0_zz*w_B_probe_z;
+  const T t91 = t62*t90 - t89*w_B_probe_z;
+  const T t92 = -t61*t90 + t88*w_B_probe_z;
+  const T t93 = t61*t89 - t62*t88;
   // ---- body bus: bias force
-  const T t96 = -bus_mass*t23 - t76;
-  const T t97 = -bus_mass*t24 - t77;
-  const T t98 = -bus_mass*t25 - t78;
-  const T t99 = -bus_S0_y*t25 + bus_S0_z*t24 - t82;
-  const T t100 = bus_S0_x*t25 - bus_S0_z*t23 - t83;
-  const T t101 = -bus_S0_x*t24 + bus_S0_y*t23 - t84;
+  const T t94 = -bus_mass*t23 - t74;
+  const T t95 = -bus_mass*t24 - t75;
+  const T t96 = -bus_mass*t25 - t76;
+  const T t97 = -bus_S0_y*t25 + bus_S0_z*t24 - t80;
+  const T t98 = bus_S0_x*t25 - bus_S0_z*t23 - t81;
+  const T t99 = -bus_S0_x*t24 + bus_S0_y*t23 - t82;
   // ---- body probe: bias force
-  const T t102 = -probe_S0_z*t69 - probe_mass*t71 - t87;
-  const T t103 = probe_S0_z*t68 - probe_mass*t72 - t88;
-  const T t104 = -probe_mass*t62 - t89;
-  const T t105 = -probe_J0_xx*t68 + probe_S0_z*t72 - t93;
-  const T t106 = -probe_J0_yy*t69 - probe_S0_z*t71 - t94;
+  const T t100 = -probe_S0_z*t67 - probe_mass*t69 - t85;
+  const T t101 = probe_S0_z*t66 - probe_mass*t70 - t86;
+  const T t102 = -probe_mass*t60 - t87;
+  const T t103 = -probe_J0_xx*t66 + probe_S0_z*t70 - t91;
+  const T t104 = -probe_J0_yy*t67 - probe_S0_z*t69 - t92;
   // ---- body probe: generalized forces (inward)
-  const T t107 = -probe_k*q[7] + tau[6];
-  const T t108 = t107 - t95;
-  const T t109 = angle_c[0]*t102 - angle_s[0]*t103;
-  const T t110 = angle_c[0]*t103 + angle_s[0]*t102;
-  const T t111 = probe_p_J_y*t104 - probe_p_J_z*t110;
-  const T t112 = probe_p_J_z*t109;
-  const T t113 = -probe_p_J_y*t109;
-  const T t114 = angle_c[0]*t105 - angle_s[0]*t106;
-  const T t115 = angle_c[0]*t106 + angle_s[0]*t105;
-  const T t116 = t111 + t114;
-  const T t117 = t112 + t115;
-  const T t118 = t113 - t95;
-  const T t119 = probe_R_PJ_xy*t110 + probe_R_PJ_xz*t104;
-  const T t120 = probe_R_PJ_yy*t110 + probe_R_PJ_yz*t104;
-  const T t121 = probe_R_PJ_xy*t117 + probe_R_PJ_xz*t118;
-  const T t122 = probe_R_PJ_yy*t117 + probe_R_PJ_yz*t118;
-  const T t123 = t119 + t96;
-  const T t124 = t120 + t97;
-  const T t125 = t109 + t98;
-  const T t126 = t121 + t99;
-  const T t127 = t100 + t122;
-  const T t128 = t101 + t116;
+  const T t105 = -probe_k*q[7] + tau[6];
+  const T t106 = t105 - t93;
+  const T t107 = angle_c[0]*t100 - angle_s[0]*t101;
+  const T t108 = angle_c[0]*t101 + angle_s[0]*t100;
+  const T t109 = probe_p_J_y*t102;
+  const T t110 = -probe_p_J_y*t107;
+  const T t111 = angle_c[0]*t103 - angle_s[0]*t104;
+  const T t112 = angle_c[0]*t104 + angle_s[0]*t103;
+  const T t113 = t109 + t111;
+  const T t114 = t110 - t93;
+  const T t115 = probe_R_PJ_xy*t108 + probe_R_PJ_xz*t102;
+  const T t116 = probe_R_PJ_yy*t108 + probe_R_PJ_yz*t102;
+  const T t117 = probe_R_PJ_xy*t112 + probe_R_PJ_xz*t114;
+  const T t118 = probe_R_PJ_yy*t112 + probe_R_PJ_yz*t114;
+  const T t119 = t115 + t94;
+  const T t120 = t116 + t95;
+  const T t121 = t107 + t96;
+  const T t122 = t117 + t97;
+  const T t123 = t118 + t98;
+  const T t124 = t113 + t99;
   // ---- body bus: generalized forces (inward)
-  const T t129 = t123 + tau[0];
-  const T t130 = t124 + tau[1];
-  const T t131 = t125 + tau[2];
-  const T t132 = t126 + tau[3];
-  const T t133 = t127 + tau[4];
-  const T t134 = t128 + tau[5];
-  F[0] = t129;
-  F[1] = t130;
-  F[2] = t131;
-  F[3] = t132;
-  F[4] = t133;
-  F[5] = t134;
-  F[6] = t108;
+  const T t125 = t119 + tau[0];
+  const T t126 = t120 + tau[1];
+  const T t127 = t121 + tau[2];
+  const T t128 = t122 + tau[3];
+  const T t129 = t123 + tau[4];
+  const T t130 = t124 + tau[5];
+  F[0] = t125;
+  F[1] = t126;
+  F[2] = t127;
+  F[3] = t128;
+  F[4] = t129;
+  F[5] = t130;
+  F[6] = t106;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
@@ -650,146 +634,143 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   // ---- body probe: outward pass (velocities)
   const T t45 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
   const T t46 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
-  const T t47 = -probe_p_J_y*t46 + probe_p_J_z*t45;
-  const T t48 = -probe_p_J_z*u[5];
-  const T t49 = probe_p_J_y*u[5];
-  const T t55 = t45*t49 - t46*t48;
-  const T t56 = t46*t47 - t49*u[5];
-  const T t57 = -t45*t47 + t48*u[5];
-  const T t58 = probe_R_PJ_xy*t23 + probe_R_PJ_yy*t24;
-  const T t59 = probe_R_PJ_xz*t23 + probe_R_PJ_yz*t24;
-  const T t60 = t25 + t55;
-  const T t61 = t56 + t58;
-  const T t62 = t57 + t59;
-  const T t63 = angle_c[0]*u[5] + angle_s[0]*t45;
-  const T t64 = angle_c[0]*t45 - angle_s[0]*u[5];
+  const T t47 = -probe_p_J_y*t46;
+  const T t48 = probe_p_J_y*u[5];
+  const T t53 = t45*t48;
+  const T t54 = t46*t47 - t48*u[5];
+  const T t55 = -t45*t47;
+  const T t56 = probe_R_PJ_xy*t23 + probe_R_PJ_yy*t24;
+  const T t57 = probe_R_PJ_xz*t23 + probe_R_PJ_yz*t24;
+  const T t58 = t25 + t53;
+  const T t59 = t54 + t56;
+  const T t60 = t55 + t57;
+  const T t61 = angle_c[0]*u[5] + angle_s[0]*t45;
+  const T t62 = angle_c[0]*t45 - angle_s[0]*u[5];
   const T w_B_probe_z = t46 + u[6];
-  const T t68 = t64*u[6];
-  const T t69 = -t63*u[6];
-  const T t71 = angle_c[0]*t60 + angle_s[0]*t61;
-  const T t72 = angle_c[0]*t61 - angle_s[0]*t60;
+  const T t66 = t62*u[6];
+  const T t67 = -t61*u[6];
+  const T t69 = angle_c[0]*t58 + angle_s[0]*t59;
+  const T t70 = angle_c[0]*t59 - angle_s[0]*t58;
   // ---- body bus: mass and velocity terms
-  const T t73 = -bus_S0_y*u[5] + bus_S0_z*u[4];
-  const T t74 = bus_S0_x*u[5] - bus_S0_z*u[3];
-  const T t75 = -bus_S0_x*u[4] + bus_S0_y*u[3];
-  const T t76 = -t74*u[5] + t75*u[4];
-  const T t77 = t73*u[5] - t75*u[3];
-  const T t78 = -t73*u[4] + t74*u[3];
-  const T t79 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5];
-  const T t80 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
-  const T t81 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5];
-  const T t82 = -t80*u[5] + t81*u[4];
-  const T t83 = t79*u[5] - t81*u[3];
-  const T t84 = -t79*u[4] + t80*u[3];
+  const T t71 = -bus_S0_y*u[5] + bus_S0_z*u[4];
+  const T t72 = bus_S0_x*u[5] - bus_S0_z*u[3];
+  const T t73 = -bus_S0_x*u[4] + bus_S0_y*u[3];
+  const T t74 = -t72*u[5] + t73*u[4];
+  const T t75 = t71*u[5] - t73*u[3];
+  const T t76 = -t71*u[4] + t72*u[3];
+  const T t77 = bus_J0_xx*u[3] + bus_J0_xy*u[4] + bus_J0_xz*u[5];
+  const T t78 = bus_J0_xy*u[3] + bus_J0_yy*u[4] + bus_J0_yz*u[5];
+  const T t79 = bus_J0_xz*u[3] + bus_J0_yz*u[4] + bus_J0_zz*u[5];
+  const T t80 = -t78*u[5] + t79*u[4];
+  const T t81 = t77*u[5] - t79*u[3];
+  const T t82 = -t77*u[4] + t78*u[3];
   // ---- body probe: mass and velocity terms
-  const T t85 = probe_S0_z*t64;
-  const T t86 = -probe_S0_z*t63;
-  const T t87 = -t86*w_B_probe_z;
-  const T t88 = t85*w_B_probe_z;
-  const T t89 = t63*t86 - t64*t85;
-  const T t90 = probe_J0_xx*t63;
-  const T t91 = probe_J0_yy*t64;
-  const T t92 = probe_J0_zz*w_B_probe_z;
-  const T t93 = t64*t92 - t91*w_B_probe_z;
-  const T t94 = -t63*t92 + t90*w_B_probe_z;
-  const T t95 = t63*t91 - t64*t90;
+  const T t83 = probe_S0_z*t62;
+  const T t84 = -probe_S0_z*t61;
+  const T t85 = -t84*w_B_probe_z;
+  const T t86 = t83*w_B_probe_z;
+  const T t87 = t61*t84 - t62*t83;
+  const T t88 = probe_J0_xx*t61;
+  const T t89 = probe_J0_yy*t62;
+  const T t90 = probe_J0_zz*w_B_probe_z;
+  const T t91 = t62*t90 - t89*w_B_probe_z;
+  const T t92 = -t61*t90 + t88*w_B_probe_z;
+  const T t93 = t61*t89 - t62*t88;
   // ---- body bus: bias force
-  const T t99 = -bus_mass*t23 - t76;
-  const T t100 = -bus_mass*t24 - t77;
-  const T t101 = -bus_mass*t25 - t78;
-  const T t102 = -bus_S0_y*t25 + bus_S0_z*t24 - t82;
-  const T t103 = bus_S0_x*t25 - bus_S0_z*t23 - t83;
-  const T t104 = -bus_S0_x*t24 + bus_S0_y*t23 - t84;
+  const T t97 = -bus_mass*t23 - t74;
+  const T t98 = -bus_mass*t24 - t75;
+  const T t99 = -bus_mass*t25 - t76;
+  const T t100 = -bus_S0_y*t25 + bus_S0_z*t24 - t80;
+  const T t101 = bus_S0_x*t25 - bus_S0_z*t23 - t81;
+  const T t102 = -bus_S0_x*t24 + bus_S0_y*t23 - t82;
   // ---- body probe: bias force
-  const T t105 = -probe_S0_z*t69 - probe_mass*t71 - t87;
-  const T t106 = probe_S0_z*t68 - probe_mass*t72 - t88;
-  const T t107 = -probe_mass*t62 - t89;
-  const T t108 = -probe_J0_xx*t68 + probe_S0_z*t72 - t93;
-  const T t109 = -probe_J0_yy*t69 - probe_S0_z*t71 - t94;
+  const T t103 = -probe_S0_z*t67 - probe_mass*t69 - t85;
+  const T t104 = probe_S0_z*t66 - probe_mass*t70 - t86;
+  const T t105 = -probe_mass*t60 - t87;
+  const T t106 = -probe_J0_xx*t66 + probe_S0_z*t70 - t91;
+  const T t107 = -probe_J0_yy*t67 - probe_S0_z*t69 - t92;
   // ---- body probe: generalized forces (inward)
-  const T t110 = -probe_k*q[7] + tau[6];
-  const T t111 = t110 - t95;
-  const T t112 = angle_c[0]*t105 - angle_s[0]*t106;
-  const T t113 = angle_c[0]*t106 + angle_s[0]*t105;
-  const T t114 = probe_p_J_y*t107 - probe_p_J_z*t113;
-  const T t115 = probe_p_J_z*t112;
-  const T t116 = -probe_p_J_y*t112;
-  const T t117 = angle_c[0]*t108 - angle_s[0]*t109;
-  const T t118 = angle_c[0]*t109 + angle_s[0]*t108;
-  const T t119 = t114 + t117;
-  const T t120 = t115 + t118;
-  const T t121 = t116 - t95;
-  const T t122 = probe_R_PJ_xy*t113 + probe_R_PJ_xz*t107;
-  const T t123 = probe_R_PJ_yy*t113 + probe_R_PJ_yz*t107;
-  const T t124 = probe_R_PJ_xy*t120 + probe_R_PJ_xz*t121;
-  const T t125 = probe_R_PJ_yy*t120 + probe_R_PJ_yz*t121;
-  const T t126 = t122 + t99;
-  const T t127 = t100 + t123;
-  const T t128 = t101 + t112;
-  const T t129 = t102 + t124;
-  const T t130 = t103 + t125;
-  const T t131 = t104 + t119;
+  const T t108 = -probe_k*q[7] + tau[6];
+  const T t109 = t108 - t93;
+  const T t110 = angle_c[0]*t103 - angle_s[0]*t104;
+  const T t111 = angle_c[0]*t104 + angle_s[0]*t103;
+  const T t112 = probe_p_J_y*t105;
+  const T t113 = -probe_p_J_y*t110;
+  const T t114 = angle_c[0]*t106 - angle_s[0]*t107;
+  const T t115 = angle_c[0]*t107 + angle_s[0]*t106;
+  const T t116 = t112 + t114;
+  const T t117 = t113 - t93;
+  const T t118 = probe_R_PJ_xy*t111 + probe_R_PJ_xz*t105;
+  const T t119 = probe_R_PJ_yy*t111 + probe_R_PJ_yz*t105;
+  const T t120 = probe_R_PJ_xy*t115 + probe_R_PJ_xz*t117;
+  const T t121 = probe_R_PJ_yy*t115 + probe_R_PJ_yz*t117;
+  const T t122 = t118 + t97;
+  const T t123 = t119 + t98;
+  const T t124 = t110 + t99;
+  const T t125 = t100 + t120;
+  const T t126 = t101 + t121;
+  const T t127 = t102 + t116;
   // ---- body bus: generalized forces (inward)
-  const T t132 = t126 + tau[0];
-  const T t133 = t127 + tau[1];
-  const T t134 = t128 + tau[2];
-  const T t135 = t129 + tau[3];
-  const T t136 = t130 + tau[4];
-  const T t137 = t131 + tau[5];
+  const T t128 = t122 + tau[0];
+  const T t129 = t123 + tau[1];
+  const T t130 = t124 + tau[2];
+  const T t131 = t125 + tau[3];
+  const T t132 = t126 + tau[4];
+  const T t133 = t127 + tau[5];
   // ---- M u_dot = F: L^T D L along the dof tree
-  const T t138 = -kcf881ceb*t111 + t136;
-  const T t139 = -k4ab06a8f*t111 + t135;
-  const T t140 = -kbdb64d6e*t137 + t138;
-  const T t141 = -k1bdc33d2*t137 + t139;
-  const T t142 = -k4799cce7*t137 + t133;
-  const T t143 = kd447e126*t137 + t132;
-  const T t144 = -kec9ce579*t140 + t141;
-  const T t145 = k14fbf280*t140 + t134;
-  const T t146 = k7a50ebb4*t140 + t142;
-  const T t147 = k1d77e7da*t140 + t143;
-  const T t148 = -kd3e4ee15*t144 + t145;
-  const T t149 = -kc2a315ce*t144 + t146;
-  const T t150 = k8a1d27a2*t144 + t147;
-  const T t151 = k4d1afa91*t148 + t149;
-  const T t152 = k1dd8b291*t148 + t150;
-  const T t153 = -k42c83df6*t151 + t152;
-  const T t154 = kf00a5655*t153;
-  const T t155 = k531ff1b5*t151;
-  const T t156 = kf1b96bf6*t148;
-  const T t157 = k71c4f190*t144;
-  const T t158 = k4a3c96b2*t140;
-  const T t159 = k9e4c8ac7*t137;
-  const T t160 = k70ce114d*t111;
-  const T t161 = -k42c83df6*t154 + t155;
-  const T t162 = k4d1afa91*t161 + t156;
-  const T t163 = k1dd8b291*t154 + t162;
-  const T t164 = -kd3e4ee15*t163 + t157;
-  const T t165 = -kc2a315ce*t161 + t164;
-  const T t166 = k8a1d27a2*t154 + t165;
-  const T t167 = -kec9ce579*t166 + t158;
-  const T t168 = k14fbf280*t163 + t167;
-  const T t169 = k7a50ebb4*t161 + t168;
-  const T t170 = k1d77e7da*t154 + t169;
-  const T t171 = -kbdb64d6e*t170 + t159;
-  const T t172 = -k1bdc33d2*t166 + t171;
-  const T t173 = -k4799cce7*t161 + t172;
-  const T t174 = kd447e126*t154 + t173;
-  const T t175 = -kcf881ceb*t170 + t160;
-  const T t176 = -k4ab06a8f*t166 + t175;
-  if (!(k0117888d > 1e-14*kfd32cd94)) return 1;
-  if (!(k5579ef2f > 1e-14*kfd32cd94)) return 2;
-  if (!(kd3553756 > 1e-14*kfd32cd94)) return 3;
-  if (!(kaca03149 > 1e-14*k20a2e8a0)) return 4;
-  if (!(k3688a0d6 > 1e-14*k25891712)) return 5;
-  if (!(kc929d4ee > 0.0)) return 6;
+  const T t134 = -kcf881ceb*t109 + t132;
+  const T t135 = -k4ab06a8f*t109 + t131;
+  const T t136 = -k28af8ec1*t133 + t134;
+  const T t137 = -k0b43e3e4*t133 + t135;
+  const T t138 = -k56cfbabb*t133 + t129;
+  const T t139 = kbf73205d*t133 + t128;
+  const T t140 = -k022dbcaa*t136 + t137;
+  const T t141 = kef5ddd0e*t136 + t130;
+  const T t142 = k01f8e742*t136 + t138;
+  const T t143 = kfa4dd229*t136 + t139;
+  const T t144 = -k5209e803*t140 + t141;
+  const T t145 = -kd3e17b9b*t140 + t142;
+  const T t146 = k1e6b0f41*t140 + t143;
+  const T t147 = k601e0e53*t144 + t145;
+  const T t148 = k5eeba388*t144 + t146;
+  const T t149 = -k524c9b42*t147 + t148;
+  const T t150 = k7b2a00c7*t149;
+  const T t151 = kbab1e35c*t147;
+  const T t152 = k813bfd17*t144;
+  const T t153 = kc4890bf7*t140;
+  const T t154 = k8faf47f6*t136;
+  const T t155 = k052e42c3*t133;
+  const T t156 = k70ce114d*t109;
+  const T t157 = -k524c9b42*t150 + t151;
+  const T t158 = k601e0e53*t157 + t152;
+  const T t159 = k5eeba388*t150 + t158;
+  const T t160 = -k5209e803*t159 + t153;
+  const T t161 = -kd3e17b9b*t157 + t160;
+  const T t162 = k1e6b0f41*t150 + t161;
+  const T t163 = -k022dbcaa*t162 + t154;
+  const T t164 = kef5ddd0e*t159 + t163;
+  const T t165 = k01f8e742*t157 + t164;
+  const T t166 = kfa4dd229*t150 + t165;
+  const T t167 = -k28af8ec1*t166 + t155;
+  const T t168 = -k0b43e3e4*t162 + t167;
+  const T t169 = -k56cfbabb*t157 + t168;
+  const T t170 = kbf73205d*t150 + t169;
+  const T t171 = -kcf881ceb*t166 + t156;
+  const T t172 = -k4ab06a8f*t162 + t171;
+  if (!(k1ffadf40 > 1e-14*kfd32cd94)) return 1;
+  if (!(k0c7c1f74 > 1e-14*kfd32cd94)) return 2;
+  if (!(k77eb7d5e > 1e-14*kfd32cd94)) return 3;
+  if (!(k3de19718 > 1e-14*k6cc768ec)) return 4;
+  if (!(ked6184d6 > 1e-14*k2baff61d)) return 5;
+  if (!(kdbbf6c7d > 0.0)) return 6;
   if (!(probe_J0_zz > 0.0)) return 7;
-  udot[0] = t154;
-  udot[1] = t161;
-  udot[2] = t163;
-  udot[3] = t166;
-  udot[4] = t170;
-  udot[5] = t174;
-  udot[6] = t176;
+  udot[0] = t150;
+  udot[1] = t157;
+  udot[2] = t159;
+  udot[3] = t162;
+  udot[4] = t166;
+  udot[5] = t170;
+  udot[6] = t172;
   return 0;
 }
 
@@ -805,38 +786,36 @@ void energy(const T* q, const T* u, T* TV) {
   // ---- body probe: outward pass (velocities)
   const T t45 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
   const T t46 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
-  const T t47 = -probe_p_J_y*t46 + probe_p_J_z*t45;
-  const T t48 = -probe_p_J_z*u[5];
-  const T t49 = probe_p_J_y*u[5];
-  const T t50 = probe_R_PJ_xy*u[0] + probe_R_PJ_yy*u[1];
-  const T t51 = probe_R_PJ_xz*u[0] + probe_R_PJ_yz*u[1];
-  const T t52 = t47 + u[2];
-  const T t53 = t48 + t50;
-  const T t54 = t49 + t51;
-  const T t63 = angle_c[0]*u[5] + angle_s[0]*t45;
-  const T t64 = angle_c[0]*t45 - angle_s[0]*u[5];
+  const T t47 = -probe_p_J_y*t46;
+  const T t48 = probe_p_J_y*u[5];
+  const T t49 = probe_R_PJ_xy*u[0] + probe_R_PJ_yy*u[1];
+  const T t50 = probe_R_PJ_xz*u[0] + probe_R_PJ_yz*u[1];
+  const T t51 = t47 + u[2];
+  const T t52 = t48 + t50;
+  const T t61 = angle_c[0]*u[5] + angle_s[0]*t45;
+  const T t62 = angle_c[0]*t45 - angle_s[0]*u[5];
   const T w_B_probe_z = t46 + u[6];
-  const T t66 = angle_c[0]*t52 + angle_s[0]*t53;
-  const T t67 = angle_c[0]*t53 - angle_s[0]*t52;
+  const T t64 = angle_c[0]*t51 + angle_s[0]*t49;
+  const T t65 = angle_c[0]*t49 - angle_s[0]*t51;
   // ---- body probe: mass and velocity terms
-  const T t92 = probe_J0_zz*w_B_probe_z;
-  const T t96 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
-  const T t97 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
-  const T t98 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
-  const T t99 = ((bus_J0_xx*u[3] + bus_J0_xy*u[4]) + (bus_J0_xz*u[5] + bus_S0_y*u[2])) - bus_S0_z*u[1];
-  const T t100 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
-  const T t101 = ((bus_J0_xz*u[3] + bus_J0_yz*u[4]) + (bus_J0_zz*u[5] + bus_S0_x*u[1])) - bus_S0_y*u[0];
-  const T t102 = ((t100*u[4] + t101*u[5]) + t96*u[0]) + ((t97*u[1] + t98*u[2]) + t99*u[3]);
-  const T t103 = probe_S0_z*t64 + probe_mass*t66;
-  const T t104 = -probe_S0_z*t63 + probe_mass*t67;
-  const T t105 = probe_mass*t54;
-  const T t106 = probe_J0_xx*t63 - probe_S0_z*t67;
-  const T t107 = probe_J0_yy*t64 + probe_S0_z*t66;
-  const T t108 = ((t103*t66 + t104*t67) + t105*t54) + ((t106*t63 + t107*t64) + t92*w_B_probe_z);
-  const T t109 = t102/2.0 + t108/2.0;
-  const T t110 = probe_k*q[7]*q[7]/2.0;
-  TV[0] = t109;
-  TV[1] = t110;
+  const T t90 = probe_J0_zz*w_B_probe_z;
+  const T t94 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
+  const T t95 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
+  const T t96 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
+  const T t97 = ((bus_J0_xx*u[3] + bus_J0_xy*u[4]) + (bus_J0_xz*u[5] + bus_S0_y*u[2])) - bus_S0_z*u[1];
+  const T t98 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
+  const T t99 = ((bus_J0_xz*u[3] + bus_J0_yz*u[4]) + (bus_J0_zz*u[5] + bus_S0_x*u[1])) - bus_S0_y*u[0];
+  const T t100 = ((t94*u[0] + t95*u[1]) + t96*u[2]) + ((t97*u[3] + t98*u[4]) + t99*u[5]);
+  const T t101 = probe_S0_z*t62 + probe_mass*t64;
+  const T t102 = -probe_S0_z*t61 + probe_mass*t65;
+  const T t103 = probe_mass*t52;
+  const T t104 = probe_J0_xx*t61 - probe_S0_z*t65;
+  const T t105 = probe_J0_yy*t62 + probe_S0_z*t64;
+  const T t106 = ((t101*t64 + t102*t65) + t103*t52) + ((t104*t61 + t105*t62) + t90*w_B_probe_z);
+  const T t107 = t100/2.0 + t106/2.0;
+  const T t108 = probe_k*q[7]*q[7]/2.0;
+  TV[0] = t107;
+  TV[1] = t108;
 }
 
 // ---- momentum: p_N[3], H_N[3] about N's origin ---------------------------------
@@ -894,68 +873,66 @@ void momentum(const T* q, const T* u, T* pH) {
   const T r_NO_N_probe_z = q[2] + t41;
   const T t45 = probe_R_PJ_xy*u[3] + probe_R_PJ_yy*u[4];
   const T t46 = probe_R_PJ_xz*u[3] + probe_R_PJ_yz*u[4];
-  const T t47 = -probe_p_J_y*t46 + probe_p_J_z*t45;
-  const T t48 = -probe_p_J_z*u[5];
-  const T t49 = probe_p_J_y*u[5];
-  const T t50 = probe_R_PJ_xy*u[0] + probe_R_PJ_yy*u[1];
-  const T t51 = probe_R_PJ_xz*u[0] + probe_R_PJ_yz*u[1];
-  const T t52 = t47 + u[2];
-  const T t53 = t48 + t50;
-  const T t54 = t49 + t51;
-  const T t63 = angle_c[0]*u[5] + angle_s[0]*t45;
-  const T t64 = angle_c[0]*t45 - angle_s[0]*u[5];
+  const T t47 = -probe_p_J_y*t46;
+  const T t48 = probe_p_J_y*u[5];
+  const T t49 = probe_R_PJ_xy*u[0] + probe_R_PJ_yy*u[1];
+  const T t50 = probe_R_PJ_xz*u[0] + probe_R_PJ_yz*u[1];
+  const T t51 = t47 + u[2];
+  const T t52 = t48 + t50;
+  const T t61 = angle_c[0]*u[5] + angle_s[0]*t45;
+  const T t62 = angle_c[0]*t45 - angle_s[0]*u[5];
   const T w_B_probe_z = t46 + u[6];
-  const T t66 = angle_c[0]*t52 + angle_s[0]*t53;
-  const T t67 = angle_c[0]*t53 - angle_s[0]*t52;
+  const T t64 = angle_c[0]*t51 + angle_s[0]*t49;
+  const T t65 = angle_c[0]*t49 - angle_s[0]*t51;
   // ---- body probe: mass and velocity terms
-  const T t92 = probe_J0_zz*w_B_probe_z;
-  const T t96 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
-  const T t97 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
-  const T t98 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
-  const T t99 = ((bus_J0_xx*u[3] + bus_J0_xy*u[4]) + (bus_J0_xz*u[5] + bus_S0_y*u[2])) - bus_S0_z*u[1];
-  const T t100 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
-  const T t101 = ((bus_J0_xz*u[3] + bus_J0_yz*u[4]) + (bus_J0_zz*u[5] + bus_S0_x*u[1])) - bus_S0_y*u[0];
-  const T t102 = t14*t96 + t15*t97 + t16*t98;
-  const T t103 = t17*t96 + t18*t97 + t19*t98;
-  const T t104 = t20*t96 + t21*t97 + t22*t98;
-  const T t105 = t100*t15 + t101*t16 + t14*t99;
-  const T t106 = t100*t18 + t101*t19 + t17*t99;
-  const T t107 = t100*t21 + t101*t22 + t20*t99;
-  const T t108 = q[1]*t104 - q[2]*t103;
-  const T t109 = -q[0]*t104 + q[2]*t102;
-  const T t110 = q[0]*t103 - q[1]*t102;
+  const T t90 = probe_J0_zz*w_B_probe_z;
+  const T t94 = -bus_S0_y*u[5] + bus_S0_z*u[4] + bus_mass*u[0];
+  const T t95 = bus_S0_x*u[5] - bus_S0_z*u[3] + bus_mass*u[1];
+  const T t96 = -bus_S0_x*u[4] + bus_S0_y*u[3] + bus_mass*u[2];
+  const T t97 = ((bus_J0_xx*u[3] + bus_J0_xy*u[4]) + (bus_J0_xz*u[5] + bus_S0_y*u[2])) - bus_S0_z*u[1];
+  const T t98 = ((bus_J0_xy*u[3] + bus_J0_yy*u[4]) + (bus_J0_yz*u[5] + bus_S0_z*u[0])) - bus_S0_x*u[2];
+  const T t99 = ((bus_J0_xz*u[3] + bus_J0_yz*u[4]) + (bus_J0_zz*u[5] + bus_S0_x*u[1])) - bus_S0_y*u[0];
+  const T t100 = t14*t94 + t15*t95 + t16*t96;
+  const T t101 = t17*t94 + t18*t95 + t19*t96;
+  const T t102 = t20*t94 + t21*t95 + t22*t96;
+  const T t103 = t14*t97 + t15*t98 + t16*t99;
+  const T t104 = t17*t97 + t18*t98 + t19*t99;
+  const T t105 = t20*t97 + t21*t98 + t22*t99;
+  const T t106 = q[1]*t102 - q[2]*t101;
+  const T t107 = -q[0]*t102 + q[2]*t100;
+  const T t108 = q[0]*t101 - q[1]*t100;
+  const T t109 = t103 + t106;
+  const T t110 = t104 + t107;
   const T t111 = t105 + t108;
-  const T t112 = t106 + t109;
-  const T t113 = t107 + t110;
-  const T t114 = probe_S0_z*t64 + probe_mass*t66;
-  const T t115 = -probe_S0_z*t63 + probe_mass*t67;
-  const T t116 = probe_mass*t54;
-  const T t117 = probe_J0_xx*t63 - probe_S0_z*t67;
-  const T t118 = probe_J0_yy*t64 + probe_S0_z*t66;
-  const T t119 = R_NB_probe_xx*t114 + R_NB_probe_xy*t115 + R_NB_probe_xz*t116;
-  const T t120 = R_NB_probe_yx*t114 + R_NB_probe_yy*t115 + R_NB_probe_yz*t116;
-  const T t121 = R_NB_probe_zx*t114 + R_NB_probe_zy*t115 + R_NB_probe_zz*t116;
-  const T t122 = R_NB_probe_xx*t117 + R_NB_probe_xy*t118 + R_NB_probe_xz*t92;
-  const T t123 = R_NB_probe_yx*t117 + R_NB_probe_yy*t118 + R_NB_probe_yz*t92;
-  const T t124 = R_NB_probe_zx*t117 + R_NB_probe_zy*t118 + R_NB_probe_zz*t92;
-  const T t125 = r_NO_N_probe_y*t121 - r_NO_N_probe_z*t120;
-  const T t126 = -r_NO_N_probe_x*t121 + r_NO_N_probe_z*t119;
-  const T t127 = r_NO_N_probe_x*t120 - r_NO_N_probe_y*t119;
+  const T t112 = probe_S0_z*t62 + probe_mass*t64;
+  const T t113 = -probe_S0_z*t61 + probe_mass*t65;
+  const T t114 = probe_mass*t52;
+  const T t115 = probe_J0_xx*t61 - probe_S0_z*t65;
+  const T t116 = probe_J0_yy*t62 + probe_S0_z*t64;
+  const T t117 = R_NB_probe_xx*t112 + R_NB_probe_xy*t113 + R_NB_probe_xz*t114;
+  const T t118 = R_NB_probe_yx*t112 + R_NB_probe_yy*t113 + R_NB_probe_yz*t114;
+  const T t119 = R_NB_probe_zx*t112 + R_NB_probe_zy*t113 + R_NB_probe_zz*t114;
+  const T t120 = R_NB_probe_xx*t115 + R_NB_probe_xy*t116 + R_NB_probe_xz*t90;
+  const T t121 = R_NB_probe_yx*t115 + R_NB_probe_yy*t116 + R_NB_probe_yz*t90;
+  const T t122 = R_NB_probe_zx*t115 + R_NB_probe_zy*t116 + R_NB_probe_zz*t90;
+  const T t123 = r_NO_N_probe_y*t119 - r_NO_N_probe_z*t118;
+  const T t124 = -r_NO_N_probe_x*t119 + r_NO_N_probe_z*t117;
+  const T t125 = r_NO_N_probe_x*t118 - r_NO_N_probe_y*t117;
+  const T t126 = t120 + t123;
+  const T t127 = t121 + t124;
   const T t128 = t122 + t125;
-  const T t129 = t123 + t126;
-  const T t130 = t124 + t127;
+  const T t129 = t100 + t117;
+  const T t130 = t101 + t118;
   const T t131 = t102 + t119;
-  const T t132 = t103 + t120;
-  const T t133 = t104 + t121;
+  const T t132 = t109 + t126;
+  const T t133 = t110 + t127;
   const T t134 = t111 + t128;
-  const T t135 = t112 + t129;
-  const T t136 = t113 + t130;
-  pH[0] = t131;
-  pH[1] = t132;
-  pH[2] = t133;
-  pH[3] = t134;
-  pH[4] = t135;
-  pH[5] = t136;
+  pH[0] = t129;
+  pH[1] = t130;
+  pH[2] = t131;
+  pH[3] = t132;
+  pH[4] = t133;
+  pH[5] = t134;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

@@ -16,12 +16,12 @@
 //
 // Operation counts (add + mul + div + sqrt/sin/cos):
 //   qdot             109 (32 add, 64 mul, 13 div, 0 func)
-//   mass_matrix     1227 (579 add, 616 mul, 0 div, 32 func)
-//   forcing         2087 (847 add, 1208 mul, 0 div, 32 func)
-//   udot            4391 (1915 add, 2433 mul, 11 div, 32 func) -- composite form; composite 4391, articulated 4643; compact code: 26 kernels (3562 operations of code), 34 calls, workspace 738 (678 values)
-//     udot by pass: joint angles' sin and cos 32; outward pass (velocities) 697; mass and velocity terms 397; composite inertia (inward) 981; its columns of M (walked to the root) 214; bias force 320; generalized forces (inward) 641; M u_dot = F: L^T D L along the dof tree 1109
-//   energy          1140 (432 add, 643 mul, 33 div, 32 func)
-//   momentum        2524 (1049 add, 1441 mul, 1 div, 33 func)
+//   mass_matrix     1184 (556 add, 596 mul, 0 div, 32 func)
+//   forcing         2038 (824 add, 1182 mul, 0 div, 32 func)
+//   udot            4299 (1869 add, 2387 mul, 11 div, 32 func) -- composite form; composite 4299, articulated 4455; compact code: 25 kernels (3326 operations of code), 34 calls, workspace 738 (678 values)
+//     udot by pass: joint angles' sin and cos 32; outward pass (velocities) 668; mass and velocity terms 397; composite inertia (inward) 958; its columns of M (walked to the root) 194; bias force 320; generalized forces (inward) 621; M u_dot = F: L^T D L along the dof tree 1109
+//   energy          1120 (422 add, 633 mul, 33 div, 32 func)
+//   momentum        2474 (1024 add, 1416 mul, 1 div, 33 func)
 
 #pragma once
 
@@ -98,17 +98,14 @@ inline constexpr double app3_R_PJ_xy = 0.7071067811865474;  // joint frame orien
 inline constexpr double app3_R_PJ_xz = 0.7071067811865477;  // joint frame orientation in the parent
 inline constexpr double app3_R_PJ_yy = -0.7071067811865477;  // joint frame orientation in the parent
 inline constexpr double app3_R_PJ_yz = 0.7071067811865474;  // joint frame orientation in the parent
-inline constexpr double app3_p_PJ_x = 0.424264;  // joint frame origin in the parent x [m]
-inline constexpr double app3_p_PJ_y = 0.424264;  // joint frame origin in the parent y [m]
 inline constexpr double app3_p_PJ_z = 0.1;  // joint frame origin in the parent z [m]
 inline constexpr double app3_p_J_x = 0.1;  // joint origin from the parent's origin, joint axes x [m]
-inline constexpr double app3_p_J_z = 0.5999999028266587;  // joint origin from the parent's origin, joint axes z [m]
 inline constexpr double app3_mass = 0.8;  // mass (rigid part and nodes) [kg]
 inline constexpr double app3_S0_x = 0.024;  // first mass moment about O (undeformed) x [kg m]
-inline constexpr double app3_S0_z = 0.30000000000000004;  // first mass moment about O (undeformed) z [kg m]
-inline constexpr double app3_J0_xx = 0.15;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app3_J0_xz = -0.009;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app3_J0_yy = 0.15072000000000002;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app3_S0_z = 0.779999922261327;  // first mass moment about O (undeformed) z [kg m]
+inline constexpr double app3_J0_xx = 0.7979998484095953;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app3_J0_xz = -0.02339999766783981;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app3_J0_yy = 0.7987198484095952;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app3_J0_zz = 0.0008800000000000096;  // inertia about O (undeformed) [kg m^2]
 
 // body app4: revolute joint to hub, mass 0.9 kg
@@ -146,19 +143,18 @@ inline constexpr double app6_R_PJ_xy = 0.923879532511287;  // joint frame orient
 inline constexpr double app6_R_PJ_xz = -0.38268343236508895;  // joint frame orientation in the parent
 inline constexpr double app6_R_PJ_yy = 0.38268343236508895;  // joint frame orientation in the parent
 inline constexpr double app6_R_PJ_yz = 0.923879532511287;  // joint frame orientation in the parent
-inline constexpr double app6_p_PJ_x = -0.22961;  // joint frame origin in the parent x [m]
-inline constexpr double app6_p_PJ_y = 0.554328;  // joint frame origin in the parent y [m]
+inline constexpr double app6_p_PJ_x = 1.4988666613424684e-07;  // joint frame origin in the parent x [m]
+inline constexpr double app6_p_PJ_y = 6.208509018001962e-08;  // joint frame origin in the parent y [m]
 inline constexpr double app6_p_PJ_z = -0.1;  // joint frame origin in the parent z [m]
 inline constexpr double app6_p_J_x = -0.1;  // joint origin from the parent's origin, joint axes x [m]
-inline constexpr double app6_p_J_y = 1.6223615845190054e-07;  // joint origin from the parent's origin, joint axes y [m]
-inline constexpr double app6_p_J_z = 0.6000002364032647;  // joint origin from the parent's origin, joint axes z [m]
+inline constexpr double app6_p_J_y = 1.622361584465693e-07;  // joint origin from the parent's origin, joint axes y [m]
 inline constexpr double app6_mass = 0.6;  // mass (rigid part and nodes) [kg]
 inline constexpr double app6_S0_x = 0.018;  // first mass moment about O (undeformed) x [kg m]
-inline constexpr double app6_S0_z = 0.21;  // first mass moment about O (undeformed) z [kg m]
-inline constexpr double app6_J0_xx = 0.09799999999999998;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app6_J0_xz = -0.006299999999999999;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app6_J0_yy = 0.09853999999999999;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app6_J0_zz = 0.0006599999999999988;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app6_S0_z = 0.5700001418419588;  // first mass moment about O (undeformed) z [kg m]
+inline constexpr double app6_J0_xx = 0.5660002694997552;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app6_J0_xz = -0.017100004255258764;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app6_J0_yy = 0.5665402694997552;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app6_J0_zz = 0.0006600000000000072;  // inertia about O (undeformed) [kg m^2]
 
 // body app7: revolute joint to hub, mass 0.7 kg
 inline constexpr double app7_R_PJ_xx = -0.7071067811865441;  // joint frame orientation in the parent
@@ -200,17 +196,15 @@ inline constexpr double app8_R_PJ_xx_C2 = 0.7071067811865488;  // a turn's cos o
 inline constexpr double app8_k = 2;  // joint spring stiffness [N m/rad or N/m]
 
 // body app9: revolute joint to hub, mass 0.9 kg
-inline constexpr double app9_p_PJ_x = -0.6;  // joint frame origin in the parent x [m]
 inline constexpr double app9_p_PJ_z = 0.1;  // joint frame origin in the parent z [m]
 inline constexpr double app9_p_J_x = 0.1;  // joint origin from the parent's origin, joint axes x [m]
-inline constexpr double app9_p_J_z = 0.6;  // joint origin from the parent's origin, joint axes z [m]
 inline constexpr double app9_mass = 0.9;  // mass (rigid part and nodes) [kg]
 inline constexpr double app9_S0_x = 0.027;  // first mass moment about O (undeformed) x [kg m]
-inline constexpr double app9_S0_z = 0.29250000000000004;  // first mass moment about O (undeformed) z [kg m]
-inline constexpr double app9_J0_xx = 0.12675050000000002;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app9_J0_xz = -0.008775;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app9_J0_yy = 0.12756050000000002;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app9_J0_zz = 0.0009899999999999983;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app9_S0_z = 0.8325;  // first mass moment about O (undeformed) z [kg m]
+inline constexpr double app9_J0_xx = 0.8017505000000001;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app9_J0_xz = -0.024975;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app9_J0_yy = 0.8025605000000001;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app9_J0_zz = 0.0009900000000000106;  // inertia about O (undeformed) [kg m^2]
 
 // body app10: revolute joint to hub, mass 0.5 kg
 inline constexpr double app10_R_PJ_xx = -0.9238795325112859;  // joint frame orientation in the parent
@@ -256,19 +250,18 @@ inline constexpr double app12_R_PJ_xy = -0.9238795325112885;  // joint frame ori
 inline constexpr double app12_R_PJ_xz = -0.3826834323650854;  // joint frame orientation in the parent
 inline constexpr double app12_R_PJ_yy = 0.3826834323650854;  // joint frame orientation in the parent
 inline constexpr double app12_R_PJ_yz = -0.9238795325112885;  // joint frame orientation in the parent
-inline constexpr double app12_p_PJ_x = -0.22961;  // joint frame origin in the parent x [m]
-inline constexpr double app12_p_PJ_y = -0.554328;  // joint frame origin in the parent y [m]
+inline constexpr double app12_p_PJ_x = 1.498866640248231e-07;  // joint frame origin in the parent x [m]
+inline constexpr double app12_p_PJ_y = -6.20850891808189e-08;  // joint frame origin in the parent y [m]
 inline constexpr double app12_p_PJ_z = -0.1;  // joint frame origin in the parent z [m]
 inline constexpr double app12_p_J_x = -0.1;  // joint origin from the parent's origin, joint axes x [m]
-inline constexpr double app12_p_J_y = -1.6223615612043218e-07;  // joint origin from the parent's origin, joint axes y [m]
-inline constexpr double app12_p_J_z = 0.6000002364032648;  // joint origin from the parent's origin, joint axes z [m]
+inline constexpr double app12_p_J_y = -1.6223615611533834e-07;  // joint origin from the parent's origin, joint axes y [m]
 inline constexpr double app12_mass = 0.7;  // mass (rigid part and nodes) [kg]
 inline constexpr double app12_S0_x = 0.020999999999999998;  // first mass moment about O (undeformed) x [kg m]
-inline constexpr double app12_S0_z = 0.21;  // first mass moment about O (undeformed) z [kg m]
-inline constexpr double app12_J0_xx = 0.084;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app12_J0_xz = -0.006299999999999999;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app12_J0_yy = 0.08463;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app12_J0_zz = 0.0007699999999999986;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app12_S0_z = 0.6300001654822853;  // first mass moment about O (undeformed) z [kg m]
+inline constexpr double app12_J0_xx = 0.5880002978681529;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app12_J0_xz = -0.018900004964468562;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app12_J0_yy = 0.5886302978681528;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app12_J0_zz = 0.0007700000000000083;  // inertia about O (undeformed) [kg m^2]
 
 // body app13: revolute joint to hub, mass 0.8 kg
 inline constexpr double app13_p_PJ_y = -0.6;  // joint frame origin in the parent y [m]
@@ -309,17 +302,14 @@ inline constexpr double app15_R_PJ_xy = -0.7071067811865465;  // joint frame ori
 inline constexpr double app15_R_PJ_xz = 0.7071067811865486;  // joint frame orientation in the parent
 inline constexpr double app15_R_PJ_yy = -0.7071067811865486;  // joint frame orientation in the parent
 inline constexpr double app15_R_PJ_yz = -0.7071067811865465;  // joint frame orientation in the parent
-inline constexpr double app15_p_PJ_x = 0.424264;  // joint frame origin in the parent x [m]
-inline constexpr double app15_p_PJ_y = -0.424264;  // joint frame origin in the parent y [m]
 inline constexpr double app15_p_PJ_z = 0.1;  // joint frame origin in the parent z [m]
 inline constexpr double app15_p_J_x = 0.1;  // joint origin from the parent's origin, joint axes x [m]
-inline constexpr double app15_p_J_z = 0.5999999028266587;  // joint origin from the parent's origin, joint axes z [m]
 inline constexpr double app15_mass = 0.5;  // mass (rigid part and nodes) [kg]
 inline constexpr double app15_S0_x = 0.015;  // first mass moment about O (undeformed) x [kg m]
-inline constexpr double app15_S0_z = 0.1875;  // first mass moment about O (undeformed) z [kg m]
-inline constexpr double app15_J0_xx = 0.0937505;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app15_J0_xz = -0.005625;  // inertia about O (undeformed) [kg m^2]
-inline constexpr double app15_J0_yy = 0.0942005;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app15_S0_z = 0.48749995141332936;  // first mass moment about O (undeformed) z [kg m]
+inline constexpr double app15_J0_xx = 0.498750405255997;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app15_J0_xz = -0.01462499854239988;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app15_J0_yy = 0.499200405255997;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app15_J0_zz = 0.000550000000000006;  // inertia about O (undeformed) [kg m^2]
 
 // body app16: revolute joint to hub, mass 0.6 kg
@@ -352,7 +342,6 @@ inline constexpr double hub_J0_yz = 0.02;  // inertia about O (undeformed) [kg m
 inline constexpr double hub_J0_zz = 9.012;  // inertia about O (undeformed) [kg m^2]
 
 // derived: constant subexpressions, evaluated here exactly
-inline constexpr double k00da5c78 = 0.5266114645763161;  // = app6_R_PJ_yz*ka5a4ff5d
 inline constexpr double k00e8ba04 = 2.5000000000000004;  // = app4_S0_x*kc660aa80
 inline constexpr double k00ed9eb2 = 0.5543277195067715;  // = app16_R_PJ_yz*app16_mass
 inline constexpr double k01b026f4 = 0.07188;  // = -app16_J0_xx + app16_J0_yy
@@ -360,51 +349,39 @@ inline constexpr double k01df5890 = 69.8;  // = app3_mass + k252cdcab
 inline constexpr double k0417a482 = 68.1;  // = app5_mass + kbc8e7f4e
 inline constexpr double k056ef3a0 = 0.0703165;  // = -app5_J0_xx + app5_J0_yy
 inline constexpr double k05b7a508 = 0.0050000000000131615;  // = k5453f2f0 + k82f3193c
-inline constexpr double k06ff8039 = 0.21600017021038412;  // = app6_mass*app6_p_J_z*app6_p_J_z
 inline constexpr double k07abff12 = 5.587658166136983e-08;  // = app4_R_PJ_yz*kf1b1ba1b
-inline constexpr double k086a3f65 = 1010.1010101010119;  // = 1.0/app9_J0_zz
+inline constexpr double k086a3f65 = 1010.1010101009992;  // = 1.0/app9_J0_zz
 inline constexpr double k09d36bcf = 0.05;  // = app15_mass*app15_p_J_x
-inline constexpr double k09d36c55 = 0.29999995141332936;  // = app15_mass*app15_p_J_z
-inline constexpr double k0f4e317c = 0.17999994169599995;  // = app15_mass*app15_p_J_z*app15_p_J_z
 inline constexpr double k0fb06a45 = 0.08438000000000001;  // = -app1_J0_xx + app1_J0_yy
 inline constexpr double k123e673f = 0.18000014184200006;  // = k526ce869 + k5453f2f0
 inline constexpr double k138bca40 = 0.08156699999999999;  // = -app10_J0_xx + app10_J0_yy
 inline constexpr double k1696d187 = 61.1;  // = app15_mass + k581864f6
 inline constexpr double k17465638 = 2.307697769698863;  // = app5_S0_x*k509c11c6
-inline constexpr double k17b32ea7 = 1298.701298701301;  // = 1.0/app12_J0_zz
+inline constexpr double k17b32ea7 = 1298.7012987012847;  // = 1.0/app12_J0_zz
 inline constexpr double k187c3973 = 0.102512626584706;  // = app12_R_PJ_xz*kc06872e4
 inline constexpr double k19cb1206 = 0.44999999999999996;  // = app16_mass - kce978826
-inline constexpr double k1a292250 = 1.0220880520308216e-07;  // = -k88427b02 - kf6123610
 inline constexpr double k1cd8abda = 62.8;  // = app13_mass + k2061fed8
-inline constexpr double k1ee2b732 = 0.188501;  // = app15_J0_xx + app15_J0_yy + app15_J0_zz
+inline constexpr double k1ee2b732 = 0.998500810511994;  // = app15_J0_xx + app15_J0_yy + app15_J0_zz
 inline constexpr double k1eed7dbb = 0.3999999999999998;  // = app3_R_PJ_yz*k8df9c22a
 inline constexpr double k1efc121e = 0.14412;  // = app16_J0_xx + app16_J0_yy + app16_J0_zz
 inline constexpr double k2061fed8 = 62;  // = app14_mass + k1696d187
 inline constexpr double k20dca6d0 = 66.3;  // = app8_mass + k8b49cdad
-inline constexpr double k2147d6ad = -0.24109062571733275;  // = app12_R_PJ_xz*kfc7bedef
 inline constexpr double k215d1cf1 = 0.3065;  // = app1_J0_zz + ke967616b + keb4a28fb
-inline constexpr double k218840d1 = 0.5727272727272736;  // = app12_mass - ka93bf3bc
-inline constexpr double k21d30aad = 0.42000016548228536;  // = app12_mass*app12_p_J_z
-inline constexpr double k21d317f8 = -1.1356530928430253e-07;  // = app12_mass*app12_p_J_y
+inline constexpr double k218840d1 = 0.5727272727272664;  // = app12_mass - ka93bf3bc
+inline constexpr double k21d317f8 = -1.1356530928073684e-07;  // = app12_mass*app12_p_J_y
 inline constexpr double k21d31807 = -0.06999999999999999;  // = app12_mass*app12_p_J_x
 inline constexpr double k227ced49 = 0.6545454545454474;  // = app3_mass - k6fac1021
 inline constexpr double k22849c36 = 2.3688514581890515e-14;  // = app4_mass*app4_p_J_z*app4_p_J_z
-inline constexpr double k2372ebd5 = 0.324;  // = app9_mass*app9_p_J_z*app9_p_J_z
-inline constexpr double k2462394e = 0.08325;  // = kbb35569c + kd089a616
 inline constexpr double k252cdcab = 69;  // = app4_mass + k0417a482
-inline constexpr double k2565049d = 0.24545454545454276;  // = app3_S0_z - k27dbf138
-inline constexpr double k26ed7363 = 0.34471452147247816;  // = app15_R_PJ_xz*k7d1ed90d
+inline constexpr double k2565049d = 0.6381817545774424;  // = app3_S0_z - k27dbf138
 inline constexpr double k2701700d = -0.4619397662556429;  // = app10_R_PJ_yz*app10_mass
-inline constexpr double k27ab12de = 0.4680002694997711;  // = 2.0*kf7719834 + k06ff8039 + k2e069f71
-inline constexpr double k27dbf138 = 0.05454545454545729;  // = app3_J0_xz*k464392e4 + app3_S0_z
+inline constexpr double k27dbf138 = 0.14181816768388458;  // = app3_J0_xz*k464392e4 + app3_S0_z
 inline constexpr double k298b260d = 27.272727272726975;  // = app15_S0_x*kf4d45cb3
 inline constexpr double k2b535d60 = 8.746381184784797;  // = 1.0/app2_J0_zz
 inline constexpr double k2c1ae18a = 9.734169625352784e-09;  // = app16_mass*app16_p_J_y*app16_p_J_z
 inline constexpr double k2c1ae737 = 0.006;  // = app16_mass*app16_p_J_y*app16_p_J_y
-inline constexpr double k2e06983c = 5.84050400545787e-08;  // = app6_mass*app6_p_J_y*app6_p_J_z
-inline constexpr double k2e069f71 = 1.5792342665538106e-14;  // = app6_mass*app6_p_J_y*app6_p_J_y
+inline constexpr double k2e069f71 = 1.5792342664500205e-14;  // = app6_mass*app6_p_J_y*app6_p_J_y
 inline constexpr double k2e149664 = 0.007;  // = app2_mass*app2_p_J_z*app2_p_J_z
-inline constexpr double k2e8d5174 = 0.6479998484095952;  // = 2.0*ke54b765e + ke2882043
 inline constexpr double k2ed3eaea = 2.142848396537157;  // = app10_S0_x*kc3e4e4c4
 inline constexpr double k2ef966cc = -0.22961005941905335;  // = app6_R_PJ_xz*app6_mass
 inline constexpr double k2f27ebe6 = 0.3444150891285829;  // = app4_R_PJ_yz*app4_mass
@@ -422,7 +399,6 @@ inline constexpr double k36a43f36 = 0.005000000000000001;  // = app5_mass*app5_p
 inline constexpr double k36e67de4 = 0.5121320343559632;  // = app16_R_PJ_yz*k00ed9eb2
 inline constexpr double k37714853 = 0.22500000000000003;  // = -app14_S0_x*kcfd50b69 + app14_mass
 inline constexpr double k37abbdd7 = 0.3240002553156;  // = k22849c36 + k6ac7868d
-inline constexpr double k37ee0a3f = 0.5515432343559643;  // = app3_R_PJ_xz*k8b9d235e
 inline constexpr double k384e2939 = 0.11250700000000002;  // = -app13_J0_xx + app13_J0_yy
 inline constexpr double k396ac4b4 = -0.08000000000000002;  // = app8_mass*app8_p_J_z
 inline constexpr double k396ac5de = 0.48000018912261205;  // = app8_mass*app8_p_J_x
@@ -430,46 +406,40 @@ inline constexpr double k396adaad = 1.2978892676152044e-07;  // = app8_mass*app8
 inline constexpr double k3e210c7b = 9.734169625352784e-08;  // = app16_mass*app16_p_J_z
 inline constexpr double k3e21148e = 0.06;  // = app16_mass*app16_p_J_y
 inline constexpr double k3e2117d1 = 0.36000014184195894;  // = app16_mass*app16_p_J_x
-inline constexpr double k3e8288d3 = 0.1090909090909082;  // = -app6_S0_x*k7eecddfc + app6_mass
-inline constexpr double k3ec33457 = 0.479999922261327;  // = app3_mass*app3_p_J_z
+inline constexpr double k3e8288d3 = 0.10909090909091447;  // = -app6_S0_x*k7eecddfc + app6_mass
 inline constexpr double k3ec33d3d = 0.08000000000000002;  // = app3_mass*app3_p_J_x
-inline constexpr double k3fd7e6e2 = 0.0005400000000000127;  // = -app6_J0_xx + app6_J0_yy
-inline constexpr double k40194504 = 0.2393181818181822;  // = app9_S0_z - k5ad31814
+inline constexpr double k3fd7e6e2 = 0.0005399999999999849;  // = -app6_J0_xx + app6_J0_yy
+inline constexpr double k40194504 = 0.6811363636363563;  // = app9_S0_z - k5ad31814
 inline constexpr double k40d5d0f2 = 0.21600017021040008;  // = kc6502646 + kfa4e2778
 inline constexpr double k41401011 = 0.3284999300352;  // = app11_J0_zz + k30cd45f3
 inline constexpr double k41c850c7 = 0.1311095;  // = -app7_J0_xx + app7_J0_yy
 inline constexpr double k4365f15c = 6.802721088435375;  // = 1.0/app14_J0_zz
 inline constexpr double k4464ab3a = 0.005000000000000001;  // = app15_mass*app15_p_J_x*app15_p_J_x
-inline constexpr double k4464d690 = 0.029999995141332936;  // = app15_mass*app15_p_J_x*app15_p_J_z
-inline constexpr double k4592495f = -9.545454545454563;  // = app6_J0_xz*kfdd24f5a
+inline constexpr double k4592495f = -25.909097356452392;  // = app6_J0_xz*kfdd24f5a
 inline constexpr double k464392e4 = 27.272727272726975;  // = app3_S0_x*k581eff3e
-inline constexpr double k474da613 = 0.07799999222613271;  // = kcda7f4e2 + ke54b48f4
 inline constexpr double k48024c3f = 0.4090909090909046;  // = app15_mass - kb484462b
 inline constexpr double k4856677c = 0.39999999999999997;  // = app3_R_PJ_yz*k4a714f15
 inline constexpr double k493f3cc1 = 0.008000000000000002;  // = app13_mass*app13_p_J_y*app13_p_J_y
 inline constexpr double k4a714f15 = 0.5656854249492381;  // = app3_R_PJ_xz*app3_mass
 inline constexpr double k4b36588b = -0.06;  // = app6_mass*app6_p_J_x
-inline constexpr double k4b365911 = 0.36000014184195883;  // = app6_mass*app6_p_J_z
-inline constexpr double k4b3669f8 = 9.734169507114032e-08;  // = app6_mass*app6_p_J_y
+inline constexpr double k4b3669f8 = 9.734169506794159e-08;  // = app6_mass*app6_p_J_y
 inline constexpr double k4da28d79 = 0.5250015306167073;  // = app2_mass - kc9fed1e7
 inline constexpr double k4df735bc = 0.12499911242393476;  // = -app5_S0_x*k17465638 + app5_mass
-inline constexpr double k4e3dc307 = 0.03622209090909154;  // = app15_J0_xx - app15_J0_xz*k71865801
+inline constexpr double k4e3dc307 = 0.10985843731927647;  // = app15_J0_xx - app15_J0_xz*k71865801
 inline constexpr double k4e667183 = -0.05400002127629385;  // = app14_mass*app14_p_J_x*app14_p_J_z
 inline constexpr double k4e6672ed = 0.32400025531557647;  // = app14_mass*app14_p_J_x*app14_p_J_x
 inline constexpr double k4e66775e = -8.760755900273088e-08;  // = app14_mass*app14_p_J_x*app14_p_J_y
-inline constexpr double k50067db4 = 0.0008100000000000052;  // = -app9_J0_xx + app9_J0_yy
+inline constexpr double k50067db4 = 0.0008099999999999774;  // = -app9_J0_xx + app9_J0_yy
 inline constexpr double k501472cf = 0.2500000000000007;  // = app15_R_PJ_xz*k6218aeff
 inline constexpr double k509c11c6 = 14.201217044300694;  // = 1.0/app5_J0_zz
 inline constexpr double k526ce869 = 0.1800001418419869;  // = app10_mass*app10_p_J_x*app10_p_J_x
 inline constexpr double k526ce8ba = 0.03000001182016325;  // = app10_mass*app10_p_J_x*app10_p_J_y
 inline constexpr double k526ce90f = -4.8670867311669605e-08;  // = app10_mass*app10_p_J_x*app10_p_J_z
-inline constexpr double k530a6605 = 0.05217545454545462;  // = app12_J0_yy - k96b21cd1
-inline constexpr double k533482e1 = 0.06300001654822854;  // = -k533baced - kf61235c3
-inline constexpr double k533baaf4 = 1.1356530928430254e-08;  // = app12_mass*app12_p_J_x*app12_p_J_y
-inline constexpr double k533baced = -0.04200001654822854;  // = app12_mass*app12_p_J_x*app12_p_J_z
+inline constexpr double k530a6605 = 0.4645393346193927;  // = app12_J0_yy - k96b21cd1
+inline constexpr double k533baaf4 = 1.1356530928073684e-08;  // = app12_mass*app12_p_J_x*app12_p_J_y
 inline constexpr double k533bad8b = 0.007;  // = app12_mass*app12_p_J_x*app12_p_J_x
-inline constexpr double k54066b52 = 0.16363636363636241;  // = -app9_S0_x*k5438da8b + app9_mass
-inline constexpr double k5438da8b = 27.27272727272732;  // = app9_S0_x*k086a3f65
+inline constexpr double k54066b52 = 0.1636363636363716;  // = -app9_S0_x*k5438da8b + app9_mass
+inline constexpr double k5438da8b = 27.27272727272698;  // = app9_S0_x*k086a3f65
 inline constexpr double k5453f2f0 = 1.3160285878828065e-14;  // = app10_mass*app10_p_J_z*app10_p_J_z
 inline constexpr double k54bb34e7 = 0.16343399999999997;  // = app10_J0_xx + app10_J0_yy + app10_J0_zz
 inline constexpr double k55020ad7 = 0.26666714184198687;  // = app10_J0_zz + k526ce869 + k82f3193c
@@ -479,31 +449,28 @@ inline constexpr double k57fab797 = 0.08786796564403536;  // = app6_R_PJ_xz*k2ef
 inline constexpr double k581864f6 = 60.6;  // = app16_mass + hub_mass
 inline constexpr double k581eff3e = 1136.363636363624;  // = 1.0/app3_J0_zz
 inline constexpr double k595616b1 = 0.5999982248573229;  // = app13_mass - k9ba74356
-inline constexpr double k5aab348d = 0.25530100000000006;  // = app9_J0_xx + app9_J0_yy + app9_J0_zz
-inline constexpr double k5ad31814 = 0.053181818181817817;  // = app9_J0_xz*k5438da8b + app9_S0_z
-inline constexpr double k5b5e485b = -0.036000014184195885;  // = app6_mass*app6_p_J_x*app6_p_J_z
+inline constexpr double k5aab348d = 1.6053010000000003;  // = app9_J0_xx + app9_J0_yy + app9_J0_zz
+inline constexpr double k5ad31814 = 0.15136363636364372;  // = app9_J0_xz*k5438da8b + app9_S0_z
 inline constexpr double k5b5e49b1 = 0.006;  // = app6_mass*app6_p_J_x*app6_p_J_x
-inline constexpr double k5b5e4f0e = -9.734169507114032e-09;  // = app6_mass*app6_p_J_x*app6_p_J_y
+inline constexpr double k5b5e4f0e = -9.73416950679416e-09;  // = app6_mass*app6_p_J_x*app6_p_J_y
 inline constexpr double k5e33233d = -0.21213203435596384;  // = app6_R_PJ_yz*k2ef966cc
-inline constexpr double k5e818574 = 0.05797840909090847;  // = app15_J0_yy - k4e3dc307
+inline constexpr double k5e818574 = 0.38934196793672055;  // = app15_J0_yy - k4e3dc307
 inline constexpr double k5fe7bab9 = 2;  // = app11_S0_x*k8faecbe1
 inline constexpr double k60e04058 = 2.142863390272275;  // = app2_S0_x*k2b535d60
-inline constexpr double k61fb7dc9 = 0.03818181818181788;  // = app6_J0_xz*k7eecddfc + app6_S0_z
-inline constexpr double k621805c7 = 0.006660000000015791;  // = app6_J0_zz + k2e069f71 + k5b5e49b1
+inline constexpr double k61fb7dc9 = 0.10363638942581578;  // = app6_J0_xz*k7eecddfc + app6_S0_z
+inline constexpr double k621805c7 = 0.0066600000000158;  // = app6_J0_zz + k2e069f71 + k5b5e49b1
 inline constexpr double k6218aeff = 0.3535533905932743;  // = app15_R_PJ_xz*app15_mass
 inline constexpr double k62bd4355 = 0.009000000000023689;  // = kd9f2323c + kea318e45
 inline constexpr double k63499774 = 0.45000000000000007;  // = app1_mass - ke70597c1
-inline constexpr double k6374fcbf = 0.684;  // = 2.0*kbb355076 + k2372ebd5 + kd089a3f0
-inline constexpr double k6448fd9f = 0.009989999999999999;  // = app9_J0_zz + kd089a3f0
+inline constexpr double k6448fd9f = 0.009990000000000011;  // = app9_J0_zz + kd089a3f0
 inline constexpr double k644cb850 = 0.21618;  // = app4_J0_xx + app4_J0_yy + app4_J0_zz
 inline constexpr double k65a3f532 = -0.08000000000000002;  // = app13_mass*app13_p_J_y
 inline constexpr double k65a3f7e1 = 0.48;  // = app13_mass*app13_p_J_x
-inline constexpr double k65b3febe = 0.0007200000000000262;  // = -app3_J0_xx + app3_J0_yy
+inline constexpr double k65b3febe = 0.0007199999999999429;  // = -app3_J0_xx + app3_J0_yy
 inline constexpr double k6829729b = 0.1250015306059975;  // = -app10_S0_x*k2ed3eaea + app10_mass
-inline constexpr double k6948e384 = 0.30160000000000003;  // = app3_J0_xx + app3_J0_yy + app3_J0_zz
-inline constexpr double k6ab4ab38 = 0.048749995141332936;  // = k4464d690 + kee45a5a9
+inline constexpr double k68bd703f = -0.24109062571733275;  // = app12_R_PJ_xz*app12_S0_z
+inline constexpr double k6948e384 = 1.5975996968191906;  // = app3_J0_xx + app3_J0_yy + app3_J0_zz
 inline constexpr double k6ac156b2 = 0.09000000000000001;  // = app9_mass*app9_p_J_x
-inline constexpr double k6ac15858 = 0.54;  // = app9_mass*app9_p_J_z
 inline constexpr double k6ac783e7 = 8.760756116100528e-08;  // = app4_mass*app4_p_J_x*app4_p_J_z
 inline constexpr double k6ac783fe = 0.05400002127629384;  // = app4_mass*app4_p_J_x*app4_p_J_y
 inline constexpr double k6ac7868d = 0.3240002553155763;  // = app4_mass*app4_p_J_x*app4_p_J_x
@@ -518,9 +485,8 @@ inline constexpr double k6f9c2bde = 0.30000011820163247;  // = app10_mass*app10_
 inline constexpr double k6fac1021 = 0.14545454545455264;  // = -app3_S0_x*k464392e4 + app3_mass
 inline constexpr double k6ff2167e = 71.1;  // = app1_mass + ka5a803e4
 inline constexpr double k70f91721 = 0.20000000000000018;  // = -app8_S0_x*k360d7882 + app8_mass
-inline constexpr double k71865801 = -10.227272727272616;  // = app15_J0_xz*kf4d45cb3
+inline constexpr double k71865801 = -26.590906440726766;  // = app15_J0_xz*kf4d45cb3
 inline constexpr double k7225d524 = -0.35355339059327323;  // = app15_R_PJ_yz*app15_mass
-inline constexpr double k72e29a8e = -0.3447145214724771;  // = app15_R_PJ_yz*k7d1ed90d
 inline constexpr double k7434e911 = 3.7251054434540255e-08;  // = app16_R_PJ_xz*k3e210c7b
 inline constexpr double k7459aa53 = 0.4199999319786611;  // = app7_mass*app7_p_J_x
 inline constexpr double k7459af00 = -0.06999999999999999;  // = app7_mass*app7_p_J_y
@@ -528,18 +494,15 @@ inline constexpr double k7512b9cc = 0.5400002127629384;  // = app14_mass*app14_p
 inline constexpr double k7512ba66 = -0.09000000000000001;  // = app14_mass*app14_p_J_z
 inline constexpr double k7512bebb = -1.4601254080814918e-07;  // = app14_mass*app14_p_J_y
 inline constexpr double k76cd47bc = 0.5974873734152938;  // = app12_R_PJ_yz*ka8b128c3
-inline constexpr double k772ebd95 = 27.27272727272732;  // = app12_S0_x*k17b32ea7
-inline constexpr double k77b73ce6 = 9.247463332947781e-08;  // = k2e06983c + kf7719741
-inline constexpr double k78440732 = 0.2520001985787816;  // = app12_mass*app12_p_J_z*app12_p_J_z
+inline constexpr double k772ebd95 = 27.272727272726975;  // = app12_S0_x*k17b32ea7
 inline constexpr double k7a272588 = -0.04199999319786611;  // = app7_mass*app7_p_J_x*app7_p_J_y
 inline constexpr double k7a272cf7 = 0.2519999183743999;  // = app7_mass*app7_p_J_x*app7_p_J_x
 inline constexpr double k7b3c2851 = 0.009000000000000001;  // = app4_mass*app4_p_J_y*app4_p_J_y
 inline constexpr double k7b3c2e78 = 1.460125444052718e-08;  // = app4_mass*app4_p_J_y*app4_p_J_z
 inline constexpr double k7bf69b36 = 0.00045000000000000595;  // = -app15_J0_xx + app15_J0_yy
-inline constexpr double k7d1ed90d = 0.48749995141332936;  // = app15_S0_z + k09d36c55
-inline constexpr double k7eecddfc = 27.272727272727323;  // = app6_S0_x*kfdd24f5a
-inline constexpr double k7f0372da = 0.07858840909090922;  // = app9_J0_yy - kbb9f5eb7
-inline constexpr double k7f0a7ca7 = 0.19719999999999996;  // = app6_J0_xx + app6_J0_yy + app6_J0_zz
+inline constexpr double k7eecddfc = 27.272727272726975;  // = app6_S0_x*kfdd24f5a
+inline constexpr double k7f0372da = 0.6308611363636296;  // = app9_J0_yy - kbb9f5eb7
+inline constexpr double k7f0a7ca7 = 1.1332005389995106;  // = app6_J0_xx + app6_J0_yy + app6_J0_zz
 inline constexpr double k80187168 = 0.3;  // = app5_mass*app5_p_J_x
 inline constexpr double k80198fc2 = 0.05;  // = app5_mass*app5_p_J_z
 inline constexpr double k829d5082 = 0.007000000000018425;  // = k2e149664 + kd6f1f8db
@@ -547,47 +510,42 @@ inline constexpr double k82f30525 = -8.111808022515099e-09;  // = app10_mass*app
 inline constexpr double k82f3193c = 0.005000000000000001;  // = app10_mass*app10_p_J_y*app10_p_J_y
 inline constexpr double k83559a3b = 0.009000000000023689;  // = k22849c36 + k7b3c2851
 inline constexpr double k83b29de8 = 0.47100025531560014;  // = app14_J0_zz + k4e6672ed + kea318e45
+inline constexpr double k855cc421 = 0.5515432343559641;  // = app3_R_PJ_yz*app3_S0_z
 inline constexpr double k858945a8 = 0.38400022694720026;  // = app8_J0_zz + kcc39bf89 + kf3ee62cd
-inline constexpr double k867cf753 = 0.17181818181818212;  // = app6_S0_z - k61fb7dc9
+inline constexpr double k867cf753 = 0.46636375241614303;  // = app6_S0_z - k61fb7dc9
 inline constexpr double k87018aac = 0.15000000000000002;  // = -app11_S0_x*k5fe7bab9 + app11_mass
 inline constexpr double k876cd418 = 0.9999999999999999;  // = app13_J0_zz*kb4458319
-inline constexpr double k88426457 = 1.842439924691327e-14;  // = app12_mass*app12_p_J_y*app12_p_J_y
-inline constexpr double k88427b02 = -6.81392124177914e-08;  // = app12_mass*app12_p_J_y*app12_p_J_z
+inline constexpr double k88426457 = 1.84243992457563e-14;  // = app12_mass*app12_p_J_y*app12_p_J_y
 inline constexpr double k8aaf66ee = 0.22199993003520002;  // = k30cd45f3 + kc2cb00dd
 inline constexpr double k8b49cdad = 65.5;  // = app9_mass + ka2414b97
 inline constexpr double k8b4df84b = 0.4000000000000002;  // = app3_R_PJ_xz*k4a714f15
-inline constexpr double k8b9d235e = 0.779999922261327;  // = app3_S0_z + k3ec33457
 inline constexpr double k8df9c22a = 0.5656854249492379;  // = app3_R_PJ_yz*app3_mass
 inline constexpr double k8faecbe1 = 8.88888888888889;  // = 1.0/app11_J0_zz
 inline constexpr double k9161929f = 7.494333403662547e-08;  // = app10_R_PJ_yz*k6f9c1964
 inline constexpr double k91f2ab96 = 0.24999999999999925;  // = app15_R_PJ_yz*k7225d524
-inline constexpr double k944ca89f = 0.06067636363636375;  // = app6_J0_yy - kc4fc8014
-inline constexpr double k94541ea8 = 0.1694;  // = app12_J0_xx + app12_J0_yy + app12_J0_zz
+inline constexpr double k944ca89f = 0.4435856750452495;  // = app6_J0_yy - kc4fc8014
+inline constexpr double k94541ea8 = 1.1774005957363056;  // = app12_J0_xx + app12_J0_yy + app12_J0_zz
 inline constexpr double k95b5be47 = 0.16912000000000002;  // = app1_J0_xx + app1_J0_yy + app1_J0_zz
 inline constexpr double k96549ca9 = 0.07322330470336401;  // = app10_R_PJ_xz*kbfc7a269
-inline constexpr double k96b21cd1 = 0.032454545454545375;  // = app12_J0_xx - app12_J0_xz*kc23d229d
-inline constexpr double k98792947 = 0.8325;  // = app9_S0_z + k6ac15858
+inline constexpr double k9667d35f = 0.5515432343559643;  // = app3_R_PJ_xz*app3_S0_z
+inline constexpr double k96b21cd1 = 0.1240909632487601;  // = app12_J0_xx - app12_J0_xz*kc23d229d
 inline constexpr double k9890ba3f = 0.14681999999999998;  // = -app14_J0_xx + app14_J0_yy
-inline constexpr double k997cf9b2 = 0.0381818181818179;  // = app12_J0_xz*k772ebd95 + app12_S0_z
+inline constexpr double k997cf9b2 = 0.11454548463314836;  // = app12_J0_xz*k772ebd95 + app12_S0_z
 inline constexpr double k9ba74356 = 0.20000177514267717;  // = -app13_S0_x*k6ca4f092 + app13_mass
-inline constexpr double k9c743670 = 0.034090909090910775;  // = app15_J0_xz*k298b260d + app15_S0_z
+inline constexpr double k9c743670 = 0.08863635480242789;  // = app15_J0_xz*k298b260d + app15_S0_z
 inline constexpr double k9c864b98 = 0.29418;  // = app14_J0_xx + app14_J0_yy + app14_J0_zz
 inline constexpr double ka2414b97 = 64.6;  // = app10_mass + kb10eca25
-inline constexpr double ka2cdca31 = 0.40999990525599694;  // = 2.0*kee45a343 + k0f4e317c + k4464ab3a
 inline constexpr double ka391f0b6 = 0.35000000000000003;  // = app7_R_PJ_yz*ke0474ab4
-inline constexpr double ka3ff29e7 = 0.007770000000018423;  // = app12_J0_zz + k533bad8b + k88426457
+inline constexpr double ka3ff29e7 = 0.007770000000018433;  // = app12_J0_zz + k533bad8b + k88426457
 inline constexpr double ka555cc6e = 0.6750000000000002;  // = app4_mass - k5520f657
-inline constexpr double ka5a4ff5d = 0.5700001418419588;  // = app6_S0_z + k4b365911
 inline constexpr double ka5a803e4 = 70.5;  // = app2_mass + k01df5890
 inline constexpr double ka8b128c3 = -0.6467156727579019;  // = app12_R_PJ_yz*app12_mass
-inline constexpr double ka93bf3bc = 0.12727272727272632;  // = -app12_S0_x*k772ebd95 + app12_mass
+inline constexpr double ka93bf3bc = 0.12727272727273353;  // = -app12_S0_x*k772ebd95 + app12_mass
 inline constexpr double ka96059e1 = 0.3599999416959953;  // = app11_mass*app11_p_J_x
 inline constexpr double ka9605b4b = 0.06;  // = app11_mass*app11_p_J_z
-inline constexpr double ka999b224 = -0.5820442583678082;  // = app12_R_PJ_yz*kfc7bedef
 inline constexpr double kac63e435 = 11.834319526627219;  // = 1.0/app1_J0_zz
-inline constexpr double kacce474b = -10.227272727272615;  // = app3_J0_xz*k581eff3e
+inline constexpr double kacce474b = -26.590906440726766;  // = app3_J0_xz*k581eff3e
 inline constexpr double kad1ddbae = 67;  // = app7_mass + k20dca6d0
-inline constexpr double kad510176 = 0.05700001418419588;  // = -k5b5e485b - kf771899e
 inline constexpr double kad736288 = 0.08786796564403679;  // = app16_R_PJ_xz*k576c709b
 inline constexpr double kae3702f4 = -0.49497474683058085;  // = app7_R_PJ_yz*app7_mass
 inline constexpr double kaf03326a = 0.5250020000076189;  // = app7_mass - kbbc265f6
@@ -596,7 +554,8 @@ inline constexpr double kb0f2529d = 0.3500000000000034;  // = app7_R_PJ_xz*ke047
 inline constexpr double kb10eca25 = 64.1;  // = app11_mass + kba51d774
 inline constexpr double kb17fee32 = 0.3499999999999966;  // = app7_R_PJ_yz*kae3702f4
 inline constexpr double kb1dbe7fc = 0.008880000000000011;  // = app3_J0_zz + kcda7ee0c
-inline constexpr double kb2d2f709 = -8.86363636363638;  // = app9_J0_xz*k086a3f65
+inline constexpr double kb25f6a3f = -0.21812961072866835;  // = app6_R_PJ_xz*app6_S0_z
+inline constexpr double kb2d2f709 = -25.227272727272457;  // = app9_J0_xz*k086a3f65
 inline constexpr double kb31da827 = 0.29400017021038427;  // = app16_J0_zz + k2c1ae737 + kfa4e2778
 inline constexpr double kb4458319 = 8.875713385463355;  // = 1.0/app13_J0_zz
 inline constexpr double kb484462b = 0.0909090909090954;  // = -app15_S0_x*k298b260d + app15_mass
@@ -604,54 +563,52 @@ inline constexpr double kb4fb00da = 0.19216;  // = app8_J0_xx + app8_J0_yy + app
 inline constexpr double kb54bee3a = 0.11238;  // = -app11_J0_xx + app11_J0_yy
 inline constexpr double kb63c57f5 = 0.36633319857880003;  // = app2_J0_zz + kd3091556 + kd6f1f8db
 inline constexpr double kb6a842b6 = 2.000007619076644;  // = app7_S0_x*kf0b5dfbb
+inline constexpr double kb92db8bc = 0.9999999999999999;  // = app6_J0_zz*kfdd24f5a
 inline constexpr double kba51d774 = 63.5;  // = app12_mass + k1cd8abda
 inline constexpr double kba9820b7 = 0.11419299999999998;  // = -app2_J0_xx + app2_J0_yy
 inline constexpr double kbae12506 = 0.408667;  // = app13_J0_zz + k493f3cc1 + kcea8c064
 inline constexpr double kbb251356 = 0.5121320343559644;  // = app6_R_PJ_yz*kcc15d2d4
-inline constexpr double kbb355076 = 0.17550000000000002;  // = app9_S0_z*app9_p_J_z
-inline constexpr double kbb35569c = 0.029250000000000005;  // = app9_S0_z*app9_p_J_x
-inline constexpr double kbb9f5eb7 = 0.04897209090909079;  // = app9_J0_xx - app9_J0_xz*kb2d2f709
+inline constexpr double kbb35569c = 0.08325;  // = app9_S0_z*app9_p_J_x
+inline constexpr double kbb9f5eb7 = 0.17169936363637053;  // = app9_J0_xx - app9_J0_xz*kb2d2f709
 inline constexpr double kbbc265f6 = 0.17499799999238105;  // = -app7_S0_x*kb6a842b6 + app7_mass
 inline constexpr double kbc57cd56 = -0.3181980515339479;  // = app4_R_PJ_yz*kc7f3dc42
 inline constexpr double kbc8e7f4e = 67.6;  // = app6_mass + kad1ddbae
 inline constexpr double kbfc7a269 = 0.19134171618254606;  // = app10_R_PJ_xz*app10_mass
 inline constexpr double kc06872e4 = -0.26787840265555973;  // = app12_R_PJ_xz*app12_mass
-inline constexpr double kc23d229d = -8.181818181818196;  // = app12_J0_xz*k17b32ea7
+inline constexpr double kc23d229d = -24.54546099281605;  // = app12_J0_xz*k17b32ea7
 inline constexpr double kc2cb00dd = 0.006;  // = app11_mass*app11_p_J_z*app11_p_J_z
 inline constexpr double kc3085376 = 2.307692307692308;  // = app1_S0_x*kac63e435
+inline constexpr double kc3a7dc33 = -0.5820442583678082;  // = app12_R_PJ_yz*app12_S0_z
 inline constexpr double kc3e4e4c4 = 12.244847980212327;  // = 1.0/app10_J0_zz
-inline constexpr double kc4342491 = 0.6559998484095952;  // = 2.0*ke54b765e + kcda7ee0c + ke2882043
 inline constexpr double kc4d8db8c = 0.18;  // = app5_mass*app5_p_J_x*app5_p_J_x
 inline constexpr double kc4d8dcf2 = 0.03;  // = app5_mass*app5_p_J_x*app5_p_J_z
 inline constexpr double kc4ddfc31 = 0.185;  // = k36a43f36 + kc4d8db8c
-inline constexpr double kc4fc8014 = 0.03786363636363624;  // = app6_J0_xx - app6_J0_xz*k4592495f
+inline constexpr double kc4fc8014 = 0.12295459445450574;  // = app6_J0_xx - app6_J0_xz*k4592495f
 inline constexpr double kc5df6b85 = 0.2960002269471792;  // = ke900ec92 + kf3ee62cd
 inline constexpr double kc6502646 = 1.5792343049190128e-14;  // = app16_mass*app16_p_J_z*app16_p_J_z
 inline constexpr double kc660aa80 = 9.25925925925926;  // = 1.0/app4_J0_zz
 inline constexpr double kc727c284 = -0.17677669529663778;  // = app10_R_PJ_yz*kbfc7a269
 inline constexpr double kc74a58c8 = 0.5999999999999999;  // = app8_mass - k70f91721
-inline constexpr double kc763ccfd = 0.7363636363636377;  // = app9_mass - k54066b52
+inline constexpr double kc763ccfd = 0.7363636363636284;  // = app9_mass - k54066b52
 inline constexpr double kc7f3dc42 = -0.8314915792601572;  // = app4_R_PJ_xz*app4_mass
-inline constexpr double kc8687047 = 0.1718181818181821;  // = app12_S0_z - k997cf9b2
+inline constexpr double kc8687047 = 0.5154546808491369;  // = app12_S0_z - k997cf9b2
 inline constexpr double kc9fed1e7 = 0.1749984693832926;  // = -app2_S0_x*k60e04058 + app2_mass
-inline constexpr double kca97a18f = 0.15340909090908922;  // = app15_S0_z - k9c743670
+inline constexpr double kca97a18f = 0.3988635966109015;  // = app15_S0_z - k9c743670
 inline constexpr double kcc15d2d4 = 0.5543277195067722;  // = app6_R_PJ_yz*app6_mass
 inline constexpr double kcc39b7f0 = -1.2978892676152044e-08;  // = app8_mass*app8_p_J_y*app8_p_J_z
 inline constexpr double kcc39bf89 = 2.1056456887384143e-14;  // = app8_mass*app8_p_J_y*app8_p_J_y
 inline constexpr double kcc4a034d = 0.007;  // = app7_mass*app7_p_J_y*app7_p_J_y
 inline constexpr double kcda7ee0c = 0.008000000000000002;  // = app3_mass*app3_p_J_x*app3_p_J_x
-inline constexpr double kcda7f4e2 = 0.0479999922261327;  // = app3_mass*app3_p_J_x*app3_p_J_z
+inline constexpr double kcdd5e91f = 0.5266114645763161;  // = app6_R_PJ_yz*app6_S0_z
 inline constexpr double kce978826 = 0.15;  // = -app16_S0_x*kf044d001 + app16_mass
 inline constexpr double kcea8c064 = 0.288;  // = app13_mass*app13_p_J_x*app13_p_J_x
 inline constexpr double kcea8c3d7 = -0.048;  // = app13_mass*app13_p_J_x*app13_p_J_y
-inline constexpr double kcebfb7bb = 0.0006299999999999917;  // = -app12_J0_xx + app12_J0_yy
-inline constexpr double kcef3e627 = 0.5040002978681712;  // = 2.0*kf6122c39 + k78440732 + k88426457
+inline constexpr double kcebfb7bb = 0.0006299999999999084;  // = -app12_J0_xx + app12_J0_yy
 inline constexpr double kcfd50b69 = 2.142857142857143;  // = app14_S0_x*k4365f15c
 inline constexpr double kd04d167d = 0.675;  // = app14_mass - k37714853
 inline constexpr double kd089a3f0 = 0.009000000000000001;  // = app9_mass*app9_p_J_x*app9_p_J_x
-inline constexpr double kd089a616 = 0.054;  // = app9_mass*app9_p_J_x*app9_p_J_z
+inline constexpr double kd1c07d2f = -0.3447145214724771;  // = app15_R_PJ_yz*app15_S0_z
 inline constexpr double kd1f64f00 = 0.22512;  // = app11_J0_xx + app11_J0_yy + app11_J0_zz
-inline constexpr double kd301e187 = 0.5110002978681528;  // = 2.0*kf6122c39 + k533bad8b + k78440732
 inline constexpr double kd3091556 = 0.25200019857878164;  // = app2_mass*app2_p_J_x*app2_p_J_x
 inline constexpr double kd3092ae1 = -6.813921356021136e-08;  // = app2_mass*app2_p_J_x*app2_p_J_y
 inline constexpr double kd3092fbc = -0.04200001654822855;  // = app2_mass*app2_p_J_x*app2_p_J_z
@@ -668,11 +625,8 @@ inline constexpr double kda586977 = 8.993200082856488e-08;  // = app16_R_PJ_yz*k
 inline constexpr double kdadf1a0d = 0.10782;  // = -app4_J0_xx + app4_J0_yy
 inline constexpr double kdd74b102 = 0.39024941837439986;  // = app7_J0_zz + k7a272cf7 + kcc4a034d
 inline constexpr double ke0474ab4 = -0.4949747468305857;  // = app7_R_PJ_xz*app7_mass
-inline constexpr double ke2882043 = 0.28799990671359993;  // = app3_mass*app3_p_J_z*app3_p_J_z
 inline constexpr double ke29e8751 = 0.3749984693940025;  // = app10_mass - k6829729b
-inline constexpr double ke54b48f4 = 0.030000000000000006;  // = app3_S0_z*app3_p_J_x
-inline constexpr double ke54b765e = 0.17999997084799765;  // = app3_S0_z*app3_p_J_z
-inline constexpr double ke599a6a7 = 0.5515432343559641;  // = app3_R_PJ_yz*k8b9d235e
+inline constexpr double ke54b48f4 = 0.0779999922261327;  // = app3_S0_z*app3_p_J_x
 inline constexpr double ke70597c1 = 0.1499999999999999;  // = -app1_S0_x*kc3085376 + app1_mass
 inline constexpr double ke900ec92 = 0.008000000000000002;  // = app8_mass*app8_p_J_z*app8_p_J_z
 inline constexpr double ke967616b = 0.21599999999999997;  // = app1_mass*app1_p_J_x*app1_p_J_x
@@ -684,9 +638,8 @@ inline constexpr double keb4a28fb = 0.006;  // = app1_mass*app1_p_J_y*app1_p_J_y
 inline constexpr double kec02ae44 = 0.4410002553155763;  // = app4_J0_zz + k6ac7868d + k7b3c2851
 inline constexpr double kec4548ac = 0.36;  // = app1_mass*app1_p_J_x
 inline constexpr double kec4549df = -0.06;  // = app1_mass*app1_p_J_y
-inline constexpr double ked24d8c6 = 0.4909090909090918;  // = app6_mass - k3e8288d3
-inline constexpr double kee45a343 = 0.11249998177999851;  // = app15_S0_z*app15_p_J_z
-inline constexpr double kee45a5a9 = 0.018750000000000003;  // = app15_S0_z*app15_p_J_x
+inline constexpr double ked24d8c6 = 0.4909090909090855;  // = app6_mass - k3e8288d3
+inline constexpr double kee45a5a9 = 0.048749995141332936;  // = app15_S0_z*app15_p_J_x
 inline constexpr double kef293309 = 0.09584000000000001;  // = -app8_J0_xx + app8_J0_yy
 inline constexpr double kf01823c8 = 0.22880599999999995;  // = app2_J0_xx + app2_J0_yy + app2_J0_zz
 inline constexpr double kf044d001 = 2.5;  // = app16_S0_x*k33138656
@@ -696,29 +649,23 @@ inline constexpr double kf19089ec = -1.3489800126592586e-07;  // = app4_R_PJ_xz*
 inline constexpr double kf1b1b802 = 0.09000000000000001;  // = app4_mass*app4_p_J_y
 inline constexpr double kf1b1b971 = 0.5400002127629384;  // = app4_mass*app4_p_J_x
 inline constexpr double kf1b1ba1b = 1.460125444052718e-07;  // = app4_mass*app4_p_J_z
-inline constexpr double kf22fc453 = 0.40499990525599694;  // = 2.0*kee45a343 + k0f4e317c
+inline constexpr double kf1c6e8c5 = 0.34471452147247816;  // = app15_R_PJ_xz*app15_S0_z
 inline constexpr double kf3ed9f9e = 7.787338673943832e-08;  // = app8_mass*app8_p_J_x*app8_p_J_y
 inline constexpr double kf3ee62cd = 0.2880002269471792;  // = app8_mass*app8_p_J_x*app8_p_J_x
 inline constexpr double kf3ee6767 = -0.04800001891226121;  // = app8_mass*app8_p_J_x*app8_p_J_z
 inline constexpr double kf4d45cb3 = 1818.1818181817985;  // = 1.0/app15_J0_zz
-inline constexpr double kf587b669 = 0.057954545454546466;  // = app3_J0_xx - app3_J0_xz*kacce474b
-inline constexpr double kf6122c39 = 0.1260000496446856;  // = app12_S0_z*app12_p_J_z
-inline constexpr double kf61235c3 = -0.021;  // = app12_S0_z*app12_p_J_x
-inline constexpr double kf6123610 = -3.406959278529076e-08;  // = app12_S0_z*app12_p_J_y
+inline constexpr double kf587b669 = 0.17577269971084236;  // = app3_J0_xx - app3_J0_xz*kacce474b
+inline constexpr double kf61235c3 = -0.06300001654822854;  // = app12_S0_z*app12_p_J_x
+inline constexpr double kf6123610 = -1.0220880519987303e-07;  // = app12_S0_z*app12_p_J_y
 inline constexpr double kf6cea03d = 0.3330002553155765;  // = k4e6672ed + kd9f2323c
-inline constexpr double kf771899e = -0.021;  // = app6_S0_z*app6_p_J_x
-inline constexpr double kf7719741 = 3.406959327489911e-08;  // = app6_S0_z*app6_p_J_y
-inline constexpr double kf7719834 = 0.12600004964468559;  // = app6_S0_z*app6_p_J_z
-inline constexpr double kf8b225cd = 0.09276545454545355;  // = app3_J0_yy - kf587b669
-inline constexpr double kfa032c1b = 0.47400026949975527;  // = 2.0*kf7719834 + k06ff8039 + k5b5e49b1
+inline constexpr double kf771899e = -0.05700001418419588;  // = app6_S0_z*app6_p_J_x
+inline constexpr double kf7719741 = 9.247463332643901e-08;  // = app6_S0_z*app6_p_J_y
+inline constexpr double kf8b225cd = 0.6229471486987528;  // = app3_J0_yy - kf587b669
 inline constexpr double kfa4e222f = 0.0360000141841959;  // = app16_mass*app16_p_J_x*app16_p_J_y
 inline constexpr double kfa4e2778 = 0.21600017021038428;  // = app16_mass*app16_p_J_x*app16_p_J_x
 inline constexpr double kfa4e5c16 = 5.8405040764011515e-08;  // = app16_mass*app16_p_J_x*app16_p_J_z
 inline constexpr double kfc018a05 = 0.2121320343559653;  // = app16_R_PJ_yz*k576c709b
-inline constexpr double kfc24650e = 0.675;  // = 2.0*kbb355076 + k2372ebd5
-inline constexpr double kfc7bedef = 0.6300001654822853;  // = app12_S0_z + k21d30aad
-inline constexpr double kfdd24f5a = 1515.151515151518;  // = 1.0/app6_J0_zz
-inline constexpr double kfe2250aa = -0.21812961072866835;  // = app6_R_PJ_xz*ka5a4ff5d
+inline constexpr double kfdd24f5a = 1515.1515151514986;  // = 1.0/app6_J0_zz
 inline constexpr double kffe44b4f = 0.2504165;  // = app5_J0_zz + kc4d8db8c
 
 
@@ -1004,819 +951,793 @@ void mass_matrix(const T* q, T* M) {
   const T t333 = -k7bf69b36*t328;
   const T t334 = angle_c[14]*app15_J0_xz;
   const T t335 = angle_s[14]*app15_J0_xz;
-  const T t336 = kf22fc453 + t331;
-  const T t337 = -app15_p_J_x*t326 + t333;
-  const T t338 = -app15_p_J_z*t325 - k6ab4ab38 + t334;
-  const T t339 = 2.0*app15_p_J_x*t325 + ka2cdca31 + t332;
-  const T t340 = -app15_p_J_z*t326 + t335;
-  const T t341 = 2.0*app15_p_J_x*t325 + kd460c4ed;
-  const T t342 = k09d36bcf + t325;
-  const T t343 = app15_R_PJ_xy*t326 + k26ed7363;
-  const T t344 = app15_R_PJ_yy*t326 + k72e29a8e;
-  const T t345 = app15_R_PJ_xy*t337 + app15_R_PJ_xz*t338;
-  const T t346 = app15_R_PJ_xy*t339 + app15_R_PJ_xz*t340;
-  const T t347 = app15_R_PJ_xy*t340 + app15_R_PJ_xz*t341;
-  const T t348 = app15_R_PJ_yy*t337 + app15_R_PJ_yz*t338;
-  const T t349 = app15_R_PJ_yy*t339 + app15_R_PJ_yz*t340;
-  const T t350 = app15_R_PJ_yy*t340 + app15_R_PJ_yz*t341;
-  const T t351 = app15_R_PJ_xy*t346 + app15_R_PJ_xz*t347;
-  const T t352 = app15_R_PJ_yy*t346 + app15_R_PJ_yz*t347;
-  const T t353 = app15_R_PJ_yy*t349 + app15_R_PJ_yz*t350;
-  const T t354 = t315 + t351;
-  const T t355 = t316 + t352;
-  const T t356 = t317 + t345;
-  const T t357 = t318 + t353;
-  const T t358 = t319 + t348;
-  const T t359 = t320 + t336;
-  const T t360 = t303 - t342;
-  const T t361 = t321 + t344;
-  const T t362 = -t303 + t342;
-  const T t363 = t322 - t343;
-  const T t364 = t323 - t344;
-  const T t365 = t324 + t343;
+  const T t336 = -app15_p_J_x*t326 + t333;
+  const T t337 = -kee45a5a9 + t334;
+  const T t338 = 2.0*app15_p_J_x*t325 + k4464ab3a + t332;
+  const T t339 = 2.0*app15_p_J_x*t325 + kd460c4ed;
+  const T t340 = k09d36bcf + t325;
+  const T t341 = app15_R_PJ_xy*t326 + kf1c6e8c5;
+  const T t342 = app15_R_PJ_yy*t326 + kd1c07d2f;
+  const T t343 = app15_R_PJ_xy*t336 + app15_R_PJ_xz*t337;
+  const T t344 = app15_R_PJ_xy*t338 + app15_R_PJ_xz*t335;
+  const T t345 = app15_R_PJ_xy*t335 + app15_R_PJ_xz*t339;
+  const T t346 = app15_R_PJ_yy*t336 + app15_R_PJ_yz*t337;
+  const T t347 = app15_R_PJ_yy*t338 + app15_R_PJ_yz*t335;
+  const T t348 = app15_R_PJ_yy*t335 + app15_R_PJ_yz*t339;
+  const T t349 = app15_R_PJ_xy*t344 + app15_R_PJ_xz*t345;
+  const T t350 = app15_R_PJ_yy*t344 + app15_R_PJ_yz*t345;
+  const T t351 = app15_R_PJ_yy*t347 + app15_R_PJ_yz*t348;
+  const T t352 = t315 + t349;
+  const T t353 = t316 + t350;
+  const T t354 = t317 + t343;
+  const T t355 = t318 + t351;
+  const T t356 = t319 + t346;
+  const T t357 = t320 + t331;
+  const T t358 = t303 - t340;
+  const T t359 = t321 + t342;
+  const T t360 = -t303 + t340;
+  const T t361 = t322 - t341;
+  const T t362 = t323 - t342;
+  const T t363 = t324 + t341;
   // ---- body app14: composite inertia (inward)
-  const T t366 = angle_c[13]*app14_S0_x;
-  const T t367 = angle_s[13]*app14_S0_x;
-  const T t368 = angle_s[13]*angle_s[13];
-  const T t369 = angle_c[13]*angle_s[13];
-  const T t371 = -k9890ba3f*t368;
-  const T t372 = app14_J0_xx - t371;
-  const T t373 = app14_J0_yy + t371;
-  const T t374 = -k9890ba3f*t369;
-  const T t375 = 2.0*app14_p_J_y*t367 + k62bd4355 + t372;
-  const T t376 = t374 - ((app14_p_J_x*t367 + app14_p_J_y*t366) + k4e66775e);
-  const T t377 = -app14_p_J_z*t366 - k4e667183;
-  const T t378 = 2.0*app14_p_J_x*t366 + kf6cea03d + t373;
-  const T t379 = -app14_p_J_z*t367 - kea31843c;
-  const T t380 = 2.0*app14_p_J_x*t366 + 2.0*app14_p_J_y*t367 + k83b29de8;
-  const T t381 = k7512b9cc + t366;
-  const T t382 = k7512bebb + t367;
-  const T t383 = app14_R_PJ_xx*t381 + app14_R_PJ_xy*t382;
-  const T t384 = app14_R_PJ_yx*t381 + app14_R_PJ_yy*t382;
-  const T t385 = t375 - t378;
-  const T t386 = app14_R_PJ_xx_S2*t376 + app14_R_PJ_xx_ss*t385;
-  const T t387 = t375 - t386;
-  const T t388 = t378 + t386;
-  const T t389 = app14_R_PJ_xx_C2*t376 + app14_R_PJ_xx_cs*t385;
-  const T t390 = app14_R_PJ_xx*t377 - app14_R_PJ_yx*t379;
-  const T t391 = app14_R_PJ_xx*t379 + app14_R_PJ_yx*t377;
-  const T t392 = t354 + t387;
-  const T t393 = t355 + t389;
-  const T t394 = t356 + t390;
-  const T t395 = t357 + t388;
-  const T t396 = t358 + t391;
-  const T t397 = t359 + t380;
-  const T t398 = -k7512ba66 + t360;
-  const T t399 = t361 + t384;
-  const T t400 = k7512ba66 + t362;
-  const T t401 = t363 - t383;
-  const T t402 = t364 - t384;
-  const T t403 = t365 + t383;
+  const T t364 = angle_c[13]*app14_S0_x;
+  const T t365 = angle_s[13]*app14_S0_x;
+  const T t366 = angle_s[13]*angle_s[13];
+  const T t367 = angle_c[13]*angle_s[13];
+  const T t369 = -k9890ba3f*t366;
+  const T t370 = app14_J0_xx - t369;
+  const T t371 = app14_J0_yy + t369;
+  const T t372 = -k9890ba3f*t367;
+  const T t373 = 2.0*app14_p_J_y*t365 + k62bd4355 + t370;
+  const T t374 = t372 - ((app14_p_J_x*t365 + app14_p_J_y*t364) + k4e66775e);
+  const T t375 = -app14_p_J_z*t364 - k4e667183;
+  const T t376 = 2.0*app14_p_J_x*t364 + kf6cea03d + t371;
+  const T t377 = -app14_p_J_z*t365 - kea31843c;
+  const T t378 = 2.0*app14_p_J_x*t364 + 2.0*app14_p_J_y*t365 + k83b29de8;
+  const T t379 = k7512b9cc + t364;
+  const T t380 = k7512bebb + t365;
+  const T t381 = app14_R_PJ_xx*t379 + app14_R_PJ_xy*t380;
+  const T t382 = app14_R_PJ_yx*t379 + app14_R_PJ_yy*t380;
+  const T t383 = t373 - t376;
+  const T t384 = app14_R_PJ_xx_S2*t374 + app14_R_PJ_xx_ss*t383;
+  const T t385 = t373 - t384;
+  const T t386 = t376 + t384;
+  const T t387 = app14_R_PJ_xx_C2*t374 + app14_R_PJ_xx_cs*t383;
+  const T t388 = app14_R_PJ_xx*t375 - app14_R_PJ_yx*t377;
+  const T t389 = app14_R_PJ_xx*t377 + app14_R_PJ_yx*t375;
+  const T t390 = t352 + t385;
+  const T t391 = t353 + t387;
+  const T t392 = t354 + t388;
+  const T t393 = t355 + t386;
+  const T t394 = t356 + t389;
+  const T t395 = t357 + t378;
+  const T t396 = -k7512ba66 + t358;
+  const T t397 = t359 + t382;
+  const T t398 = k7512ba66 + t360;
+  const T t399 = t361 - t381;
+  const T t400 = t362 - t382;
+  const T t401 = t363 + t381;
   // ---- body app13: composite inertia (inward)
-  const T t404 = angle_c[12]*app13_S0_x;
-  const T t405 = angle_s[12]*app13_S0_x;
-  const T t406 = angle_s[12]*angle_s[12];
-  const T t407 = angle_c[12]*angle_s[12];
-  const T t409 = -k384e2939*t406;
-  const T t410 = app13_J0_xx - t409;
-  const T t411 = app13_J0_yy + t409;
-  const T t412 = -k384e2939*t407;
-  const T t413 = 2.0*app13_p_J_y*t405 + k493f3cc1 + t410;
-  const T t414 = t412 - ((app13_p_J_x*t405 + app13_p_J_y*t404) + kcea8c3d7);
-  const T t415 = 2.0*app13_p_J_x*t404 + kcea8c064 + t411;
-  const T t416 = 2.0*app13_p_J_x*t404 + 2.0*app13_p_J_y*t405 + kbae12506;
-  const T t417 = k65a3f7e1 + t404;
-  const T t418 = k65a3f532 + t405;
-  const T t419 = t392 + t416;
+  const T t402 = angle_c[12]*app13_S0_x;
+  const T t403 = angle_s[12]*app13_S0_x;
+  const T t404 = angle_s[12]*angle_s[12];
+  const T t405 = angle_c[12]*angle_s[12];
+  const T t407 = -k384e2939*t404;
+  const T t408 = app13_J0_xx - t407;
+  const T t409 = app13_J0_yy + t407;
+  const T t410 = -k384e2939*t405;
+  const T t411 = 2.0*app13_p_J_y*t403 + k493f3cc1 + t408;
+  const T t412 = t410 - ((app13_p_J_x*t403 + app13_p_J_y*t402) + kcea8c3d7);
+  const T t413 = 2.0*app13_p_J_x*t402 + kcea8c064 + t409;
+  const T t414 = 2.0*app13_p_J_x*t402 + 2.0*app13_p_J_y*t403 + kbae12506;
+  const T t415 = k65a3f7e1 + t402;
+  const T t416 = k65a3f532 + t403;
+  const T t417 = t390 + t414;
+  const T t418 = t393 + t411;
+  const T t419 = t394 + t412;
   const T t420 = t395 + t413;
-  const T t421 = t396 + t414;
-  const T t422 = t397 + t415;
-  const T t423 = t398 + t418;
-  const T t424 = t399 - t417;
-  const T t425 = t400 - t418;
-  const T t426 = t402 + t417;
+  const T t421 = t396 + t416;
+  const T t422 = t397 - t415;
+  const T t423 = t398 - t416;
+  const T t424 = t400 + t415;
   // ---- body app12: composite inertia (inward)
-  const T t427 = angle_c[11]*app12_S0_x;
-  const T t428 = angle_s[11]*app12_S0_x;
-  const T t429 = angle_s[11]*angle_s[11];
-  const T t430 = angle_c[11]*angle_s[11];
-  const T t432 = -kcebfb7bb*t429;
-  const T t433 = app12_J0_xx - t432;
-  const T t434 = app12_J0_yy + t432;
-  const T t435 = -kcebfb7bb*t430;
-  const T t436 = angle_c[11]*app12_J0_xz;
-  const T t437 = angle_s[11]*app12_J0_xz;
-  const T t438 = 2.0*app12_p_J_y*t428 + kcef3e627 + t433;
-  const T t439 = t435 - ((app12_p_J_x*t428 + app12_p_J_y*t427) + k533baaf4);
-  const T t440 = -app12_p_J_z*t427 + k533482e1 + t436;
-  const T t441 = 2.0*app12_p_J_x*t427 + kd301e187 + t434;
-  const T t442 = -app12_p_J_z*t428 + k1a292250 + t437;
-  const T t443 = 2.0*app12_p_J_x*t427 + 2.0*app12_p_J_y*t428 + ka3ff29e7;
-  const T t444 = k21d31807 + t427;
-  const T t445 = k21d317f8 + t428;
-  const T t446 = app12_R_PJ_xy*t445 + k2147d6ad;
-  const T t447 = app12_R_PJ_yy*t445 + ka999b224;
-  const T t448 = app12_R_PJ_xy*t439 + app12_R_PJ_xz*t440;
-  const T t449 = app12_R_PJ_xy*t441 + app12_R_PJ_xz*t442;
-  const T t450 = app12_R_PJ_xy*t442 + app12_R_PJ_xz*t443;
-  const T t451 = app12_R_PJ_yy*t439 + app12_R_PJ_yz*t440;
-  const T t452 = app12_R_PJ_yy*t441 + app12_R_PJ_yz*t442;
-  const T t453 = app12_R_PJ_yy*t442 + app12_R_PJ_yz*t443;
-  const T t454 = app12_R_PJ_xy*t449 + app12_R_PJ_xz*t450;
-  const T t455 = app12_R_PJ_yy*t449 + app12_R_PJ_yz*t450;
-  const T t456 = app12_R_PJ_yy*t452 + app12_R_PJ_yz*t453;
-  const T t457 = t419 + t454;
-  const T t458 = t393 + t455;
-  const T t459 = t394 + t448;
-  const T t460 = t420 + t456;
-  const T t461 = t421 + t451;
-  const T t462 = t422 + t438;
-  const T t463 = t423 - t444;
-  const T t464 = t424 + t447;
-  const T t465 = t425 + t444;
-  const T t466 = t401 - t446;
-  const T t467 = t426 - t447;
-  const T t468 = t403 + t446;
+  const T t425 = angle_c[11]*app12_S0_x;
+  const T t426 = angle_s[11]*app12_S0_x;
+  const T t427 = angle_s[11]*angle_s[11];
+  const T t428 = angle_c[11]*angle_s[11];
+  const T t430 = -kcebfb7bb*t427;
+  const T t431 = app12_J0_xx - t430;
+  const T t432 = app12_J0_yy + t430;
+  const T t433 = -kcebfb7bb*t428;
+  const T t434 = angle_c[11]*app12_J0_xz;
+  const T t435 = angle_s[11]*app12_J0_xz;
+  const T t436 = 2.0*app12_p_J_y*t426 + k88426457 + t431;
+  const T t437 = t433 - ((app12_p_J_x*t426 + app12_p_J_y*t425) + k533baaf4);
+  const T t438 = -kf61235c3 + t434;
+  const T t439 = 2.0*app12_p_J_x*t425 + k533bad8b + t432;
+  const T t440 = -kf6123610 + t435;
+  const T t441 = 2.0*app12_p_J_x*t425 + 2.0*app12_p_J_y*t426 + ka3ff29e7;
+  const T t442 = k21d31807 + t425;
+  const T t443 = k21d317f8 + t426;
+  const T t444 = app12_R_PJ_xy*t443 + k68bd703f;
+  const T t445 = app12_R_PJ_yy*t443 + kc3a7dc33;
+  const T t446 = app12_R_PJ_xy*t437 + app12_R_PJ_xz*t438;
+  const T t447 = app12_R_PJ_xy*t439 + app12_R_PJ_xz*t440;
+  const T t448 = app12_R_PJ_xy*t440 + app12_R_PJ_xz*t441;
+  const T t449 = app12_R_PJ_yy*t437 + app12_R_PJ_yz*t438;
+  const T t450 = app12_R_PJ_yy*t439 + app12_R_PJ_yz*t440;
+  const T t451 = app12_R_PJ_yy*t440 + app12_R_PJ_yz*t441;
+  const T t452 = app12_R_PJ_xy*t447 + app12_R_PJ_xz*t448;
+  const T t453 = app12_R_PJ_yy*t447 + app12_R_PJ_yz*t448;
+  const T t454 = app12_R_PJ_yy*t450 + app12_R_PJ_yz*t451;
+  const T t455 = t417 + t452;
+  const T t456 = t391 + t453;
+  const T t457 = t392 + t446;
+  const T t458 = t418 + t454;
+  const T t459 = t419 + t449;
+  const T t460 = t420 + t436;
+  const T t461 = t421 - t442;
+  const T t462 = t422 + t445;
+  const T t463 = t423 + t442;
+  const T t464 = t399 - t444;
+  const T t465 = t424 - t445;
+  const T t466 = t401 + t444;
   // ---- body app11: composite inertia (inward)
-  const T t469 = angle_c[10]*app11_S0_x;
-  const T t470 = angle_s[10]*app11_S0_x;
-  const T t471 = angle_s[10]*angle_s[10];
-  const T t472 = angle_c[10]*angle_s[10];
-  const T t474 = -kb54bee3a*t471;
-  const T t475 = app11_J0_xx - t474;
-  const T t476 = app11_J0_yy + t474;
-  const T t477 = -kb54bee3a*t472;
-  const T t478 = kc2cb00dd + t475;
-  const T t479 = -app11_p_J_x*t470 + t477;
-  const T t480 = -app11_p_J_z*t469 - k30cd4e49;
-  const T t481 = 2.0*app11_p_J_x*t469 + k8aaf66ee + t476;
-  const T t482 = -app11_p_J_z*t470;
-  const T t483 = 2.0*app11_p_J_x*t469 + k41401011;
-  const T t484 = ka96059e1 + t469;
-  const T t485 = app11_R_PJ_xx*t484 + app11_R_PJ_xy*t470;
-  const T t486 = app11_R_PJ_yx*t484 + app11_R_PJ_yy*t470;
-  const T t487 = t478 - t481;
-  const T t488 = app11_R_PJ_xx_S2*t479 + app11_R_PJ_xx_ss*t487;
-  const T t489 = t478 - t488;
-  const T t490 = t481 + t488;
-  const T t491 = app11_R_PJ_xx_C2*t479 + app11_R_PJ_xx_cs*t487;
-  const T t492 = app11_R_PJ_xx*t480 - app11_R_PJ_yx*t482;
-  const T t493 = app11_R_PJ_xx*t482 + app11_R_PJ_yx*t480;
-  const T t494 = t457 + t489;
-  const T t495 = t458 + t491;
-  const T t496 = t459 + t492;
-  const T t497 = t460 + t490;
-  const T t498 = t461 + t493;
-  const T t499 = t462 + t483;
-  const T t500 = -ka9605b4b + t463;
-  const T t501 = t464 + t486;
-  const T t502 = ka9605b4b + t465;
-  const T t503 = t466 - t485;
-  const T t504 = t467 - t486;
-  const T t505 = t468 + t485;
+  const T t467 = angle_c[10]*app11_S0_x;
+  const T t468 = angle_s[10]*app11_S0_x;
+  const T t469 = angle_s[10]*angle_s[10];
+  const T t470 = angle_c[10]*angle_s[10];
+  const T t472 = -kb54bee3a*t469;
+  const T t473 = app11_J0_xx - t472;
+  const T t474 = app11_J0_yy + t472;
+  const T t475 = -kb54bee3a*t470;
+  const T t476 = kc2cb00dd + t473;
+  const T t477 = -app11_p_J_x*t468 + t475;
+  const T t478 = -app11_p_J_z*t467 - k30cd4e49;
+  const T t479 = 2.0*app11_p_J_x*t467 + k8aaf66ee + t474;
+  const T t480 = -app11_p_J_z*t468;
+  const T t481 = 2.0*app11_p_J_x*t467 + k41401011;
+  const T t482 = ka96059e1 + t467;
+  const T t483 = app11_R_PJ_xx*t482 + app11_R_PJ_xy*t468;
+  const T t484 = app11_R_PJ_yx*t482 + app11_R_PJ_yy*t468;
+  const T t485 = t476 - t479;
+  const T t486 = app11_R_PJ_xx_S2*t477 + app11_R_PJ_xx_ss*t485;
+  const T t487 = t476 - t486;
+  const T t488 = t479 + t486;
+  const T t489 = app11_R_PJ_xx_C2*t477 + app11_R_PJ_xx_cs*t485;
+  const T t490 = app11_R_PJ_xx*t478 - app11_R_PJ_yx*t480;
+  const T t491 = app11_R_PJ_xx*t480 + app11_R_PJ_yx*t478;
+  const T t492 = t455 + t487;
+  const T t493 = t456 + t489;
+  const T t494 = t457 + t490;
+  const T t495 = t458 + t488;
+  const T t496 = t459 + t491;
+  const T t497 = t460 + t481;
+  const T t498 = -ka9605b4b + t461;
+  const T t499 = t462 + t484;
+  const T t500 = ka9605b4b + t463;
+  const T t501 = t464 - t483;
+  const T t502 = t465 - t484;
+  const T t503 = t466 + t483;
   // ---- body app10: composite inertia (inward)
-  const T t506 = angle_c[9]*app10_S0_x;
-  const T t507 = angle_s[9]*app10_S0_x;
-  const T t508 = angle_s[9]*angle_s[9];
-  const T t509 = angle_c[9]*angle_s[9];
-  const T t511 = -k138bca40*t508;
-  const T t512 = app10_J0_xx - t511;
-  const T t513 = app10_J0_yy + t511;
-  const T t514 = -k138bca40*t509;
-  const T t515 = 2.0*app10_p_J_y*t507 + k05b7a508 + t512;
-  const T t516 = t514 - ((app10_p_J_x*t507 + app10_p_J_y*t506) + k526ce8ba);
-  const T t517 = -app10_p_J_z*t506 - k526ce90f;
-  const T t518 = 2.0*app10_p_J_x*t506 + k123e673f + t513;
-  const T t519 = -app10_p_J_z*t507 - k82f30525;
-  const T t520 = 2.0*app10_p_J_x*t506 + 2.0*app10_p_J_y*t507 + k55020ad7;
-  const T t521 = k6f9c2bde + t506;
-  const T t522 = k6f9c26a9 + t507;
-  const T t523 = app10_R_PJ_xx*t521 + kd4837370;
-  const T t524 = app10_R_PJ_yx*t521 + k9161929f;
-  const T t525 = app10_R_PJ_xx*t515 + app10_R_PJ_xz*t517;
-  const T t526 = app10_R_PJ_xx*t516 + app10_R_PJ_xz*t519;
-  const T t527 = app10_R_PJ_xx*t517 + app10_R_PJ_xz*t520;
-  const T t528 = app10_R_PJ_yx*t515 + app10_R_PJ_yz*t517;
-  const T t529 = app10_R_PJ_yx*t516 + app10_R_PJ_yz*t519;
-  const T t530 = app10_R_PJ_yx*t517 + app10_R_PJ_yz*t520;
-  const T t531 = app10_R_PJ_xx*t525 + app10_R_PJ_xz*t527;
-  const T t532 = app10_R_PJ_yx*t525 + app10_R_PJ_yz*t527;
-  const T t533 = app10_R_PJ_yx*t528 + app10_R_PJ_yz*t530;
-  const T t534 = t494 + t531;
-  const T t535 = t495 + t532;
-  const T t536 = t496 - t526;
-  const T t537 = t497 + t533;
-  const T t538 = t498 - t529;
-  const T t539 = t499 + t518;
-  const T t540 = t500 + t522;
-  const T t541 = t501 + t524;
+  const T t504 = angle_c[9]*app10_S0_x;
+  const T t505 = angle_s[9]*app10_S0_x;
+  const T t506 = angle_s[9]*angle_s[9];
+  const T t507 = angle_c[9]*angle_s[9];
+  const T t509 = -k138bca40*t506;
+  const T t510 = app10_J0_xx - t509;
+  const T t511 = app10_J0_yy + t509;
+  const T t512 = -k138bca40*t507;
+  const T t513 = 2.0*app10_p_J_y*t505 + k05b7a508 + t510;
+  const T t514 = t512 - ((app10_p_J_x*t505 + app10_p_J_y*t504) + k526ce8ba);
+  const T t515 = -app10_p_J_z*t504 - k526ce90f;
+  const T t516 = 2.0*app10_p_J_x*t504 + k123e673f + t511;
+  const T t517 = -app10_p_J_z*t505 - k82f30525;
+  const T t518 = 2.0*app10_p_J_x*t504 + 2.0*app10_p_J_y*t505 + k55020ad7;
+  const T t519 = k6f9c2bde + t504;
+  const T t520 = k6f9c26a9 + t505;
+  const T t521 = app10_R_PJ_xx*t519 + kd4837370;
+  const T t522 = app10_R_PJ_yx*t519 + k9161929f;
+  const T t523 = app10_R_PJ_xx*t513 + app10_R_PJ_xz*t515;
+  const T t524 = app10_R_PJ_xx*t514 + app10_R_PJ_xz*t517;
+  const T t525 = app10_R_PJ_xx*t515 + app10_R_PJ_xz*t518;
+  const T t526 = app10_R_PJ_yx*t513 + app10_R_PJ_yz*t515;
+  const T t527 = app10_R_PJ_yx*t514 + app10_R_PJ_yz*t517;
+  const T t528 = app10_R_PJ_yx*t515 + app10_R_PJ_yz*t518;
+  const T t529 = app10_R_PJ_xx*t523 + app10_R_PJ_xz*t525;
+  const T t530 = app10_R_PJ_yx*t523 + app10_R_PJ_yz*t525;
+  const T t531 = app10_R_PJ_yx*t526 + app10_R_PJ_yz*t528;
+  const T t532 = t492 + t529;
+  const T t533 = t493 + t530;
+  const T t534 = t494 - t524;
+  const T t535 = t495 + t531;
+  const T t536 = t496 - t527;
+  const T t537 = t497 + t516;
+  const T t538 = t498 + t520;
+  const T t539 = t499 + t522;
+  const T t540 = t500 - t520;
+  const T t541 = t501 - t521;
   const T t542 = t502 - t522;
-  const T t543 = t503 - t523;
-  const T t544 = t504 - t524;
-  const T t545 = t505 + t523;
+  const T t543 = t503 + t521;
   // ---- body app9: composite inertia (inward)
-  const T t546 = angle_c[8]*app9_S0_x;
-  const T t547 = angle_s[8]*app9_S0_x;
-  const T t548 = angle_s[8]*angle_s[8];
-  const T t549 = angle_c[8]*angle_s[8];
-  const T t551 = -k50067db4*t548;
-  const T t552 = app9_J0_xx - t551;
-  const T t553 = app9_J0_yy + t551;
-  const T t554 = -k50067db4*t549;
-  const T t555 = angle_c[8]*app9_J0_xz;
-  const T t556 = angle_s[8]*app9_J0_xz;
-  const T t557 = kfc24650e + t552;
-  const T t558 = -app9_p_J_x*t547 + t554;
-  const T t559 = -app9_p_J_z*t546 - k2462394e + t555;
-  const T t560 = 2.0*app9_p_J_x*t546 + k6374fcbf + t553;
-  const T t561 = -app9_p_J_z*t547 + t556;
-  const T t562 = 2.0*app9_p_J_x*t546 + k6448fd9f;
-  const T t563 = k6ac156b2 + t546;
-  const T t564 = t534 + t562;
-  const T t565 = t535 - t561;
-  const T t566 = t536 - t559;
-  const T t567 = t537 + t560;
-  const T t568 = t538 + t558;
-  const T t569 = t539 + t557;
-  const T t570 = t540 - t563;
-  const T t571 = t541 + t547;
-  const T t572 = t542 + t563;
-  const T t573 = k98792947 + t543;
-  const T t574 = t544 - t547;
-  const T t575 = -k98792947 + t545;
+  const T t544 = angle_c[8]*app9_S0_x;
+  const T t545 = angle_s[8]*app9_S0_x;
+  const T t546 = angle_s[8]*angle_s[8];
+  const T t547 = angle_c[8]*angle_s[8];
+  const T t549 = -k50067db4*t546;
+  const T t550 = app9_J0_xx - t549;
+  const T t551 = app9_J0_yy + t549;
+  const T t552 = -k50067db4*t547;
+  const T t553 = angle_c[8]*app9_J0_xz;
+  const T t554 = angle_s[8]*app9_J0_xz;
+  const T t555 = -app9_p_J_x*t545 + t552;
+  const T t556 = -kbb35569c + t553;
+  const T t557 = 2.0*app9_p_J_x*t544 + kd089a3f0 + t551;
+  const T t558 = 2.0*app9_p_J_x*t544 + k6448fd9f;
+  const T t559 = k6ac156b2 + t544;
+  const T t560 = t532 + t558;
+  const T t561 = t533 - t554;
+  const T t562 = t534 - t556;
+  const T t563 = t535 + t557;
+  const T t564 = t536 + t555;
+  const T t565 = t537 + t550;
+  const T t566 = t538 - t559;
+  const T t567 = t539 + t545;
+  const T t568 = t540 + t559;
+  const T t569 = app9_S0_z + t541;
+  const T t570 = t542 - t545;
+  const T t571 = -app9_S0_z + t543;
   // ---- body app8: composite inertia (inward)
-  const T t576 = angle_c[7]*app8_S0_x;
-  const T t577 = angle_s[7]*app8_S0_x;
-  const T t578 = angle_s[7]*angle_s[7];
-  const T t579 = angle_c[7]*angle_s[7];
-  const T t581 = -kef293309*t578;
-  const T t582 = app8_J0_xx - t581;
-  const T t583 = app8_J0_yy + t581;
-  const T t584 = -kef293309*t579;
-  const T t585 = 2.0*app8_p_J_y*t577 + k6d475432 + t582;
-  const T t586 = t584 - ((app8_p_J_x*t577 + app8_p_J_y*t576) + kf3ed9f9e);
-  const T t587 = -app8_p_J_z*t576 - kf3ee6767;
-  const T t588 = 2.0*app8_p_J_x*t576 + kc5df6b85 + t583;
-  const T t589 = -app8_p_J_z*t577 - kcc39b7f0;
-  const T t590 = 2.0*app8_p_J_x*t576 + 2.0*app8_p_J_y*t577 + k858945a8;
-  const T t591 = k396ac5de + t576;
-  const T t592 = k396adaad + t577;
-  const T t593 = app8_R_PJ_xx*t591 + app8_R_PJ_xy*t592;
-  const T t594 = app8_R_PJ_yx*t591 + app8_R_PJ_yy*t592;
-  const T t595 = t585 - t588;
-  const T t596 = app8_R_PJ_xx_S2*t586 + app8_R_PJ_xx_ss*t595;
-  const T t597 = t585 - t596;
-  const T t598 = t588 + t596;
-  const T t599 = app8_R_PJ_xx_C2*t586 + app8_R_PJ_xx_cs*t595;
-  const T t600 = app8_R_PJ_xx*t587 - app8_R_PJ_yx*t589;
-  const T t601 = app8_R_PJ_xx*t589 + app8_R_PJ_yx*t587;
+  const T t572 = angle_c[7]*app8_S0_x;
+  const T t573 = angle_s[7]*app8_S0_x;
+  const T t574 = angle_s[7]*angle_s[7];
+  const T t575 = angle_c[7]*angle_s[7];
+  const T t577 = -kef293309*t574;
+  const T t578 = app8_J0_xx - t577;
+  const T t579 = app8_J0_yy + t577;
+  const T t580 = -kef293309*t575;
+  const T t581 = 2.0*app8_p_J_y*t573 + k6d475432 + t578;
+  const T t582 = t580 - ((app8_p_J_x*t573 + app8_p_J_y*t572) + kf3ed9f9e);
+  const T t583 = -app8_p_J_z*t572 - kf3ee6767;
+  const T t584 = 2.0*app8_p_J_x*t572 + kc5df6b85 + t579;
+  const T t585 = -app8_p_J_z*t573 - kcc39b7f0;
+  const T t586 = 2.0*app8_p_J_x*t572 + 2.0*app8_p_J_y*t573 + k858945a8;
+  const T t587 = k396ac5de + t572;
+  const T t588 = k396adaad + t573;
+  const T t589 = app8_R_PJ_xx*t587 + app8_R_PJ_xy*t588;
+  const T t590 = app8_R_PJ_yx*t587 + app8_R_PJ_yy*t588;
+  const T t591 = t581 - t584;
+  const T t592 = app8_R_PJ_xx_S2*t582 + app8_R_PJ_xx_ss*t591;
+  const T t593 = t581 - t592;
+  const T t594 = t584 + t592;
+  const T t595 = app8_R_PJ_xx_C2*t582 + app8_R_PJ_xx_cs*t591;
+  const T t596 = app8_R_PJ_xx*t583 - app8_R_PJ_yx*t585;
+  const T t597 = app8_R_PJ_xx*t585 + app8_R_PJ_yx*t583;
+  const T t598 = t560 + t593;
+  const T t599 = t561 + t595;
+  const T t600 = t562 + t596;
+  const T t601 = t563 + t594;
   const T t602 = t564 + t597;
-  const T t603 = t565 + t599;
-  const T t604 = t566 + t600;
-  const T t605 = t567 + t598;
-  const T t606 = t568 + t601;
-  const T t607 = t569 + t590;
-  const T t608 = -k396ac4b4 + t570;
-  const T t609 = t571 + t594;
-  const T t610 = k396ac4b4 + t572;
-  const T t611 = t573 - t593;
-  const T t612 = t574 - t594;
-  const T t613 = t575 + t593;
+  const T t603 = t565 + t586;
+  const T t604 = -k396ac4b4 + t566;
+  const T t605 = t567 + t590;
+  const T t606 = k396ac4b4 + t568;
+  const T t607 = t569 - t589;
+  const T t608 = t570 - t590;
+  const T t609 = t571 + t589;
   // ---- body app7: composite inertia (inward)
-  const T t614 = angle_c[6]*app7_S0_x;
-  const T t615 = angle_s[6]*app7_S0_x;
-  const T t616 = angle_s[6]*angle_s[6];
-  const T t617 = angle_c[6]*angle_s[6];
-  const T t619 = -k41c850c7*t616;
-  const T t620 = app7_J0_xx - t619;
-  const T t621 = app7_J0_yy + t619;
-  const T t622 = -k41c850c7*t617;
-  const T t623 = 2.0*app7_p_J_y*t615 + kcc4a034d + t620;
-  const T t624 = t622 - ((app7_p_J_x*t615 + app7_p_J_y*t614) + k7a272588);
-  const T t625 = 2.0*app7_p_J_x*t614 + k7a272cf7 + t621;
-  const T t626 = 2.0*app7_p_J_x*t614 + 2.0*app7_p_J_y*t615 + kdd74b102;
-  const T t627 = k7459aa53 + t614;
-  const T t628 = k7459af00 + t615;
-  const T t629 = app7_R_PJ_xx*t627;
-  const T t630 = app7_R_PJ_yx*t627;
-  const T t631 = app7_R_PJ_xx*t623;
-  const T t632 = app7_R_PJ_xx*t624;
-  const T t633 = app7_R_PJ_xz*t626;
-  const T t634 = app7_R_PJ_yx*t623;
-  const T t635 = app7_R_PJ_yx*t624;
-  const T t636 = app7_R_PJ_yz*t626;
-  const T t637 = app7_R_PJ_xx*t631 + app7_R_PJ_xz*t633;
-  const T t638 = app7_R_PJ_yx*t631 + app7_R_PJ_yz*t633;
-  const T t639 = app7_R_PJ_yx*t634 + app7_R_PJ_yz*t636;
-  const T t640 = t602 + t637;
-  const T t641 = t603 + t638;
-  const T t642 = t604 - t632;
-  const T t643 = t605 + t639;
-  const T t644 = t606 - t635;
-  const T t645 = t607 + t625;
-  const T t646 = t608 + t628;
-  const T t647 = t609 + t630;
-  const T t648 = t610 - t628;
-  const T t649 = t611 - t629;
-  const T t650 = t612 - t630;
-  const T t651 = t613 + t629;
+  const T t610 = angle_c[6]*app7_S0_x;
+  const T t611 = angle_s[6]*app7_S0_x;
+  const T t612 = angle_s[6]*angle_s[6];
+  const T t613 = angle_c[6]*angle_s[6];
+  const T t615 = -k41c850c7*t612;
+  const T t616 = app7_J0_xx - t615;
+  const T t617 = app7_J0_yy + t615;
+  const T t618 = -k41c850c7*t613;
+  const T t619 = 2.0*app7_p_J_y*t611 + kcc4a034d + t616;
+  const T t620 = t618 - ((app7_p_J_x*t611 + app7_p_J_y*t610) + k7a272588);
+  const T t621 = 2.0*app7_p_J_x*t610 + k7a272cf7 + t617;
+  const T t622 = 2.0*app7_p_J_x*t610 + 2.0*app7_p_J_y*t611 + kdd74b102;
+  const T t623 = k7459aa53 + t610;
+  const T t624 = k7459af00 + t611;
+  const T t625 = app7_R_PJ_xx*t623;
+  const T t626 = app7_R_PJ_yx*t623;
+  const T t627 = app7_R_PJ_xx*t619;
+  const T t628 = app7_R_PJ_xx*t620;
+  const T t629 = app7_R_PJ_xz*t622;
+  const T t630 = app7_R_PJ_yx*t619;
+  const T t631 = app7_R_PJ_yx*t620;
+  const T t632 = app7_R_PJ_yz*t622;
+  const T t633 = app7_R_PJ_xx*t627 + app7_R_PJ_xz*t629;
+  const T t634 = app7_R_PJ_yx*t627 + app7_R_PJ_yz*t629;
+  const T t635 = app7_R_PJ_yx*t630 + app7_R_PJ_yz*t632;
+  const T t636 = t598 + t633;
+  const T t637 = t599 + t634;
+  const T t638 = t600 - t628;
+  const T t639 = t601 + t635;
+  const T t640 = t602 - t631;
+  const T t641 = t603 + t621;
+  const T t642 = t604 + t624;
+  const T t643 = t605 + t626;
+  const T t644 = t606 - t624;
+  const T t645 = t607 - t625;
+  const T t646 = t608 - t626;
+  const T t647 = t609 + t625;
   // ---- body app6: composite inertia (inward)
-  const T t652 = angle_c[5]*app6_S0_x;
-  const T t653 = angle_s[5]*app6_S0_x;
-  const T t654 = angle_s[5]*angle_s[5];
-  const T t655 = angle_c[5]*angle_s[5];
-  const T t657 = -k3fd7e6e2*t654;
-  const T t658 = app6_J0_xx - t657;
-  const T t659 = app6_J0_yy + t657;
-  const T t660 = -k3fd7e6e2*t655;
-  const T t661 = angle_c[5]*app6_J0_xz;
-  const T t662 = angle_s[5]*app6_J0_xz;
-  const T t663 = 2.0*app6_p_J_y*t653 + k27ab12de + t658;
-  const T t664 = t660 - ((app6_p_J_x*t653 + app6_p_J_y*t652) + k5b5e4f0e);
-  const T t665 = -app6_p_J_z*t652 + kad510176 + t661;
-  const T t666 = 2.0*app6_p_J_x*t652 + kfa032c1b + t659;
-  const T t667 = -app6_p_J_z*t653 - k77b73ce6 + t662;
-  const T t668 = 2.0*app6_p_J_x*t652 + 2.0*app6_p_J_y*t653 + k621805c7;
-  const T t669 = k4b36588b + t652;
-  const T t670 = k4b3669f8 + t653;
-  const T t671 = app6_R_PJ_xy*t670 + kfe2250aa;
-  const T t672 = app6_R_PJ_yy*t670 + k00da5c78;
-  const T t673 = app6_R_PJ_xy*t664 + app6_R_PJ_xz*t665;
-  const T t674 = app6_R_PJ_xy*t666 + app6_R_PJ_xz*t667;
-  const T t675 = app6_R_PJ_xy*t667 + app6_R_PJ_xz*t668;
-  const T t676 = app6_R_PJ_yy*t664 + app6_R_PJ_yz*t665;
-  const T t677 = app6_R_PJ_yy*t666 + app6_R_PJ_yz*t667;
-  const T t678 = app6_R_PJ_yy*t667 + app6_R_PJ_yz*t668;
-  const T t679 = app6_R_PJ_xy*t674 + app6_R_PJ_xz*t675;
-  const T t680 = app6_R_PJ_yy*t674 + app6_R_PJ_yz*t675;
-  const T t681 = app6_R_PJ_yy*t677 + app6_R_PJ_yz*t678;
-  const T t682 = t640 + t679;
-  const T t683 = t641 + t680;
-  const T t684 = t642 + t673;
-  const T t685 = t643 + t681;
-  const T t686 = t644 + t676;
-  const T t687 = t645 + t663;
-  const T t688 = t646 - t669;
-  const T t689 = t647 + t672;
-  const T t690 = t648 + t669;
-  const T t691 = t649 - t671;
-  const T t692 = t650 - t672;
-  const T t693 = t651 + t671;
+  const T t648 = angle_c[5]*app6_S0_x;
+  const T t649 = angle_s[5]*app6_S0_x;
+  const T t650 = angle_s[5]*angle_s[5];
+  const T t651 = angle_c[5]*angle_s[5];
+  const T t653 = -k3fd7e6e2*t650;
+  const T t654 = app6_J0_xx - t653;
+  const T t655 = app6_J0_yy + t653;
+  const T t656 = -k3fd7e6e2*t651;
+  const T t657 = angle_c[5]*app6_J0_xz;
+  const T t658 = angle_s[5]*app6_J0_xz;
+  const T t659 = 2.0*app6_p_J_y*t649 + k2e069f71 + t654;
+  const T t660 = t656 - ((app6_p_J_x*t649 + app6_p_J_y*t648) + k5b5e4f0e);
+  const T t661 = -kf771899e + t657;
+  const T t662 = 2.0*app6_p_J_x*t648 + k5b5e49b1 + t655;
+  const T t663 = -kf7719741 + t658;
+  const T t664 = 2.0*app6_p_J_x*t648 + 2.0*app6_p_J_y*t649 + k621805c7;
+  const T t665 = k4b36588b + t648;
+  const T t666 = k4b3669f8 + t649;
+  const T t667 = app6_R_PJ_xy*t666 + kb25f6a3f;
+  const T t668 = app6_R_PJ_yy*t666 + kcdd5e91f;
+  const T t669 = app6_R_PJ_xy*t660 + app6_R_PJ_xz*t661;
+  const T t670 = app6_R_PJ_xy*t662 + app6_R_PJ_xz*t663;
+  const T t671 = app6_R_PJ_xy*t663 + app6_R_PJ_xz*t664;
+  const T t672 = app6_R_PJ_yy*t660 + app6_R_PJ_yz*t661;
+  const T t673 = app6_R_PJ_yy*t662 + app6_R_PJ_yz*t663;
+  const T t674 = app6_R_PJ_yy*t663 + app6_R_PJ_yz*t664;
+  const T t675 = app6_R_PJ_xy*t670 + app6_R_PJ_xz*t671;
+  const T t676 = app6_R_PJ_yy*t670 + app6_R_PJ_yz*t671;
+  const T t677 = app6_R_PJ_yy*t673 + app6_R_PJ_yz*t674;
+  const T t678 = t636 + t675;
+  const T t679 = t637 + t676;
+  const T t680 = t638 + t669;
+  const T t681 = t639 + t677;
+  const T t682 = t640 + t672;
+  const T t683 = t641 + t659;
+  const T t684 = t642 - t665;
+  const T t685 = t643 + t668;
+  const T t686 = t644 + t665;
+  const T t687 = t645 - t667;
+  const T t688 = t646 - t668;
+  const T t689 = t647 + t667;
   // ---- body app5: composite inertia (inward)
-  const T t694 = angle_c[4]*app5_S0_x;
-  const T t695 = angle_s[4]*app5_S0_x;
-  const T t696 = angle_s[4]*angle_s[4];
-  const T t697 = angle_c[4]*angle_s[4];
-  const T t699 = -k056ef3a0*t696;
-  const T t700 = app5_J0_xx - t699;
-  const T t701 = app5_J0_yy + t699;
-  const T t702 = -k056ef3a0*t697;
-  const T t703 = k36a43f36 + t700;
-  const T t704 = -app5_p_J_x*t695 + t702;
-  const T t705 = -app5_p_J_z*t694 - kc4d8dcf2;
-  const T t706 = 2.0*app5_p_J_x*t694 + kc4ddfc31 + t701;
-  const T t707 = -app5_p_J_z*t695;
-  const T t708 = 2.0*app5_p_J_x*t694 + kffe44b4f;
-  const T t709 = k80187168 + t694;
-  const T t710 = t682 + t706;
-  const T t711 = t683 - t704;
-  const T t712 = t684 - t707;
-  const T t713 = t685 + t703;
-  const T t714 = t686 + t705;
-  const T t715 = t687 + t708;
-  const T t716 = -k80198fc2 + t688;
-  const T t717 = t689 + t709;
-  const T t718 = k80198fc2 + t690;
-  const T t719 = t691 + t695;
-  const T t720 = t692 - t709;
-  const T t721 = t693 - t695;
+  const T t690 = angle_c[4]*app5_S0_x;
+  const T t691 = angle_s[4]*app5_S0_x;
+  const T t692 = angle_s[4]*angle_s[4];
+  const T t693 = angle_c[4]*angle_s[4];
+  const T t695 = -k056ef3a0*t692;
+  const T t696 = app5_J0_xx - t695;
+  const T t697 = app5_J0_yy + t695;
+  const T t698 = -k056ef3a0*t693;
+  const T t699 = k36a43f36 + t696;
+  const T t700 = -app5_p_J_x*t691 + t698;
+  const T t701 = -app5_p_J_z*t690 - kc4d8dcf2;
+  const T t702 = 2.0*app5_p_J_x*t690 + kc4ddfc31 + t697;
+  const T t703 = -app5_p_J_z*t691;
+  const T t704 = 2.0*app5_p_J_x*t690 + kffe44b4f;
+  const T t705 = k80187168 + t690;
+  const T t706 = t678 + t702;
+  const T t707 = t679 - t700;
+  const T t708 = t680 - t703;
+  const T t709 = t681 + t699;
+  const T t710 = t682 + t701;
+  const T t711 = t683 + t704;
+  const T t712 = -k80198fc2 + t684;
+  const T t713 = t685 + t705;
+  const T t714 = k80198fc2 + t686;
+  const T t715 = t687 + t691;
+  const T t716 = t688 - t705;
+  const T t717 = t689 - t691;
   // ---- body app4: composite inertia (inward)
-  const T t722 = angle_c[3]*app4_S0_x;
-  const T t723 = angle_s[3]*app4_S0_x;
-  const T t724 = angle_s[3]*angle_s[3];
-  const T t725 = angle_c[3]*angle_s[3];
-  const T t727 = -kdadf1a0d*t724;
-  const T t728 = app4_J0_xx - t727;
-  const T t729 = app4_J0_yy + t727;
-  const T t730 = -kdadf1a0d*t725;
-  const T t731 = 2.0*app4_p_J_y*t723 + k83559a3b + t728;
-  const T t732 = t730 - ((app4_p_J_x*t723 + app4_p_J_y*t722) + k6ac783fe);
-  const T t733 = -app4_p_J_z*t722 - k6ac783e7;
-  const T t734 = 2.0*app4_p_J_x*t722 + k37abbdd7 + t729;
-  const T t735 = -app4_p_J_z*t723 - k7b3c2e78;
-  const T t736 = 2.0*app4_p_J_x*t722 + 2.0*app4_p_J_y*t723 + kec02ae44;
-  const T t737 = kf1b1b971 + t722;
-  const T t738 = kf1b1b802 + t723;
-  const T t739 = app4_R_PJ_xx*t737 + kf19089ec;
-  const T t740 = app4_R_PJ_yx*t737 + k07abff12;
-  const T t741 = app4_R_PJ_xx*t731 + app4_R_PJ_xz*t733;
-  const T t742 = app4_R_PJ_xx*t732 + app4_R_PJ_xz*t735;
-  const T t743 = app4_R_PJ_xx*t733 + app4_R_PJ_xz*t736;
-  const T t744 = app4_R_PJ_yx*t731 + app4_R_PJ_yz*t733;
-  const T t745 = app4_R_PJ_yx*t732 + app4_R_PJ_yz*t735;
-  const T t746 = app4_R_PJ_yx*t733 + app4_R_PJ_yz*t736;
-  const T t747 = app4_R_PJ_xx*t741 + app4_R_PJ_xz*t743;
-  const T t748 = app4_R_PJ_yx*t741 + app4_R_PJ_yz*t743;
-  const T t749 = app4_R_PJ_yx*t744 + app4_R_PJ_yz*t746;
-  const T t750 = t710 + t747;
-  const T t751 = t711 + t748;
-  const T t752 = t712 - t742;
-  const T t753 = t713 + t749;
-  const T t754 = t714 - t745;
-  const T t755 = t715 + t734;
-  const T t756 = t716 + t738;
-  const T t757 = t717 + t740;
-  const T t758 = t718 - t738;
-  const T t759 = t719 - t739;
-  const T t760 = t720 - t740;
-  const T t761 = t721 + t739;
+  const T t718 = angle_c[3]*app4_S0_x;
+  const T t719 = angle_s[3]*app4_S0_x;
+  const T t720 = angle_s[3]*angle_s[3];
+  const T t721 = angle_c[3]*angle_s[3];
+  const T t723 = -kdadf1a0d*t720;
+  const T t724 = app4_J0_xx - t723;
+  const T t725 = app4_J0_yy + t723;
+  const T t726 = -kdadf1a0d*t721;
+  const T t727 = 2.0*app4_p_J_y*t719 + k83559a3b + t724;
+  const T t728 = t726 - ((app4_p_J_x*t719 + app4_p_J_y*t718) + k6ac783fe);
+  const T t729 = -app4_p_J_z*t718 - k6ac783e7;
+  const T t730 = 2.0*app4_p_J_x*t718 + k37abbdd7 + t725;
+  const T t731 = -app4_p_J_z*t719 - k7b3c2e78;
+  const T t732 = 2.0*app4_p_J_x*t718 + 2.0*app4_p_J_y*t719 + kec02ae44;
+  const T t733 = kf1b1b971 + t718;
+  const T t734 = kf1b1b802 + t719;
+  const T t735 = app4_R_PJ_xx*t733 + kf19089ec;
+  const T t736 = app4_R_PJ_yx*t733 + k07abff12;
+  const T t737 = app4_R_PJ_xx*t727 + app4_R_PJ_xz*t729;
+  const T t738 = app4_R_PJ_xx*t728 + app4_R_PJ_xz*t731;
+  const T t739 = app4_R_PJ_xx*t729 + app4_R_PJ_xz*t732;
+  const T t740 = app4_R_PJ_yx*t727 + app4_R_PJ_yz*t729;
+  const T t741 = app4_R_PJ_yx*t728 + app4_R_PJ_yz*t731;
+  const T t742 = app4_R_PJ_yx*t729 + app4_R_PJ_yz*t732;
+  const T t743 = app4_R_PJ_xx*t737 + app4_R_PJ_xz*t739;
+  const T t744 = app4_R_PJ_yx*t737 + app4_R_PJ_yz*t739;
+  const T t745 = app4_R_PJ_yx*t740 + app4_R_PJ_yz*t742;
+  const T t746 = t706 + t743;
+  const T t747 = t707 + t744;
+  const T t748 = t708 - t738;
+  const T t749 = t709 + t745;
+  const T t750 = t710 - t741;
+  const T t751 = t711 + t730;
+  const T t752 = t712 + t734;
+  const T t753 = t713 + t736;
+  const T t754 = t714 - t734;
+  const T t755 = t715 - t735;
+  const T t756 = t716 - t736;
+  const T t757 = t717 + t735;
   // ---- body app3: composite inertia (inward)
-  const T t762 = angle_c[2]*app3_S0_x;
-  const T t763 = angle_s[2]*app3_S0_x;
-  const T t764 = angle_s[2]*angle_s[2];
-  const T t765 = angle_c[2]*angle_s[2];
-  const T t767 = -k65b3febe*t764;
-  const T t768 = app3_J0_xx - t767;
-  const T t769 = app3_J0_yy + t767;
-  const T t770 = -k65b3febe*t765;
-  const T t771 = angle_c[2]*app3_J0_xz;
-  const T t772 = angle_s[2]*app3_J0_xz;
-  const T t773 = k2e8d5174 + t768;
-  const T t774 = -app3_p_J_x*t763 + t770;
-  const T t775 = -app3_p_J_z*t762 - k474da613 + t771;
-  const T t776 = 2.0*app3_p_J_x*t762 + kc4342491 + t769;
-  const T t777 = -app3_p_J_z*t763 + t772;
-  const T t778 = 2.0*app3_p_J_x*t762 + kb1dbe7fc;
-  const T t779 = k3ec33d3d + t762;
-  const T t780 = app3_R_PJ_xy*t763 + k37ee0a3f;
-  const T t781 = app3_R_PJ_yy*t763 + ke599a6a7;
-  const T t782 = app3_R_PJ_xy*t774 + app3_R_PJ_xz*t775;
-  const T t783 = app3_R_PJ_xy*t776 + app3_R_PJ_xz*t777;
-  const T t784 = app3_R_PJ_xy*t777 + app3_R_PJ_xz*t778;
-  const T t785 = app3_R_PJ_yy*t774 + app3_R_PJ_yz*t775;
-  const T t786 = app3_R_PJ_yy*t776 + app3_R_PJ_yz*t777;
-  const T t787 = app3_R_PJ_yy*t777 + app3_R_PJ_yz*t778;
-  const T t788 = app3_R_PJ_xy*t783 + app3_R_PJ_xz*t784;
-  const T t789 = app3_R_PJ_yy*t783 + app3_R_PJ_yz*t784;
-  const T t790 = app3_R_PJ_yy*t786 + app3_R_PJ_yz*t787;
-  const T t791 = t750 + t788;
-  const T t792 = t751 + t789;
-  const T t793 = t752 + t782;
-  const T t794 = t753 + t790;
-  const T t795 = t754 + t785;
-  const T t796 = t755 + t773;
-  const T t797 = t756 - t779;
-  const T t798 = t757 + t781;
-  const T t799 = t758 + t779;
-  const T t800 = t759 - t780;
-  const T t801 = t760 - t781;
-  const T t802 = t761 + t780;
+  const T t758 = angle_c[2]*app3_S0_x;
+  const T t759 = angle_s[2]*app3_S0_x;
+  const T t760 = angle_s[2]*angle_s[2];
+  const T t761 = angle_c[2]*angle_s[2];
+  const T t763 = -k65b3febe*t760;
+  const T t764 = app3_J0_xx - t763;
+  const T t765 = app3_J0_yy + t763;
+  const T t766 = -k65b3febe*t761;
+  const T t767 = angle_c[2]*app3_J0_xz;
+  const T t768 = angle_s[2]*app3_J0_xz;
+  const T t769 = -app3_p_J_x*t759 + t766;
+  const T t770 = -ke54b48f4 + t767;
+  const T t771 = 2.0*app3_p_J_x*t758 + kcda7ee0c + t765;
+  const T t772 = 2.0*app3_p_J_x*t758 + kb1dbe7fc;
+  const T t773 = k3ec33d3d + t758;
+  const T t774 = app3_R_PJ_xy*t759 + k9667d35f;
+  const T t775 = app3_R_PJ_yy*t759 + k855cc421;
+  const T t776 = app3_R_PJ_xy*t769 + app3_R_PJ_xz*t770;
+  const T t777 = app3_R_PJ_xy*t771 + app3_R_PJ_xz*t768;
+  const T t778 = app3_R_PJ_xy*t768 + app3_R_PJ_xz*t772;
+  const T t779 = app3_R_PJ_yy*t769 + app3_R_PJ_yz*t770;
+  const T t780 = app3_R_PJ_yy*t771 + app3_R_PJ_yz*t768;
+  const T t781 = app3_R_PJ_yy*t768 + app3_R_PJ_yz*t772;
+  const T t782 = app3_R_PJ_xy*t777 + app3_R_PJ_xz*t778;
+  const T t783 = app3_R_PJ_yy*t777 + app3_R_PJ_yz*t778;
+  const T t784 = app3_R_PJ_yy*t780 + app3_R_PJ_yz*t781;
+  const T t785 = t746 + t782;
+  const T t786 = t747 + t783;
+  const T t787 = t748 + t776;
+  const T t788 = t749 + t784;
+  const T t789 = t750 + t779;
+  const T t790 = t751 + t764;
+  const T t791 = t752 - t773;
+  const T t792 = t753 + t775;
+  const T t793 = t754 + t773;
+  const T t794 = t755 - t774;
+  const T t795 = t756 - t775;
+  const T t796 = t757 + t774;
   // ---- body app2: composite inertia (inward)
-  const T t803 = angle_c[1]*app2_S0_x;
-  const T t804 = angle_s[1]*app2_S0_x;
-  const T t805 = angle_s[1]*angle_s[1];
-  const T t806 = angle_c[1]*angle_s[1];
-  const T t808 = -kba9820b7*t805;
-  const T t809 = app2_J0_xx - t808;
-  const T t810 = app2_J0_yy + t808;
-  const T t811 = -kba9820b7*t806;
-  const T t812 = 2.0*app2_p_J_y*t804 + k829d5082 + t809;
-  const T t813 = t811 - ((app2_p_J_x*t804 + app2_p_J_y*t803) + kd3092ae1);
-  const T t814 = -app2_p_J_z*t803 - kd3092fbc;
-  const T t815 = 2.0*app2_p_J_x*t803 + kd64512a2 + t810;
-  const T t816 = -app2_p_J_z*t804 - kd6f1e92e;
-  const T t817 = 2.0*app2_p_J_x*t803 + 2.0*app2_p_J_y*t804 + kb63c57f5;
-  const T t818 = k6e9a3cb9 + t803;
-  const T t819 = k6e9a3d4a + t804;
-  const T t820 = app2_R_PJ_xx*t818 + app2_R_PJ_xy*t819;
-  const T t821 = app2_R_PJ_yx*t818 + app2_R_PJ_yy*t819;
-  const T t822 = t812 - t815;
-  const T t823 = app2_R_PJ_xx_S2*t813 + app2_R_PJ_xx_ss*t822;
-  const T t824 = t812 - t823;
-  const T t825 = t815 + t823;
-  const T t826 = app2_R_PJ_xx_C2*t813 + app2_R_PJ_xx_cs*t822;
-  const T t827 = app2_R_PJ_xx*t814 - app2_R_PJ_yx*t816;
-  const T t828 = app2_R_PJ_xx*t816 + app2_R_PJ_yx*t814;
-  const T t829 = t791 + t824;
-  const T t830 = t792 + t826;
-  const T t831 = t793 + t827;
-  const T t832 = t794 + t825;
-  const T t833 = t795 + t828;
-  const T t834 = t796 + t817;
-  const T t835 = -k6e9bc523 + t797;
-  const T t836 = t798 + t821;
-  const T t837 = k6e9bc523 + t799;
-  const T t838 = t800 - t820;
-  const T t839 = t801 - t821;
-  const T t840 = t802 + t820;
+  const T t797 = angle_c[1]*app2_S0_x;
+  const T t798 = angle_s[1]*app2_S0_x;
+  const T t799 = angle_s[1]*angle_s[1];
+  const T t800 = angle_c[1]*angle_s[1];
+  const T t802 = -kba9820b7*t799;
+  const T t803 = app2_J0_xx - t802;
+  const T t804 = app2_J0_yy + t802;
+  const T t805 = -kba9820b7*t800;
+  const T t806 = 2.0*app2_p_J_y*t798 + k829d5082 + t803;
+  const T t807 = t805 - ((app2_p_J_x*t798 + app2_p_J_y*t797) + kd3092ae1);
+  const T t808 = -app2_p_J_z*t797 - kd3092fbc;
+  const T t809 = 2.0*app2_p_J_x*t797 + kd64512a2 + t804;
+  const T t810 = -app2_p_J_z*t798 - kd6f1e92e;
+  const T t811 = 2.0*app2_p_J_x*t797 + 2.0*app2_p_J_y*t798 + kb63c57f5;
+  const T t812 = k6e9a3cb9 + t797;
+  const T t813 = k6e9a3d4a + t798;
+  const T t814 = app2_R_PJ_xx*t812 + app2_R_PJ_xy*t813;
+  const T t815 = app2_R_PJ_yx*t812 + app2_R_PJ_yy*t813;
+  const T t816 = t806 - t809;
+  const T t817 = app2_R_PJ_xx_S2*t807 + app2_R_PJ_xx_ss*t816;
+  const T t818 = t806 - t817;
+  const T t819 = t809 + t817;
+  const T t820 = app2_R_PJ_xx_C2*t807 + app2_R_PJ_xx_cs*t816;
+  const T t821 = app2_R_PJ_xx*t808 - app2_R_PJ_yx*t810;
+  const T t822 = app2_R_PJ_xx*t810 + app2_R_PJ_yx*t808;
+  const T t823 = t785 + t818;
+  const T t824 = t786 + t820;
+  const T t825 = t787 + t821;
+  const T t826 = t788 + t819;
+  const T t827 = t789 + t822;
+  const T t828 = t790 + t811;
+  const T t829 = -k6e9bc523 + t791;
+  const T t830 = t792 + t815;
+  const T t831 = k6e9bc523 + t793;
+  const T t832 = t794 - t814;
+  const T t833 = t795 - t815;
+  const T t834 = t796 + t814;
   // ---- body app1: composite inertia (inward)
-  const T t841 = angle_c[0]*app1_S0_x;
-  const T t842 = angle_s[0]*app1_S0_x;
-  const T t843 = angle_s[0]*angle_s[0];
-  const T t844 = angle_c[0]*angle_s[0];
-  const T t846 = -k0fb06a45*t843;
-  const T t847 = app1_J0_xx - t846;
-  const T t848 = app1_J0_yy + t846;
-  const T t849 = -k0fb06a45*t844;
-  const T t850 = 2.0*app1_p_J_y*t842 + keb4a28fb + t847;
-  const T t851 = t849 - ((app1_p_J_x*t842 + app1_p_J_y*t841) + ke96767d8);
-  const T t852 = 2.0*app1_p_J_x*t841 + ke967616b + t848;
-  const T t853 = 2.0*app1_p_J_x*t841 + 2.0*app1_p_J_y*t842 + k215d1cf1;
-  const T t854 = kec4548ac + t841;
-  const T t855 = kec4549df + t842;
-  const T t856 = t829 + t850;
-  const T t857 = t831 - t851;
-  const T t858 = t832 + t853;
-  const T t859 = t834 + t852;
-  const T t860 = t835 + t855;
-  const T t861 = t837 - t855;
-  const T t862 = t838 - t854;
-  const T t863 = t840 + t854;
+  const T t835 = angle_c[0]*app1_S0_x;
+  const T t836 = angle_s[0]*app1_S0_x;
+  const T t837 = angle_s[0]*angle_s[0];
+  const T t838 = angle_c[0]*angle_s[0];
+  const T t840 = -k0fb06a45*t837;
+  const T t841 = app1_J0_xx - t840;
+  const T t842 = app1_J0_yy + t840;
+  const T t843 = -k0fb06a45*t838;
+  const T t844 = 2.0*app1_p_J_y*t836 + keb4a28fb + t841;
+  const T t845 = t843 - ((app1_p_J_x*t836 + app1_p_J_y*t835) + ke96767d8);
+  const T t846 = 2.0*app1_p_J_x*t835 + ke967616b + t842;
+  const T t847 = 2.0*app1_p_J_x*t835 + 2.0*app1_p_J_y*t836 + k215d1cf1;
+  const T t848 = kec4548ac + t835;
+  const T t849 = kec4549df + t836;
+  const T t850 = t823 + t844;
+  const T t851 = t825 - t845;
+  const T t852 = t826 + t847;
+  const T t853 = t828 + t846;
+  const T t854 = t829 + t849;
+  const T t855 = t831 - t849;
+  const T t856 = t832 - t848;
+  const T t857 = t834 + t848;
   // ---- body app1: its columns of M (walked to the root)
-  const T t864 = -angle_s[0]*app1_S0_x;
-  const T t865 = app1_p_J_x*t841 - app1_p_J_y*t864;
-  const T t866 = app1_J0_zz + t865;
+  const T t858 = -angle_s[0]*app1_S0_x;
+  const T t859 = app1_p_J_x*t835 - app1_p_J_y*t858;
+  const T t860 = app1_J0_zz + t859;
   // ---- body app2: its columns of M (walked to the root)
-  const T t867 = -angle_s[1]*app2_S0_x;
-  const T t868 = -app2_p_J_z*t803;
-  const T t869 = app2_p_J_z*t867;
-  const T t870 = app2_p_J_x*t803 - app2_p_J_y*t867;
-  const T t871 = app2_J0_zz + t870;
-  const T t872 = app2_R_PJ_xx*t867 + app2_R_PJ_xy*t803;
-  const T t873 = app2_R_PJ_yx*t867 + app2_R_PJ_yy*t803;
-  const T t874 = app2_R_PJ_xx*t868 + app2_R_PJ_xy*t869;
-  const T t875 = app2_R_PJ_yx*t868 + app2_R_PJ_yy*t869;
+  const T t861 = -angle_s[1]*app2_S0_x;
+  const T t862 = -app2_p_J_z*t797;
+  const T t863 = app2_p_J_z*t861;
+  const T t864 = app2_p_J_x*t797 - app2_p_J_y*t861;
+  const T t865 = app2_J0_zz + t864;
+  const T t866 = app2_R_PJ_xx*t861 + app2_R_PJ_xy*t797;
+  const T t867 = app2_R_PJ_yx*t861 + app2_R_PJ_yy*t797;
+  const T t868 = app2_R_PJ_xx*t862 + app2_R_PJ_xy*t863;
+  const T t869 = app2_R_PJ_yx*t862 + app2_R_PJ_yy*t863;
   // ---- body app3: its columns of M (walked to the root)
-  const T t876 = -angle_s[2]*app3_S0_x;
-  const T t877 = -app3_p_J_z*t762;
-  const T t878 = app3_p_J_z*t876;
-  const T t879 = app3_p_J_x*t762;
-  const T t880 = t771 + t877;
-  const T t881 = t772 + t878;
-  const T t882 = app3_J0_zz + t879;
-  const T t883 = app3_R_PJ_xy*t762;
-  const T t884 = app3_R_PJ_yy*t762;
-  const T t885 = app3_R_PJ_xy*t881 + app3_R_PJ_xz*t882;
-  const T t886 = app3_R_PJ_yy*t881 + app3_R_PJ_yz*t882;
+  const T t870 = -angle_s[2]*app3_S0_x;
+  const T t871 = app3_p_J_x*t758;
+  const T t872 = app3_J0_zz + t871;
+  const T t873 = app3_R_PJ_xy*t758;
+  const T t874 = app3_R_PJ_yy*t758;
+  const T t875 = app3_R_PJ_xy*t768 + app3_R_PJ_xz*t872;
+  const T t876 = app3_R_PJ_yy*t768 + app3_R_PJ_yz*t872;
   // ---- body app4: its columns of M (walked to the root)
-  const T t887 = -angle_s[3]*app4_S0_x;
-  const T t888 = -app4_p_J_z*t722;
-  const T t889 = app4_p_J_z*t887;
-  const T t890 = app4_p_J_x*t722 - app4_p_J_y*t887;
-  const T t891 = app4_J0_zz + t890;
-  const T t892 = app4_R_PJ_xx*t887;
-  const T t893 = app4_R_PJ_yx*t887;
-  const T t894 = app4_R_PJ_xx*t888 + app4_R_PJ_xz*t891;
-  const T t895 = app4_R_PJ_yx*t888 + app4_R_PJ_yz*t891;
+  const T t877 = -angle_s[3]*app4_S0_x;
+  const T t878 = -app4_p_J_z*t718;
+  const T t879 = app4_p_J_z*t877;
+  const T t880 = app4_p_J_x*t718 - app4_p_J_y*t877;
+  const T t881 = app4_J0_zz + t880;
+  const T t882 = app4_R_PJ_xx*t877;
+  const T t883 = app4_R_PJ_yx*t877;
+  const T t884 = app4_R_PJ_xx*t878 + app4_R_PJ_xz*t881;
+  const T t885 = app4_R_PJ_yx*t878 + app4_R_PJ_yz*t881;
   // ---- body app5: its columns of M (walked to the root)
-  const T t896 = -angle_s[4]*app5_S0_x;
-  const T t897 = -app5_p_J_z*t694;
-  const T t898 = app5_p_J_z*t896;
-  const T t899 = app5_p_J_x*t694;
-  const T t900 = app5_J0_zz + t899;
+  const T t886 = -angle_s[4]*app5_S0_x;
+  const T t887 = -app5_p_J_z*t690;
+  const T t888 = app5_p_J_z*t886;
+  const T t889 = app5_p_J_x*t690;
+  const T t890 = app5_J0_zz + t889;
   // ---- body app6: its columns of M (walked to the root)
-  const T t901 = -angle_s[5]*app6_S0_x;
-  const T t902 = -app6_p_J_z*t652;
-  const T t903 = app6_p_J_z*t901;
-  const T t904 = app6_p_J_x*t652 - app6_p_J_y*t901;
-  const T t905 = t661 + t902;
-  const T t906 = t662 + t903;
-  const T t907 = app6_J0_zz + t904;
-  const T t908 = app6_R_PJ_xy*t652;
-  const T t909 = app6_R_PJ_yy*t652;
-  const T t910 = app6_R_PJ_xy*t906 + app6_R_PJ_xz*t907;
-  const T t911 = app6_R_PJ_yy*t906 + app6_R_PJ_yz*t907;
+  const T t891 = -angle_s[5]*app6_S0_x;
+  const T t892 = app6_p_J_x*t648 - app6_p_J_y*t891;
+  const T t893 = app6_J0_zz + t892;
+  const T t894 = app6_R_PJ_xy*t648;
+  const T t895 = app6_R_PJ_yy*t648;
+  const T t896 = app6_R_PJ_xy*t658 + app6_R_PJ_xz*t893;
+  const T t897 = app6_R_PJ_yy*t658 + app6_R_PJ_yz*t893;
   // ---- body app7: its columns of M (walked to the root)
-  const T t912 = -angle_s[6]*app7_S0_x;
-  const T t913 = app7_p_J_x*t614 - app7_p_J_y*t912;
-  const T t914 = app7_J0_zz + t913;
-  const T t915 = app7_R_PJ_xx*t912;
-  const T t916 = app7_R_PJ_yx*t912;
-  const T t917 = app7_R_PJ_xz*t914;
-  const T t918 = app7_R_PJ_yz*t914;
+  const T t898 = -angle_s[6]*app7_S0_x;
+  const T t899 = app7_p_J_x*t610 - app7_p_J_y*t898;
+  const T t900 = app7_J0_zz + t899;
+  const T t901 = app7_R_PJ_xx*t898;
+  const T t902 = app7_R_PJ_yx*t898;
+  const T t903 = app7_R_PJ_xz*t900;
+  const T t904 = app7_R_PJ_yz*t900;
   // ---- body app8: its columns of M (walked to the root)
-  const T t919 = -angle_s[7]*app8_S0_x;
-  const T t920 = -app8_p_J_z*t576;
-  const T t921 = app8_p_J_z*t919;
-  const T t922 = app8_p_J_x*t576 - app8_p_J_y*t919;
-  const T t923 = app8_J0_zz + t922;
-  const T t924 = app8_R_PJ_xx*t919 + app8_R_PJ_xy*t576;
-  const T t925 = app8_R_PJ_yx*t919 + app8_R_PJ_yy*t576;
-  const T t926 = app8_R_PJ_xx*t920 + app8_R_PJ_xy*t921;
-  const T t927 = app8_R_PJ_yx*t920 + app8_R_PJ_yy*t921;
+  const T t905 = -angle_s[7]*app8_S0_x;
+  const T t906 = -app8_p_J_z*t572;
+  const T t907 = app8_p_J_z*t905;
+  const T t908 = app8_p_J_x*t572 - app8_p_J_y*t905;
+  const T t909 = app8_J0_zz + t908;
+  const T t910 = app8_R_PJ_xx*t905 + app8_R_PJ_xy*t572;
+  const T t911 = app8_R_PJ_yx*t905 + app8_R_PJ_yy*t572;
+  const T t912 = app8_R_PJ_xx*t906 + app8_R_PJ_xy*t907;
+  const T t913 = app8_R_PJ_yx*t906 + app8_R_PJ_yy*t907;
   // ---- body app9: its columns of M (walked to the root)
-  const T t928 = -angle_s[8]*app9_S0_x;
-  const T t929 = -app9_p_J_z*t546;
-  const T t930 = app9_p_J_z*t928;
-  const T t931 = app9_p_J_x*t546;
-  const T t932 = t555 + t929;
-  const T t933 = t556 + t930;
-  const T t934 = app9_J0_zz + t931;
+  const T t914 = -angle_s[8]*app9_S0_x;
+  const T t915 = app9_p_J_x*t544;
+  const T t916 = app9_J0_zz + t915;
   // ---- body app10: its columns of M (walked to the root)
-  const T t935 = -angle_s[9]*app10_S0_x;
-  const T t936 = -app10_p_J_z*t506;
-  const T t937 = app10_p_J_z*t935;
-  const T t938 = app10_p_J_x*t506 - app10_p_J_y*t935;
-  const T t939 = app10_J0_zz + t938;
-  const T t940 = app10_R_PJ_xx*t935;
-  const T t941 = app10_R_PJ_yx*t935;
-  const T t942 = app10_R_PJ_xx*t936 + app10_R_PJ_xz*t939;
-  const T t943 = app10_R_PJ_yx*t936 + app10_R_PJ_yz*t939;
+  const T t917 = -angle_s[9]*app10_S0_x;
+  const T t918 = -app10_p_J_z*t504;
+  const T t919 = app10_p_J_z*t917;
+  const T t920 = app10_p_J_x*t504 - app10_p_J_y*t917;
+  const T t921 = app10_J0_zz + t920;
+  const T t922 = app10_R_PJ_xx*t917;
+  const T t923 = app10_R_PJ_yx*t917;
+  const T t924 = app10_R_PJ_xx*t918 + app10_R_PJ_xz*t921;
+  const T t925 = app10_R_PJ_yx*t918 + app10_R_PJ_yz*t921;
   // ---- body app11: its columns of M (walked to the root)
-  const T t944 = -angle_s[10]*app11_S0_x;
-  const T t945 = -app11_p_J_z*t469;
-  const T t946 = app11_p_J_z*t944;
-  const T t947 = app11_p_J_x*t469;
-  const T t948 = app11_J0_zz + t947;
-  const T t949 = app11_R_PJ_xx*t944 + app11_R_PJ_xy*t469;
-  const T t950 = app11_R_PJ_yx*t944 + app11_R_PJ_yy*t469;
-  const T t951 = app11_R_PJ_xx*t945 + app11_R_PJ_xy*t946;
-  const T t952 = app11_R_PJ_yx*t945 + app11_R_PJ_yy*t946;
+  const T t926 = -angle_s[10]*app11_S0_x;
+  const T t927 = -app11_p_J_z*t467;
+  const T t928 = app11_p_J_z*t926;
+  const T t929 = app11_p_J_x*t467;
+  const T t930 = app11_J0_zz + t929;
+  const T t931 = app11_R_PJ_xx*t926 + app11_R_PJ_xy*t467;
+  const T t932 = app11_R_PJ_yx*t926 + app11_R_PJ_yy*t467;
+  const T t933 = app11_R_PJ_xx*t927 + app11_R_PJ_xy*t928;
+  const T t934 = app11_R_PJ_yx*t927 + app11_R_PJ_yy*t928;
   // ---- body app12: its columns of M (walked to the root)
-  const T t953 = -angle_s[11]*app12_S0_x;
-  const T t954 = -app12_p_J_z*t427;
-  const T t955 = app12_p_J_z*t953;
-  const T t956 = app12_p_J_x*t427 - app12_p_J_y*t953;
-  const T t957 = t436 + t954;
-  const T t958 = t437 + t955;
-  const T t959 = app12_J0_zz + t956;
-  const T t960 = app12_R_PJ_xy*t427;
-  const T t961 = app12_R_PJ_yy*t427;
-  const T t962 = app12_R_PJ_xy*t958 + app12_R_PJ_xz*t959;
-  const T t963 = app12_R_PJ_yy*t958 + app12_R_PJ_yz*t959;
+  const T t935 = -angle_s[11]*app12_S0_x;
+  const T t936 = app12_p_J_x*t425 - app12_p_J_y*t935;
+  const T t937 = app12_J0_zz + t936;
+  const T t938 = app12_R_PJ_xy*t425;
+  const T t939 = app12_R_PJ_yy*t425;
+  const T t940 = app12_R_PJ_xy*t435 + app12_R_PJ_xz*t937;
+  const T t941 = app12_R_PJ_yy*t435 + app12_R_PJ_yz*t937;
   // ---- body app13: its columns of M (walked to the root)
-  const T t964 = -angle_s[12]*app13_S0_x;
-  const T t965 = app13_p_J_x*t404 - app13_p_J_y*t964;
-  const T t966 = app13_J0_zz + t965;
+  const T t942 = -angle_s[12]*app13_S0_x;
+  const T t943 = app13_p_J_x*t402 - app13_p_J_y*t942;
+  const T t944 = app13_J0_zz + t943;
   // ---- body app14: its columns of M (walked to the root)
-  const T t967 = -angle_s[13]*app14_S0_x;
-  const T t968 = -app14_p_J_z*t366;
-  const T t969 = app14_p_J_z*t967;
-  const T t970 = app14_p_J_x*t366 - app14_p_J_y*t967;
-  const T t971 = app14_J0_zz + t970;
-  const T t972 = app14_R_PJ_xx*t967 + app14_R_PJ_xy*t366;
-  const T t973 = app14_R_PJ_yx*t967 + app14_R_PJ_yy*t366;
-  const T t974 = app14_R_PJ_xx*t968 + app14_R_PJ_xy*t969;
-  const T t975 = app14_R_PJ_yx*t968 + app14_R_PJ_yy*t969;
+  const T t945 = -angle_s[13]*app14_S0_x;
+  const T t946 = -app14_p_J_z*t364;
+  const T t947 = app14_p_J_z*t945;
+  const T t948 = app14_p_J_x*t364 - app14_p_J_y*t945;
+  const T t949 = app14_J0_zz + t948;
+  const T t950 = app14_R_PJ_xx*t945 + app14_R_PJ_xy*t364;
+  const T t951 = app14_R_PJ_yx*t945 + app14_R_PJ_yy*t364;
+  const T t952 = app14_R_PJ_xx*t946 + app14_R_PJ_xy*t947;
+  const T t953 = app14_R_PJ_yx*t946 + app14_R_PJ_yy*t947;
   // ---- body app15: its columns of M (walked to the root)
-  const T t976 = -angle_s[14]*app15_S0_x;
-  const T t977 = -app15_p_J_z*t325;
-  const T t978 = app15_p_J_z*t976;
-  const T t979 = app15_p_J_x*t325;
-  const T t980 = t334 + t977;
-  const T t981 = t335 + t978;
-  const T t982 = app15_J0_zz + t979;
-  const T t983 = app15_R_PJ_xy*t325;
-  const T t984 = app15_R_PJ_yy*t325;
-  const T t985 = app15_R_PJ_xy*t981 + app15_R_PJ_xz*t982;
-  const T t986 = app15_R_PJ_yy*t981 + app15_R_PJ_yz*t982;
+  const T t954 = -angle_s[14]*app15_S0_x;
+  const T t955 = app15_p_J_x*t325;
+  const T t956 = app15_J0_zz + t955;
+  const T t957 = app15_R_PJ_xy*t325;
+  const T t958 = app15_R_PJ_yy*t325;
+  const T t959 = app15_R_PJ_xy*t335 + app15_R_PJ_xz*t956;
+  const T t960 = app15_R_PJ_yy*t335 + app15_R_PJ_yz*t956;
   // ---- body app16: its columns of M (walked to the root)
-  const T t987 = -angle_s[15]*app16_S0_x;
-  const T t988 = -app16_p_J_z*t287;
-  const T t989 = app16_p_J_z*t987;
-  const T t990 = app16_p_J_x*t287 - app16_p_J_y*t987;
-  const T t991 = app16_J0_zz + t990;
-  const T t992 = app16_R_PJ_xx*t987;
-  const T t993 = app16_R_PJ_yx*t987;
-  const T t994 = app16_R_PJ_xx*t988 + app16_R_PJ_xz*t991;
-  const T t995 = app16_R_PJ_yx*t988 + app16_R_PJ_yz*t991;
+  const T t961 = -angle_s[15]*app16_S0_x;
+  const T t962 = -app16_p_J_z*t287;
+  const T t963 = app16_p_J_z*t961;
+  const T t964 = app16_p_J_x*t287 - app16_p_J_y*t961;
+  const T t965 = app16_J0_zz + t964;
+  const T t966 = app16_R_PJ_xx*t961;
+  const T t967 = app16_R_PJ_yx*t961;
+  const T t968 = app16_R_PJ_xx*t962 + app16_R_PJ_xz*t965;
+  const T t969 = app16_R_PJ_yx*t962 + app16_R_PJ_yz*t965;
   M[0] = k6ff2167e;
   M[1] = 0.0;
   M[2] = 0.0;
   M[3] = 0.0;
-  M[4] = t861;
-  M[5] = t839;
-  M[6] = t864;
-  M[7] = t872;
-  M[8] = t883;
-  M[9] = t892;
-  M[10] = -t694;
-  M[11] = t908;
-  M[12] = t915;
-  M[13] = t924;
+  M[4] = t855;
+  M[5] = t833;
+  M[6] = t858;
+  M[7] = t866;
+  M[8] = t873;
+  M[9] = t882;
+  M[10] = -t690;
+  M[11] = t894;
+  M[12] = t901;
+  M[13] = t910;
   M[14] = 0.0;
-  M[15] = t940;
-  M[16] = t949;
-  M[17] = t960;
+  M[15] = t922;
+  M[16] = t931;
+  M[17] = t938;
   M[18] = 0.0;
-  M[19] = t972;
-  M[20] = t983;
-  M[21] = t992;
+  M[19] = t950;
+  M[20] = t957;
+  M[21] = t966;
   M[22] = 0.0;
   M[23] = k6ff2167e;
   M[24] = 0.0;
-  M[25] = t860;
+  M[25] = t854;
   M[26] = 0.0;
-  M[27] = t863;
+  M[27] = t857;
   M[28] = 0.0;
-  M[29] = t873;
-  M[30] = t884;
-  M[31] = t893;
-  M[32] = t896;
-  M[33] = t909;
-  M[34] = t916;
-  M[35] = t925;
-  M[36] = t546;
-  M[37] = t941;
-  M[38] = t950;
-  M[39] = t961;
-  M[40] = -t964;
-  M[41] = t973;
-  M[42] = t984;
-  M[43] = t993;
+  M[29] = t867;
+  M[30] = t874;
+  M[31] = t883;
+  M[32] = t886;
+  M[33] = t895;
+  M[34] = t902;
+  M[35] = t911;
+  M[36] = t544;
+  M[37] = t923;
+  M[38] = t932;
+  M[39] = t939;
+  M[40] = -t942;
+  M[41] = t951;
+  M[42] = t958;
+  M[43] = t967;
   M[44] = 0.0;
   M[45] = 0.0;
   M[46] = k6ff2167e;
-  M[47] = t836;
-  M[48] = t862;
+  M[47] = t830;
+  M[48] = t856;
   M[49] = 0.0;
-  M[50] = -t841;
+  M[50] = -t835;
   M[51] = 0.0;
-  M[52] = t876;
-  M[53] = -t722;
+  M[52] = t870;
+  M[53] = -t718;
   M[54] = 0.0;
-  M[55] = t901;
-  M[56] = -t614;
+  M[55] = t891;
+  M[56] = -t610;
   M[57] = 0.0;
-  M[58] = t928;
-  M[59] = -t506;
+  M[58] = t914;
+  M[59] = -t504;
   M[60] = 0.0;
-  M[61] = t953;
-  M[62] = -t404;
+  M[61] = t935;
+  M[62] = -t402;
   M[63] = 0.0;
-  M[64] = t976;
+  M[64] = t954;
   M[65] = -t287;
   M[66] = 0.0;
-  M[67] = t860;
-  M[68] = t836;
-  M[69] = t856;
-  M[70] = t830;
-  M[71] = t857;
+  M[67] = t854;
+  M[68] = t830;
+  M[69] = t850;
+  M[70] = t824;
+  M[71] = t851;
   M[72] = 0.0;
-  M[73] = t874;
-  M[74] = t885;
-  M[75] = t894;
-  M[76] = -t898;
-  M[77] = t910;
-  M[78] = t917;
-  M[79] = t926;
-  M[80] = -t934;
-  M[81] = t942;
-  M[82] = t951;
-  M[83] = t962;
-  M[84] = t966;
-  M[85] = t974;
-  M[86] = t985;
-  M[87] = t994;
-  M[88] = t861;
+  M[73] = t868;
+  M[74] = t875;
+  M[75] = t884;
+  M[76] = -t888;
+  M[77] = t896;
+  M[78] = t903;
+  M[79] = t912;
+  M[80] = -t916;
+  M[81] = t924;
+  M[82] = t933;
+  M[83] = t940;
+  M[84] = t944;
+  M[85] = t952;
+  M[86] = t959;
+  M[87] = t968;
+  M[88] = t855;
   M[89] = 0.0;
-  M[90] = t862;
-  M[91] = t830;
-  M[92] = t858;
-  M[93] = t833;
-  M[94] = t866;
-  M[95] = t875;
-  M[96] = t886;
-  M[97] = t895;
-  M[98] = t897;
-  M[99] = t911;
-  M[100] = t918;
-  M[101] = t927;
-  M[102] = t933;
-  M[103] = t943;
-  M[104] = t952;
-  M[105] = t963;
+  M[90] = t856;
+  M[91] = t824;
+  M[92] = t852;
+  M[93] = t827;
+  M[94] = t860;
+  M[95] = t869;
+  M[96] = t876;
+  M[97] = t885;
+  M[98] = t887;
+  M[99] = t897;
+  M[100] = t904;
+  M[101] = t913;
+  M[102] = t554;
+  M[103] = t925;
+  M[104] = t934;
+  M[105] = t941;
   M[106] = 0.0;
-  M[107] = t975;
-  M[108] = t986;
-  M[109] = t995;
-  M[110] = t839;
-  M[111] = t863;
+  M[107] = t953;
+  M[108] = t960;
+  M[109] = t969;
+  M[110] = t833;
+  M[111] = t857;
   M[112] = 0.0;
-  M[113] = t857;
-  M[114] = t833;
-  M[115] = t859;
+  M[113] = t851;
+  M[114] = t827;
+  M[115] = t853;
   M[116] = 0.0;
-  M[117] = t871;
-  M[118] = t880;
-  M[119] = -t889;
-  M[120] = t900;
-  M[121] = t905;
+  M[117] = t865;
+  M[118] = t767;
+  M[119] = -t879;
+  M[120] = t890;
+  M[121] = t657;
   M[122] = 0.0;
-  M[123] = t923;
-  M[124] = t932;
-  M[125] = -t937;
-  M[126] = t948;
-  M[127] = t957;
+  M[123] = t909;
+  M[124] = t553;
+  M[125] = -t919;
+  M[126] = t930;
+  M[127] = t434;
   M[128] = 0.0;
-  M[129] = t971;
-  M[130] = t980;
-  M[131] = -t989;
-  M[132] = t864;
+  M[129] = t949;
+  M[130] = t334;
+  M[131] = -t963;
+  M[132] = t858;
   M[133] = 0.0;
-  M[134] = -t841;
+  M[134] = -t835;
   M[135] = 0.0;
-  M[136] = t866;
+  M[136] = t860;
   M[137] = 0.0;
   M[138] = app1_J0_zz;
   M[139] = 0.0;
@@ -1834,12 +1755,12 @@ void mass_matrix(const T* q, T* M) {
   M[151] = 0.0;
   M[152] = 0.0;
   M[153] = 0.0;
-  M[154] = t872;
-  M[155] = t873;
+  M[154] = t866;
+  M[155] = t867;
   M[156] = 0.0;
-  M[157] = t874;
-  M[158] = t875;
-  M[159] = t871;
+  M[157] = t868;
+  M[158] = t869;
+  M[159] = t865;
   M[160] = 0.0;
   M[161] = app2_J0_zz;
   M[162] = 0.0;
@@ -1856,12 +1777,12 @@ void mass_matrix(const T* q, T* M) {
   M[173] = 0.0;
   M[174] = 0.0;
   M[175] = 0.0;
-  M[176] = t883;
-  M[177] = t884;
-  M[178] = t876;
-  M[179] = t885;
-  M[180] = t886;
-  M[181] = t880;
+  M[176] = t873;
+  M[177] = t874;
+  M[178] = t870;
+  M[179] = t875;
+  M[180] = t876;
+  M[181] = t767;
   M[182] = 0.0;
   M[183] = 0.0;
   M[184] = app3_J0_zz;
@@ -1878,12 +1799,12 @@ void mass_matrix(const T* q, T* M) {
   M[195] = 0.0;
   M[196] = 0.0;
   M[197] = 0.0;
-  M[198] = t892;
-  M[199] = t893;
-  M[200] = -t722;
-  M[201] = t894;
-  M[202] = t895;
-  M[203] = -t889;
+  M[198] = t882;
+  M[199] = t883;
+  M[200] = -t718;
+  M[201] = t884;
+  M[202] = t885;
+  M[203] = -t879;
   M[204] = 0.0;
   M[205] = 0.0;
   M[206] = 0.0;
@@ -1900,12 +1821,12 @@ void mass_matrix(const T* q, T* M) {
   M[217] = 0.0;
   M[218] = 0.0;
   M[219] = 0.0;
-  M[220] = -t694;
-  M[221] = t896;
+  M[220] = -t690;
+  M[221] = t886;
   M[222] = 0.0;
-  M[223] = -t898;
-  M[224] = t897;
-  M[225] = t900;
+  M[223] = -t888;
+  M[224] = t887;
+  M[225] = t890;
   M[226] = 0.0;
   M[227] = 0.0;
   M[228] = 0.0;
@@ -1922,12 +1843,12 @@ void mass_matrix(const T* q, T* M) {
   M[239] = 0.0;
   M[240] = 0.0;
   M[241] = 0.0;
-  M[242] = t908;
-  M[243] = t909;
-  M[244] = t901;
-  M[245] = t910;
-  M[246] = t911;
-  M[247] = t905;
+  M[242] = t894;
+  M[243] = t895;
+  M[244] = t891;
+  M[245] = t896;
+  M[246] = t897;
+  M[247] = t657;
   M[248] = 0.0;
   M[249] = 0.0;
   M[250] = 0.0;
@@ -1944,11 +1865,11 @@ void mass_matrix(const T* q, T* M) {
   M[261] = 0.0;
   M[262] = 0.0;
   M[263] = 0.0;
-  M[264] = t915;
-  M[265] = t916;
-  M[266] = -t614;
-  M[267] = t917;
-  M[268] = t918;
+  M[264] = t901;
+  M[265] = t902;
+  M[266] = -t610;
+  M[267] = t903;
+  M[268] = t904;
   M[269] = 0.0;
   M[270] = 0.0;
   M[271] = 0.0;
@@ -1966,12 +1887,12 @@ void mass_matrix(const T* q, T* M) {
   M[283] = 0.0;
   M[284] = 0.0;
   M[285] = 0.0;
-  M[286] = t924;
-  M[287] = t925;
+  M[286] = t910;
+  M[287] = t911;
   M[288] = 0.0;
-  M[289] = t926;
-  M[290] = t927;
-  M[291] = t923;
+  M[289] = t912;
+  M[290] = t913;
+  M[291] = t909;
   M[292] = 0.0;
   M[293] = 0.0;
   M[294] = 0.0;
@@ -1989,11 +1910,11 @@ void mass_matrix(const T* q, T* M) {
   M[306] = 0.0;
   M[307] = 0.0;
   M[308] = 0.0;
-  M[309] = t546;
-  M[310] = t928;
-  M[311] = -t934;
-  M[312] = t933;
-  M[313] = t932;
+  M[309] = t544;
+  M[310] = t914;
+  M[311] = -t916;
+  M[312] = t554;
+  M[313] = t553;
   M[314] = 0.0;
   M[315] = 0.0;
   M[316] = 0.0;
@@ -2010,12 +1931,12 @@ void mass_matrix(const T* q, T* M) {
   M[327] = 0.0;
   M[328] = 0.0;
   M[329] = 0.0;
-  M[330] = t940;
-  M[331] = t941;
-  M[332] = -t506;
-  M[333] = t942;
-  M[334] = t943;
-  M[335] = -t937;
+  M[330] = t922;
+  M[331] = t923;
+  M[332] = -t504;
+  M[333] = t924;
+  M[334] = t925;
+  M[335] = -t919;
   M[336] = 0.0;
   M[337] = 0.0;
   M[338] = 0.0;
@@ -2032,12 +1953,12 @@ void mass_matrix(const T* q, T* M) {
   M[349] = 0.0;
   M[350] = 0.0;
   M[351] = 0.0;
-  M[352] = t949;
-  M[353] = t950;
+  M[352] = t931;
+  M[353] = t932;
   M[354] = 0.0;
-  M[355] = t951;
-  M[356] = t952;
-  M[357] = t948;
+  M[355] = t933;
+  M[356] = t934;
+  M[357] = t930;
   M[358] = 0.0;
   M[359] = 0.0;
   M[360] = 0.0;
@@ -2054,12 +1975,12 @@ void mass_matrix(const T* q, T* M) {
   M[371] = 0.0;
   M[372] = 0.0;
   M[373] = 0.0;
-  M[374] = t960;
-  M[375] = t961;
-  M[376] = t953;
-  M[377] = t962;
-  M[378] = t963;
-  M[379] = t957;
+  M[374] = t938;
+  M[375] = t939;
+  M[376] = t935;
+  M[377] = t940;
+  M[378] = t941;
+  M[379] = t434;
   M[380] = 0.0;
   M[381] = 0.0;
   M[382] = 0.0;
@@ -2077,9 +1998,9 @@ void mass_matrix(const T* q, T* M) {
   M[394] = 0.0;
   M[395] = 0.0;
   M[396] = 0.0;
-  M[397] = -t964;
-  M[398] = -t404;
-  M[399] = t966;
+  M[397] = -t942;
+  M[398] = -t402;
+  M[399] = t944;
   M[400] = 0.0;
   M[401] = 0.0;
   M[402] = 0.0;
@@ -2098,12 +2019,12 @@ void mass_matrix(const T* q, T* M) {
   M[415] = 0.0;
   M[416] = 0.0;
   M[417] = 0.0;
-  M[418] = t972;
-  M[419] = t973;
+  M[418] = t950;
+  M[419] = t951;
   M[420] = 0.0;
-  M[421] = t974;
-  M[422] = t975;
-  M[423] = t971;
+  M[421] = t952;
+  M[422] = t953;
+  M[423] = t949;
   M[424] = 0.0;
   M[425] = 0.0;
   M[426] = 0.0;
@@ -2120,12 +2041,12 @@ void mass_matrix(const T* q, T* M) {
   M[437] = app14_J0_zz;
   M[438] = 0.0;
   M[439] = 0.0;
-  M[440] = t983;
-  M[441] = t984;
-  M[442] = t976;
-  M[443] = t985;
-  M[444] = t986;
-  M[445] = t980;
+  M[440] = t957;
+  M[441] = t958;
+  M[442] = t954;
+  M[443] = t959;
+  M[444] = t960;
+  M[445] = t334;
   M[446] = 0.0;
   M[447] = 0.0;
   M[448] = 0.0;
@@ -2142,12 +2063,12 @@ void mass_matrix(const T* q, T* M) {
   M[459] = 0.0;
   M[460] = app15_J0_zz;
   M[461] = 0.0;
-  M[462] = t992;
-  M[463] = t993;
+  M[462] = t966;
+  M[463] = t967;
   M[464] = -t287;
-  M[465] = t994;
-  M[466] = t995;
-  M[467] = -t989;
+  M[465] = t968;
+  M[466] = t969;
+  M[467] = -t963;
   M[468] = 0.0;
   M[469] = 0.0;
   M[470] = 0.0;
@@ -2220,1002 +2141,993 @@ void forcing(const T* q, const T* u, const T* tau, T* F) {
   // ---- body app3: outward pass (velocities)
   const T t123 = app3_R_PJ_xy*u[3] + app3_R_PJ_yy*u[4];
   const T t124 = app3_R_PJ_xz*u[3] + app3_R_PJ_yz*u[4];
-  const T t125 = app3_p_J_z*t123;
-  const T t126 = app3_p_J_x*t124 - app3_p_J_z*u[5];
-  const T t127 = -app3_p_J_x*t123;
-  const T t133 = t123*t127 - t124*t126;
-  const T t134 = t124*t125 - t127*u[5];
-  const T t135 = -t123*t125 + t126*u[5];
-  const T t136 = app3_R_PJ_xy*t23 + app3_R_PJ_yy*t24;
-  const T t137 = app3_R_PJ_xz*t23 + app3_R_PJ_yz*t24;
-  const T t138 = t133 + t25;
-  const T t139 = t134 + t136;
-  const T t140 = t135 + t137;
-  const T t141 = angle_c[2]*u[5] + angle_s[2]*t123;
-  const T t142 = angle_c[2]*t123 - angle_s[2]*u[5];
+  const T t125 = app3_p_J_x*t124;
+  const T t126 = -app3_p_J_x*t123;
+  const T t131 = t123*t126 - t124*t125;
+  const T t132 = -t126*u[5];
+  const T t133 = t125*u[5];
+  const T t134 = app3_R_PJ_xy*t23 + app3_R_PJ_yy*t24;
+  const T t135 = app3_R_PJ_xz*t23 + app3_R_PJ_yz*t24;
+  const T t136 = t131 + t25;
+  const T t137 = t132 + t134;
+  const T t138 = t133 + t135;
+  const T t139 = angle_c[2]*u[5] + angle_s[2]*t123;
+  const T t140 = angle_c[2]*t123 - angle_s[2]*u[5];
   const T w_B_app3_z = t124 + u[8];
-  const T t146 = t142*u[8];
-  const T t147 = -t141*u[8];
-  const T t149 = angle_c[2]*t138 + angle_s[2]*t139;
-  const T t150 = angle_c[2]*t139 - angle_s[2]*t138;
+  const T t144 = t140*u[8];
+  const T t145 = -t139*u[8];
+  const T t147 = angle_c[2]*t136 + angle_s[2]*t137;
+  const T t148 = angle_c[2]*t137 - angle_s[2]*t136;
   // ---- body app4: outward pass (velocities)
-  const T t170 = app4_R_PJ_xx*u[3] + app4_R_PJ_yx*u[4];
-  const T t171 = app4_R_PJ_xz*u[3] + app4_R_PJ_yz*u[4];
-  const T t172 = -app4_p_J_y*t171 - app4_p_J_z*u[5];
-  const T t173 = app4_p_J_x*t171 - app4_p_J_z*t170;
-  const T t174 = app4_p_J_x*u[5] + app4_p_J_y*t170;
-  const T t180 = -t171*t173 - t174*u[5];
-  const T t181 = -t170*t174 + t171*t172;
-  const T t182 = t170*t173 + t172*u[5];
-  const T t183 = app4_R_PJ_xx*t23 + app4_R_PJ_yx*t24;
-  const T t184 = app4_R_PJ_xz*t23 + app4_R_PJ_yz*t24;
-  const T t185 = t180 + t183;
-  const T t186 = t181 - t25;
-  const T t187 = t182 + t184;
-  const T t188 = angle_c[3]*t170 - angle_s[3]*u[5];
-  const T t189 = -angle_c[3]*u[5] - angle_s[3]*t170;
-  const T w_B_app4_z = t171 + u[9];
-  const T t193 = t189*u[9];
-  const T t194 = -t188*u[9];
-  const T t196 = angle_c[3]*t185 + angle_s[3]*t186;
-  const T t197 = angle_c[3]*t186 - angle_s[3]*t185;
+  const T t168 = app4_R_PJ_xx*u[3] + app4_R_PJ_yx*u[4];
+  const T t169 = app4_R_PJ_xz*u[3] + app4_R_PJ_yz*u[4];
+  const T t170 = -app4_p_J_y*t169 - app4_p_J_z*u[5];
+  const T t171 = app4_p_J_x*t169 - app4_p_J_z*t168;
+  const T t172 = app4_p_J_x*u[5] + app4_p_J_y*t168;
+  const T t178 = -t169*t171 - t172*u[5];
+  const T t179 = -t168*t172 + t169*t170;
+  const T t180 = t168*t171 + t170*u[5];
+  const T t181 = app4_R_PJ_xx*t23 + app4_R_PJ_yx*t24;
+  const T t182 = app4_R_PJ_xz*t23 + app4_R_PJ_yz*t24;
+  const T t183 = t178 + t181;
+  const T t184 = t179 - t25;
+  const T t185 = t180 + t182;
+  const T t186 = angle_c[3]*t168 - angle_s[3]*u[5];
+  const T t187 = -angle_c[3]*u[5] - angle_s[3]*t168;
+  const T w_B_app4_z = t169 + u[9];
+  const T t191 = t187*u[9];
+  const T t192 = -t186*u[9];
+  const T t194 = angle_c[3]*t183 + angle_s[3]*t184;
+  const T t195 = angle_c[3]*t184 - angle_s[3]*t183;
   // ---- body app5: outward pass (velocities)
-  const T t210 = -app5_p_J_z*u[3];
-  const T t211 = app5_p_J_x*u[5] - app5_p_J_z*u[4];
-  const T t212 = app5_p_J_x*u[3];
-  const T t216 = -t211*u[5] - t212*u[3];
-  const T t217 = t210*u[5] - t212*u[4];
-  const T t218 = t210*u[3] + t211*u[4];
-  const T t219 = t216 + t24;
-  const T t220 = t217 - t23;
-  const T t221 = t218 + t25;
-  const T t222 = angle_c[4]*u[4] - angle_s[4]*u[3];
-  const T t223 = -angle_c[4]*u[3] - angle_s[4]*u[4];
+  const T t208 = -app5_p_J_z*u[3];
+  const T t209 = app5_p_J_x*u[5] - app5_p_J_z*u[4];
+  const T t210 = app5_p_J_x*u[3];
+  const T t214 = -t209*u[5] - t210*u[3];
+  const T t215 = t208*u[5] - t210*u[4];
+  const T t216 = t208*u[3] + t209*u[4];
+  const T t217 = t214 + t24;
+  const T t218 = t215 - t23;
+  const T t219 = t216 + t25;
+  const T t220 = angle_c[4]*u[4] - angle_s[4]*u[3];
+  const T t221 = -angle_c[4]*u[3] - angle_s[4]*u[4];
   const T w_B_app5_z = u[10] + u[5];
-  const T t227 = t223*u[10];
-  const T t228 = -t222*u[10];
-  const T t230 = angle_c[4]*t219 + angle_s[4]*t220;
-  const T t231 = angle_c[4]*t220 - angle_s[4]*t219;
+  const T t225 = t221*u[10];
+  const T t226 = -t220*u[10];
+  const T t228 = angle_c[4]*t217 + angle_s[4]*t218;
+  const T t229 = angle_c[4]*t218 - angle_s[4]*t217;
   // ---- body app6: outward pass (velocities)
-  const T t251 = app6_R_PJ_xy*u[3] + app6_R_PJ_yy*u[4];
-  const T t252 = app6_R_PJ_xz*u[3] + app6_R_PJ_yz*u[4];
-  const T t253 = -app6_p_J_y*t252 + app6_p_J_z*t251;
-  const T t254 = app6_p_J_x*t252 - app6_p_J_z*u[5];
-  const T t255 = -app6_p_J_x*t251 + app6_p_J_y*u[5];
-  const T t261 = t251*t255 - t252*t254;
-  const T t262 = t252*t253 - t255*u[5];
-  const T t263 = -t251*t253 + t254*u[5];
-  const T t264 = app6_R_PJ_xy*t23 + app6_R_PJ_yy*t24;
-  const T t265 = app6_R_PJ_xz*t23 + app6_R_PJ_yz*t24;
-  const T t266 = t25 + t261;
-  const T t267 = t262 + t264;
-  const T t268 = t263 + t265;
-  const T t269 = angle_c[5]*u[5] + angle_s[5]*t251;
-  const T t270 = angle_c[5]*t251 - angle_s[5]*u[5];
-  const T w_B_app6_z = t252 + u[11];
-  const T t274 = t270*u[11];
-  const T t275 = -t269*u[11];
-  const T t277 = angle_c[5]*t266 + angle_s[5]*t267;
-  const T t278 = angle_c[5]*t267 - angle_s[5]*t266;
+  const T t249 = app6_R_PJ_xy*u[3] + app6_R_PJ_yy*u[4];
+  const T t250 = app6_R_PJ_xz*u[3] + app6_R_PJ_yz*u[4];
+  const T t251 = -app6_p_J_y*t250;
+  const T t252 = app6_p_J_x*t250;
+  const T t253 = -app6_p_J_x*t249 + app6_p_J_y*u[5];
+  const T t259 = t249*t253 - t250*t252;
+  const T t260 = t250*t251 - t253*u[5];
+  const T t261 = -t249*t251 + t252*u[5];
+  const T t262 = app6_R_PJ_xy*t23 + app6_R_PJ_yy*t24;
+  const T t263 = app6_R_PJ_xz*t23 + app6_R_PJ_yz*t24;
+  const T t264 = t25 + t259;
+  const T t265 = t260 + t262;
+  const T t266 = t261 + t263;
+  const T t267 = angle_c[5]*u[5] + angle_s[5]*t249;
+  const T t268 = angle_c[5]*t249 - angle_s[5]*u[5];
+  const T w_B_app6_z = t250 + u[11];
+  const T t272 = t268*u[11];
+  const T t273 = -t267*u[11];
+  const T t275 = angle_c[5]*t264 + angle_s[5]*t265;
+  const T t276 = angle_c[5]*t265 - angle_s[5]*t264;
   // ---- body app7: outward pass (velocities)
-  const T t298 = app7_R_PJ_xx*u[3] + app7_R_PJ_yx*u[4];
-  const T t299 = app7_R_PJ_xz*u[3] + app7_R_PJ_yz*u[4];
-  const T t300 = -app7_p_J_y*t299;
-  const T t301 = app7_p_J_x*t299;
-  const T t302 = app7_p_J_x*u[5] + app7_p_J_y*t298;
-  const T t308 = -t299*t301 - t302*u[5];
-  const T t309 = -t298*t302 + t299*t300;
-  const T t310 = t298*t301 + t300*u[5];
-  const T t311 = app7_R_PJ_xx*t23 + app7_R_PJ_yx*t24;
-  const T t312 = app7_R_PJ_xz*t23 + app7_R_PJ_yz*t24;
-  const T t313 = t308 + t311;
-  const T t314 = -t25 + t309;
-  const T t315 = t310 + t312;
-  const T t316 = angle_c[6]*t298 - angle_s[6]*u[5];
-  const T t317 = -angle_c[6]*u[5] - angle_s[6]*t298;
-  const T w_B_app7_z = t299 + u[12];
-  const T t321 = t317*u[12];
-  const T t322 = -t316*u[12];
-  const T t324 = angle_c[6]*t313 + angle_s[6]*t314;
-  const T t325 = angle_c[6]*t314 - angle_s[6]*t313;
+  const T t296 = app7_R_PJ_xx*u[3] + app7_R_PJ_yx*u[4];
+  const T t297 = app7_R_PJ_xz*u[3] + app7_R_PJ_yz*u[4];
+  const T t298 = -app7_p_J_y*t297;
+  const T t299 = app7_p_J_x*t297;
+  const T t300 = app7_p_J_x*u[5] + app7_p_J_y*t296;
+  const T t306 = -t297*t299 - t300*u[5];
+  const T t307 = -t296*t300 + t297*t298;
+  const T t308 = t296*t299 + t298*u[5];
+  const T t309 = app7_R_PJ_xx*t23 + app7_R_PJ_yx*t24;
+  const T t310 = app7_R_PJ_xz*t23 + app7_R_PJ_yz*t24;
+  const T t311 = t306 + t309;
+  const T t312 = -t25 + t307;
+  const T t313 = t308 + t310;
+  const T t314 = angle_c[6]*t296 - angle_s[6]*u[5];
+  const T t315 = -angle_c[6]*u[5] - angle_s[6]*t296;
+  const T w_B_app7_z = t297 + u[12];
+  const T t319 = t315*u[12];
+  const T t320 = -t314*u[12];
+  const T t322 = angle_c[6]*t311 + angle_s[6]*t312;
+  const T t323 = angle_c[6]*t312 - angle_s[6]*t311;
   // ---- body app8: outward pass (velocities)
-  const T t342 = app8_R_PJ_xx*u[3] + app8_R_PJ_yx*u[4];
-  const T t343 = app8_R_PJ_xy*u[3] + app8_R_PJ_yy*u[4];
-  const T t344 = -app8_p_J_y*u[5] + app8_p_J_z*t343;
-  const T t345 = app8_p_J_x*u[5] - app8_p_J_z*t342;
-  const T t346 = -app8_p_J_x*t343 + app8_p_J_y*t342;
-  const T t352 = t343*t346 - t345*u[5];
-  const T t353 = -t342*t346 + t344*u[5];
-  const T t354 = t342*t345 - t343*t344;
-  const T t355 = app8_R_PJ_xx*t23 + app8_R_PJ_yx*t24;
-  const T t356 = app8_R_PJ_xy*t23 + app8_R_PJ_yy*t24;
-  const T t357 = t352 + t355;
-  const T t358 = t353 + t356;
-  const T t359 = t25 + t354;
-  const T t360 = angle_c[7]*t342 + angle_s[7]*t343;
-  const T t361 = angle_c[7]*t343 - angle_s[7]*t342;
+  const T t340 = app8_R_PJ_xx*u[3] + app8_R_PJ_yx*u[4];
+  const T t341 = app8_R_PJ_xy*u[3] + app8_R_PJ_yy*u[4];
+  const T t342 = -app8_p_J_y*u[5] + app8_p_J_z*t341;
+  const T t343 = app8_p_J_x*u[5] - app8_p_J_z*t340;
+  const T t344 = -app8_p_J_x*t341 + app8_p_J_y*t340;
+  const T t350 = t341*t344 - t343*u[5];
+  const T t351 = -t340*t344 + t342*u[5];
+  const T t352 = t340*t343 - t341*t342;
+  const T t353 = app8_R_PJ_xx*t23 + app8_R_PJ_yx*t24;
+  const T t354 = app8_R_PJ_xy*t23 + app8_R_PJ_yy*t24;
+  const T t355 = t350 + t353;
+  const T t356 = t351 + t354;
+  const T t357 = t25 + t352;
+  const T t358 = angle_c[7]*t340 + angle_s[7]*t341;
+  const T t359 = angle_c[7]*t341 - angle_s[7]*t340;
   const T w_B_app8_z = u[13] + u[5];
-  const T t365 = t361*u[13];
-  const T t366 = -t360*u[13];
-  const T t368 = angle_c[7]*t357 + angle_s[7]*t358;
-  const T t369 = angle_c[7]*t358 - angle_s[7]*t357;
+  const T t363 = t359*u[13];
+  const T t364 = -t358*u[13];
+  const T t366 = angle_c[7]*t355 + angle_s[7]*t356;
+  const T t367 = angle_c[7]*t356 - angle_s[7]*t355;
   // ---- body app9: outward pass (velocities)
-  const T t382 = app9_p_J_z*u[4];
-  const T t383 = -app9_p_J_x*u[3] - app9_p_J_z*u[5];
-  const T t384 = -app9_p_J_x*u[4];
-  const T t388 = t383*u[3] + t384*u[4];
-  const T t389 = -t382*u[3] - t384*u[5];
-  const T t390 = -t382*u[4] + t383*u[5];
-  const T t391 = t25 + t388;
-  const T t392 = t24 + t389;
-  const T t393 = -t23 + t390;
-  const T t394 = angle_c[8]*u[5] + angle_s[8]*u[4];
-  const T t395 = angle_c[8]*u[4] - angle_s[8]*u[5];
+  const T t380 = -app9_p_J_x*u[3];
+  const T t381 = -app9_p_J_x*u[4];
+  const T t384 = t380*u[3] + t381*u[4];
+  const T t385 = -t381*u[5];
+  const T t386 = t380*u[5];
+  const T t387 = t25 + t384;
+  const T t388 = t24 + t385;
+  const T t389 = -t23 + t386;
+  const T t390 = angle_c[8]*u[5] + angle_s[8]*u[4];
+  const T t391 = angle_c[8]*u[4] - angle_s[8]*u[5];
   const T w_B_app9_z = u[14] - u[3];
-  const T t399 = t395*u[14];
-  const T t400 = -t394*u[14];
-  const T t402 = angle_c[8]*t391 + angle_s[8]*t392;
-  const T t403 = angle_c[8]*t392 - angle_s[8]*t391;
+  const T t395 = t391*u[14];
+  const T t396 = -t390*u[14];
+  const T t398 = angle_c[8]*t387 + angle_s[8]*t388;
+  const T t399 = angle_c[8]*t388 - angle_s[8]*t387;
   // ---- body app10: outward pass (velocities)
-  const T t423 = app10_R_PJ_xx*u[3] + app10_R_PJ_yx*u[4];
-  const T t424 = app10_R_PJ_xz*u[3] + app10_R_PJ_yz*u[4];
-  const T t425 = -app10_p_J_y*t424 - app10_p_J_z*u[5];
-  const T t426 = app10_p_J_x*t424 - app10_p_J_z*t423;
-  const T t427 = app10_p_J_x*u[5] + app10_p_J_y*t423;
-  const T t433 = -t424*t426 - t427*u[5];
-  const T t434 = -t423*t427 + t424*t425;
-  const T t435 = t423*t426 + t425*u[5];
-  const T t436 = app10_R_PJ_xx*t23 + app10_R_PJ_yx*t24;
-  const T t437 = app10_R_PJ_xz*t23 + app10_R_PJ_yz*t24;
-  const T t438 = t433 + t436;
-  const T t439 = -t25 + t434;
-  const T t440 = t435 + t437;
-  const T t441 = angle_c[9]*t423 - angle_s[9]*u[5];
-  const T t442 = -angle_c[9]*u[5] - angle_s[9]*t423;
-  const T w_B_app10_z = t424 + u[15];
-  const T t446 = t442*u[15];
-  const T t447 = -t441*u[15];
-  const T t449 = angle_c[9]*t438 + angle_s[9]*t439;
-  const T t450 = angle_c[9]*t439 - angle_s[9]*t438;
+  const T t419 = app10_R_PJ_xx*u[3] + app10_R_PJ_yx*u[4];
+  const T t420 = app10_R_PJ_xz*u[3] + app10_R_PJ_yz*u[4];
+  const T t421 = -app10_p_J_y*t420 - app10_p_J_z*u[5];
+  const T t422 = app10_p_J_x*t420 - app10_p_J_z*t419;
+  const T t423 = app10_p_J_x*u[5] + app10_p_J_y*t419;
+  const T t429 = -t420*t422 - t423*u[5];
+  const T t430 = -t419*t423 + t420*t421;
+  const T t431 = t419*t422 + t421*u[5];
+  const T t432 = app10_R_PJ_xx*t23 + app10_R_PJ_yx*t24;
+  const T t433 = app10_R_PJ_xz*t23 + app10_R_PJ_yz*t24;
+  const T t434 = t429 + t432;
+  const T t435 = -t25 + t430;
+  const T t436 = t431 + t433;
+  const T t437 = angle_c[9]*t419 - angle_s[9]*u[5];
+  const T t438 = -angle_c[9]*u[5] - angle_s[9]*t419;
+  const T w_B_app10_z = t420 + u[15];
+  const T t442 = t438*u[15];
+  const T t443 = -t437*u[15];
+  const T t445 = angle_c[9]*t434 + angle_s[9]*t435;
+  const T t446 = angle_c[9]*t435 - angle_s[9]*t434;
   // ---- body app11: outward pass (velocities)
-  const T t467 = app11_R_PJ_xx*u[3] + app11_R_PJ_yx*u[4];
-  const T t468 = app11_R_PJ_xy*u[3] + app11_R_PJ_yy*u[4];
-  const T t469 = app11_p_J_z*t468;
-  const T t470 = app11_p_J_x*u[5] - app11_p_J_z*t467;
-  const T t471 = -app11_p_J_x*t468;
-  const T t477 = t468*t471 - t470*u[5];
-  const T t478 = -t467*t471 + t469*u[5];
-  const T t479 = t467*t470 - t468*t469;
-  const T t480 = app11_R_PJ_xx*t23 + app11_R_PJ_yx*t24;
-  const T t481 = app11_R_PJ_xy*t23 + app11_R_PJ_yy*t24;
-  const T t482 = t477 + t480;
-  const T t483 = t478 + t481;
-  const T t484 = t25 + t479;
-  const T t485 = angle_c[10]*t467 + angle_s[10]*t468;
-  const T t486 = angle_c[10]*t468 - angle_s[10]*t467;
+  const T t463 = app11_R_PJ_xx*u[3] + app11_R_PJ_yx*u[4];
+  const T t464 = app11_R_PJ_xy*u[3] + app11_R_PJ_yy*u[4];
+  const T t465 = app11_p_J_z*t464;
+  const T t466 = app11_p_J_x*u[5] - app11_p_J_z*t463;
+  const T t467 = -app11_p_J_x*t464;
+  const T t473 = t464*t467 - t466*u[5];
+  const T t474 = -t463*t467 + t465*u[5];
+  const T t475 = t463*t466 - t464*t465;
+  const T t476 = app11_R_PJ_xx*t23 + app11_R_PJ_yx*t24;
+  const T t477 = app11_R_PJ_xy*t23 + app11_R_PJ_yy*t24;
+  const T t478 = t473 + t476;
+  const T t479 = t474 + t477;
+  const T t480 = t25 + t475;
+  const T t481 = angle_c[10]*t463 + angle_s[10]*t464;
+  const T t482 = angle_c[10]*t464 - angle_s[10]*t463;
   const T w_B_app11_z = u[16] + u[5];
-  const T t490 = t486*u[16];
-  const T t491 = -t485*u[16];
-  const T t493 = angle_c[10]*t482 + angle_s[10]*t483;
-  const T t494 = angle_c[10]*t483 - angle_s[10]*t482;
+  const T t486 = t482*u[16];
+  const T t487 = -t481*u[16];
+  const T t489 = angle_c[10]*t478 + angle_s[10]*t479;
+  const T t490 = angle_c[10]*t479 - angle_s[10]*t478;
   // ---- body app12: outward pass (velocities)
-  const T t514 = app12_R_PJ_xy*u[3] + app12_R_PJ_yy*u[4];
-  const T t515 = app12_R_PJ_xz*u[3] + app12_R_PJ_yz*u[4];
-  const T t516 = -app12_p_J_y*t515 + app12_p_J_z*t514;
-  const T t517 = app12_p_J_x*t515 - app12_p_J_z*u[5];
-  const T t518 = -app12_p_J_x*t514 + app12_p_J_y*u[5];
-  const T t524 = t514*t518 - t515*t517;
-  const T t525 = t515*t516 - t518*u[5];
-  const T t526 = -t514*t516 + t517*u[5];
-  const T t527 = app12_R_PJ_xy*t23 + app12_R_PJ_yy*t24;
-  const T t528 = app12_R_PJ_xz*t23 + app12_R_PJ_yz*t24;
-  const T t529 = t25 + t524;
-  const T t530 = t525 + t527;
-  const T t531 = t526 + t528;
-  const T t532 = angle_c[11]*u[5] + angle_s[11]*t514;
-  const T t533 = angle_c[11]*t514 - angle_s[11]*u[5];
-  const T w_B_app12_z = t515 + u[17];
-  const T t537 = t533*u[17];
-  const T t538 = -t532*u[17];
-  const T t540 = angle_c[11]*t529 + angle_s[11]*t530;
-  const T t541 = angle_c[11]*t530 - angle_s[11]*t529;
+  const T t510 = app12_R_PJ_xy*u[3] + app12_R_PJ_yy*u[4];
+  const T t511 = app12_R_PJ_xz*u[3] + app12_R_PJ_yz*u[4];
+  const T t512 = -app12_p_J_y*t511;
+  const T t513 = app12_p_J_x*t511;
+  const T t514 = -app12_p_J_x*t510 + app12_p_J_y*u[5];
+  const T t520 = t510*t514 - t511*t513;
+  const T t521 = t511*t512 - t514*u[5];
+  const T t522 = -t510*t512 + t513*u[5];
+  const T t523 = app12_R_PJ_xy*t23 + app12_R_PJ_yy*t24;
+  const T t524 = app12_R_PJ_xz*t23 + app12_R_PJ_yz*t24;
+  const T t525 = t25 + t520;
+  const T t526 = t521 + t523;
+  const T t527 = t522 + t524;
+  const T t528 = angle_c[11]*u[5] + angle_s[11]*t510;
+  const T t529 = angle_c[11]*t510 - angle_s[11]*u[5];
+  const T w_B_app12_z = t511 + u[17];
+  const T t533 = t529*u[17];
+  const T t534 = -t528*u[17];
+  const T t536 = angle_c[11]*t525 + angle_s[11]*t526;
+  const T t537 = angle_c[11]*t526 - angle_s[11]*t525;
   // ---- body app13: outward pass (velocities)
-  const T t554 = -app13_p_J_y*u[3];
-  const T t555 = app13_p_J_x*u[3];
-  const T t556 = app13_p_J_x*u[5] - app13_p_J_y*u[4];
-  const T t560 = -t555*u[3] - t556*u[5];
-  const T t561 = t554*u[3] + t556*u[4];
-  const T t562 = t554*u[5] - t555*u[4];
-  const T t563 = -t24 + t560;
-  const T t564 = -t25 + t561;
-  const T t565 = t23 + t562;
-  const T t566 = -angle_c[12]*u[4] - angle_s[12]*u[5];
-  const T t567 = -angle_c[12]*u[5] + angle_s[12]*u[4];
+  const T t550 = -app13_p_J_y*u[3];
+  const T t551 = app13_p_J_x*u[3];
+  const T t552 = app13_p_J_x*u[5] - app13_p_J_y*u[4];
+  const T t556 = -t551*u[3] - t552*u[5];
+  const T t557 = t550*u[3] + t552*u[4];
+  const T t558 = t550*u[5] - t551*u[4];
+  const T t559 = -t24 + t556;
+  const T t560 = -t25 + t557;
+  const T t561 = t23 + t558;
+  const T t562 = -angle_c[12]*u[4] - angle_s[12]*u[5];
+  const T t563 = -angle_c[12]*u[5] + angle_s[12]*u[4];
   const T w_B_app13_z = u[18] + u[3];
-  const T t571 = t567*u[18];
-  const T t572 = -t566*u[18];
-  const T t574 = angle_c[12]*t563 + angle_s[12]*t564;
-  const T t575 = angle_c[12]*t564 - angle_s[12]*t563;
+  const T t567 = t563*u[18];
+  const T t568 = -t562*u[18];
+  const T t570 = angle_c[12]*t559 + angle_s[12]*t560;
+  const T t571 = angle_c[12]*t560 - angle_s[12]*t559;
   // ---- body app14: outward pass (velocities)
-  const T t592 = app14_R_PJ_xx*u[3] + app14_R_PJ_yx*u[4];
-  const T t593 = app14_R_PJ_xy*u[3] + app14_R_PJ_yy*u[4];
-  const T t594 = -app14_p_J_y*u[5] + app14_p_J_z*t593;
-  const T t595 = app14_p_J_x*u[5] - app14_p_J_z*t592;
-  const T t596 = -app14_p_J_x*t593 + app14_p_J_y*t592;
-  const T t602 = t593*t596 - t595*u[5];
-  const T t603 = -t592*t596 + t594*u[5];
-  const T t604 = t592*t595 - t593*t594;
-  const T t605 = app14_R_PJ_xx*t23 + app14_R_PJ_yx*t24;
-  const T t606 = app14_R_PJ_xy*t23 + app14_R_PJ_yy*t24;
-  const T t607 = t602 + t605;
-  const T t608 = t603 + t606;
-  const T t609 = t25 + t604;
-  const T t610 = angle_c[13]*t592 + angle_s[13]*t593;
-  const T t611 = angle_c[13]*t593 - angle_s[13]*t592;
+  const T t588 = app14_R_PJ_xx*u[3] + app14_R_PJ_yx*u[4];
+  const T t589 = app14_R_PJ_xy*u[3] + app14_R_PJ_yy*u[4];
+  const T t590 = -app14_p_J_y*u[5] + app14_p_J_z*t589;
+  const T t591 = app14_p_J_x*u[5] - app14_p_J_z*t588;
+  const T t592 = -app14_p_J_x*t589 + app14_p_J_y*t588;
+  const T t598 = t589*t592 - t591*u[5];
+  const T t599 = -t588*t592 + t590*u[5];
+  const T t600 = t588*t591 - t589*t590;
+  const T t601 = app14_R_PJ_xx*t23 + app14_R_PJ_yx*t24;
+  const T t602 = app14_R_PJ_xy*t23 + app14_R_PJ_yy*t24;
+  const T t603 = t598 + t601;
+  const T t604 = t599 + t602;
+  const T t605 = t25 + t600;
+  const T t606 = angle_c[13]*t588 + angle_s[13]*t589;
+  const T t607 = angle_c[13]*t589 - angle_s[13]*t588;
   const T w_B_app14_z = u[19] + u[5];
-  const T t615 = t611*u[19];
-  const T t616 = -t610*u[19];
-  const T t618 = angle_c[13]*t607 + angle_s[13]*t608;
-  const T t619 = angle_c[13]*t608 - angle_s[13]*t607;
+  const T t611 = t607*u[19];
+  const T t612 = -t606*u[19];
+  const T t614 = angle_c[13]*t603 + angle_s[13]*t604;
+  const T t615 = angle_c[13]*t604 - angle_s[13]*t603;
   // ---- body app15: outward pass (velocities)
-  const T t639 = app15_R_PJ_xy*u[3] + app15_R_PJ_yy*u[4];
-  const T t640 = app15_R_PJ_xz*u[3] + app15_R_PJ_yz*u[4];
-  const T t641 = app15_p_J_z*t639;
-  const T t642 = app15_p_J_x*t640 - app15_p_J_z*u[5];
-  const T t643 = -app15_p_J_x*t639;
-  const T t649 = t639*t643 - t640*t642;
-  const T t650 = t640*t641 - t643*u[5];
-  const T t651 = -t639*t641 + t642*u[5];
-  const T t652 = app15_R_PJ_xy*t23 + app15_R_PJ_yy*t24;
-  const T t653 = app15_R_PJ_xz*t23 + app15_R_PJ_yz*t24;
-  const T t654 = t25 + t649;
-  const T t655 = t650 + t652;
-  const T t656 = t651 + t653;
-  const T t657 = angle_c[14]*u[5] + angle_s[14]*t639;
-  const T t658 = angle_c[14]*t639 - angle_s[14]*u[5];
-  const T w_B_app15_z = t640 + u[20];
-  const T t662 = t658*u[20];
-  const T t663 = -t657*u[20];
-  const T t665 = angle_c[14]*t654 + angle_s[14]*t655;
-  const T t666 = angle_c[14]*t655 - angle_s[14]*t654;
+  const T t635 = app15_R_PJ_xy*u[3] + app15_R_PJ_yy*u[4];
+  const T t636 = app15_R_PJ_xz*u[3] + app15_R_PJ_yz*u[4];
+  const T t637 = app15_p_J_x*t636;
+  const T t638 = -app15_p_J_x*t635;
+  const T t643 = t635*t638 - t636*t637;
+  const T t644 = -t638*u[5];
+  const T t645 = t637*u[5];
+  const T t646 = app15_R_PJ_xy*t23 + app15_R_PJ_yy*t24;
+  const T t647 = app15_R_PJ_xz*t23 + app15_R_PJ_yz*t24;
+  const T t648 = t25 + t643;
+  const T t649 = t644 + t646;
+  const T t650 = t645 + t647;
+  const T t651 = angle_c[14]*u[5] + angle_s[14]*t635;
+  const T t652 = angle_c[14]*t635 - angle_s[14]*u[5];
+  const T w_B_app15_z = t636 + u[20];
+  const T t656 = t652*u[20];
+  const T t657 = -t651*u[20];
+  const T t659 = angle_c[14]*t648 + angle_s[14]*t649;
+  const T t660 = angle_c[14]*t649 - angle_s[14]*t648;
   // ---- body app16: outward pass (velocities)
-  const T t686 = app16_R_PJ_xx*u[3] + app16_R_PJ_yx*u[4];
-  const T t687 = app16_R_PJ_xz*u[3] + app16_R_PJ_yz*u[4];
-  const T t688 = -app16_p_J_y*t687 - app16_p_J_z*u[5];
-  const T t689 = app16_p_J_x*t687 - app16_p_J_z*t686;
-  const T t690 = app16_p_J_x*u[5] + app16_p_J_y*t686;
-  const T t696 = -t687*t689 - t690*u[5];
-  const T t697 = -t686*t690 + t687*t688;
-  const T t698 = t686*t689 + t688*u[5];
-  const T t699 = app16_R_PJ_xx*t23 + app16_R_PJ_yx*t24;
-  const T t700 = app16_R_PJ_xz*t23 + app16_R_PJ_yz*t24;
-  const T t701 = t696 + t699;
-  const T t702 = -t25 + t697;
-  const T t703 = t698 + t700;
-  const T t704 = angle_c[15]*t686 - angle_s[15]*u[5];
-  const T t705 = -angle_c[15]*u[5] - angle_s[15]*t686;
-  const T w_B_app16_z = t687 + u[21];
-  const T t709 = t705*u[21];
-  const T t710 = -t704*u[21];
-  const T t712 = angle_c[15]*t701 + angle_s[15]*t702;
-  const T t713 = angle_c[15]*t702 - angle_s[15]*t701;
+  const T t680 = app16_R_PJ_xx*u[3] + app16_R_PJ_yx*u[4];
+  const T t681 = app16_R_PJ_xz*u[3] + app16_R_PJ_yz*u[4];
+  const T t682 = -app16_p_J_y*t681 - app16_p_J_z*u[5];
+  const T t683 = app16_p_J_x*t681 - app16_p_J_z*t680;
+  const T t684 = app16_p_J_x*u[5] + app16_p_J_y*t680;
+  const T t690 = -t681*t683 - t684*u[5];
+  const T t691 = -t680*t684 + t681*t682;
+  const T t692 = t680*t683 + t682*u[5];
+  const T t693 = app16_R_PJ_xx*t23 + app16_R_PJ_yx*t24;
+  const T t694 = app16_R_PJ_xz*t23 + app16_R_PJ_yz*t24;
+  const T t695 = t690 + t693;
+  const T t696 = -t25 + t691;
+  const T t697 = t692 + t694;
+  const T t698 = angle_c[15]*t680 - angle_s[15]*u[5];
+  const T t699 = -angle_c[15]*u[5] - angle_s[15]*t680;
+  const T w_B_app16_z = t681 + u[21];
+  const T t703 = t699*u[21];
+  const T t704 = -t698*u[21];
+  const T t706 = angle_c[15]*t695 + angle_s[15]*t696;
+  const T t707 = angle_c[15]*t696 - angle_s[15]*t695;
   // ---- body hub: mass and velocity terms
-  const T t714 = -hub_S0_y*u[5];
-  const T t715 = hub_S0_x*u[5];
-  const T t716 = -hub_S0_x*u[4] + hub_S0_y*u[3];
+  const T t708 = -hub_S0_y*u[5];
+  const T t709 = hub_S0_x*u[5];
+  const T t710 = -hub_S0_x*u[4] + hub_S0_y*u[3];
+  const T t711 = -t709*u[5] + t710*u[4];
+  const T t712 = t708*u[5] - t710*u[3];
+  const T t713 = -t708*u[4] + t709*u[3];
+  const T t714 = hub_J0_xx*u[3] + hub_J0_xy*u[4] + hub_J0_xz*u[5];
+  const T t715 = hub_J0_xy*u[3] + hub_J0_yy*u[4] + hub_J0_yz*u[5];
+  const T t716 = hub_J0_xz*u[3] + hub_J0_yz*u[4] + hub_J0_zz*u[5];
   const T t717 = -t715*u[5] + t716*u[4];
   const T t718 = t714*u[5] - t716*u[3];
   const T t719 = -t714*u[4] + t715*u[3];
-  const T t720 = hub_J0_xx*u[3] + hub_J0_xy*u[4] + hub_J0_xz*u[5];
-  const T t721 = hub_J0_xy*u[3] + hub_J0_yy*u[4] + hub_J0_yz*u[5];
-  const T t722 = hub_J0_xz*u[3] + hub_J0_yz*u[4] + hub_J0_zz*u[5];
-  const T t723 = -t721*u[5] + t722*u[4];
-  const T t724 = t720*u[5] - t722*u[3];
-  const T t725 = -t720*u[4] + t721*u[3];
   // ---- body app1: mass and velocity terms
-  const T t726 = app1_S0_x*w_B_app1_z;
-  const T t727 = -app1_S0_x*t51;
+  const T t720 = app1_S0_x*w_B_app1_z;
+  const T t721 = -app1_S0_x*t51;
+  const T t722 = t51*t721 - t720*w_B_app1_z;
+  const T t723 = -t50*t721;
+  const T t724 = t50*t720;
+  const T t725 = app1_J0_xx*t50;
+  const T t726 = app1_J0_yy*t51;
+  const T t727 = app1_J0_zz*w_B_app1_z;
   const T t728 = t51*t727 - t726*w_B_app1_z;
-  const T t729 = -t50*t727;
-  const T t730 = t50*t726;
-  const T t731 = app1_J0_xx*t50;
-  const T t732 = app1_J0_yy*t51;
-  const T t733 = app1_J0_zz*w_B_app1_z;
-  const T t734 = t51*t733 - t732*w_B_app1_z;
-  const T t735 = -t50*t733 + t731*w_B_app1_z;
-  const T t736 = t50*t732 - t51*t731;
+  const T t729 = -t50*t727 + t725*w_B_app1_z;
+  const T t730 = t50*t726 - t51*t725;
   // ---- body app2: mass and velocity terms
-  const T t737 = app2_S0_x*w_B_app2_z;
-  const T t738 = -app2_S0_x*t95;
+  const T t731 = app2_S0_x*w_B_app2_z;
+  const T t732 = -app2_S0_x*t95;
+  const T t733 = -t731*w_B_app2_z + t732*t95;
+  const T t734 = -t732*t94;
+  const T t735 = t731*t94;
+  const T t736 = app2_J0_xx*t94;
+  const T t737 = app2_J0_yy*t95;
+  const T t738 = app2_J0_zz*w_B_app2_z;
   const T t739 = -t737*w_B_app2_z + t738*t95;
-  const T t740 = -t738*t94;
-  const T t741 = t737*t94;
-  const T t742 = app2_J0_xx*t94;
-  const T t743 = app2_J0_yy*t95;
-  const T t744 = app2_J0_zz*w_B_app2_z;
-  const T t745 = -t743*w_B_app2_z + t744*t95;
-  const T t746 = t742*w_B_app2_z - t744*t94;
-  const T t747 = -t742*t95 + t743*t94;
+  const T t740 = t736*w_B_app2_z - t738*t94;
+  const T t741 = -t736*t95 + t737*t94;
   // ---- body app3: mass and velocity terms
-  const T t748 = app3_S0_z*t142;
-  const T t749 = app3_S0_x*w_B_app3_z - app3_S0_z*t141;
-  const T t750 = -app3_S0_x*t142;
-  const T t751 = t142*t750 - t749*w_B_app3_z;
-  const T t752 = -t141*t750 + t748*w_B_app3_z;
-  const T t753 = t141*t749 - t142*t748;
-  const T t754 = app3_J0_xx*t141 + app3_J0_xz*w_B_app3_z;
-  const T t755 = app3_J0_yy*t142;
-  const T t756 = app3_J0_xz*t141 + app3_J0_zz*w_B_app3_z;
-  const T t757 = t142*t756 - t755*w_B_app3_z;
-  const T t758 = -t141*t756 + t754*w_B_app3_z;
-  const T t759 = t141*t755 - t142*t754;
+  const T t742 = app3_S0_z*t140;
+  const T t743 = app3_S0_x*w_B_app3_z - app3_S0_z*t139;
+  const T t744 = -app3_S0_x*t140;
+  const T t745 = t140*t744 - t743*w_B_app3_z;
+  const T t746 = -t139*t744 + t742*w_B_app3_z;
+  const T t747 = t139*t743 - t140*t742;
+  const T t748 = app3_J0_xx*t139 + app3_J0_xz*w_B_app3_z;
+  const T t749 = app3_J0_yy*t140;
+  const T t750 = app3_J0_xz*t139 + app3_J0_zz*w_B_app3_z;
+  const T t751 = t140*t750 - t749*w_B_app3_z;
+  const T t752 = -t139*t750 + t748*w_B_app3_z;
+  const T t753 = t139*t749 - t140*t748;
   // ---- body app4: mass and velocity terms
-  const T t760 = app4_S0_x*w_B_app4_z;
-  const T t761 = -app4_S0_x*t189;
-  const T t762 = t189*t761 - t760*w_B_app4_z;
-  const T t763 = -t188*t761;
-  const T t764 = t188*t760;
-  const T t765 = app4_J0_xx*t188;
-  const T t766 = app4_J0_yy*t189;
-  const T t767 = app4_J0_zz*w_B_app4_z;
-  const T t768 = t189*t767 - t766*w_B_app4_z;
-  const T t769 = -t188*t767 + t765*w_B_app4_z;
-  const T t770 = t188*t766 - t189*t765;
+  const T t754 = app4_S0_x*w_B_app4_z;
+  const T t755 = -app4_S0_x*t187;
+  const T t756 = t187*t755 - t754*w_B_app4_z;
+  const T t757 = -t186*t755;
+  const T t758 = t186*t754;
+  const T t759 = app4_J0_xx*t186;
+  const T t760 = app4_J0_yy*t187;
+  const T t761 = app4_J0_zz*w_B_app4_z;
+  const T t762 = t187*t761 - t760*w_B_app4_z;
+  const T t763 = -t186*t761 + t759*w_B_app4_z;
+  const T t764 = t186*t760 - t187*t759;
   // ---- body app5: mass and velocity terms
-  const T t771 = app5_S0_x*w_B_app5_z;
-  const T t772 = -app5_S0_x*t223;
-  const T t773 = t223*t772 - t771*w_B_app5_z;
-  const T t774 = -t222*t772;
-  const T t775 = t222*t771;
-  const T t776 = app5_J0_xx*t222;
-  const T t777 = app5_J0_yy*t223;
-  const T t778 = app5_J0_zz*w_B_app5_z;
-  const T t779 = t223*t778 - t777*w_B_app5_z;
-  const T t780 = -t222*t778 + t776*w_B_app5_z;
-  const T t781 = t222*t777 - t223*t776;
+  const T t765 = app5_S0_x*w_B_app5_z;
+  const T t766 = -app5_S0_x*t221;
+  const T t767 = t221*t766 - t765*w_B_app5_z;
+  const T t768 = -t220*t766;
+  const T t769 = t220*t765;
+  const T t770 = app5_J0_xx*t220;
+  const T t771 = app5_J0_yy*t221;
+  const T t772 = app5_J0_zz*w_B_app5_z;
+  const T t773 = t221*t772 - t771*w_B_app5_z;
+  const T t774 = -t220*t772 + t770*w_B_app5_z;
+  const T t775 = t220*t771 - t221*t770;
   // ---- body app6: mass and velocity terms
-  const T t782 = app6_S0_z*t270;
-  const T t783 = app6_S0_x*w_B_app6_z - app6_S0_z*t269;
-  const T t784 = -app6_S0_x*t270;
-  const T t785 = t270*t784 - t783*w_B_app6_z;
-  const T t786 = -t269*t784 + t782*w_B_app6_z;
-  const T t787 = t269*t783 - t270*t782;
-  const T t788 = app6_J0_xx*t269 + app6_J0_xz*w_B_app6_z;
-  const T t789 = app6_J0_yy*t270;
-  const T t790 = app6_J0_xz*t269 + app6_J0_zz*w_B_app6_z;
-  const T t791 = t270*t790 - t789*w_B_app6_z;
-  const T t792 = -t269*t790 + t788*w_B_app6_z;
-  const T t793 = t269*t789 - t270*t788;
+  const T t776 = app6_S0_z*t268;
+  const T t777 = app6_S0_x*w_B_app6_z - app6_S0_z*t267;
+  const T t778 = -app6_S0_x*t268;
+  const T t779 = t268*t778 - t777*w_B_app6_z;
+  const T t780 = -t267*t778 + t776*w_B_app6_z;
+  const T t781 = t267*t777 - t268*t776;
+  const T t782 = app6_J0_xx*t267 + app6_J0_xz*w_B_app6_z;
+  const T t783 = app6_J0_yy*t268;
+  const T t784 = app6_J0_xz*t267 + app6_J0_zz*w_B_app6_z;
+  const T t785 = t268*t784 - t783*w_B_app6_z;
+  const T t786 = -t267*t784 + t782*w_B_app6_z;
+  const T t787 = t267*t783 - t268*t782;
   // ---- body app7: mass and velocity terms
-  const T t794 = app7_S0_x*w_B_app7_z;
-  const T t795 = -app7_S0_x*t317;
-  const T t796 = t317*t795 - t794*w_B_app7_z;
-  const T t797 = -t316*t795;
-  const T t798 = t316*t794;
-  const T t799 = app7_J0_xx*t316;
-  const T t800 = app7_J0_yy*t317;
-  const T t801 = app7_J0_zz*w_B_app7_z;
-  const T t802 = t317*t801 - t800*w_B_app7_z;
-  const T t803 = -t316*t801 + t799*w_B_app7_z;
-  const T t804 = t316*t800 - t317*t799;
+  const T t788 = app7_S0_x*w_B_app7_z;
+  const T t789 = -app7_S0_x*t315;
+  const T t790 = t315*t789 - t788*w_B_app7_z;
+  const T t791 = -t314*t789;
+  const T t792 = t314*t788;
+  const T t793 = app7_J0_xx*t314;
+  const T t794 = app7_J0_yy*t315;
+  const T t795 = app7_J0_zz*w_B_app7_z;
+  const T t796 = t315*t795 - t794*w_B_app7_z;
+  const T t797 = -t314*t795 + t793*w_B_app7_z;
+  const T t798 = t314*t794 - t315*t793;
   // ---- body app8: mass and velocity terms
-  const T t805 = app8_S0_x*w_B_app8_z;
-  const T t806 = -app8_S0_x*t361;
-  const T t807 = t361*t806 - t805*w_B_app8_z;
-  const T t808 = -t360*t806;
-  const T t809 = t360*t805;
-  const T t810 = app8_J0_xx*t360;
-  const T t811 = app8_J0_yy*t361;
-  const T t812 = app8_J0_zz*w_B_app8_z;
-  const T t813 = t361*t812 - t811*w_B_app8_z;
-  const T t814 = -t360*t812 + t810*w_B_app8_z;
-  const T t815 = t360*t811 - t361*t810;
+  const T t799 = app8_S0_x*w_B_app8_z;
+  const T t800 = -app8_S0_x*t359;
+  const T t801 = t359*t800 - t799*w_B_app8_z;
+  const T t802 = -t358*t800;
+  const T t803 = t358*t799;
+  const T t804 = app8_J0_xx*t358;
+  const T t805 = app8_J0_yy*t359;
+  const T t806 = app8_J0_zz*w_B_app8_z;
+  const T t807 = t359*t806 - t805*w_B_app8_z;
+  const T t808 = -t358*t806 + t804*w_B_app8_z;
+  const T t809 = t358*t805 - t359*t804;
   // ---- body app9: mass and velocity terms
-  const T t816 = app9_S0_z*t395;
-  const T t817 = app9_S0_x*w_B_app9_z - app9_S0_z*t394;
-  const T t818 = -app9_S0_x*t395;
-  const T t819 = t395*t818 - t817*w_B_app9_z;
-  const T t820 = -t394*t818 + t816*w_B_app9_z;
-  const T t821 = t394*t817 - t395*t816;
-  const T t822 = app9_J0_xx*t394 + app9_J0_xz*w_B_app9_z;
-  const T t823 = app9_J0_yy*t395;
-  const T t824 = app9_J0_xz*t394 + app9_J0_zz*w_B_app9_z;
-  const T t825 = t395*t824 - t823*w_B_app9_z;
-  const T t826 = -t394*t824 + t822*w_B_app9_z;
-  const T t827 = t394*t823 - t395*t822;
+  const T t810 = app9_S0_z*t391;
+  const T t811 = app9_S0_x*w_B_app9_z - app9_S0_z*t390;
+  const T t812 = -app9_S0_x*t391;
+  const T t813 = t391*t812 - t811*w_B_app9_z;
+  const T t814 = -t390*t812 + t810*w_B_app9_z;
+  const T t815 = t390*t811 - t391*t810;
+  const T t816 = app9_J0_xx*t390 + app9_J0_xz*w_B_app9_z;
+  const T t817 = app9_J0_yy*t391;
+  const T t818 = app9_J0_xz*t390 + app9_J0_zz*w_B_app9_z;
+  const T t819 = t391*t818 - t817*w_B_app9_z;
+  const T t820 = -t390*t818 + t816*w_B_app9_z;
+  const T t821 = t390*t817 - t391*t816;
   // ---- body app10: mass and velocity terms
-  const T t828 = app10_S0_x*w_B_app10_z;
-  const T t829 = -app10_S0_x*t442;
-  const T t830 = t442*t829 - t828*w_B_app10_z;
-  const T t831 = -t441*t829;
-  const T t832 = t441*t828;
-  const T t833 = app10_J0_xx*t441;
-  const T t834 = app10_J0_yy*t442;
-  const T t835 = app10_J0_zz*w_B_app10_z;
-  const T t836 = t442*t835 - t834*w_B_app10_z;
-  const T t837 = -t441*t835 + t833*w_B_app10_z;
-  const T t838 = t441*t834 - t442*t833;
+  const T t822 = app10_S0_x*w_B_app10_z;
+  const T t823 = -app10_S0_x*t438;
+  const T t824 = t438*t823 - t822*w_B_app10_z;
+  const T t825 = -t437*t823;
+  const T t826 = t437*t822;
+  const T t827 = app10_J0_xx*t437;
+  const T t828 = app10_J0_yy*t438;
+  const T t829 = app10_J0_zz*w_B_app10_z;
+  const T t830 = t438*t829 - t828*w_B_app10_z;
+  const T t831 = -t437*t829 + t827*w_B_app10_z;
+  const T t832 = t437*t828 - t438*t827;
   // ---- body app11: mass and velocity terms
-  const T t839 = app11_S0_x*w_B_app11_z;
-  const T t840 = -app11_S0_x*t486;
-  const T t841 = t486*t840 - t839*w_B_app11_z;
-  const T t842 = -t485*t840;
-  const T t843 = t485*t839;
-  const T t844 = app11_J0_xx*t485;
-  const T t845 = app11_J0_yy*t486;
-  const T t846 = app11_J0_zz*w_B_app11_z;
-  const T t847 = t486*t846 - t845*w_B_app11_z;
-  const T t848 = -t485*t846 + t844*w_B_app11_z;
-  const T t849 = t485*t845 - t486*t844;
+  const T t833 = app11_S0_x*w_B_app11_z;
+  const T t834 = -app11_S0_x*t482;
+  const T t835 = t482*t834 - t833*w_B_app11_z;
+  const T t836 = -t481*t834;
+  const T t837 = t481*t833;
+  const T t838 = app11_J0_xx*t481;
+  const T t839 = app11_J0_yy*t482;
+  const T t840 = app11_J0_zz*w_B_app11_z;
+  const T t841 = t482*t840 - t839*w_B_app11_z;
+  const T t842 = -t481*t840 + t838*w_B_app11_z;
+  const T t843 = t481*t839 - t482*t838;
   // ---- body app12: mass and velocity terms
-  const T t850 = app12_S0_z*t533;
-  const T t851 = app12_S0_x*w_B_app12_z - app12_S0_z*t532;
-  const T t852 = -app12_S0_x*t533;
-  const T t853 = t533*t852 - t851*w_B_app12_z;
-  const T t854 = -t532*t852 + t850*w_B_app12_z;
-  const T t855 = t532*t851 - t533*t850;
-  const T t856 = app12_J0_xx*t532 + app12_J0_xz*w_B_app12_z;
-  const T t857 = app12_J0_yy*t533;
-  const T t858 = app12_J0_xz*t532 + app12_J0_zz*w_B_app12_z;
-  const T t859 = t533*t858 - t857*w_B_app12_z;
-  const T t860 = -t532*t858 + t856*w_B_app12_z;
-  const T t861 = t532*t857 - t533*t856;
+  const T t844 = app12_S0_z*t529;
+  const T t845 = app12_S0_x*w_B_app12_z - app12_S0_z*t528;
+  const T t846 = -app12_S0_x*t529;
+  const T t847 = t529*t846 - t845*w_B_app12_z;
+  const T t848 = -t528*t846 + t844*w_B_app12_z;
+  const T t849 = t528*t845 - t529*t844;
+  const T t850 = app12_J0_xx*t528 + app12_J0_xz*w_B_app12_z;
+  const T t851 = app12_J0_yy*t529;
+  const T t852 = app12_J0_xz*t528 + app12_J0_zz*w_B_app12_z;
+  const T t853 = t529*t852 - t851*w_B_app12_z;
+  const T t854 = -t528*t852 + t850*w_B_app12_z;
+  const T t855 = t528*t851 - t529*t850;
   // ---- body app13: mass and velocity terms
-  const T t862 = app13_S0_x*w_B_app13_z;
-  const T t863 = -app13_S0_x*t567;
-  const T t864 = t567*t863 - t862*w_B_app13_z;
-  const T t865 = -t566*t863;
-  const T t866 = t566*t862;
-  const T t867 = app13_J0_xx*t566;
-  const T t868 = app13_J0_yy*t567;
-  const T t869 = app13_J0_zz*w_B_app13_z;
-  const T t870 = t567*t869 - t868*w_B_app13_z;
-  const T t871 = -t566*t869 + t867*w_B_app13_z;
-  const T t872 = t566*t868 - t567*t867;
+  const T t856 = app13_S0_x*w_B_app13_z;
+  const T t857 = -app13_S0_x*t563;
+  const T t858 = t563*t857 - t856*w_B_app13_z;
+  const T t859 = -t562*t857;
+  const T t860 = t562*t856;
+  const T t861 = app13_J0_xx*t562;
+  const T t862 = app13_J0_yy*t563;
+  const T t863 = app13_J0_zz*w_B_app13_z;
+  const T t864 = t563*t863 - t862*w_B_app13_z;
+  const T t865 = -t562*t863 + t861*w_B_app13_z;
+  const T t866 = t562*t862 - t563*t861;
   // ---- body app14: mass and velocity terms
-  const T t873 = app14_S0_x*w_B_app14_z;
-  const T t874 = -app14_S0_x*t611;
-  const T t875 = t611*t874 - t873*w_B_app14_z;
-  const T t876 = -t610*t874;
-  const T t877 = t610*t873;
-  const T t878 = app14_J0_xx*t610;
-  const T t879 = app14_J0_yy*t611;
-  const T t880 = app14_J0_zz*w_B_app14_z;
-  const T t881 = t611*t880 - t879*w_B_app14_z;
-  const T t882 = -t610*t880 + t878*w_B_app14_z;
-  const T t883 = t610*t879 - t611*t878;
+  const T t867 = app14_S0_x*w_B_app14_z;
+  const T t868 = -app14_S0_x*t607;
+  const T t869 = t607*t868 - t867*w_B_app14_z;
+  const T t870 = -t606*t868;
+  const T t871 = t606*t867;
+  const T t872 = app14_J0_xx*t606;
+  const T t873 = app14_J0_yy*t607;
+  const T t874 = app14_J0_zz*w_B_app14_z;
+  const T t875 = t607*t874 - t873*w_B_app14_z;
+  const T t876 = -t606*t874 + t872*w_B_app14_z;
+  const T t877 = t606*t873 - t607*t872;
   // ---- body app15: mass and velocity terms
-  const T t884 = app15_S0_z*t658;
-  const T t885 = app15_S0_x*w_B_app15_z - app15_S0_z*t657;
-  const T t886 = -app15_S0_x*t658;
-  const T t887 = t658*t886 - t885*w_B_app15_z;
-  const T t888 = -t657*t886 + t884*w_B_app15_z;
-  const T t889 = t657*t885 - t658*t884;
-  const T t890 = app15_J0_xx*t657 + app15_J0_xz*w_B_app15_z;
-  const T t891 = app15_J0_yy*t658;
-  const T t892 = app15_J0_xz*t657 + app15_J0_zz*w_B_app15_z;
-  const T t893 = t658*t892 - t891*w_B_app15_z;
-  const T t894 = -t657*t892 + t890*w_B_app15_z;
-  const T t895 = t657*t891 - t658*t890;
+  const T t878 = app15_S0_z*t652;
+  const T t879 = app15_S0_x*w_B_app15_z - app15_S0_z*t651;
+  const T t880 = -app15_S0_x*t652;
+  const T t881 = t652*t880 - t879*w_B_app15_z;
+  const T t882 = -t651*t880 + t878*w_B_app15_z;
+  const T t883 = t651*t879 - t652*t878;
+  const T t884 = app15_J0_xx*t651 + app15_J0_xz*w_B_app15_z;
+  const T t885 = app15_J0_yy*t652;
+  const T t886 = app15_J0_xz*t651 + app15_J0_zz*w_B_app15_z;
+  const T t887 = t652*t886 - t885*w_B_app15_z;
+  const T t888 = -t651*t886 + t884*w_B_app15_z;
+  const T t889 = t651*t885 - t652*t884;
   // ---- body app16: mass and velocity terms
-  const T t896 = app16_S0_x*w_B_app16_z;
-  const T t897 = -app16_S0_x*t705;
-  const T t898 = t705*t897 - t896*w_B_app16_z;
-  const T t899 = -t704*t897;
-  const T t900 = t704*t896;
-  const T t901 = app16_J0_xx*t704;
-  const T t902 = app16_J0_yy*t705;
-  const T t903 = app16_J0_zz*w_B_app16_z;
-  const T t904 = t705*t903 - t902*w_B_app16_z;
-  const T t905 = -t704*t903 + t901*w_B_app16_z;
-  const T t906 = t704*t902 - t705*t901;
+  const T t890 = app16_S0_x*w_B_app16_z;
+  const T t891 = -app16_S0_x*t699;
+  const T t892 = t699*t891 - t890*w_B_app16_z;
+  const T t893 = -t698*t891;
+  const T t894 = t698*t890;
+  const T t895 = app16_J0_xx*t698;
+  const T t896 = app16_J0_yy*t699;
+  const T t897 = app16_J0_zz*w_B_app16_z;
+  const T t898 = t699*t897 - t896*w_B_app16_z;
+  const T t899 = -t698*t897 + t895*w_B_app16_z;
+  const T t900 = t698*t896 - t699*t895;
   // ---- body hub: bias force
-  const T t907 = -hub_mass*t23 - t717;
-  const T t908 = -hub_mass*t24 - t718;
-  const T t909 = -hub_mass*t25 - t719;
-  const T t910 = -hub_S0_y*t25 - t723;
-  const T t911 = hub_S0_x*t25 - t724;
-  const T t912 = -hub_S0_x*t24 + hub_S0_y*t23 - t725;
+  const T t901 = -hub_mass*t23 - t711;
+  const T t902 = -hub_mass*t24 - t712;
+  const T t903 = -hub_mass*t25 - t713;
+  const T t904 = -hub_S0_y*t25 - t717;
+  const T t905 = hub_S0_x*t25 - t718;
+  const T t906 = -hub_S0_x*t24 + hub_S0_y*t23 - t719;
   // ---- body app1: bias force
-  const T t913 = -app1_mass*t58 - t728;
-  const T t914 = -app1_mass*t59 - t729;
-  const T t915 = app1_S0_x*t56 - app1_mass*t49 - t730;
-  const T t916 = -app1_J0_xx*t55 - t734;
-  const T t917 = -app1_J0_yy*t56 + app1_S0_x*t49 - t735;
-  const T t918 = -app1_S0_x*t59 - t736;
+  const T t907 = -app1_mass*t58 - t722;
+  const T t908 = -app1_mass*t59 - t723;
+  const T t909 = app1_S0_x*t56 - app1_mass*t49 - t724;
+  const T t910 = -app1_J0_xx*t55 - t728;
+  const T t911 = -app1_J0_yy*t56 + app1_S0_x*t49 - t729;
+  const T t912 = -app1_S0_x*t59 - t730;
   // ---- body app2: bias force
-  const T t919 = -app2_mass*t102 - t739;
-  const T t920 = -app2_mass*t103 - t740;
-  const T t921 = app2_S0_x*t100 - app2_mass*t93 - t741;
-  const T t922 = -app2_J0_xx*t99 - t745;
-  const T t923 = -app2_J0_yy*t100 + app2_S0_x*t93 - t746;
-  const T t924 = -app2_S0_x*t103 - t747;
+  const T t913 = -app2_mass*t102 - t733;
+  const T t914 = -app2_mass*t103 - t734;
+  const T t915 = app2_S0_x*t100 - app2_mass*t93 - t735;
+  const T t916 = -app2_J0_xx*t99 - t739;
+  const T t917 = -app2_J0_yy*t100 + app2_S0_x*t93 - t740;
+  const T t918 = -app2_S0_x*t103 - t741;
   // ---- body app3: bias force
-  const T t925 = -app3_S0_z*t147 - app3_mass*t149 - t751;
-  const T t926 = app3_S0_z*t146 - app3_mass*t150 - t752;
-  const T t927 = app3_S0_x*t147 - app3_mass*t140 - t753;
-  const T t928 = -app3_J0_xx*t146 + app3_S0_z*t150 - t757;
-  const T t929 = app3_S0_x*t140 - ((app3_J0_yy*t147 + app3_S0_z*t149) + t758);
-  const T t930 = -app3_J0_xz*t146 - app3_S0_x*t150 - t759;
+  const T t919 = -app3_S0_z*t145 - app3_mass*t147 - t745;
+  const T t920 = app3_S0_z*t144 - app3_mass*t148 - t746;
+  const T t921 = app3_S0_x*t145 - app3_mass*t138 - t747;
+  const T t922 = -app3_J0_xx*t144 + app3_S0_z*t148 - t751;
+  const T t923 = app3_S0_x*t138 - ((app3_J0_yy*t145 + app3_S0_z*t147) + t752);
+  const T t924 = -app3_J0_xz*t144 - app3_S0_x*t148 - t753;
   // ---- body app4: bias force
-  const T t931 = -app4_mass*t196 - t762;
-  const T t932 = -app4_mass*t197 - t763;
-  const T t933 = app4_S0_x*t194 - app4_mass*t187 - t764;
-  const T t934 = -app4_J0_xx*t193 - t768;
-  const T t935 = -app4_J0_yy*t194 + app4_S0_x*t187 - t769;
-  const T t936 = -app4_S0_x*t197 - t770;
+  const T t925 = -app4_mass*t194 - t756;
+  const T t926 = -app4_mass*t195 - t757;
+  const T t927 = app4_S0_x*t192 - app4_mass*t185 - t758;
+  const T t928 = -app4_J0_xx*t191 - t762;
+  const T t929 = -app4_J0_yy*t192 + app4_S0_x*t185 - t763;
+  const T t930 = -app4_S0_x*t195 - t764;
   // ---- body app5: bias force
-  const T t937 = -app5_mass*t230 - t773;
-  const T t938 = -app5_mass*t231 - t774;
-  const T t939 = app5_S0_x*t228 - app5_mass*t221 - t775;
-  const T t940 = -app5_J0_xx*t227 - t779;
-  const T t941 = -app5_J0_yy*t228 + app5_S0_x*t221 - t780;
-  const T t942 = -app5_S0_x*t231 - t781;
+  const T t931 = -app5_mass*t228 - t767;
+  const T t932 = -app5_mass*t229 - t768;
+  const T t933 = app5_S0_x*t226 - app5_mass*t219 - t769;
+  const T t934 = -app5_J0_xx*t225 - t773;
+  const T t935 = -app5_J0_yy*t226 + app5_S0_x*t219 - t774;
+  const T t936 = -app5_S0_x*t229 - t775;
   // ---- body app6: bias force
-  const T t943 = -app6_S0_z*t275 - app6_mass*t277 - t785;
-  const T t944 = app6_S0_z*t274 - app6_mass*t278 - t786;
-  const T t945 = app6_S0_x*t275 - app6_mass*t268 - t787;
-  const T t946 = -app6_J0_xx*t274 + app6_S0_z*t278 - t791;
-  const T t947 = app6_S0_x*t268 - ((app6_J0_yy*t275 + app6_S0_z*t277) + t792);
-  const T t948 = -app6_J0_xz*t274 - app6_S0_x*t278 - t793;
+  const T t937 = -app6_S0_z*t273 - app6_mass*t275 - t779;
+  const T t938 = app6_S0_z*t272 - app6_mass*t276 - t780;
+  const T t939 = app6_S0_x*t273 - app6_mass*t266 - t781;
+  const T t940 = -app6_J0_xx*t272 + app6_S0_z*t276 - t785;
+  const T t941 = app6_S0_x*t266 - ((app6_J0_yy*t273 + app6_S0_z*t275) + t786);
+  const T t942 = -app6_J0_xz*t272 - app6_S0_x*t276 - t787;
   // ---- body app7: bias force
-  const T t949 = -app7_mass*t324 - t796;
-  const T t950 = -app7_mass*t325 - t797;
-  const T t951 = app7_S0_x*t322 - app7_mass*t315 - t798;
-  const T t952 = -app7_J0_xx*t321 - t802;
-  const T t953 = -app7_J0_yy*t322 + app7_S0_x*t315 - t803;
-  const T t954 = -app7_S0_x*t325 - t804;
+  const T t943 = -app7_mass*t322 - t790;
+  const T t944 = -app7_mass*t323 - t791;
+  const T t945 = app7_S0_x*t320 - app7_mass*t313 - t792;
+  const T t946 = -app7_J0_xx*t319 - t796;
+  const T t947 = -app7_J0_yy*t320 + app7_S0_x*t313 - t797;
+  const T t948 = -app7_S0_x*t323 - t798;
   // ---- body app8: bias force
-  const T t955 = -app8_mass*t368 - t807;
-  const T t956 = -app8_mass*t369 - t808;
-  const T t957 = app8_S0_x*t366 - app8_mass*t359 - t809;
-  const T t958 = -app8_J0_xx*t365 - t813;
-  const T t959 = -app8_J0_yy*t366 + app8_S0_x*t359 - t814;
-  const T t960 = -app8_S0_x*t369 - t815;
+  const T t949 = -app8_mass*t366 - t801;
+  const T t950 = -app8_mass*t367 - t802;
+  const T t951 = app8_S0_x*t364 - app8_mass*t357 - t803;
+  const T t952 = -app8_J0_xx*t363 - t807;
+  const T t953 = -app8_J0_yy*t364 + app8_S0_x*t357 - t808;
+  const T t954 = -app8_S0_x*t367 - t809;
   // ---- body app9: bias force
-  const T t961 = -app9_S0_z*t400 - app9_mass*t402 - t819;
-  const T t962 = app9_S0_z*t399 - app9_mass*t403 - t820;
-  const T t963 = app9_S0_x*t400 - app9_mass*t393 - t821;
-  const T t964 = -app9_J0_xx*t399 + app9_S0_z*t403 - t825;
-  const T t965 = app9_S0_x*t393 - ((app9_J0_yy*t400 + app9_S0_z*t402) + t826);
-  const T t966 = -app9_J0_xz*t399 - app9_S0_x*t403 - t827;
+  const T t955 = -app9_S0_z*t396 - app9_mass*t398 - t813;
+  const T t956 = app9_S0_z*t395 - app9_mass*t399 - t814;
+  const T t957 = app9_S0_x*t396 - app9_mass*t389 - t815;
+  const T t958 = -app9_J0_xx*t395 + app9_S0_z*t399 - t819;
+  const T t959 = app9_S0_x*t389 - ((app9_J0_yy*t396 + app9_S0_z*t398) + t820);
+  const T t960 = -app9_J0_xz*t395 - app9_S0_x*t399 - t821;
   // ---- body app10: bias force
-  const T t967 = -app10_mass*t449 - t830;
-  const T t968 = -app10_mass*t450 - t831;
-  const T t969 = app10_S0_x*t447 - app10_mass*t440 - t832;
-  const T t970 = -app10_J0_xx*t446 - t836;
-  const T t971 = -app10_J0_yy*t447 + app10_S0_x*t440 - t837;
-  const T t972 = -app10_S0_x*t450 - t838;
+  const T t961 = -app10_mass*t445 - t824;
+  const T t962 = -app10_mass*t446 - t825;
+  const T t963 = app10_S0_x*t443 - app10_mass*t436 - t826;
+  const T t964 = -app10_J0_xx*t442 - t830;
+  const T t965 = -app10_J0_yy*t443 + app10_S0_x*t436 - t831;
+  const T t966 = -app10_S0_x*t446 - t832;
   // ---- body app11: bias force
-  const T t973 = -app11_mass*t493 - t841;
-  const T t974 = -app11_mass*t494 - t842;
-  const T t975 = app11_S0_x*t491 - app11_mass*t484 - t843;
-  const T t976 = -app11_J0_xx*t490 - t847;
-  const T t977 = -app11_J0_yy*t491 + app11_S0_x*t484 - t848;
-  const T t978 = -app11_S0_x*t494 - t849;
+  const T t967 = -app11_mass*t489 - t835;
+  const T t968 = -app11_mass*t490 - t836;
+  const T t969 = app11_S0_x*t487 - app11_mass*t480 - t837;
+  const T t970 = -app11_J0_xx*t486 - t841;
+  const T t971 = -app11_J0_yy*t487 + app11_S0_x*t480 - t842;
+  const T t972 = -app11_S0_x*t490 - t843;
   // ---- body app12: bias force
-  const T t979 = -app12_S0_z*t538 - app12_mass*t540 - t853;
-  const T t980 = app12_S0_z*t537 - app12_mass*t541 - t854;
-  const T t981 = app12_S0_x*t538 - app12_mass*t531 - t855;
-  const T t982 = -app12_J0_xx*t537 + app12_S0_z*t541 - t859;
-  const T t983 = app12_S0_x*t531 - ((app12_J0_yy*t538 + app12_S0_z*t540) + t860);
-  const T t984 = -app12_J0_xz*t537 - app12_S0_x*t541 - t861;
+  const T t973 = -app12_S0_z*t534 - app12_mass*t536 - t847;
+  const T t974 = app12_S0_z*t533 - app12_mass*t537 - t848;
+  const T t975 = app12_S0_x*t534 - app12_mass*t527 - t849;
+  const T t976 = -app12_J0_xx*t533 + app12_S0_z*t537 - t853;
+  const T t977 = app12_S0_x*t527 - ((app12_J0_yy*t534 + app12_S0_z*t536) + t854);
+  const T t978 = -app12_J0_xz*t533 - app12_S0_x*t537 - t855;
   // ---- body app13: bias force
-  const T t985 = -app13_mass*t574 - t864;
-  const T t986 = -app13_mass*t575 - t865;
-  const T t987 = app13_S0_x*t572 - app13_mass*t565 - t866;
-  const T t988 = -app13_J0_xx*t571 - t870;
-  const T t989 = -app13_J0_yy*t572 + app13_S0_x*t565 - t871;
-  const T t990 = -app13_S0_x*t575 - t872;
+  const T t979 = -app13_mass*t570 - t858;
+  const T t980 = -app13_mass*t571 - t859;
+  const T t981 = app13_S0_x*t568 - app13_mass*t561 - t860;
+  const T t982 = -app13_J0_xx*t567 - t864;
+  const T t983 = -app13_J0_yy*t568 + app13_S0_x*t561 - t865;
+  const T t984 = -app13_S0_x*t571 - t866;
   // ---- body app14: bias force
-  const T t991 = -app14_mass*t618 - t875;
-  const T t992 = -app14_mass*t619 - t876;
-  const T t993 = app14_S0_x*t616 - app14_mass*t609 - t877;
-  const T t994 = -app14_J0_xx*t615 - t881;
-  const T t995 = -app14_J0_yy*t616 + app14_S0_x*t609 - t882;
-  const T t996 = -app14_S0_x*t619 - t883;
+  const T t985 = -app14_mass*t614 - t869;
+  const T t986 = -app14_mass*t615 - t870;
+  const T t987 = app14_S0_x*t612 - app14_mass*t605 - t871;
+  const T t988 = -app14_J0_xx*t611 - t875;
+  const T t989 = -app14_J0_yy*t612 + app14_S0_x*t605 - t876;
+  const T t990 = -app14_S0_x*t615 - t877;
   // ---- body app15: bias force
-  const T t997 = -app15_S0_z*t663 - app15_mass*t665 - t887;
-  const T t998 = app15_S0_z*t662 - app15_mass*t666 - t888;
-  const T t999 = app15_S0_x*t663 - app15_mass*t656 - t889;
-  const T t1000 = -app15_J0_xx*t662 + app15_S0_z*t666 - t893;
-  const T t1001 = app15_S0_x*t656 - ((app15_J0_yy*t663 + app15_S0_z*t665) + t894);
-  const T t1002 = -app15_J0_xz*t662 - app15_S0_x*t666 - t895;
+  const T t991 = -app15_S0_z*t657 - app15_mass*t659 - t881;
+  const T t992 = app15_S0_z*t656 - app15_mass*t660 - t882;
+  const T t993 = app15_S0_x*t657 - app15_mass*t650 - t883;
+  const T t994 = -app15_J0_xx*t656 + app15_S0_z*t660 - t887;
+  const T t995 = app15_S0_x*t650 - ((app15_J0_yy*t657 + app15_S0_z*t659) + t888);
+  const T t996 = -app15_J0_xz*t656 - app15_S0_x*t660 - t889;
   // ---- body app16: bias force
-  const T t1003 = -app16_mass*t712 - t898;
-  const T t1004 = -app16_mass*t713 - t899;
-  const T t1005 = app16_S0_x*t710 - app16_mass*t703 - t900;
-  const T t1006 = -app16_J0_xx*t709 - t904;
-  const T t1007 = -app16_J0_yy*t710 + app16_S0_x*t703 - t905;
-  const T t1008 = -app16_S0_x*t713 - t906;
+  const T t997 = -app16_mass*t706 - t892;
+  const T t998 = -app16_mass*t707 - t893;
+  const T t999 = app16_S0_x*t704 - app16_mass*t697 - t894;
+  const T t1000 = -app16_J0_xx*t703 - t898;
+  const T t1001 = -app16_J0_yy*t704 + app16_S0_x*t697 - t899;
+  const T t1002 = -app16_S0_x*t707 - t900;
   // ---- body app16: generalized forces (inward)
-  const T t1009 = -app16_k*q[22] + tau[21];
-  const T t1010 = t1008 + t1009;
-  const T t1011 = angle_c[15]*t1003 - angle_s[15]*t1004;
-  const T t1012 = angle_c[15]*t1004 + angle_s[15]*t1003;
-  const T t1013 = app16_p_J_y*t1005 - app16_p_J_z*t1012;
-  const T t1014 = -app16_p_J_x*t1005 + app16_p_J_z*t1011;
-  const T t1015 = app16_p_J_x*t1012 - app16_p_J_y*t1011;
-  const T t1016 = angle_c[15]*t1006 - angle_s[15]*t1007;
-  const T t1017 = angle_c[15]*t1007 + angle_s[15]*t1006;
-  const T t1018 = t1013 + t1016;
-  const T t1019 = t1014 + t1017;
-  const T t1020 = t1008 + t1015;
-  const T t1021 = app16_R_PJ_xx*t1011 + app16_R_PJ_xz*t1005;
-  const T t1022 = app16_R_PJ_yx*t1011 + app16_R_PJ_yz*t1005;
-  const T t1023 = app16_R_PJ_xx*t1018 + app16_R_PJ_xz*t1020;
-  const T t1024 = app16_R_PJ_yx*t1018 + app16_R_PJ_yz*t1020;
-  const T t1025 = t1021 + t907;
-  const T t1026 = t1022 + t908;
-  const T t1027 = -t1012 + t909;
-  const T t1028 = t1023 + t910;
-  const T t1029 = t1024 + t911;
-  const T t1030 = -t1019 + t912;
+  const T t1003 = -app16_k*q[22] + tau[21];
+  const T t1004 = t1002 + t1003;
+  const T t1005 = angle_c[15]*t997 - angle_s[15]*t998;
+  const T t1006 = angle_c[15]*t998 + angle_s[15]*t997;
+  const T t1007 = app16_p_J_y*t999 - app16_p_J_z*t1006;
+  const T t1008 = -app16_p_J_x*t999 + app16_p_J_z*t1005;
+  const T t1009 = app16_p_J_x*t1006 - app16_p_J_y*t1005;
+  const T t1010 = angle_c[15]*t1000 - angle_s[15]*t1001;
+  const T t1011 = angle_c[15]*t1001 + angle_s[15]*t1000;
+  const T t1012 = t1007 + t1010;
+  const T t1013 = t1008 + t1011;
+  const T t1014 = t1002 + t1009;
+  const T t1015 = app16_R_PJ_xx*t1005 + app16_R_PJ_xz*t999;
+  const T t1016 = app16_R_PJ_yx*t1005 + app16_R_PJ_yz*t999;
+  const T t1017 = app16_R_PJ_xx*t1012 + app16_R_PJ_xz*t1014;
+  const T t1018 = app16_R_PJ_yx*t1012 + app16_R_PJ_yz*t1014;
+  const T t1019 = t1015 + t901;
+  const T t1020 = t1016 + t902;
+  const T t1021 = -t1006 + t903;
+  const T t1022 = t1017 + t904;
+  const T t1023 = t1018 + t905;
+  const T t1024 = -t1013 + t906;
   // ---- body app15: generalized forces (inward)
-  const T t1031 = -q[21] + tau[20];
-  const T t1032 = t1002 + t1031;
-  const T t1033 = angle_c[14]*t997 - angle_s[14]*t998;
-  const T t1034 = angle_c[14]*t998 + angle_s[14]*t997;
-  const T t1035 = -app15_p_J_z*t1034;
-  const T t1036 = -app15_p_J_x*t999 + app15_p_J_z*t1033;
-  const T t1037 = app15_p_J_x*t1034;
-  const T t1038 = angle_c[14]*t1000 - angle_s[14]*t1001;
-  const T t1039 = angle_c[14]*t1001 + angle_s[14]*t1000;
-  const T t1040 = t1035 + t1038;
-  const T t1041 = t1036 + t1039;
-  const T t1042 = t1002 + t1037;
-  const T t1043 = app15_R_PJ_xy*t1034 + app15_R_PJ_xz*t999;
-  const T t1044 = app15_R_PJ_yy*t1034 + app15_R_PJ_yz*t999;
-  const T t1045 = app15_R_PJ_xy*t1041 + app15_R_PJ_xz*t1042;
-  const T t1046 = app15_R_PJ_yy*t1041 + app15_R_PJ_yz*t1042;
-  const T t1047 = t1025 + t1043;
-  const T t1048 = t1026 + t1044;
-  const T t1049 = t1027 + t1033;
-  const T t1050 = t1028 + t1045;
-  const T t1051 = t1029 + t1046;
-  const T t1052 = t1030 + t1040;
+  const T t1025 = -q[21] + tau[20];
+  const T t1026 = t1025 + t996;
+  const T t1027 = angle_c[14]*t991 - angle_s[14]*t992;
+  const T t1028 = angle_c[14]*t992 + angle_s[14]*t991;
+  const T t1029 = -app15_p_J_x*t993;
+  const T t1030 = app15_p_J_x*t1028;
+  const T t1031 = angle_c[14]*t994 - angle_s[14]*t995;
+  const T t1032 = angle_c[14]*t995 + angle_s[14]*t994;
+  const T t1033 = t1029 + t1032;
+  const T t1034 = t1030 + t996;
+  const T t1035 = app15_R_PJ_xy*t1028 + app15_R_PJ_xz*t993;
+  const T t1036 = app15_R_PJ_yy*t1028 + app15_R_PJ_yz*t993;
+  const T t1037 = app15_R_PJ_xy*t1033 + app15_R_PJ_xz*t1034;
+  const T t1038 = app15_R_PJ_yy*t1033 + app15_R_PJ_yz*t1034;
+  const T t1039 = t1019 + t1035;
+  const T t1040 = t1020 + t1036;
+  const T t1041 = t1021 + t1027;
+  const T t1042 = t1022 + t1037;
+  const T t1043 = t1023 + t1038;
+  const T t1044 = t1024 + t1031;
   // ---- body app14: generalized forces (inward)
-  const T t1053 = -app14_k*q[20] + tau[19];
-  const T t1054 = t1053 + t996;
-  const T t1055 = angle_c[13]*t991 - angle_s[13]*t992;
-  const T t1056 = angle_c[13]*t992 + angle_s[13]*t991;
-  const T t1057 = app14_p_J_y*t993 - app14_p_J_z*t1056;
-  const T t1058 = -app14_p_J_x*t993 + app14_p_J_z*t1055;
-  const T t1059 = app14_p_J_x*t1056 - app14_p_J_y*t1055;
-  const T t1060 = angle_c[13]*t994 - angle_s[13]*t995;
-  const T t1061 = angle_c[13]*t995 + angle_s[13]*t994;
-  const T t1062 = t1057 + t1060;
-  const T t1063 = t1058 + t1061;
-  const T t1064 = t1059 + t996;
-  const T t1065 = app14_R_PJ_xx*t1055 + app14_R_PJ_xy*t1056;
-  const T t1066 = app14_R_PJ_yx*t1055 + app14_R_PJ_yy*t1056;
-  const T t1067 = app14_R_PJ_xx*t1062 + app14_R_PJ_xy*t1063;
-  const T t1068 = app14_R_PJ_yx*t1062 + app14_R_PJ_yy*t1063;
-  const T t1069 = t1047 + t1065;
-  const T t1070 = t1048 + t1066;
-  const T t1071 = t1049 + t993;
-  const T t1072 = t1050 + t1067;
-  const T t1073 = t1051 + t1068;
-  const T t1074 = t1052 + t1064;
+  const T t1045 = -app14_k*q[20] + tau[19];
+  const T t1046 = t1045 + t990;
+  const T t1047 = angle_c[13]*t985 - angle_s[13]*t986;
+  const T t1048 = angle_c[13]*t986 + angle_s[13]*t985;
+  const T t1049 = app14_p_J_y*t987 - app14_p_J_z*t1048;
+  const T t1050 = -app14_p_J_x*t987 + app14_p_J_z*t1047;
+  const T t1051 = app14_p_J_x*t1048 - app14_p_J_y*t1047;
+  const T t1052 = angle_c[13]*t988 - angle_s[13]*t989;
+  const T t1053 = angle_c[13]*t989 + angle_s[13]*t988;
+  const T t1054 = t1049 + t1052;
+  const T t1055 = t1050 + t1053;
+  const T t1056 = t1051 + t990;
+  const T t1057 = app14_R_PJ_xx*t1047 + app14_R_PJ_xy*t1048;
+  const T t1058 = app14_R_PJ_yx*t1047 + app14_R_PJ_yy*t1048;
+  const T t1059 = app14_R_PJ_xx*t1054 + app14_R_PJ_xy*t1055;
+  const T t1060 = app14_R_PJ_yx*t1054 + app14_R_PJ_yy*t1055;
+  const T t1061 = t1039 + t1057;
+  const T t1062 = t1040 + t1058;
+  const T t1063 = t1041 + t987;
+  const T t1064 = t1042 + t1059;
+  const T t1065 = t1043 + t1060;
+  const T t1066 = t1044 + t1056;
   // ---- body app13: generalized forces (inward)
-  const T t1075 = -app13_k*q[19] + tau[18];
-  const T t1076 = t1075 + t990;
-  const T t1077 = angle_c[12]*t985 - angle_s[12]*t986;
-  const T t1078 = angle_c[12]*t986 + angle_s[12]*t985;
-  const T t1079 = app13_p_J_y*t987;
-  const T t1080 = -app13_p_J_x*t987;
-  const T t1081 = app13_p_J_x*t1078 - app13_p_J_y*t1077;
-  const T t1082 = angle_c[12]*t988 - angle_s[12]*t989;
-  const T t1083 = angle_c[12]*t989 + angle_s[12]*t988;
-  const T t1084 = t1079 + t1082;
-  const T t1085 = t1080 + t1083;
-  const T t1086 = t1081 + t990;
-  const T t1087 = t1069 + t987;
-  const T t1088 = t1070 - t1077;
-  const T t1089 = t1071 - t1078;
-  const T t1090 = t1072 + t1086;
-  const T t1091 = t1073 - t1084;
-  const T t1092 = t1074 - t1085;
+  const T t1067 = -app13_k*q[19] + tau[18];
+  const T t1068 = t1067 + t984;
+  const T t1069 = angle_c[12]*t979 - angle_s[12]*t980;
+  const T t1070 = angle_c[12]*t980 + angle_s[12]*t979;
+  const T t1071 = app13_p_J_y*t981;
+  const T t1072 = -app13_p_J_x*t981;
+  const T t1073 = app13_p_J_x*t1070 - app13_p_J_y*t1069;
+  const T t1074 = angle_c[12]*t982 - angle_s[12]*t983;
+  const T t1075 = angle_c[12]*t983 + angle_s[12]*t982;
+  const T t1076 = t1071 + t1074;
+  const T t1077 = t1072 + t1075;
+  const T t1078 = t1073 + t984;
+  const T t1079 = t1061 + t981;
+  const T t1080 = t1062 - t1069;
+  const T t1081 = t1063 - t1070;
+  const T t1082 = t1064 + t1078;
+  const T t1083 = t1065 - t1076;
+  const T t1084 = t1066 - t1077;
   // ---- body app12: generalized forces (inward)
-  const T t1093 = -q[18] + tau[17];
-  const T t1094 = t1093 + t984;
-  const T t1095 = angle_c[11]*t979 - angle_s[11]*t980;
-  const T t1096 = angle_c[11]*t980 + angle_s[11]*t979;
-  const T t1097 = app12_p_J_y*t981 - app12_p_J_z*t1096;
-  const T t1098 = -app12_p_J_x*t981 + app12_p_J_z*t1095;
-  const T t1099 = app12_p_J_x*t1096 - app12_p_J_y*t1095;
-  const T t1100 = angle_c[11]*t982 - angle_s[11]*t983;
-  const T t1101 = angle_c[11]*t983 + angle_s[11]*t982;
-  const T t1102 = t1097 + t1100;
-  const T t1103 = t1098 + t1101;
-  const T t1104 = t1099 + t984;
-  const T t1105 = app12_R_PJ_xy*t1096 + app12_R_PJ_xz*t981;
-  const T t1106 = app12_R_PJ_yy*t1096 + app12_R_PJ_yz*t981;
-  const T t1107 = app12_R_PJ_xy*t1103 + app12_R_PJ_xz*t1104;
-  const T t1108 = app12_R_PJ_yy*t1103 + app12_R_PJ_yz*t1104;
-  const T t1109 = t1087 + t1105;
-  const T t1110 = t1088 + t1106;
-  const T t1111 = t1089 + t1095;
-  const T t1112 = t1090 + t1107;
-  const T t1113 = t1091 + t1108;
-  const T t1114 = t1092 + t1102;
+  const T t1085 = -q[18] + tau[17];
+  const T t1086 = t1085 + t978;
+  const T t1087 = angle_c[11]*t973 - angle_s[11]*t974;
+  const T t1088 = angle_c[11]*t974 + angle_s[11]*t973;
+  const T t1089 = app12_p_J_y*t975;
+  const T t1090 = -app12_p_J_x*t975;
+  const T t1091 = app12_p_J_x*t1088 - app12_p_J_y*t1087;
+  const T t1092 = angle_c[11]*t976 - angle_s[11]*t977;
+  const T t1093 = angle_c[11]*t977 + angle_s[11]*t976;
+  const T t1094 = t1089 + t1092;
+  const T t1095 = t1090 + t1093;
+  const T t1096 = t1091 + t978;
+  const T t1097 = app12_R_PJ_xy*t1088 + app12_R_PJ_xz*t975;
+  const T t1098 = app12_R_PJ_yy*t1088 + app12_R_PJ_yz*t975;
+  const T t1099 = app12_R_PJ_xy*t1095 + app12_R_PJ_xz*t1096;
+  const T t1100 = app12_R_PJ_yy*t1095 + app12_R_PJ_yz*t1096;
+  const T t1101 = t1079 + t1097;
+  const T t1102 = t1080 + t1098;
+  const T t1103 = t1081 + t1087;
+  const T t1104 = t1082 + t1099;
+  const T t1105 = t1083 + t1100;
+  const T t1106 = t1084 + t1094;
   // ---- body app11: generalized forces (inward)
-  const T t1115 = -app11_k*q[17] + tau[16];
-  const T t1116 = t1115 + t978;
-  const T t1117 = angle_c[10]*t973 - angle_s[10]*t974;
-  const T t1118 = angle_c[10]*t974 + angle_s[10]*t973;
-  const T t1119 = -app11_p_J_z*t1118;
-  const T t1120 = -app11_p_J_x*t975 + app11_p_J_z*t1117;
-  const T t1121 = app11_p_J_x*t1118;
-  const T t1122 = angle_c[10]*t976 - angle_s[10]*t977;
-  const T t1123 = angle_c[10]*t977 + angle_s[10]*t976;
-  const T t1124 = t1119 + t1122;
-  const T t1125 = t1120 + t1123;
-  const T t1126 = t1121 + t978;
-  const T t1127 = app11_R_PJ_xx*t1117 + app11_R_PJ_xy*t1118;
-  const T t1128 = app11_R_PJ_yx*t1117 + app11_R_PJ_yy*t1118;
-  const T t1129 = app11_R_PJ_xx*t1124 + app11_R_PJ_xy*t1125;
-  const T t1130 = app11_R_PJ_yx*t1124 + app11_R_PJ_yy*t1125;
-  const T t1131 = t1109 + t1127;
-  const T t1132 = t1110 + t1128;
-  const T t1133 = t1111 + t975;
-  const T t1134 = t1112 + t1129;
-  const T t1135 = t1113 + t1130;
-  const T t1136 = t1114 + t1126;
+  const T t1107 = -app11_k*q[17] + tau[16];
+  const T t1108 = t1107 + t972;
+  const T t1109 = angle_c[10]*t967 - angle_s[10]*t968;
+  const T t1110 = angle_c[10]*t968 + angle_s[10]*t967;
+  const T t1111 = -app11_p_J_z*t1110;
+  const T t1112 = -app11_p_J_x*t969 + app11_p_J_z*t1109;
+  const T t1113 = app11_p_J_x*t1110;
+  const T t1114 = angle_c[10]*t970 - angle_s[10]*t971;
+  const T t1115 = angle_c[10]*t971 + angle_s[10]*t970;
+  const T t1116 = t1111 + t1114;
+  const T t1117 = t1112 + t1115;
+  const T t1118 = t1113 + t972;
+  const T t1119 = app11_R_PJ_xx*t1109 + app11_R_PJ_xy*t1110;
+  const T t1120 = app11_R_PJ_yx*t1109 + app11_R_PJ_yy*t1110;
+  const T t1121 = app11_R_PJ_xx*t1116 + app11_R_PJ_xy*t1117;
+  const T t1122 = app11_R_PJ_yx*t1116 + app11_R_PJ_yy*t1117;
+  const T t1123 = t1101 + t1119;
+  const T t1124 = t1102 + t1120;
+  const T t1125 = t1103 + t969;
+  const T t1126 = t1104 + t1121;
+  const T t1127 = t1105 + t1122;
+  const T t1128 = t1106 + t1118;
   // ---- body app10: generalized forces (inward)
-  const T t1137 = -app10_k*q[16] + tau[15];
-  const T t1138 = t1137 + t972;
-  const T t1139 = angle_c[9]*t967 - angle_s[9]*t968;
-  const T t1140 = angle_c[9]*t968 + angle_s[9]*t967;
-  const T t1141 = app10_p_J_y*t969 - app10_p_J_z*t1140;
-  const T t1142 = -app10_p_J_x*t969 + app10_p_J_z*t1139;
-  const T t1143 = app10_p_J_x*t1140 - app10_p_J_y*t1139;
-  const T t1144 = angle_c[9]*t970 - angle_s[9]*t971;
-  const T t1145 = angle_c[9]*t971 + angle_s[9]*t970;
-  const T t1146 = t1141 + t1144;
-  const T t1147 = t1142 + t1145;
-  const T t1148 = t1143 + t972;
-  const T t1149 = app10_R_PJ_xx*t1139 + app10_R_PJ_xz*t969;
-  const T t1150 = app10_R_PJ_yx*t1139 + app10_R_PJ_yz*t969;
-  const T t1151 = app10_R_PJ_xx*t1146 + app10_R_PJ_xz*t1148;
-  const T t1152 = app10_R_PJ_yx*t1146 + app10_R_PJ_yz*t1148;
-  const T t1153 = t1131 + t1149;
-  const T t1154 = t1132 + t1150;
-  const T t1155 = t1133 - t1140;
-  const T t1156 = t1134 + t1151;
-  const T t1157 = t1135 + t1152;
-  const T t1158 = t1136 - t1147;
+  const T t1129 = -app10_k*q[16] + tau[15];
+  const T t1130 = t1129 + t966;
+  const T t1131 = angle_c[9]*t961 - angle_s[9]*t962;
+  const T t1132 = angle_c[9]*t962 + angle_s[9]*t961;
+  const T t1133 = app10_p_J_y*t963 - app10_p_J_z*t1132;
+  const T t1134 = -app10_p_J_x*t963 + app10_p_J_z*t1131;
+  const T t1135 = app10_p_J_x*t1132 - app10_p_J_y*t1131;
+  const T t1136 = angle_c[9]*t964 - angle_s[9]*t965;
+  const T t1137 = angle_c[9]*t965 + angle_s[9]*t964;
+  const T t1138 = t1133 + t1136;
+  const T t1139 = t1134 + t1137;
+  const T t1140 = t1135 + t966;
+  const T t1141 = app10_R_PJ_xx*t1131 + app10_R_PJ_xz*t963;
+  const T t1142 = app10_R_PJ_yx*t1131 + app10_R_PJ_yz*t963;
+  const T t1143 = app10_R_PJ_xx*t1138 + app10_R_PJ_xz*t1140;
+  const T t1144 = app10_R_PJ_yx*t1138 + app10_R_PJ_yz*t1140;
+  const T t1145 = t1123 + t1141;
+  const T t1146 = t1124 + t1142;
+  const T t1147 = t1125 - t1132;
+  const T t1148 = t1126 + t1143;
+  const T t1149 = t1127 + t1144;
+  const T t1150 = t1128 - t1139;
   // ---- body app9: generalized forces (inward)
-  const T t1159 = -q[15] + tau[14];
-  const T t1160 = t1159 + t966;
-  const T t1161 = angle_c[8]*t961 - angle_s[8]*t962;
-  const T t1162 = angle_c[8]*t962 + angle_s[8]*t961;
-  const T t1163 = -app9_p_J_z*t1162;
-  const T t1164 = -app9_p_J_x*t963 + app9_p_J_z*t1161;
-  const T t1165 = app9_p_J_x*t1162;
-  const T t1166 = angle_c[8]*t964 - angle_s[8]*t965;
-  const T t1167 = angle_c[8]*t965 + angle_s[8]*t964;
-  const T t1168 = t1163 + t1166;
-  const T t1169 = t1164 + t1167;
-  const T t1170 = t1165 + t966;
-  const T t1171 = t1153 - t963;
-  const T t1172 = t1154 + t1162;
-  const T t1173 = t1155 + t1161;
-  const T t1174 = t1156 - t1170;
-  const T t1175 = t1157 + t1169;
-  const T t1176 = t1158 + t1168;
+  const T t1151 = -q[15] + tau[14];
+  const T t1152 = t1151 + t960;
+  const T t1153 = angle_c[8]*t955 - angle_s[8]*t956;
+  const T t1154 = angle_c[8]*t956 + angle_s[8]*t955;
+  const T t1155 = -app9_p_J_x*t957;
+  const T t1156 = app9_p_J_x*t1154;
+  const T t1157 = angle_c[8]*t958 - angle_s[8]*t959;
+  const T t1158 = angle_c[8]*t959 + angle_s[8]*t958;
+  const T t1159 = t1155 + t1158;
+  const T t1160 = t1156 + t960;
+  const T t1161 = t1145 - t957;
+  const T t1162 = t1146 + t1154;
+  const T t1163 = t1147 + t1153;
+  const T t1164 = t1148 - t1160;
+  const T t1165 = t1149 + t1159;
+  const T t1166 = t1150 + t1157;
   // ---- body app8: generalized forces (inward)
-  const T t1177 = -app8_k*q[14] + tau[13];
-  const T t1178 = t1177 + t960;
-  const T t1179 = angle_c[7]*t955 - angle_s[7]*t956;
-  const T t1180 = angle_c[7]*t956 + angle_s[7]*t955;
-  const T t1181 = app8_p_J_y*t957 - app8_p_J_z*t1180;
-  const T t1182 = -app8_p_J_x*t957 + app8_p_J_z*t1179;
-  const T t1183 = app8_p_J_x*t1180 - app8_p_J_y*t1179;
-  const T t1184 = angle_c[7]*t958 - angle_s[7]*t959;
-  const T t1185 = angle_c[7]*t959 + angle_s[7]*t958;
-  const T t1186 = t1181 + t1184;
-  const T t1187 = t1182 + t1185;
-  const T t1188 = t1183 + t960;
-  const T t1189 = app8_R_PJ_xx*t1179 + app8_R_PJ_xy*t1180;
-  const T t1190 = app8_R_PJ_yx*t1179 + app8_R_PJ_yy*t1180;
-  const T t1191 = app8_R_PJ_xx*t1186 + app8_R_PJ_xy*t1187;
-  const T t1192 = app8_R_PJ_yx*t1186 + app8_R_PJ_yy*t1187;
-  const T t1193 = t1171 + t1189;
-  const T t1194 = t1172 + t1190;
-  const T t1195 = t1173 + t957;
-  const T t1196 = t1174 + t1191;
-  const T t1197 = t1175 + t1192;
-  const T t1198 = t1176 + t1188;
+  const T t1167 = -app8_k*q[14] + tau[13];
+  const T t1168 = t1167 + t954;
+  const T t1169 = angle_c[7]*t949 - angle_s[7]*t950;
+  const T t1170 = angle_c[7]*t950 + angle_s[7]*t949;
+  const T t1171 = app8_p_J_y*t951 - app8_p_J_z*t1170;
+  const T t1172 = -app8_p_J_x*t951 + app8_p_J_z*t1169;
+  const T t1173 = app8_p_J_x*t1170 - app8_p_J_y*t1169;
+  const T t1174 = angle_c[7]*t952 - angle_s[7]*t953;
+  const T t1175 = angle_c[7]*t953 + angle_s[7]*t952;
+  const T t1176 = t1171 + t1174;
+  const T t1177 = t1172 + t1175;
+  const T t1178 = t1173 + t954;
+  const T t1179 = app8_R_PJ_xx*t1169 + app8_R_PJ_xy*t1170;
+  const T t1180 = app8_R_PJ_yx*t1169 + app8_R_PJ_yy*t1170;
+  const T t1181 = app8_R_PJ_xx*t1176 + app8_R_PJ_xy*t1177;
+  const T t1182 = app8_R_PJ_yx*t1176 + app8_R_PJ_yy*t1177;
+  const T t1183 = t1161 + t1179;
+  const T t1184 = t1162 + t1180;
+  const T t1185 = t1163 + t951;
+  const T t1186 = t1164 + t1181;
+  const T t1187 = t1165 + t1182;
+  const T t1188 = t1166 + t1178;
   // ---- body app7: generalized forces (inward)
-  const T t1199 = -app7_k*q[13] + tau[12];
-  const T t1200 = t1199 + t954;
-  const T t1201 = angle_c[6]*t949 - angle_s[6]*t950;
-  const T t1202 = angle_c[6]*t950 + angle_s[6]*t949;
-  const T t1203 = app7_p_J_y*t951;
-  const T t1204 = -app7_p_J_x*t951;
-  const T t1205 = app7_p_J_x*t1202 - app7_p_J_y*t1201;
-  const T t1206 = angle_c[6]*t952 - angle_s[6]*t953;
-  const T t1207 = angle_c[6]*t953 + angle_s[6]*t952;
-  const T t1208 = t1203 + t1206;
-  const T t1209 = t1204 + t1207;
-  const T t1210 = t1205 + t954;
-  const T t1211 = app7_R_PJ_xx*t1201 + app7_R_PJ_xz*t951;
-  const T t1212 = app7_R_PJ_yx*t1201 + app7_R_PJ_yz*t951;
-  const T t1213 = app7_R_PJ_xx*t1208 + app7_R_PJ_xz*t1210;
-  const T t1214 = app7_R_PJ_yx*t1208 + app7_R_PJ_yz*t1210;
-  const T t1215 = t1193 + t1211;
-  const T t1216 = t1194 + t1212;
-  const T t1217 = t1195 - t1202;
-  const T t1218 = t1196 + t1213;
-  const T t1219 = t1197 + t1214;
-  const T t1220 = t1198 - t1209;
+  const T t1189 = -app7_k*q[13] + tau[12];
+  const T t1190 = t1189 + t948;
+  const T t1191 = angle_c[6]*t943 - angle_s[6]*t944;
+  const T t1192 = angle_c[6]*t944 + angle_s[6]*t943;
+  const T t1193 = app7_p_J_y*t945;
+  const T t1194 = -app7_p_J_x*t945;
+  const T t1195 = app7_p_J_x*t1192 - app7_p_J_y*t1191;
+  const T t1196 = angle_c[6]*t946 - angle_s[6]*t947;
+  const T t1197 = angle_c[6]*t947 + angle_s[6]*t946;
+  const T t1198 = t1193 + t1196;
+  const T t1199 = t1194 + t1197;
+  const T t1200 = t1195 + t948;
+  const T t1201 = app7_R_PJ_xx*t1191 + app7_R_PJ_xz*t945;
+  const T t1202 = app7_R_PJ_yx*t1191 + app7_R_PJ_yz*t945;
+  const T t1203 = app7_R_PJ_xx*t1198 + app7_R_PJ_xz*t1200;
+  const T t1204 = app7_R_PJ_yx*t1198 + app7_R_PJ_yz*t1200;
+  const T t1205 = t1183 + t1201;
+  const T t1206 = t1184 + t1202;
+  const T t1207 = t1185 - t1192;
+  const T t1208 = t1186 + t1203;
+  const T t1209 = t1187 + t1204;
+  const T t1210 = t1188 - t1199;
   // ---- body app6: generalized forces (inward)
-  const T t1221 = -q[12] + tau[11];
-  const T t1222 = t1221 + t948;
-  const T t1223 = angle_c[5]*t943 - angle_s[5]*t944;
-  const T t1224 = angle_c[5]*t944 + angle_s[5]*t943;
-  const T t1225 = app6_p_J_y*t945 - app6_p_J_z*t1224;
-  const T t1226 = -app6_p_J_x*t945 + app6_p_J_z*t1223;
-  const T t1227 = app6_p_J_x*t1224 - app6_p_J_y*t1223;
-  const T t1228 = angle_c[5]*t946 - angle_s[5]*t947;
-  const T t1229 = angle_c[5]*t947 + angle_s[5]*t946;
-  const T t1230 = t1225 + t1228;
-  const T t1231 = t1226 + t1229;
-  const T t1232 = t1227 + t948;
-  const T t1233 = app6_R_PJ_xy*t1224 + app6_R_PJ_xz*t945;
-  const T t1234 = app6_R_PJ_yy*t1224 + app6_R_PJ_yz*t945;
-  const T t1235 = app6_R_PJ_xy*t1231 + app6_R_PJ_xz*t1232;
-  const T t1236 = app6_R_PJ_yy*t1231 + app6_R_PJ_yz*t1232;
-  const T t1237 = t1215 + t1233;
-  const T t1238 = t1216 + t1234;
-  const T t1239 = t1217 + t1223;
-  const T t1240 = t1218 + t1235;
-  const T t1241 = t1219 + t1236;
-  const T t1242 = t1220 + t1230;
+  const T t1211 = -q[12] + tau[11];
+  const T t1212 = t1211 + t942;
+  const T t1213 = angle_c[5]*t937 - angle_s[5]*t938;
+  const T t1214 = angle_c[5]*t938 + angle_s[5]*t937;
+  const T t1215 = app6_p_J_y*t939;
+  const T t1216 = -app6_p_J_x*t939;
+  const T t1217 = app6_p_J_x*t1214 - app6_p_J_y*t1213;
+  const T t1218 = angle_c[5]*t940 - angle_s[5]*t941;
+  const T t1219 = angle_c[5]*t941 + angle_s[5]*t940;
+  const T t1220 = t1215 + t1218;
+  const T t1221 = t1216 + t1219;
+  const T t1222 = t1217 + t942;
+  const T t1223 = app6_R_PJ_xy*t1214 + app6_R_PJ_xz*t939;
+  const T t1224 = app6_R_PJ_yy*t1214 + app6_R_PJ_yz*t939;
+  const T t1225 = app6_R_PJ_xy*t1221 + app6_R_PJ_xz*t1222;
+  const T t1226 = app6_R_PJ_yy*t1221 + app6_R_PJ_yz*t1222;
+  const T t1227 = t1205 + t1223;
+  const T t1228 = t1206 + t1224;
+  const T t1229 = t1207 + t1213;
+  const T t1230 = t1208 + t1225;
+  const T t1231 = t1209 + t1226;
+  const T t1232 = t1210 + t1220;
   // ---- body app5: generalized forces (inward)
-  const T t1243 = -app5_k*q[11] + tau[10];
-  const T t1244 = t1243 + t942;
-  const T t1245 = angle_c[4]*t937 - angle_s[4]*t938;
-  const T t1246 = angle_c[4]*t938 + angle_s[4]*t937;
-  const T t1247 = -app5_p_J_z*t1246;
-  const T t1248 = -app5_p_J_x*t939 + app5_p_J_z*t1245;
-  const T t1249 = app5_p_J_x*t1246;
-  const T t1250 = angle_c[4]*t940 - angle_s[4]*t941;
-  const T t1251 = angle_c[4]*t941 + angle_s[4]*t940;
-  const T t1252 = t1247 + t1250;
-  const T t1253 = t1248 + t1251;
-  const T t1254 = t1249 + t942;
-  const T t1255 = t1237 - t1246;
-  const T t1256 = t1238 + t1245;
-  const T t1257 = t1239 + t939;
-  const T t1258 = t1240 - t1253;
-  const T t1259 = t1241 + t1252;
-  const T t1260 = t1242 + t1254;
+  const T t1233 = -app5_k*q[11] + tau[10];
+  const T t1234 = t1233 + t936;
+  const T t1235 = angle_c[4]*t931 - angle_s[4]*t932;
+  const T t1236 = angle_c[4]*t932 + angle_s[4]*t931;
+  const T t1237 = -app5_p_J_z*t1236;
+  const T t1238 = -app5_p_J_x*t933 + app5_p_J_z*t1235;
+  const T t1239 = app5_p_J_x*t1236;
+  const T t1240 = angle_c[4]*t934 - angle_s[4]*t935;
+  const T t1241 = angle_c[4]*t935 + angle_s[4]*t934;
+  const T t1242 = t1237 + t1240;
+  const T t1243 = t1238 + t1241;
+  const T t1244 = t1239 + t936;
+  const T t1245 = t1227 - t1236;
+  const T t1246 = t1228 + t1235;
+  const T t1247 = t1229 + t933;
+  const T t1248 = t1230 - t1243;
+  const T t1249 = t1231 + t1242;
+  const T t1250 = t1232 + t1244;
   // ---- body app4: generalized forces (inward)
-  const T t1261 = -app4_k*q[10] + tau[9];
-  const T t1262 = t1261 + t936;
-  const T t1263 = angle_c[3]*t931 - angle_s[3]*t932;
-  const T t1264 = angle_c[3]*t932 + angle_s[3]*t931;
-  const T t1265 = app4_p_J_y*t933 - app4_p_J_z*t1264;
-  const T t1266 = -app4_p_J_x*t933 + app4_p_J_z*t1263;
-  const T t1267 = app4_p_J_x*t1264 - app4_p_J_y*t1263;
-  const T t1268 = angle_c[3]*t934 - angle_s[3]*t935;
-  const T t1269 = angle_c[3]*t935 + angle_s[3]*t934;
-  const T t1270 = t1265 + t1268;
-  const T t1271 = t1266 + t1269;
-  const T t1272 = t1267 + t936;
-  const T t1273 = app4_R_PJ_xx*t1263 + app4_R_PJ_xz*t933;
-  const T t1274 = app4_R_PJ_yx*t1263 + app4_R_PJ_yz*t933;
-  const T t1275 = app4_R_PJ_xx*t1270 + app4_R_PJ_xz*t1272;
-  const T t1276 = app4_R_PJ_yx*t1270 + app4_R_PJ_yz*t1272;
-  const T t1277 = t1255 + t1273;
-  const T t1278 = t1256 + t1274;
-  const T t1279 = t1257 - t1264;
-  const T t1280 = t1258 + t1275;
-  const T t1281 = t1259 + t1276;
-  const T t1282 = t1260 - t1271;
+  const T t1251 = -app4_k*q[10] + tau[9];
+  const T t1252 = t1251 + t930;
+  const T t1253 = angle_c[3]*t925 - angle_s[3]*t926;
+  const T t1254 = angle_c[3]*t926 + angle_s[3]*t925;
+  const T t1255 = app4_p_J_y*t927 - app4_p_J_z*t1254;
+  const T t1256 = -app4_p_J_x*t927 + app4_p_J_z*t1253;
+  const T t1257 = app4_p_J_x*t1254 - app4_p_J_y*t1253;
+  const T t1258 = angle_c[3]*t928 - angle_s[3]*t929;
+  const T t1259 = angle_c[3]*t929 + angle_s[3]*t928;
+  const T t1260 = t1255 + t1258;
+  const T t1261 = t1256 + t1259;
+  const T t1262 = t1257 + t930;
+  const T t1263 = app4_R_PJ_xx*t1253 + app4_R_PJ_xz*t927;
+  const T t1264 = app4_R_PJ_yx*t1253 + app4_R_PJ_yz*t927;
+  const T t1265 = app4_R_PJ_xx*t1260 + app4_R_PJ_xz*t1262;
+  const T t1266 = app4_R_PJ_yx*t1260 + app4_R_PJ_yz*t1262;
+  const T t1267 = t1245 + t1263;
+  const T t1268 = t1246 + t1264;
+  const T t1269 = t1247 - t1254;
+  const T t1270 = t1248 + t1265;
+  const T t1271 = t1249 + t1266;
+  const T t1272 = t1250 - t1261;
   // ---- body app3: generalized forces (inward)
-  const T t1283 = -q[9] + tau[8];
-  const T t1284 = t1283 + t930;
-  const T t1285 = angle_c[2]*t925 - angle_s[2]*t926;
-  const T t1286 = angle_c[2]*t926 + angle_s[2]*t925;
-  const T t1287 = -app3_p_J_z*t1286;
-  const T t1288 = -app3_p_J_x*t927 + app3_p_J_z*t1285;
-  const T t1289 = app3_p_J_x*t1286;
-  const T t1290 = angle_c[2]*t928 - angle_s[2]*t929;
-  const T t1291 = angle_c[2]*t929 + angle_s[2]*t928;
-  const T t1292 = t1287 + t1290;
-  const T t1293 = t1288 + t1291;
-  const T t1294 = t1289 + t930;
-  const T t1295 = app3_R_PJ_xy*t1286 + app3_R_PJ_xz*t927;
-  const T t1296 = app3_R_PJ_yy*t1286 + app3_R_PJ_yz*t927;
-  const T t1297 = app3_R_PJ_xy*t1293 + app3_R_PJ_xz*t1294;
-  const T t1298 = app3_R_PJ_yy*t1293 + app3_R_PJ_yz*t1294;
-  const T t1299 = t1277 + t1295;
-  const T t1300 = t1278 + t1296;
-  const T t1301 = t1279 + t1285;
-  const T t1302 = t1280 + t1297;
-  const T t1303 = t1281 + t1298;
-  const T t1304 = t1282 + t1292;
+  const T t1273 = -q[9] + tau[8];
+  const T t1274 = t1273 + t924;
+  const T t1275 = angle_c[2]*t919 - angle_s[2]*t920;
+  const T t1276 = angle_c[2]*t920 + angle_s[2]*t919;
+  const T t1277 = -app3_p_J_x*t921;
+  const T t1278 = app3_p_J_x*t1276;
+  const T t1279 = angle_c[2]*t922 - angle_s[2]*t923;
+  const T t1280 = angle_c[2]*t923 + angle_s[2]*t922;
+  const T t1281 = t1277 + t1280;
+  const T t1282 = t1278 + t924;
+  const T t1283 = app3_R_PJ_xy*t1276 + app3_R_PJ_xz*t921;
+  const T t1284 = app3_R_PJ_yy*t1276 + app3_R_PJ_yz*t921;
+  const T t1285 = app3_R_PJ_xy*t1281 + app3_R_PJ_xz*t1282;
+  const T t1286 = app3_R_PJ_yy*t1281 + app3_R_PJ_yz*t1282;
+  const T t1287 = t1267 + t1283;
+  const T t1288 = t1268 + t1284;
+  const T t1289 = t1269 + t1275;
+  const T t1290 = t1270 + t1285;
+  const T t1291 = t1271 + t1286;
+  const T t1292 = t1272 + t1279;
   // ---- body app2: generalized forces (inward)
-  const T t1305 = -app2_k*q[8] + tau[7];
-  const T t1306 = t1305 + t924;
-  const T t1307 = angle_c[1]*t919 - angle_s[1]*t920;
-  const T t1308 = angle_c[1]*t920 + angle_s[1]*t919;
-  const T t1309 = app2_p_J_y*t921 - app2_p_J_z*t1308;
-  const T t1310 = -app2_p_J_x*t921 + app2_p_J_z*t1307;
-  const T t1311 = app2_p_J_x*t1308 - app2_p_J_y*t1307;
-  const T t1312 = angle_c[1]*t922 - angle_s[1]*t923;
-  const T t1313 = angle_c[1]*t923 + angle_s[1]*t922;
-  const T t1314 = t1309 + t1312;
-  const T t1315 = t1310 + t1313;
-  const T t1316 = t1311 + t924;
-  const T t1317 = app2_R_PJ_xx*t1307 + app2_R_PJ_xy*t1308;
-  const T t1318 = app2_R_PJ_yx*t1307 + app2_R_PJ_yy*t1308;
-  const T t1319 = app2_R_PJ_xx*t1314 + app2_R_PJ_xy*t1315;
-  const T t1320 = app2_R_PJ_yx*t1314 + app2_R_PJ_yy*t1315;
-  const T t1321 = t1299 + t1317;
-  const T t1322 = t1300 + t1318;
-  const T t1323 = t1301 + t921;
-  const T t1324 = t1302 + t1319;
-  const T t1325 = t1303 + t1320;
-  const T t1326 = t1304 + t1316;
+  const T t1293 = -app2_k*q[8] + tau[7];
+  const T t1294 = t1293 + t918;
+  const T t1295 = angle_c[1]*t913 - angle_s[1]*t914;
+  const T t1296 = angle_c[1]*t914 + angle_s[1]*t913;
+  const T t1297 = app2_p_J_y*t915 - app2_p_J_z*t1296;
+  const T t1298 = -app2_p_J_x*t915 + app2_p_J_z*t1295;
+  const T t1299 = app2_p_J_x*t1296 - app2_p_J_y*t1295;
+  const T t1300 = angle_c[1]*t916 - angle_s[1]*t917;
+  const T t1301 = angle_c[1]*t917 + angle_s[1]*t916;
+  const T t1302 = t1297 + t1300;
+  const T t1303 = t1298 + t1301;
+  const T t1304 = t1299 + t918;
+  const T t1305 = app2_R_PJ_xx*t1295 + app2_R_PJ_xy*t1296;
+  const T t1306 = app2_R_PJ_yx*t1295 + app2_R_PJ_yy*t1296;
+  const T t1307 = app2_R_PJ_xx*t1302 + app2_R_PJ_xy*t1303;
+  const T t1308 = app2_R_PJ_yx*t1302 + app2_R_PJ_yy*t1303;
+  const T t1309 = t1287 + t1305;
+  const T t1310 = t1288 + t1306;
+  const T t1311 = t1289 + t915;
+  const T t1312 = t1290 + t1307;
+  const T t1313 = t1291 + t1308;
+  const T t1314 = t1292 + t1304;
   // ---- body app1: generalized forces (inward)
-  const T t1327 = -app1_k*q[7] + tau[6];
-  const T t1328 = t1327 + t918;
-  const T t1329 = angle_c[0]*t913 - angle_s[0]*t914;
-  const T t1330 = angle_c[0]*t914 + angle_s[0]*t913;
-  const T t1331 = app1_p_J_y*t915;
-  const T t1332 = -app1_p_J_x*t915;
-  const T t1333 = app1_p_J_x*t1330 - app1_p_J_y*t1329;
-  const T t1334 = angle_c[0]*t916 - angle_s[0]*t917;
-  const T t1335 = angle_c[0]*t917 + angle_s[0]*t916;
-  const T t1336 = t1331 + t1334;
-  const T t1337 = t1332 + t1335;
-  const T t1338 = t1333 + t918;
-  const T t1339 = t1321 + t1329;
-  const T t1340 = t1322 + t915;
-  const T t1341 = t1323 - t1330;
-  const T t1342 = t1324 + t1336;
-  const T t1343 = t1325 + t1338;
-  const T t1344 = t1326 - t1337;
+  const T t1315 = -app1_k*q[7] + tau[6];
+  const T t1316 = t1315 + t912;
+  const T t1317 = angle_c[0]*t907 - angle_s[0]*t908;
+  const T t1318 = angle_c[0]*t908 + angle_s[0]*t907;
+  const T t1319 = app1_p_J_y*t909;
+  const T t1320 = -app1_p_J_x*t909;
+  const T t1321 = app1_p_J_x*t1318 - app1_p_J_y*t1317;
+  const T t1322 = angle_c[0]*t910 - angle_s[0]*t911;
+  const T t1323 = angle_c[0]*t911 + angle_s[0]*t910;
+  const T t1324 = t1319 + t1322;
+  const T t1325 = t1320 + t1323;
+  const T t1326 = t1321 + t912;
+  const T t1327 = t1309 + t1317;
+  const T t1328 = t1310 + t909;
+  const T t1329 = t1311 - t1318;
+  const T t1330 = t1312 + t1324;
+  const T t1331 = t1313 + t1326;
+  const T t1332 = t1314 - t1325;
   // ---- body hub: generalized forces (inward)
-  const T t1345 = t1339 + tau[0];
-  const T t1346 = t1340 + tau[1];
-  const T t1347 = t1341 + tau[2];
-  const T t1348 = t1342 + tau[3];
-  const T t1349 = t1343 + tau[4];
-  const T t1350 = t1344 + tau[5];
-  F[0] = t1345;
-  F[1] = t1346;
-  F[2] = t1347;
-  F[3] = t1348;
-  F[4] = t1349;
-  F[5] = t1350;
-  F[6] = t1328;
-  F[7] = t1306;
-  F[8] = t1284;
-  F[9] = t1262;
-  F[10] = t1244;
-  F[11] = t1222;
-  F[12] = t1200;
-  F[13] = t1178;
-  F[14] = t1160;
-  F[15] = t1138;
-  F[16] = t1116;
-  F[17] = t1094;
-  F[18] = t1076;
-  F[19] = t1054;
-  F[20] = t1032;
-  F[21] = t1010;
+  const T t1333 = t1327 + tau[0];
+  const T t1334 = t1328 + tau[1];
+  const T t1335 = t1329 + tau[2];
+  const T t1336 = t1330 + tau[3];
+  const T t1337 = t1331 + tau[4];
+  const T t1338 = t1332 + tau[5];
+  F[0] = t1333;
+  F[1] = t1334;
+  F[2] = t1335;
+  F[3] = t1336;
+  F[4] = t1337;
+  F[5] = t1338;
+  F[6] = t1316;
+  F[7] = t1294;
+  F[8] = t1274;
+  F[9] = t1252;
+  F[10] = t1234;
+  F[11] = t1212;
+  F[12] = t1190;
+  F[13] = t1168;
+  F[14] = t1152;
+  F[15] = t1130;
+  F[16] = t1108;
+  F[17] = t1086;
+  F[18] = t1068;
+  F[19] = t1046;
+  F[20] = t1026;
+  F[21] = t1004;
 }
 
 // ---- u_dot: M u_dot = F (form chosen by operation count, see the counts above) -
 
-// Compact code: 26 kernels, 34 calls, one per group of a body's code (outlined_code.hpp)
+// Compact code: 25 kernels, 34 calls, one per group of a body's code (outlined_code.hpp)
 
-// udot, kernel 1 of 26
+// udot, kernel 1 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel0(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -3268,7 +3180,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel0(T* w, const int* x, const do
   w[20] = a20;
 }
 
-// udot, kernel 2 of 26
+// udot, kernel 2 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel1(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -3329,7 +3241,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel1(T* w, const int* x, const do
   w[15] = a26;
 }
 
-// udot, kernel 3 of 26
+// udot, kernel 3 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel2(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -3398,7 +3310,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel2(T* w, const int* x, const do
   w[15] = a30;
 }
 
-// udot, kernel 4 of 26
+// udot, kernel 4 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel3(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -3423,53 +3335,51 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel3(T* w, const int* x, const do
   const double C8 = c[8];
   const double C9 = c[9];
   const double C10 = c[10];
-  const double C11 = c[11];
   const T a0 = C0*X0 + C1*X1;
   const T a1 = C2*X0 + C3*X1;
-  const T a2 = C4*a0;
-  const T a3 = -C4*X2 + C5*a1;
-  const T a4 = -C5*a0;
-  const T a5 = a0*a4 - a1*a3;
-  const T a6 = -X2*a4 + a1*a2;
-  const T a7 = X2*a3 - a0*a2;
-  const T a8 = C0*X3 + C1*X4;
-  const T a9 = C2*X3 + C3*X4;
-  const T a10 = X5 + a5;
+  const T a2 = C4*a1;
+  const T a3 = -C4*a0;
+  const T a4 = a0*a3 - a1*a2;
+  const T a5 = -X2*a3;
+  const T a6 = X2*a2;
+  const T a7 = C0*X3 + C1*X4;
+  const T a8 = C2*X3 + C3*X4;
+  const T a9 = X5 + a4;
+  const T a10 = a5 + a7;
   const T a11 = a6 + a8;
-  const T a12 = a7 + a9;
-  const T a13 = X2*X6 + X7*a0;
-  const T a14 = -X2*X7 + X6*a0;
-  const T a15 = X8 + a1;
-  const T a16 = X8*a14;
-  const T a17 = -X8*a13;
-  const T a18 = X6*a10 + X7*a11;
-  const T a19 = X6*a11 - X7*a10;
-  const T a20 = C6*a14;
-  const T a21 = -C6*a13 + C7*a15;
-  const T a22 = -C7*a14;
-  const T a23 = a14*a22 - a15*a21;
-  const T a24 = -a13*a22 + a15*a20;
-  const T a25 = a13*a21 - a14*a20;
-  const T a26 = C8*a13 + C9*a15;
-  const T a27 = C10*a14;
-  const T a28 = C11*a15 + C9*a13;
-  const T a29 = a14*a28 - a15*a27;
-  const T a30 = -a13*a28 + a15*a26;
-  const T a31 = a13*a27 - a14*a26;
-  w[21] = a12;
-  w[22] = a16;
-  w[23] = a17;
-  w[24] = a18;
-  w[25] = a19;
-  w[26] = a23;
-  w[27] = a24;
-  w[28] = a25;
-  w[29] = a29;
-  w[30] = a30;
-  w[31] = a31;
+  const T a12 = X2*X6 + X7*a0;
+  const T a13 = -X2*X7 + X6*a0;
+  const T a14 = X8 + a1;
+  const T a15 = X8*a13;
+  const T a16 = -X8*a12;
+  const T a17 = X6*a9 + X7*a10;
+  const T a18 = X6*a10 - X7*a9;
+  const T a19 = C5*a13;
+  const T a20 = -C5*a12 + C6*a14;
+  const T a21 = -C6*a13;
+  const T a22 = a13*a21 - a14*a20;
+  const T a23 = -a12*a21 + a14*a19;
+  const T a24 = a12*a20 - a13*a19;
+  const T a25 = C7*a12 + C8*a14;
+  const T a26 = C9*a13;
+  const T a27 = C10*a14 + C8*a12;
+  const T a28 = a13*a27 - a14*a26;
+  const T a29 = -a12*a27 + a14*a25;
+  const T a30 = a12*a26 - a13*a25;
+  w[21] = a11;
+  w[22] = a15;
+  w[23] = a16;
+  w[24] = a17;
+  w[25] = a18;
+  w[26] = a22;
+  w[27] = a23;
+  w[28] = a24;
+  w[29] = a28;
+  w[30] = a29;
+  w[31] = a30;
 }
 
-// udot, kernel 5 of 26
+// udot, kernel 5 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel4(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -3538,7 +3448,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel4(T* w, const int* x, const do
   w[15] = a30;
 }
 
-// udot, kernel 6 of 26
+// udot, kernel 6 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel5(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -3599,7 +3509,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel5(T* w, const int* x, const do
   w[33] = a26;
 }
 
-// udot, kernel 7 of 26
+// udot, kernel 7 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel6(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -3625,12 +3535,11 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel6(T* w, const int* x, const do
   const double C9 = c[9];
   const double C10 = c[10];
   const double C11 = c[11];
-  const double C12 = c[12];
   const T a0 = C0*X0 + C1*X1;
   const T a1 = C2*X0 + C3*X1;
-  const T a2 = -C4*a1 + C5*a0;
-  const T a3 = -C5*X2 + C6*a1;
-  const T a4 = C4*X2 - C6*a0;
+  const T a2 = -C4*a1;
+  const T a3 = C5*a1;
+  const T a4 = C4*X2 - C5*a0;
   const T a5 = a0*a4 - a1*a3;
   const T a6 = -X2*a4 + a1*a2;
   const T a7 = X2*a3 - a0*a2;
@@ -3646,32 +3555,32 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel6(T* w, const int* x, const do
   const T a17 = -X8*a13;
   const T a18 = X6*a10 + X7*a11;
   const T a19 = X6*a11 - X7*a10;
-  const T a20 = C7*a14;
-  const T a21 = -C7*a13 + C8*a15;
-  const T a22 = -C8*a14;
+  const T a20 = C6*a14;
+  const T a21 = -C6*a13 + C7*a15;
+  const T a22 = -C7*a14;
   const T a23 = a14*a22 - a15*a21;
   const T a24 = -a13*a22 + a15*a20;
   const T a25 = a13*a21 - a14*a20;
-  const T a26 = C10*a15 + C9*a13;
-  const T a27 = C11*a14;
-  const T a28 = C10*a13 + C12*a15;
+  const T a26 = C8*a13 + C9*a15;
+  const T a27 = C10*a14;
+  const T a28 = C11*a15 + C9*a13;
   const T a29 = a14*a28 - a15*a27;
   const T a30 = -a13*a28 + a15*a26;
   const T a31 = a13*a27 - a14*a26;
-  w[3] = a12;
-  w[4] = a16;
-  w[5] = a17;
-  w[6] = a18;
-  w[7] = a19;
-  w[8] = a23;
-  w[9] = a24;
-  w[10] = a25;
-  w[11] = a29;
-  w[12] = a30;
-  w[13] = a31;
+  w[5] = a12;
+  w[6] = a16;
+  w[7] = a17;
+  w[8] = a18;
+  w[9] = a19;
+  w[10] = a23;
+  w[11] = a24;
+  w[12] = a25;
+  w[13] = a29;
+  w[14] = a30;
+  w[15] = a31;
 }
 
-// udot, kernel 8 of 26
+// udot, kernel 8 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel7(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -3682,9 +3591,9 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel7(T* w, const int* x, const do
   const T X3 = w[-275];
   const T X4 = w[-274];
   const T X5 = w[-273];
-  const T X6 = w[0];
-  const T X7 = w[1];
-  const T X8 = w[2];
+  const T X6 = w[14];
+  const T X7 = w[15];
+  const T X8 = w[16];
   (void)x;
   const double C0 = c[0];
   const double C1 = c[1];
@@ -3727,26 +3636,26 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel7(T* w, const int* x, const do
   const T a28 = a14*a27 - a15*a26;
   const T a29 = -a13*a27 + a15*a25;
   const T a30 = a13*a26 - a14*a25;
-  w[5] = a12;
-  w[6] = a16;
-  w[7] = a17;
-  w[8] = a18;
-  w[9] = a19;
-  w[10] = a22;
-  w[11] = a23;
-  w[12] = a24;
-  w[13] = a28;
-  w[14] = a29;
-  w[15] = a30;
+  w[19] = a12;
+  w[20] = a16;
+  w[21] = a17;
+  w[22] = a18;
+  w[23] = a19;
+  w[24] = a22;
+  w[25] = a23;
+  w[26] = a24;
+  w[27] = a28;
+  w[28] = a29;
+  w[29] = a30;
 }
 
-// udot, kernel 9 of 26
+// udot, kernel 9 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel8(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
   (void)c;
-  const T X0 = w[-367];
-  const T X1 = w[-364];
+  const T X0 = w[-364];
+  const T X1 = w[-367];
   const T X2 = w[-366];
   const T X3 = w[-355];
   const T X4 = w[-356];
@@ -3762,49 +3671,47 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel8(T* w, const int* x, const do
   const double C4 = c[4];
   const double C5 = c[5];
   const double C6 = c[6];
-  const double C7 = c[7];
-  const T a0 = C0*X0;
-  const T a1 = -C0*X2 - C1*X1;
-  const T a2 = -C1*X0;
-  const T a3 = X0*a2 + X1*a1;
-  const T a4 = -X1*a0 - X2*a2;
-  const T a5 = -X0*a0 + X2*a1;
-  const T a6 = X3 + a3;
-  const T a7 = X4 + a4;
-  const T a8 = -X5 + a5;
-  const T a9 = X0*X7 + X2*X6;
-  const T a10 = X0*X6 - X2*X7;
-  const T a11 = -X1 + X8;
-  const T a12 = X8*a10;
-  const T a13 = -X8*a9;
-  const T a14 = X6*a6 + X7*a7;
-  const T a15 = X6*a7 - X7*a6;
-  const T a16 = C2*a10;
-  const T a17 = -C2*a9 + C3*a11;
-  const T a18 = -C3*a10;
-  const T a19 = a10*a18 - a11*a17;
-  const T a20 = a11*a16 - a18*a9;
-  const T a21 = -a10*a16 + a17*a9;
-  const T a22 = C4*a9 + C5*a11;
-  const T a23 = C6*a10;
-  const T a24 = C5*a9 + C7*a11;
-  const T a25 = a10*a24 - a11*a23;
-  const T a26 = a11*a22 - a24*a9;
-  const T a27 = -a10*a22 + a23*a9;
-  w[23] = a8;
-  w[24] = a12;
-  w[25] = a13;
-  w[26] = a14;
-  w[27] = a15;
-  w[28] = a19;
-  w[29] = a20;
-  w[30] = a21;
-  w[31] = a25;
-  w[32] = a26;
-  w[33] = a27;
+  const T a0 = -C0*X0;
+  const T a1 = -C0*X1;
+  const T a2 = X0*a0 + X1*a1;
+  const T a3 = -X2*a1;
+  const T a4 = X2*a0;
+  const T a5 = X3 + a2;
+  const T a6 = X4 + a3;
+  const T a7 = -X5 + a4;
+  const T a8 = X1*X7 + X2*X6;
+  const T a9 = X1*X6 - X2*X7;
+  const T a10 = -X0 + X8;
+  const T a11 = X8*a9;
+  const T a12 = -X8*a8;
+  const T a13 = X6*a5 + X7*a6;
+  const T a14 = X6*a6 - X7*a5;
+  const T a15 = C1*a9;
+  const T a16 = -C1*a8 + C2*a10;
+  const T a17 = -C2*a9;
+  const T a18 = -a10*a16 + a17*a9;
+  const T a19 = a10*a15 - a17*a8;
+  const T a20 = -a15*a9 + a16*a8;
+  const T a21 = C3*a8 + C4*a10;
+  const T a22 = C5*a9;
+  const T a23 = C4*a8 + C6*a10;
+  const T a24 = -a10*a22 + a23*a9;
+  const T a25 = a10*a21 - a23*a8;
+  const T a26 = -a21*a9 + a22*a8;
+  w[23] = a7;
+  w[24] = a11;
+  w[25] = a12;
+  w[26] = a13;
+  w[27] = a14;
+  w[28] = a18;
+  w[29] = a19;
+  w[30] = a20;
+  w[31] = a24;
+  w[32] = a25;
+  w[33] = a26;
 }
 
-// udot, kernel 10 of 26
+// udot, kernel 10 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel9(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -3873,7 +3780,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel9(T* w, const int* x, const do
   w[33] = a30;
 }
 
-// udot, kernel 11 of 26
+// udot, kernel 11 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel10(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -3884,9 +3791,9 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel10(T* w, const int* x, const d
   const T X3 = w[-520];
   const T X4 = w[-519];
   const T X5 = w[-521];
-  const T X6 = w[0];
-  const T X7 = w[1];
-  const T X8 = w[2];
+  const T X6 = w[14];
+  const T X7 = w[15];
+  const T X8 = w[16];
   (void)x;
   const double C0 = c[0];
   const double C1 = c[1];
@@ -3921,20 +3828,20 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel10(T* w, const int* x, const d
   const T a24 = a10*a23 - a11*a22;
   const T a25 = a11*a21 - a23*a9;
   const T a26 = -a10*a21 + a22*a9;
-  w[5] = a8;
-  w[6] = a12;
-  w[7] = a13;
-  w[8] = a14;
-  w[9] = a15;
-  w[10] = a18;
-  w[11] = a19;
-  w[12] = a20;
-  w[13] = a24;
-  w[14] = a25;
-  w[15] = a26;
+  w[19] = a8;
+  w[20] = a12;
+  w[21] = a13;
+  w[22] = a14;
+  w[23] = a15;
+  w[24] = a18;
+  w[25] = a19;
+  w[26] = a20;
+  w[27] = a24;
+  w[28] = a25;
+  w[29] = a26;
 }
 
-// udot, kernel 12 of 26
+// udot, kernel 12 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel11(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -4120,7 +4027,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel11(T* w, const int* x, const d
   w[28] = a104;
 }
 
-// udot, kernel 13 of 26
+// udot, kernel 13 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel12(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -4177,8 +4084,6 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel12(T* w, const int* x, const d
   const double C16 = c[16];
   const double C17 = c[17];
   const double C18 = c[18];
-  const double C19 = c[19];
-  const double C20 = c[20];
   const T a0 = C0*X0;
   const T a1 = C0*X1;
   const T a2 = X1*X1;
@@ -4189,103 +4094,95 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel12(T* w, const int* x, const d
   const T a7 = -C1*a3;
   const T a8 = C4*X0;
   const T a9 = C4*X1;
-  const T a10 = C5 + a5;
-  const T a11 = -C6*a1 + a7;
-  const T a12 = -C7*a0 - C8 + a8;
-  const T a13 = 2.0*C6*a0 + C9 + a6;
-  const T a14 = -C7*a1 + a9;
-  const T a15 = 2.0*C6*a0 + C10;
-  const T a16 = C11 + a0;
-  const T a17 = C12*a1 + C13;
-  const T a18 = C14*a1 + C15;
-  const T a19 = C12*a11 + C16*a12;
-  const T a20 = C12*a13 + C16*a14;
-  const T a21 = C12*a14 + C16*a15;
-  const T a22 = C14*a11 + C17*a12;
-  const T a23 = C14*a13 + C17*a14;
-  const T a24 = C14*a14 + C17*a15;
-  const T a25 = C12*a20 + C16*a21;
-  const T a26 = C14*a20 + C17*a21;
-  const T a27 = C14*a23 + C17*a24;
-  const T a28 = X2 + a25;
-  const T a29 = X3 + a26;
-  const T a30 = X4 + a19;
-  const T a31 = X5 + a27;
-  const T a32 = X6 + a22;
-  const T a33 = X7 + a10;
-  const T a34 = X8 - a16;
-  const T a35 = X9 + a18;
-  const T a36 = -X8 + a16;
-  const T a37 = X10 - a17;
-  const T a38 = X11 - a18;
-  const T a39 = X12 + a17;
-  const T a40 = -C0*X1;
-  const T a41 = -C7*a0;
-  const T a42 = C7*a40;
-  const T a43 = C6*a0;
-  const T a44 = a41 + a8;
-  const T a45 = a42 + a9;
-  const T a46 = C18 + a43;
-  const T a47 = C12*a0;
-  const T a48 = C14*a0;
-  const T a49 = C12*a45 + C16*a46;
-  const T a50 = C14*a45 + C17*a46;
-  const T a51 = -C19*X13 - C20*X14 - X15;
-  const T a52 = C19*X16 - C20*X17 - X18;
-  const T a53 = C0*X13 - C20*X19 - X20;
-  const T a54 = C19*X17 - C2*X16 - X21;
-  const T a55 = C0*X19 - ((C19*X14 + C3*X13) + X22);
-  const T a56 = -C0*X17 - C4*X16 - X23;
-  const T a57 = -X24 + X25;
-  const T a58 = a56 + a57;
-  const T a59 = X0*a51 - X1*a52;
-  const T a60 = X0*a52 + X1*a51;
-  const T a61 = -C7*a60;
-  const T a62 = -C6*a53 + C7*a59;
-  const T a63 = C6*a60;
-  const T a64 = X0*a54 - X1*a55;
-  const T a65 = X0*a55 + X1*a54;
-  const T a66 = a61 + a64;
-  const T a67 = a62 + a65;
-  const T a68 = a56 + a63;
-  const T a69 = C12*a60 + C16*a53;
-  const T a70 = C14*a60 + C17*a53;
-  const T a71 = C12*a67 + C16*a68;
-  const T a72 = C14*a67 + C17*a68;
-  const T a73 = X26 + a69;
-  const T a74 = X27 + a70;
-  const T a75 = X28 + a59;
-  const T a76 = X29 + a71;
-  const T a77 = X30 + a72;
-  const T a78 = X31 + a66;
-  w[0] = a28;
-  w[1] = a29;
-  w[2] = a30;
-  w[3] = a31;
-  w[4] = a32;
-  w[5] = a33;
-  w[6] = a34;
-  w[7] = a35;
-  w[8] = a36;
-  w[9] = a37;
-  w[10] = a38;
-  w[11] = a39;
-  w[34] = a40;
-  w[35] = a44;
-  w[36] = a47;
-  w[37] = a48;
-  w[38] = a49;
-  w[39] = a50;
-  w[40] = a58;
-  w[12] = a73;
-  w[13] = a74;
-  w[14] = a75;
-  w[15] = a76;
-  w[16] = a77;
-  w[17] = a78;
+  const T a10 = -C5*a1 + a7;
+  const T a11 = -C6 + a8;
+  const T a12 = 2.0*C5*a0 + C7 + a6;
+  const T a13 = 2.0*C5*a0 + C8;
+  const T a14 = C9 + a0;
+  const T a15 = C10*a1 + C11;
+  const T a16 = C12*a1 + C13;
+  const T a17 = C10*a10 + C14*a11;
+  const T a18 = C10*a12 + C14*a9;
+  const T a19 = C10*a9 + C14*a13;
+  const T a20 = C12*a10 + C15*a11;
+  const T a21 = C12*a12 + C15*a9;
+  const T a22 = C12*a9 + C15*a13;
+  const T a23 = C10*a18 + C14*a19;
+  const T a24 = C12*a18 + C15*a19;
+  const T a25 = C12*a21 + C15*a22;
+  const T a26 = X2 + a23;
+  const T a27 = X3 + a24;
+  const T a28 = X4 + a17;
+  const T a29 = X5 + a25;
+  const T a30 = X6 + a20;
+  const T a31 = X7 + a5;
+  const T a32 = X8 - a14;
+  const T a33 = X9 + a16;
+  const T a34 = -X8 + a14;
+  const T a35 = X10 - a15;
+  const T a36 = X11 - a16;
+  const T a37 = X12 + a15;
+  const T a38 = -C0*X1;
+  const T a39 = C5*a0;
+  const T a40 = C16 + a39;
+  const T a41 = C10*a0;
+  const T a42 = C12*a0;
+  const T a43 = C10*a9 + C14*a40;
+  const T a44 = C12*a9 + C15*a40;
+  const T a45 = -C17*X13 - C18*X14 - X15;
+  const T a46 = C17*X16 - C18*X17 - X18;
+  const T a47 = C0*X13 - C18*X19 - X20;
+  const T a48 = C17*X17 - C2*X16 - X21;
+  const T a49 = C0*X19 - ((C17*X14 + C3*X13) + X22);
+  const T a50 = -C0*X17 - C4*X16 - X23;
+  const T a51 = -X24 + X25;
+  const T a52 = a50 + a51;
+  const T a53 = X0*a45 - X1*a46;
+  const T a54 = X0*a46 + X1*a45;
+  const T a55 = -C5*a47;
+  const T a56 = C5*a54;
+  const T a57 = X0*a48 - X1*a49;
+  const T a58 = X0*a49 + X1*a48;
+  const T a59 = a55 + a58;
+  const T a60 = a50 + a56;
+  const T a61 = C10*a54 + C14*a47;
+  const T a62 = C12*a54 + C15*a47;
+  const T a63 = C10*a59 + C14*a60;
+  const T a64 = C12*a59 + C15*a60;
+  const T a65 = X26 + a61;
+  const T a66 = X27 + a62;
+  const T a67 = X28 + a53;
+  const T a68 = X29 + a63;
+  const T a69 = X30 + a64;
+  const T a70 = X31 + a57;
+  w[34] = a8;
+  w[0] = a26;
+  w[1] = a27;
+  w[2] = a28;
+  w[3] = a29;
+  w[4] = a30;
+  w[5] = a31;
+  w[6] = a32;
+  w[7] = a33;
+  w[8] = a34;
+  w[9] = a35;
+  w[10] = a36;
+  w[11] = a37;
+  w[35] = a38;
+  w[36] = a41;
+  w[37] = a42;
+  w[38] = a43;
+  w[39] = a44;
+  w[40] = a52;
+  w[12] = a65;
+  w[13] = a66;
+  w[14] = a67;
+  w[15] = a68;
+  w[16] = a69;
+  w[17] = a70;
 }
 
-// udot, kernel 14 of 26
+// udot, kernel 14 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel13(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -4451,13 +4348,13 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel13(T* w, const int* x, const d
   w[39] = a73;
 }
 
-// udot, kernel 15 of 26
+// udot, kernel 15 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel14(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
   (void)c;
-  const T X0 = w[0];
-  const T X1 = w[1];
+  const T X0 = w[14];
+  const T X1 = w[15];
   const T X2 = w[57];
   const T X3 = w[60];
   const T X4 = w[61];
@@ -4466,19 +4363,19 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel14(T* w, const int* x, const d
   const T X7 = w[64];
   const T X8 = w[65];
   const T X9 = w[67];
-  const T X10 = w[8];
-  const T X11 = w[10];
-  const T X12 = w[9];
-  const T X13 = w[11];
-  const T X14 = w[7];
-  const T X15 = w[5];
-  const T X16 = w[12];
-  const T X17 = w[6];
-  const T X18 = w[13];
-  const T X19 = w[14];
-  const T X20 = w[15];
-  const T X21 = w[3];
-  const T X22 = w[4];
+  const T X10 = w[22];
+  const T X11 = w[24];
+  const T X12 = w[23];
+  const T X13 = w[25];
+  const T X14 = w[21];
+  const T X15 = w[19];
+  const T X16 = w[26];
+  const T X17 = w[20];
+  const T X18 = w[27];
+  const T X19 = w[28];
+  const T X20 = w[29];
+  const T X21 = w[17];
+  const T X22 = w[18];
   const T X23 = w[75];
   const T X24 = w[76];
   const T X25 = w[77];
@@ -4550,65 +4447,64 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel14(T* w, const int* x, const d
   const T a46 = X26 + a42;
   const T a47 = X27 - a40;
   const T a48 = X28 - a41;
-  w[16] = a0;
-  w[17] = a14;
-  w[18] = a15;
-  w[19] = a16;
-  w[20] = a17;
-  w[21] = a18;
-  w[22] = a19;
-  w[23] = a20;
-  w[24] = a21;
-  w[25] = a22;
-  w[26] = a24;
-  w[27] = a32;
-  w[28] = a43;
-  w[29] = a44;
-  w[30] = a45;
-  w[31] = a46;
-  w[32] = a47;
-  w[33] = a48;
+  w[30] = a0;
+  w[0] = a14;
+  w[1] = a15;
+  w[2] = a16;
+  w[3] = a17;
+  w[4] = a18;
+  w[5] = a19;
+  w[6] = a20;
+  w[7] = a21;
+  w[31] = a22;
+  w[32] = a24;
+  w[33] = a32;
+  w[8] = a43;
+  w[9] = a44;
+  w[10] = a45;
+  w[11] = a46;
+  w[12] = a47;
+  w[13] = a48;
 }
 
-// udot, kernel 16 of 26
+// udot, kernel 16 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel15(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
   (void)c;
   const T X0 = w[0];
   const T X1 = w[1];
-  const T X2 = w[58];
-  const T X3 = w[99];
-  const T X4 = w[100];
-  const T X5 = w[59];
-  const T X6 = w[60];
-  const T X7 = w[61];
-  const T X8 = w[62];
-  const T X9 = w[63];
-  const T X10 = w[64];
-  const T X11 = w[107];
-  const T X12 = w[65];
-  const T X13 = w[109];
-  const T X14 = w[5];
-  const T X15 = w[6];
-  const T X16 = w[8];
-  const T X17 = w[4];
-  const T X18 = w[7];
-  const T X19 = w[9];
-  const T X20 = w[3];
-  const T X21 = w[10];
-  const T X22 = w[11];
-  const T X23 = w[12];
-  const T X24 = w[13];
-  const T X25 = w[14];
-  const T X26 = w[15];
-  const T X27 = w[69];
-  const T X28 = w[70];
-  const T X29 = w[71];
-  const T X30 = w[72];
-  const T X31 = w[73];
-  const T X32 = w[74];
-  (void)x;
+  const T X2 = w[41];
+  const T X3 = w[x[0]];
+  const T X4 = w[x[1]];
+  const T X5 = w[42];
+  const T X6 = w[43];
+  const T X7 = w[44];
+  const T X8 = w[45];
+  const T X9 = w[46];
+  const T X10 = w[47];
+  const T X11 = w[x[2]];
+  const T X12 = w[48];
+  const T X13 = w[x[3]];
+  const T X14 = w[7];
+  const T X15 = w[8];
+  const T X16 = w[10];
+  const T X17 = w[6];
+  const T X18 = w[9];
+  const T X19 = w[11];
+  const T X20 = w[5];
+  const T X21 = w[12];
+  const T X22 = w[13];
+  const T X23 = w[14];
+  const T X24 = w[15];
+  const T X25 = w[3];
+  const T X26 = w[4];
+  const T X27 = w[49];
+  const T X28 = w[50];
+  const T X29 = w[51];
+  const T X30 = w[52];
+  const T X31 = w[53];
+  const T X32 = w[54];
   const double C0 = c[0];
   const double C1 = c[1];
   const double C2 = c[2];
@@ -4633,7 +4529,6 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel15(T* w, const int* x, const d
   const double C21 = c[21];
   const double C22 = c[22];
   const double C23 = c[23];
-  const double C24 = c[24];
   const T a0 = C0*X0;
   const T a1 = C0*X1;
   const T a2 = X1*X1;
@@ -4646,23 +4541,23 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel15(T* w, const int* x, const d
   const T a9 = C4*X1;
   const T a10 = 2.0*C5*a1 + C6 + a5;
   const T a11 = a7 - ((C5*a0 + C7*a1) + C8);
-  const T a12 = C10 - C9*a0 + a8;
-  const T a13 = 2.0*C7*a0 + C11 + a6;
-  const T a14 = C12 - C9*a1 + a9;
-  const T a15 = 2.0*C5*a1 + 2.0*C7*a0 + C13;
-  const T a16 = C14 + a0;
-  const T a17 = C15 + a1;
-  const T a18 = C16*a17 + C17;
-  const T a19 = C18*a17 + C19;
-  const T a20 = C16*a11 + C20*a12;
-  const T a21 = C16*a13 + C20*a14;
-  const T a22 = C16*a14 + C20*a15;
-  const T a23 = C18*a11 + C21*a12;
-  const T a24 = C18*a13 + C21*a14;
-  const T a25 = C18*a14 + C21*a15;
-  const T a26 = C16*a21 + C20*a22;
-  const T a27 = C18*a21 + C21*a22;
-  const T a28 = C18*a24 + C21*a25;
+  const T a12 = -C9 + a8;
+  const T a13 = 2.0*C7*a0 + C10 + a6;
+  const T a14 = -C11 + a9;
+  const T a15 = 2.0*C5*a1 + 2.0*C7*a0 + C12;
+  const T a16 = C13 + a0;
+  const T a17 = C14 + a1;
+  const T a18 = C15*a17 + C16;
+  const T a19 = C17*a17 + C18;
+  const T a20 = C15*a11 + C19*a12;
+  const T a21 = C15*a13 + C19*a14;
+  const T a22 = C15*a14 + C19*a15;
+  const T a23 = C17*a11 + C20*a12;
+  const T a24 = C17*a13 + C20*a14;
+  const T a25 = C17*a14 + C20*a15;
+  const T a26 = C15*a21 + C19*a22;
+  const T a27 = C17*a21 + C20*a22;
+  const T a28 = C17*a24 + C20*a25;
   const T a29 = X2 + a26;
   const T a30 = X3 + a27;
   const T a31 = X4 + a20;
@@ -4676,90 +4571,86 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel15(T* w, const int* x, const d
   const T a39 = X12 - a19;
   const T a40 = X13 + a18;
   const T a41 = -C0*X1;
-  const T a42 = -C9*a0;
-  const T a43 = C9*a41;
-  const T a44 = -C5*a41 + C7*a0;
-  const T a45 = a42 + a8;
-  const T a46 = a43 + a9;
-  const T a47 = C22 + a44;
-  const T a48 = C16*a0;
-  const T a49 = C18*a0;
-  const T a50 = C16*a46 + C20*a47;
-  const T a51 = C18*a46 + C21*a47;
-  const T a52 = -C23*X14 - C24*X15 - X16;
-  const T a53 = C23*X17 - C24*X18 - X19;
-  const T a54 = C0*X14 - C24*X20 - X21;
-  const T a55 = -C2*X17 + C23*X18 - X22;
-  const T a56 = C0*X20 - ((C23*X15 + C3*X14) + X23);
-  const T a57 = -C0*X18 - C4*X17 - X24;
-  const T a58 = -X25 + X26;
-  const T a59 = a57 + a58;
-  const T a60 = X0*a52 - X1*a53;
-  const T a61 = X0*a53 + X1*a52;
-  const T a62 = C5*a54 - C9*a61;
-  const T a63 = -C7*a54 + C9*a60;
-  const T a64 = -C5*a60 + C7*a61;
-  const T a65 = X0*a55 - X1*a56;
-  const T a66 = X0*a56 + X1*a55;
-  const T a67 = a62 + a65;
-  const T a68 = a63 + a66;
-  const T a69 = a57 + a64;
-  const T a70 = C16*a61 + C20*a54;
-  const T a71 = C18*a61 + C21*a54;
-  const T a72 = C16*a68 + C20*a69;
-  const T a73 = C18*a68 + C21*a69;
-  const T a74 = X27 + a70;
-  const T a75 = X28 + a71;
-  const T a76 = X29 + a60;
-  const T a77 = X30 + a72;
-  const T a78 = X31 + a73;
-  const T a79 = X32 + a67;
-  w[16] = a29;
-  w[17] = a30;
-  w[18] = a31;
-  w[19] = a32;
-  w[20] = a33;
-  w[21] = a34;
-  w[22] = a35;
-  w[23] = a36;
-  w[24] = a37;
-  w[25] = a38;
-  w[26] = a39;
-  w[27] = a40;
-  w[28] = a41;
-  w[29] = a45;
-  w[30] = a48;
-  w[31] = a49;
-  w[32] = a50;
-  w[33] = a51;
-  w[34] = a59;
-  w[35] = a74;
-  w[36] = a75;
-  w[37] = a76;
-  w[38] = a77;
-  w[39] = a78;
-  w[40] = a79;
+  const T a42 = -C5*a41 + C7*a0;
+  const T a43 = C21 + a42;
+  const T a44 = C15*a0;
+  const T a45 = C17*a0;
+  const T a46 = C15*a9 + C19*a43;
+  const T a47 = C17*a9 + C20*a43;
+  const T a48 = -C22*X14 - C23*X15 - X16;
+  const T a49 = C22*X17 - C23*X18 - X19;
+  const T a50 = C0*X14 - C23*X20 - X21;
+  const T a51 = -C2*X17 + C22*X18 - X22;
+  const T a52 = C0*X20 - ((C22*X15 + C3*X14) + X23);
+  const T a53 = -C0*X18 - C4*X17 - X24;
+  const T a54 = -X25 + X26;
+  const T a55 = a53 + a54;
+  const T a56 = X0*a48 - X1*a49;
+  const T a57 = X0*a49 + X1*a48;
+  const T a58 = C5*a50;
+  const T a59 = -C7*a50;
+  const T a60 = -C5*a56 + C7*a57;
+  const T a61 = X0*a51 - X1*a52;
+  const T a62 = X0*a52 + X1*a51;
+  const T a63 = a58 + a61;
+  const T a64 = a59 + a62;
+  const T a65 = a53 + a60;
+  const T a66 = C15*a57 + C19*a50;
+  const T a67 = C17*a57 + C20*a50;
+  const T a68 = C15*a64 + C19*a65;
+  const T a69 = C17*a64 + C20*a65;
+  const T a70 = X27 + a66;
+  const T a71 = X28 + a67;
+  const T a72 = X29 + a56;
+  const T a73 = X30 + a68;
+  const T a74 = X31 + a69;
+  const T a75 = X32 + a63;
+  w[16] = a8;
+  w[17] = a29;
+  w[18] = a30;
+  w[19] = a31;
+  w[20] = a32;
+  w[21] = a33;
+  w[22] = a34;
+  w[23] = a35;
+  w[24] = a36;
+  w[25] = a37;
+  w[26] = a38;
+  w[27] = a39;
+  w[28] = a40;
+  w[29] = a41;
+  w[30] = a44;
+  w[31] = a45;
+  w[32] = a46;
+  w[33] = a47;
+  w[34] = a55;
+  w[35] = a70;
+  w[36] = a71;
+  w[37] = a72;
+  w[38] = a73;
+  w[39] = a74;
+  w[40] = a75;
 }
 
-// udot, kernel 17 of 26
+// udot, kernel 17 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel16(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
   (void)c;
   const T X0 = w[18];
   const T X1 = w[19];
-  const T X2 = w[57];
-  const T X3 = w[58];
-  const T X4 = w[59];
-  const T X5 = w[60];
-  const T X6 = w[61];
-  const T X7 = w[62];
-  const T X8 = w[63];
-  const T X9 = w[64];
-  const T X10 = w[65];
-  const T X11 = w[66];
-  const T X12 = w[67];
-  const T X13 = w[68];
+  const T X2 = w[58];
+  const T X3 = w[59];
+  const T X4 = w[60];
+  const T X5 = w[61];
+  const T X6 = w[62];
+  const T X7 = w[63];
+  const T X8 = w[64];
+  const T X9 = w[65];
+  const T X10 = w[66];
+  const T X11 = w[67];
+  const T X12 = w[68];
+  const T X13 = w[69];
   const T X14 = w[26];
   const T X15 = w[28];
   const T X16 = w[27];
@@ -4902,7 +4793,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel16(T* w, const int* x, const d
   w[17] = a72;
 }
 
-// udot, kernel 18 of 26
+// udot, kernel 18 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel17(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -5068,7 +4959,7 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel17(T* w, const int* x, const d
   w[40] = a75;
 }
 
-// udot, kernel 19 of 26
+// udot, kernel 19 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel18(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
@@ -5120,9 +5011,6 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel18(T* w, const int* x, const d
   const double C10 = c[10];
   const double C11 = c[11];
   const double C12 = c[12];
-  const double C13 = c[13];
-  const double C14 = c[14];
-  const double C15 = c[15];
   const T a0 = C0*X0;
   const T a1 = C0*X1;
   const T a2 = X1*X1;
@@ -5133,89 +5021,81 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel18(T* w, const int* x, const d
   const T a7 = -C1*a3;
   const T a8 = C4*X0;
   const T a9 = C4*X1;
-  const T a10 = C5 + a5;
-  const T a11 = -C6*a1 + a7;
-  const T a12 = -C7*a0 - C8 + a8;
-  const T a13 = 2.0*C6*a0 + C9 + a6;
-  const T a14 = -C7*a1 + a9;
-  const T a15 = 2.0*C6*a0 + C10;
-  const T a16 = C11 + a0;
-  const T a17 = X2 + a15;
-  const T a18 = X3 - a14;
-  const T a19 = X4 - a12;
-  const T a20 = X5 + a13;
-  const T a21 = X6 + a11;
-  const T a22 = X7 + a10;
-  const T a23 = X8 - a16;
-  const T a24 = X9 + a1;
-  const T a25 = X10 + a16;
-  const T a26 = C12 + X11;
-  const T a27 = X12 - a1;
-  const T a28 = -C12 + X13;
-  const T a29 = -C0*X1;
-  const T a30 = -C7*a0;
-  const T a31 = C7*a29;
-  const T a32 = C6*a0;
-  const T a33 = a30 + a8;
-  const T a34 = a31 + a9;
-  const T a35 = C13 + a32;
-  const T a36 = -C14*X14 - C15*X15 - X16;
-  const T a37 = C14*X17 - C15*X18 - X19;
-  const T a38 = C0*X14 - C15*X20 - X21;
-  const T a39 = C14*X18 - C2*X17 - X22;
-  const T a40 = C0*X20 - ((C14*X15 + C3*X14) + X23);
-  const T a41 = -C0*X18 - C4*X17 - X24;
-  const T a42 = -X25 + X26;
-  const T a43 = a41 + a42;
-  const T a44 = X0*a36 - X1*a37;
-  const T a45 = X0*a37 + X1*a36;
-  const T a46 = -C7*a45;
-  const T a47 = -C6*a38 + C7*a44;
-  const T a48 = C6*a45;
-  const T a49 = X0*a39 - X1*a40;
-  const T a50 = X0*a40 + X1*a39;
-  const T a51 = a46 + a49;
-  const T a52 = a47 + a50;
-  const T a53 = a41 + a48;
-  const T a54 = X27 - a38;
-  const T a55 = X28 + a45;
-  const T a56 = X29 + a44;
-  const T a57 = X30 - a53;
-  const T a58 = X31 + a52;
-  const T a59 = X32 + a51;
+  const T a10 = -C5*a1 + a7;
+  const T a11 = -C6 + a8;
+  const T a12 = 2.0*C5*a0 + C7 + a6;
+  const T a13 = 2.0*C5*a0 + C8;
+  const T a14 = C9 + a0;
+  const T a15 = X2 + a13;
+  const T a16 = X3 - a9;
+  const T a17 = X4 - a11;
+  const T a18 = X5 + a12;
+  const T a19 = X6 + a10;
+  const T a20 = X7 + a5;
+  const T a21 = X8 - a14;
+  const T a22 = X9 + a1;
+  const T a23 = X10 + a14;
+  const T a24 = C10 + X11;
+  const T a25 = X12 - a1;
+  const T a26 = -C10 + X13;
+  const T a27 = -C0*X1;
+  const T a28 = C5*a0;
+  const T a29 = C11 + a28;
+  const T a30 = -C10*X14 - C12*X15 - X16;
+  const T a31 = C10*X17 - C12*X18 - X19;
+  const T a32 = C0*X14 - C12*X20 - X21;
+  const T a33 = C10*X18 - C2*X17 - X22;
+  const T a34 = C0*X20 - ((C10*X15 + C3*X14) + X23);
+  const T a35 = -C0*X18 - C4*X17 - X24;
+  const T a36 = -X25 + X26;
+  const T a37 = a35 + a36;
+  const T a38 = X0*a30 - X1*a31;
+  const T a39 = X0*a31 + X1*a30;
+  const T a40 = -C5*a32;
+  const T a41 = C5*a39;
+  const T a42 = X0*a33 - X1*a34;
+  const T a43 = X0*a34 + X1*a33;
+  const T a44 = a40 + a43;
+  const T a45 = a35 + a41;
+  const T a46 = X27 - a32;
+  const T a47 = X28 + a39;
+  const T a48 = X29 + a38;
+  const T a49 = X30 - a45;
+  const T a50 = X31 + a44;
+  const T a51 = X32 + a42;
   w[34] = a0;
-  w[0] = a17;
-  w[1] = a18;
-  w[2] = a19;
-  w[3] = a20;
-  w[4] = a21;
-  w[5] = a22;
-  w[6] = a23;
-  w[7] = a24;
-  w[8] = a25;
-  w[9] = a26;
-  w[10] = a27;
-  w[11] = a28;
-  w[35] = a29;
-  w[36] = a33;
-  w[37] = a34;
-  w[38] = a35;
-  w[39] = a43;
-  w[12] = a54;
-  w[13] = a55;
-  w[14] = a56;
-  w[15] = a57;
-  w[16] = a58;
-  w[17] = a59;
+  w[35] = a8;
+  w[36] = a9;
+  w[0] = a15;
+  w[1] = a16;
+  w[2] = a17;
+  w[3] = a18;
+  w[4] = a19;
+  w[5] = a20;
+  w[6] = a21;
+  w[7] = a22;
+  w[8] = a23;
+  w[9] = a24;
+  w[10] = a25;
+  w[11] = a26;
+  w[37] = a27;
+  w[38] = a29;
+  w[39] = a37;
+  w[12] = a46;
+  w[13] = a47;
+  w[14] = a48;
+  w[15] = a49;
+  w[16] = a50;
+  w[17] = a51;
 }
 
-// udot, kernel 20 of 26
+// udot, kernel 20 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel19(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
   (void)c;
-  const T X0 = w[0];
-  const T X1 = w[1];
+  const T X0 = w[14];
+  const T X1 = w[15];
   const T X2 = w[57];
   const T X3 = w[58];
   const T X4 = w[59];
@@ -5228,19 +5108,19 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel19(T* w, const int* x, const d
   const T X11 = w[66];
   const T X12 = w[67];
   const T X13 = w[68];
-  const T X14 = w[8];
-  const T X15 = w[10];
-  const T X16 = w[9];
-  const T X17 = w[11];
-  const T X18 = w[7];
-  const T X19 = w[5];
-  const T X20 = w[12];
-  const T X21 = w[6];
-  const T X22 = w[13];
-  const T X23 = w[14];
-  const T X24 = w[15];
-  const T X25 = w[3];
-  const T X26 = w[4];
+  const T X14 = w[22];
+  const T X15 = w[24];
+  const T X16 = w[23];
+  const T X17 = w[25];
+  const T X18 = w[21];
+  const T X19 = w[19];
+  const T X20 = w[26];
+  const T X21 = w[20];
+  const T X22 = w[27];
+  const T X23 = w[28];
+  const T X24 = w[29];
+  const T X25 = w[17];
+  const T X26 = w[18];
   const T X27 = w[75];
   const T X28 = w[76];
   const T X29 = w[77];
@@ -5339,39 +5219,39 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel19(T* w, const int* x, const d
   const T a69 = X30 + a64;
   const T a70 = X31 + a65;
   const T a71 = X32 - a60;
-  w[16] = a0;
-  w[17] = a25;
-  w[18] = a26;
-  w[19] = a27;
-  w[20] = a28;
-  w[21] = a29;
-  w[22] = a30;
-  w[23] = a31;
-  w[24] = a32;
-  w[25] = a33;
-  w[26] = a34;
-  w[27] = a35;
-  w[28] = a36;
-  w[29] = a40;
-  w[30] = a41;
-  w[31] = a42;
-  w[32] = a43;
-  w[33] = a51;
-  w[34] = a66;
-  w[35] = a67;
-  w[36] = a68;
-  w[37] = a69;
-  w[38] = a70;
-  w[39] = a71;
+  w[30] = a0;
+  w[0] = a25;
+  w[31] = a26;
+  w[32] = a27;
+  w[1] = a28;
+  w[2] = a29;
+  w[3] = a30;
+  w[4] = a31;
+  w[5] = a32;
+  w[6] = a33;
+  w[33] = a34;
+  w[7] = a35;
+  w[34] = a36;
+  w[35] = a40;
+  w[36] = a41;
+  w[37] = a42;
+  w[38] = a43;
+  w[39] = a51;
+  w[8] = a66;
+  w[9] = a67;
+  w[10] = a68;
+  w[11] = a69;
+  w[12] = a70;
+  w[13] = a71;
 }
 
-// udot, kernel 21 of 26
+// udot, kernel 21 of 25
 template <class T>
 KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel20(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
   (void)c;
-  const T X0 = w[0];
-  const T X1 = w[1];
+  const T X0 = w[18];
+  const T X1 = w[19];
   const T X2 = w[58];
   const T X3 = w[59];
   const T X4 = w[60];
@@ -5384,177 +5264,6 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel20(T* w, const int* x, const d
   const T X11 = w[67];
   const T X12 = w[68];
   const T X13 = w[69];
-  const T X14 = w[5];
-  const T X15 = w[6];
-  const T X16 = w[8];
-  const T X17 = w[4];
-  const T X18 = w[7];
-  const T X19 = w[9];
-  const T X20 = w[3];
-  const T X21 = w[10];
-  const T X22 = w[11];
-  const T X23 = w[12];
-  const T X24 = w[13];
-  const T X25 = w[14];
-  const T X26 = w[15];
-  const T X27 = w[75];
-  const T X28 = w[76];
-  const T X29 = w[77];
-  const T X30 = w[78];
-  const T X31 = w[79];
-  const T X32 = w[80];
-  (void)x;
-  const double C0 = c[0];
-  const double C1 = c[1];
-  const double C2 = c[2];
-  const double C3 = c[3];
-  const double C4 = c[4];
-  const double C5 = c[5];
-  const double C6 = c[6];
-  const double C7 = c[7];
-  const double C8 = c[8];
-  const double C9 = c[9];
-  const double C10 = c[10];
-  const double C11 = c[11];
-  const double C12 = c[12];
-  const double C13 = c[13];
-  const double C14 = c[14];
-  const double C15 = c[15];
-  const double C16 = c[16];
-  const double C17 = c[17];
-  const double C18 = c[18];
-  const double C19 = c[19];
-  const double C20 = c[20];
-  const double C21 = c[21];
-  const double C22 = c[22];
-  const double C23 = c[23];
-  const double C24 = c[24];
-  const T a0 = C0*X0;
-  const T a1 = C0*X1;
-  const T a2 = X1*X1;
-  const T a3 = X0*X1;
-  const T a4 = -C1*a2;
-  const T a5 = C2 - a4;
-  const T a6 = C3 + a4;
-  const T a7 = -C1*a3;
-  const T a8 = C4*X0;
-  const T a9 = C4*X1;
-  const T a10 = 2.0*C5*a1 + C6 + a5;
-  const T a11 = a7 - ((C5*a0 + C7*a1) + C8);
-  const T a12 = C10 - C9*a0 + a8;
-  const T a13 = 2.0*C7*a0 + C11 + a6;
-  const T a14 = -C12 - C9*a1 + a9;
-  const T a15 = 2.0*C5*a1 + 2.0*C7*a0 + C13;
-  const T a16 = C14 + a0;
-  const T a17 = C15 + a1;
-  const T a18 = C16*a17 + C17;
-  const T a19 = C18*a17 + C19;
-  const T a20 = C16*a11 + C20*a12;
-  const T a21 = C16*a13 + C20*a14;
-  const T a22 = C16*a14 + C20*a15;
-  const T a23 = C18*a11 + C21*a12;
-  const T a24 = C18*a13 + C21*a14;
-  const T a25 = C18*a14 + C21*a15;
-  const T a26 = C16*a21 + C20*a22;
-  const T a27 = C18*a21 + C21*a22;
-  const T a28 = C18*a24 + C21*a25;
-  const T a29 = X2 + a26;
-  const T a30 = X3 + a27;
-  const T a31 = X4 + a20;
-  const T a32 = X5 + a28;
-  const T a33 = X6 + a23;
-  const T a34 = X7 + a10;
-  const T a35 = X8 - a16;
-  const T a36 = X9 + a19;
-  const T a37 = X10 + a16;
-  const T a38 = X11 - a18;
-  const T a39 = X12 - a19;
-  const T a40 = X13 + a18;
-  const T a41 = -C0*X1;
-  const T a42 = -C9*a0;
-  const T a43 = C9*a41;
-  const T a44 = -C5*a41 + C7*a0;
-  const T a45 = a42 + a8;
-  const T a46 = a43 + a9;
-  const T a47 = C22 + a44;
-  const T a48 = C16*a0;
-  const T a49 = C18*a0;
-  const T a50 = C16*a46 + C20*a47;
-  const T a51 = C18*a46 + C21*a47;
-  const T a52 = -C23*X14 - C24*X15 - X16;
-  const T a53 = C23*X17 - C24*X18 - X19;
-  const T a54 = C0*X14 - C24*X20 - X21;
-  const T a55 = -C2*X17 + C23*X18 - X22;
-  const T a56 = C0*X20 - ((C23*X15 + C3*X14) + X23);
-  const T a57 = -C0*X18 - C4*X17 - X24;
-  const T a58 = -X25 + X26;
-  const T a59 = a57 + a58;
-  const T a60 = X0*a52 - X1*a53;
-  const T a61 = X0*a53 + X1*a52;
-  const T a62 = C5*a54 - C9*a61;
-  const T a63 = -C7*a54 + C9*a60;
-  const T a64 = -C5*a60 + C7*a61;
-  const T a65 = X0*a55 - X1*a56;
-  const T a66 = X0*a56 + X1*a55;
-  const T a67 = a62 + a65;
-  const T a68 = a63 + a66;
-  const T a69 = a57 + a64;
-  const T a70 = C16*a61 + C20*a54;
-  const T a71 = C18*a61 + C21*a54;
-  const T a72 = C16*a68 + C20*a69;
-  const T a73 = C18*a68 + C21*a69;
-  const T a74 = X27 + a70;
-  const T a75 = X28 + a71;
-  const T a76 = X29 + a60;
-  const T a77 = X30 + a72;
-  const T a78 = X31 + a73;
-  const T a79 = X32 + a67;
-  w[16] = a29;
-  w[17] = a30;
-  w[18] = a31;
-  w[19] = a32;
-  w[20] = a33;
-  w[21] = a34;
-  w[22] = a35;
-  w[23] = a36;
-  w[24] = a37;
-  w[25] = a38;
-  w[26] = a39;
-  w[27] = a40;
-  w[28] = a41;
-  w[29] = a45;
-  w[30] = a48;
-  w[31] = a49;
-  w[32] = a50;
-  w[33] = a51;
-  w[34] = a59;
-  w[35] = a74;
-  w[36] = a75;
-  w[37] = a76;
-  w[38] = a77;
-  w[39] = a78;
-  w[40] = a79;
-}
-
-// udot, kernel 22 of 26
-template <class T>
-KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel21(T* w, const int* x, const double* c) {
-  using std::cos; using std::sin; using std::sqrt;
-  (void)c;
-  const T X0 = w[18];
-  const T X1 = w[19];
-  const T X2 = w[57];
-  const T X3 = w[58];
-  const T X4 = w[59];
-  const T X5 = w[60];
-  const T X6 = w[61];
-  const T X7 = w[62];
-  const T X8 = w[63];
-  const T X9 = w[64];
-  const T X10 = w[65];
-  const T X11 = w[66];
-  const T X12 = w[67];
-  const T X13 = w[68];
   const T X14 = w[26];
   const T X15 = w[28];
   const T X16 = w[27];
@@ -5672,9 +5381,9 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel21(T* w, const int* x, const d
   w[17] = a55;
 }
 
-// udot, kernel 23 of 26
+// udot, kernel 22 of 25
 template <class T>
-KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel22(T* w, const int* x, const double* c) {
+KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel21(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
   (void)c;
   const T X0 = w[18];
@@ -5730,8 +5439,6 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel22(T* w, const int* x, const d
   const double C16 = c[16];
   const double C17 = c[17];
   const double C18 = c[18];
-  const double C19 = c[19];
-  const double C20 = c[20];
   const T a0 = C0*X0;
   const T a1 = C0*X1;
   const T a2 = X1*X1;
@@ -5742,105 +5449,97 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel22(T* w, const int* x, const d
   const T a7 = -C1*a3;
   const T a8 = C4*X0;
   const T a9 = C4*X1;
-  const T a10 = C5 + a5;
-  const T a11 = -C6*a1 + a7;
-  const T a12 = -C7*a0 - C8 + a8;
-  const T a13 = 2.0*C6*a0 + C9 + a6;
-  const T a14 = -C7*a1 + a9;
-  const T a15 = 2.0*C6*a0 + C10;
-  const T a16 = C11 + a0;
-  const T a17 = C12*a1 + C13;
-  const T a18 = C14*a1 + C15;
-  const T a19 = C12*a11 + C16*a12;
-  const T a20 = C12*a13 + C16*a14;
-  const T a21 = C12*a14 + C16*a15;
-  const T a22 = C14*a11 + C17*a12;
-  const T a23 = C14*a13 + C17*a14;
-  const T a24 = C14*a14 + C17*a15;
-  const T a25 = C12*a20 + C16*a21;
-  const T a26 = C14*a20 + C17*a21;
-  const T a27 = C14*a23 + C17*a24;
-  const T a28 = X2 + a25;
-  const T a29 = X3 + a26;
-  const T a30 = X4 + a19;
-  const T a31 = X5 + a27;
-  const T a32 = X6 + a22;
-  const T a33 = X7 + a10;
-  const T a34 = X8 - a16;
-  const T a35 = X9 + a18;
-  const T a36 = X10 + a16;
-  const T a37 = X11 - a17;
-  const T a38 = X12 - a18;
-  const T a39 = X13 + a17;
-  const T a40 = -C0*X1;
-  const T a41 = -C7*a0;
-  const T a42 = C7*a40;
-  const T a43 = C6*a0;
-  const T a44 = a41 + a8;
-  const T a45 = a42 + a9;
-  const T a46 = C18 + a43;
-  const T a47 = C12*a0;
-  const T a48 = C14*a0;
-  const T a49 = C12*a45 + C16*a46;
-  const T a50 = C14*a45 + C17*a46;
-  const T a51 = -C19*X14 - C20*X15 - X16;
-  const T a52 = C19*X17 - C20*X18 - X19;
-  const T a53 = C0*X14 - C20*X20 - X21;
-  const T a54 = C19*X18 - C2*X17 - X22;
-  const T a55 = C0*X20 - ((C19*X15 + C3*X14) + X23);
-  const T a56 = -C0*X18 - C4*X17 - X24;
-  const T a57 = -X25 + X26;
-  const T a58 = a56 + a57;
-  const T a59 = X0*a51 - X1*a52;
-  const T a60 = X0*a52 + X1*a51;
-  const T a61 = -C7*a60;
-  const T a62 = -C6*a53 + C7*a59;
-  const T a63 = C6*a60;
-  const T a64 = X0*a54 - X1*a55;
-  const T a65 = X0*a55 + X1*a54;
-  const T a66 = a61 + a64;
-  const T a67 = a62 + a65;
-  const T a68 = a56 + a63;
-  const T a69 = C12*a60 + C16*a53;
-  const T a70 = C14*a60 + C17*a53;
-  const T a71 = C12*a67 + C16*a68;
-  const T a72 = C14*a67 + C17*a68;
-  const T a73 = X27 + a69;
-  const T a74 = X28 + a70;
-  const T a75 = X29 + a59;
-  const T a76 = X30 + a71;
-  const T a77 = X31 + a72;
-  const T a78 = X32 + a66;
-  w[0] = a28;
-  w[1] = a29;
-  w[2] = a30;
-  w[3] = a31;
-  w[4] = a32;
-  w[5] = a33;
-  w[6] = a34;
-  w[7] = a35;
-  w[8] = a36;
-  w[9] = a37;
-  w[10] = a38;
-  w[11] = a39;
-  w[34] = a40;
-  w[35] = a44;
-  w[36] = a47;
-  w[37] = a48;
-  w[38] = a49;
-  w[39] = a50;
-  w[40] = a58;
-  w[12] = a73;
-  w[13] = a74;
-  w[14] = a75;
-  w[15] = a76;
-  w[16] = a77;
-  w[17] = a78;
+  const T a10 = -C5*a1 + a7;
+  const T a11 = -C6 + a8;
+  const T a12 = 2.0*C5*a0 + C7 + a6;
+  const T a13 = 2.0*C5*a0 + C8;
+  const T a14 = C9 + a0;
+  const T a15 = C10*a1 + C11;
+  const T a16 = C12*a1 + C13;
+  const T a17 = C10*a10 + C14*a11;
+  const T a18 = C10*a12 + C14*a9;
+  const T a19 = C10*a9 + C14*a13;
+  const T a20 = C12*a10 + C15*a11;
+  const T a21 = C12*a12 + C15*a9;
+  const T a22 = C12*a9 + C15*a13;
+  const T a23 = C10*a18 + C14*a19;
+  const T a24 = C12*a18 + C15*a19;
+  const T a25 = C12*a21 + C15*a22;
+  const T a26 = X2 + a23;
+  const T a27 = X3 + a24;
+  const T a28 = X4 + a17;
+  const T a29 = X5 + a25;
+  const T a30 = X6 + a20;
+  const T a31 = X7 + a5;
+  const T a32 = X8 - a14;
+  const T a33 = X9 + a16;
+  const T a34 = X10 + a14;
+  const T a35 = X11 - a15;
+  const T a36 = X12 - a16;
+  const T a37 = X13 + a15;
+  const T a38 = -C0*X1;
+  const T a39 = C5*a0;
+  const T a40 = C16 + a39;
+  const T a41 = C10*a0;
+  const T a42 = C12*a0;
+  const T a43 = C10*a9 + C14*a40;
+  const T a44 = C12*a9 + C15*a40;
+  const T a45 = -C17*X14 - C18*X15 - X16;
+  const T a46 = C17*X17 - C18*X18 - X19;
+  const T a47 = C0*X14 - C18*X20 - X21;
+  const T a48 = C17*X18 - C2*X17 - X22;
+  const T a49 = C0*X20 - ((C17*X15 + C3*X14) + X23);
+  const T a50 = -C0*X18 - C4*X17 - X24;
+  const T a51 = -X25 + X26;
+  const T a52 = a50 + a51;
+  const T a53 = X0*a45 - X1*a46;
+  const T a54 = X0*a46 + X1*a45;
+  const T a55 = -C5*a47;
+  const T a56 = C5*a54;
+  const T a57 = X0*a48 - X1*a49;
+  const T a58 = X0*a49 + X1*a48;
+  const T a59 = a55 + a58;
+  const T a60 = a50 + a56;
+  const T a61 = C10*a54 + C14*a47;
+  const T a62 = C12*a54 + C15*a47;
+  const T a63 = C10*a59 + C14*a60;
+  const T a64 = C12*a59 + C15*a60;
+  const T a65 = X27 + a61;
+  const T a66 = X28 + a62;
+  const T a67 = X29 + a53;
+  const T a68 = X30 + a63;
+  const T a69 = X31 + a64;
+  const T a70 = X32 + a57;
+  w[34] = a8;
+  w[0] = a26;
+  w[1] = a27;
+  w[2] = a28;
+  w[3] = a29;
+  w[4] = a30;
+  w[5] = a31;
+  w[6] = a32;
+  w[7] = a33;
+  w[8] = a34;
+  w[9] = a35;
+  w[10] = a36;
+  w[11] = a37;
+  w[35] = a38;
+  w[36] = a41;
+  w[37] = a42;
+  w[38] = a43;
+  w[39] = a44;
+  w[40] = a52;
+  w[12] = a65;
+  w[13] = a66;
+  w[14] = a67;
+  w[15] = a68;
+  w[16] = a69;
+  w[17] = a70;
 }
 
-// udot, kernel 24 of 26
+// udot, kernel 23 of 25
 template <class T>
-KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel23(T* w, const int* x, const double* c) {
+KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel22(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
   (void)c;
   const T X0 = w[0];
@@ -5957,9 +5656,9 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel23(T* w, const int* x, const d
   w[33] = a48;
 }
 
-// udot, kernel 25 of 26
+// udot, kernel 24 of 25
 template <class T>
-KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel24(T* w, const int* x, const double* c) {
+KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel23(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
   (void)c;
   const T X0 = w[69];
@@ -5989,9 +5688,9 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel24(T* w, const int* x, const d
   w[26] = a5;
 }
 
-// udot, kernel 26 of 26
+// udot, kernel 25 of 25
 template <class T>
-KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel25(T* w, const int* x, const double* c) {
+KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel24(T* w, const int* x, const double* c) {
   using std::cos; using std::sin; using std::sqrt;
   (void)c;
   const T X0 = w[-24];
@@ -6012,10 +5711,10 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel25(T* w, const int* x, const d
   const T X15 = w[-639];
   const T X16 = w[-592];
   const T X17 = w[-635];
-  const T X18 = w[-47];
+  const T X18 = w[-48];
   const T X19 = w[-43];
   const T X20 = w[-44];
-  const T X21 = w[-48];
+  const T X21 = w[-47];
   const T X22 = w[-45];
   const T X23 = w[-46];
   const T X24 = w[-95];
@@ -6023,13 +5722,13 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel25(T* w, const int* x, const d
   const T X26 = w[-92];
   const T X27 = w[-93];
   const T X28 = w[-94];
-  const T X29 = w[-138];
-  const T X30 = w[-148];
-  const T X31 = w[-139];
-  const T X32 = w[-176];
+  const T X29 = w[-132];
+  const T X30 = w[-134];
+  const T X31 = w[-133];
+  const T X32 = w[-189];
   const T X33 = w[-172];
   const T X34 = w[-173];
-  const T X35 = w[-177];
+  const T X35 = w[-176];
   const T X36 = w[-174];
   const T X37 = w[-175];
   const T X38 = w[-212];
@@ -6043,25 +5742,25 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel25(T* w, const int* x, const d
   const T X46 = w[-271];
   const T X47 = w[-256];
   const T X48 = w[-257];
-  const T X49 = w[-292];
-  const T X50 = w[-291];
+  const T X49 = w[-293];
+  const T X50 = w[-292];
   const T X51 = w[-290];
-  const T X52 = w[-293];
+  const T X52 = w[-291];
   const T X53 = w[-294];
   const T X54 = w[-341];
   const T X55 = w[-337];
   const T X56 = w[-338];
   const T X57 = w[-339];
   const T X58 = w[-340];
-  const T X59 = w[-378];
-  const T X60 = w[-379];
-  const T X61 = w[-394];
-  const T X62 = w[-380];
-  const T X63 = w[-381];
-  const T X64 = w[-422];
+  const T X59 = w[-372];
+  const T X60 = w[-373];
+  const T X61 = w[-380];
+  const T X62 = w[-374];
+  const T X63 = w[-375];
+  const T X64 = w[-435];
   const T X65 = w[-418];
   const T X66 = w[-419];
-  const T X67 = w[-423];
+  const T X67 = w[-422];
   const T X68 = w[-420];
   const T X69 = w[-421];
   const T X70 = w[-454];
@@ -6075,10 +5774,10 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel25(T* w, const int* x, const d
   const T X78 = w[-517];
   const T X79 = w[-502];
   const T X80 = w[-503];
-  const T X81 = w[-539];
+  const T X81 = w[-540];
   const T X82 = w[-535];
   const T X83 = w[-536];
-  const T X84 = w[-540];
+  const T X84 = w[-539];
   const T X85 = w[-537];
   const T X86 = w[-538];
   const T X87 = w[-587];
@@ -6098,13 +5797,13 @@ KANEGEN_NOINLINE KANEGEN_DISPATCH void udot_kernel25(T* w, const int* x, const d
   const T X101 = w[-676];
   const T X102 = w[-42];
   const T X103 = w[-90];
-  const T X104 = w[-137];
+  const T X104 = w[-131];
   const T X105 = w[-171];
   const T X106 = w[-207];
   const T X107 = w[-253];
   const T X108 = w[-289];
   const T X109 = w[-336];
-  const T X110 = w[-377];
+  const T X110 = w[-371];
   const T X111 = w[-417];
   const T X112 = w[-453];
   const T X113 = w[-499];
@@ -6788,7 +6487,7 @@ static constexpr int udot_x2[] = {-77, -80, -79, -70, -69, -68};
 static constexpr double udot_c2[] = {app2_R_PJ_xx, app2_R_PJ_yx, app2_R_PJ_xy, app2_R_PJ_yy, app2_p_J_y, app2_p_J_z, app2_p_J_x, app2_S0_x, app2_J0_xx, app2_J0_yy, app2_J0_zz};
 // body app3: outward pass (velocities)
 static constexpr int udot_x3[] = {-118, -121, -120, -111, -110, -109};
-static constexpr double udot_c3[] = {app3_R_PJ_xy, app3_R_PJ_yy, app3_R_PJ_xz, app3_R_PJ_yz, app3_p_J_z, app3_p_J_x, app3_S0_z, app3_S0_x, app3_J0_xx, app3_J0_xz, app3_J0_yy, app3_J0_zz};
+static constexpr double udot_c3[] = {app3_R_PJ_xy, app3_R_PJ_yy, app3_R_PJ_xz, app3_R_PJ_yz, app3_p_J_x, app3_S0_z, app3_S0_x, app3_J0_xx, app3_J0_xz, app3_J0_yy, app3_J0_zz};
 // body app4: outward pass (velocities)
 static constexpr int udot_x4[] = {-159, -162, -161, -152, -151, -150};
 static constexpr double udot_c4[] = {app4_R_PJ_xx, app4_R_PJ_yx, app4_R_PJ_xz, app4_R_PJ_yz, app4_p_J_y, app4_p_J_z, app4_p_J_x, app4_S0_x, app4_J0_xx, app4_J0_yy, app4_J0_zz};
@@ -6796,14 +6495,14 @@ static constexpr double udot_c4[] = {app4_R_PJ_xx, app4_R_PJ_yx, app4_R_PJ_xz, a
 static constexpr double udot_c5[] = {app5_p_J_z, app5_p_J_x, app5_S0_x, app5_J0_xx, app5_J0_yy, app5_J0_zz};
 // body app6: outward pass (velocities)
 static constexpr int udot_x6[] = {-241, -244, -243, -234, -233, -232};
-static constexpr double udot_c6[] = {app6_R_PJ_xy, app6_R_PJ_yy, app6_R_PJ_xz, app6_R_PJ_yz, app6_p_J_y, app6_p_J_z, app6_p_J_x, app6_S0_z, app6_S0_x, app6_J0_xx, app6_J0_xz, app6_J0_yy, app6_J0_zz};
+static constexpr double udot_c6[] = {app6_R_PJ_xy, app6_R_PJ_yy, app6_R_PJ_xz, app6_R_PJ_yz, app6_p_J_y, app6_p_J_x, app6_S0_z, app6_S0_x, app6_J0_xx, app6_J0_xz, app6_J0_yy, app6_J0_zz};
 // body app7: outward pass (velocities)
 static constexpr double udot_c7[] = {app7_R_PJ_xx, app7_R_PJ_yx, app7_R_PJ_xz, app7_R_PJ_yz, app7_p_J_y, app7_p_J_x, app7_S0_x, app7_J0_xx, app7_J0_yy, app7_J0_zz};
 // body app8: outward pass (velocities)
 static constexpr int udot_x8[] = {-323, -326, -325, -316, -315, -314};
 static constexpr double udot_c8[] = {app8_R_PJ_xx, app8_R_PJ_yx, app8_R_PJ_xy, app8_R_PJ_yy, app8_p_J_y, app8_p_J_z, app8_p_J_x, app8_S0_x, app8_J0_xx, app8_J0_yy, app8_J0_zz};
 // body app9: outward pass (velocities)
-static constexpr double udot_c9[] = {app9_p_J_z, app9_p_J_x, app9_S0_z, app9_S0_x, app9_J0_xx, app9_J0_xz, app9_J0_yy, app9_J0_zz};
+static constexpr double udot_c9[] = {app9_p_J_x, app9_S0_z, app9_S0_x, app9_J0_xx, app9_J0_xz, app9_J0_yy, app9_J0_zz};
 // body app10: outward pass (velocities)
 static constexpr int udot_x10[] = {-405, -408, -407, -398, -397, -396};
 static constexpr double udot_c10[] = {app10_R_PJ_xx, app10_R_PJ_yx, app10_R_PJ_xz, app10_R_PJ_yz, app10_p_J_y, app10_p_J_z, app10_p_J_x, app10_S0_x, app10_J0_xx, app10_J0_yy, app10_J0_zz};
@@ -6811,7 +6510,7 @@ static constexpr double udot_c10[] = {app10_R_PJ_xx, app10_R_PJ_yx, app10_R_PJ_x
 static constexpr double udot_c11[] = {app11_R_PJ_xx, app11_R_PJ_yx, app11_R_PJ_xy, app11_R_PJ_yy, app11_p_J_z, app11_p_J_x, app11_S0_x, app11_J0_xx, app11_J0_yy, app11_J0_zz};
 // body app12: outward pass (velocities)
 static constexpr int udot_x12[] = {-487, -490, -489, -480, -479, -478};
-static constexpr double udot_c12[] = {app12_R_PJ_xy, app12_R_PJ_yy, app12_R_PJ_xz, app12_R_PJ_yz, app12_p_J_y, app12_p_J_z, app12_p_J_x, app12_S0_z, app12_S0_x, app12_J0_xx, app12_J0_xz, app12_J0_yy, app12_J0_zz};
+static constexpr double udot_c12[] = {app12_R_PJ_xy, app12_R_PJ_yy, app12_R_PJ_xz, app12_R_PJ_yz, app12_p_J_y, app12_p_J_x, app12_S0_z, app12_S0_x, app12_J0_xx, app12_J0_xz, app12_J0_yy, app12_J0_zz};
 // body app13: outward pass (velocities)
 static constexpr double udot_c13[] = {app13_p_J_y, app13_p_J_x, app13_S0_x, app13_J0_xx, app13_J0_yy, app13_J0_zz};
 // body app14: outward pass (velocities)
@@ -6819,35 +6518,37 @@ static constexpr int udot_x14[] = {-569, -572, -571, -562, -561, -560};
 static constexpr double udot_c14[] = {app14_R_PJ_xx, app14_R_PJ_yx, app14_R_PJ_xy, app14_R_PJ_yy, app14_p_J_y, app14_p_J_z, app14_p_J_x, app14_S0_x, app14_J0_xx, app14_J0_yy, app14_J0_zz};
 // body app15: outward pass (velocities)
 static constexpr int udot_x15[] = {-610, -613, -612, -603, -602, -601};
-static constexpr double udot_c15[] = {app15_R_PJ_xy, app15_R_PJ_yy, app15_R_PJ_xz, app15_R_PJ_yz, app15_p_J_z, app15_p_J_x, app15_S0_z, app15_S0_x, app15_J0_xx, app15_J0_xz, app15_J0_yy, app15_J0_zz};
+static constexpr double udot_c15[] = {app15_R_PJ_xy, app15_R_PJ_yy, app15_R_PJ_xz, app15_R_PJ_yz, app15_p_J_x, app15_S0_z, app15_S0_x, app15_J0_xx, app15_J0_xz, app15_J0_yy, app15_J0_zz};
 // body app16: outward pass (velocities)
 static constexpr double udot_c16[] = {app16_R_PJ_xx, app16_R_PJ_yx, app16_R_PJ_xz, app16_R_PJ_yz, app16_p_J_y, app16_p_J_z, app16_p_J_x, app16_S0_x, app16_J0_xx, app16_J0_yy, app16_J0_zz, k01b026f4, kb0b288e3, kfa4e222f, kfa4e5c16, k40d5d0f2, k2c1ae18a, kb31da827, k3e2117d1, k3e21148e, k7434e911, kda586977, hub_J0_xx, hub_J0_xy, hub_J0_xz, hub_J0_yy, hub_J0_yz, hub_J0_zz, hub_S0_y, hub_S0_x, app16_mass, app16_k};
 // body app15: composite inertia (inward)
-static constexpr double udot_c17[] = {app15_S0_x, k7bf69b36, app15_J0_xx, app15_J0_yy, app15_J0_xz, kf22fc453, app15_p_J_x, app15_p_J_z, k6ab4ab38, ka2cdca31, kd460c4ed, k09d36bcf, app15_R_PJ_xy, k26ed7363, app15_R_PJ_yy, k72e29a8e, app15_R_PJ_xz, app15_R_PJ_yz, app15_J0_zz, app15_S0_z, app15_mass};
+static constexpr double udot_c17[] = {app15_S0_x, k7bf69b36, app15_J0_xx, app15_J0_yy, app15_J0_xz, app15_p_J_x, kee45a5a9, k4464ab3a, kd460c4ed, k09d36bcf, app15_R_PJ_xy, kf1c6e8c5, app15_R_PJ_yy, kd1c07d2f, app15_R_PJ_xz, app15_R_PJ_yz, app15_J0_zz, app15_S0_z, app15_mass};
 // body app14: composite inertia (inward)
 static constexpr double udot_c18[] = {app14_S0_x, k9890ba3f, app14_J0_xx, app14_J0_yy, app14_p_J_y, k62bd4355, app14_p_J_x, k4e66775e, app14_p_J_z, k4e667183, kf6cea03d, kea31843c, k83b29de8, k7512b9cc, k7512bebb, app14_R_PJ_xx, app14_R_PJ_xy, app14_R_PJ_yx, app14_R_PJ_yy, app14_R_PJ_xx_S2, app14_R_PJ_xx_ss, app14_R_PJ_xx_C2, app14_R_PJ_xx_cs, k7512ba66, app14_J0_zz, app14_mass, app14_k};
 // body app13: composite inertia (inward)
 static constexpr double udot_c19[] = {app13_S0_x, k384e2939, app13_J0_xx, app13_J0_yy, app13_p_J_y, k493f3cc1, app13_p_J_x, kcea8c3d7, kcea8c064, kbae12506, k65a3f7e1, k65a3f532, app13_J0_zz, app13_mass, app13_k};
 // body app12: composite inertia (inward)
-static constexpr double udot_c20[] = {app12_S0_x, kcebfb7bb, app12_J0_xx, app12_J0_yy, app12_J0_xz, app12_p_J_y, kcef3e627, app12_p_J_x, k533baaf4, app12_p_J_z, k533482e1, kd301e187, k1a292250, ka3ff29e7, k21d31807, k21d317f8, app12_R_PJ_xy, k2147d6ad, app12_R_PJ_yy, ka999b224, app12_R_PJ_xz, app12_R_PJ_yz, app12_J0_zz, app12_S0_z, app12_mass};
+static constexpr int udot_x20[] = {99, 100, 107, 109};
+static constexpr double udot_c20[] = {app12_S0_x, kcebfb7bb, app12_J0_xx, app12_J0_yy, app12_J0_xz, app12_p_J_y, k88426457, app12_p_J_x, k533baaf4, kf61235c3, k533bad8b, kf6123610, ka3ff29e7, k21d31807, k21d317f8, app12_R_PJ_xy, k68bd703f, app12_R_PJ_yy, kc3a7dc33, app12_R_PJ_xz, app12_R_PJ_yz, app12_J0_zz, app12_S0_z, app12_mass};
 // body app11: composite inertia (inward)
 static constexpr double udot_c21[] = {app11_S0_x, kb54bee3a, app11_J0_xx, app11_J0_yy, kc2cb00dd, app11_p_J_x, app11_p_J_z, k30cd4e49, k8aaf66ee, k41401011, ka96059e1, app11_R_PJ_xx, app11_R_PJ_xy, app11_R_PJ_yx, app11_R_PJ_yy, app11_R_PJ_xx_S2, app11_R_PJ_xx_ss, app11_R_PJ_xx_C2, app11_R_PJ_xx_cs, ka9605b4b, app11_J0_zz, app11_mass, app11_k};
 // body app10: composite inertia (inward)
 static constexpr double udot_c22[] = {app10_S0_x, k138bca40, app10_J0_xx, app10_J0_yy, app10_p_J_y, k05b7a508, app10_p_J_x, k526ce8ba, app10_p_J_z, k526ce90f, k123e673f, k82f30525, k55020ad7, k6f9c2bde, k6f9c26a9, app10_R_PJ_xx, kd4837370, app10_R_PJ_yx, k9161929f, app10_R_PJ_xz, app10_R_PJ_yz, app10_J0_zz, app10_mass, app10_k};
 // body app9: composite inertia (inward)
-static constexpr double udot_c23[] = {app9_S0_x, k50067db4, app9_J0_xx, app9_J0_yy, app9_J0_xz, kfc24650e, app9_p_J_x, app9_p_J_z, k2462394e, k6374fcbf, k6448fd9f, k6ac156b2, k98792947, app9_J0_zz, app9_S0_z, app9_mass};
+static constexpr double udot_c23[] = {app9_S0_x, k50067db4, app9_J0_xx, app9_J0_yy, app9_J0_xz, app9_p_J_x, kbb35569c, kd089a3f0, k6448fd9f, k6ac156b2, app9_S0_z, app9_J0_zz, app9_mass};
 // body app8: composite inertia (inward)
 static constexpr double udot_c24[] = {app8_S0_x, kef293309, app8_J0_xx, app8_J0_yy, app8_p_J_y, k6d475432, app8_p_J_x, kf3ed9f9e, app8_p_J_z, kf3ee6767, kc5df6b85, kcc39b7f0, k858945a8, k396ac5de, k396adaad, app8_R_PJ_xx, app8_R_PJ_xy, app8_R_PJ_yx, app8_R_PJ_yy, app8_R_PJ_xx_S2, app8_R_PJ_xx_ss, app8_R_PJ_xx_C2, app8_R_PJ_xx_cs, k396ac4b4, app8_J0_zz, app8_mass, app8_k};
 // body app7: composite inertia (inward)
 static constexpr double udot_c25[] = {app7_S0_x, k41c850c7, app7_J0_xx, app7_J0_yy, app7_p_J_y, kcc4a034d, app7_p_J_x, k7a272588, k7a272cf7, kdd74b102, k7459aa53, k7459af00, app7_R_PJ_xx, app7_R_PJ_yx, app7_R_PJ_xz, app7_R_PJ_yz, app7_J0_zz, app7_mass, app7_k};
 // body app6: composite inertia (inward)
-static constexpr double udot_c26[] = {app6_S0_x, k3fd7e6e2, app6_J0_xx, app6_J0_yy, app6_J0_xz, app6_p_J_y, k27ab12de, app6_p_J_x, k5b5e4f0e, app6_p_J_z, kad510176, kfa032c1b, k77b73ce6, k621805c7, k4b36588b, k4b3669f8, app6_R_PJ_xy, kfe2250aa, app6_R_PJ_yy, k00da5c78, app6_R_PJ_xz, app6_R_PJ_yz, app6_J0_zz, app6_S0_z, app6_mass};
+static constexpr int udot_x26[] = {72, 73, 74, 75};
+static constexpr double udot_c26[] = {app6_S0_x, k3fd7e6e2, app6_J0_xx, app6_J0_yy, app6_J0_xz, app6_p_J_y, k2e069f71, app6_p_J_x, k5b5e4f0e, kf771899e, k5b5e49b1, kf7719741, k621805c7, k4b36588b, k4b3669f8, app6_R_PJ_xy, kb25f6a3f, app6_R_PJ_yy, kcdd5e91f, app6_R_PJ_xz, app6_R_PJ_yz, app6_J0_zz, app6_S0_z, app6_mass};
 // body app5: composite inertia (inward)
 static constexpr double udot_c27[] = {app5_S0_x, k056ef3a0, app5_J0_xx, app5_J0_yy, k36a43f36, app5_p_J_x, app5_p_J_z, kc4d8dcf2, kc4ddfc31, kffe44b4f, k80187168, k80198fc2, app5_J0_zz, app5_mass, app5_k};
 // body app4: composite inertia (inward)
 static constexpr double udot_c28[] = {app4_S0_x, kdadf1a0d, app4_J0_xx, app4_J0_yy, app4_p_J_y, k83559a3b, app4_p_J_x, k6ac783fe, app4_p_J_z, k6ac783e7, k37abbdd7, k7b3c2e78, kec02ae44, kf1b1b971, kf1b1b802, app4_R_PJ_xx, kf19089ec, app4_R_PJ_yx, k07abff12, app4_R_PJ_xz, app4_R_PJ_yz, app4_J0_zz, app4_mass, app4_k};
 // body app3: composite inertia (inward)
-static constexpr double udot_c29[] = {app3_S0_x, k65b3febe, app3_J0_xx, app3_J0_yy, app3_J0_xz, k2e8d5174, app3_p_J_x, app3_p_J_z, k474da613, kc4342491, kb1dbe7fc, k3ec33d3d, app3_R_PJ_xy, k37ee0a3f, app3_R_PJ_yy, ke599a6a7, app3_R_PJ_xz, app3_R_PJ_yz, app3_J0_zz, app3_S0_z, app3_mass};
+static constexpr double udot_c29[] = {app3_S0_x, k65b3febe, app3_J0_xx, app3_J0_yy, app3_J0_xz, app3_p_J_x, ke54b48f4, kcda7ee0c, kb1dbe7fc, k3ec33d3d, app3_R_PJ_xy, k9667d35f, app3_R_PJ_yy, k855cc421, app3_R_PJ_xz, app3_R_PJ_yz, app3_J0_zz, app3_S0_z, app3_mass};
 // body app2: composite inertia (inward)
 static constexpr double udot_c30[] = {app2_S0_x, kba9820b7, app2_J0_xx, app2_J0_yy, app2_p_J_y, k829d5082, app2_p_J_x, kd3092ae1, app2_p_J_z, kd3092fbc, kd64512a2, kd6f1e92e, kb63c57f5, k6e9a3cb9, k6e9a3d4a, app2_R_PJ_xx, app2_R_PJ_xy, app2_R_PJ_yx, app2_R_PJ_yy, app2_R_PJ_xx_S2, app2_R_PJ_xx_ss, app2_R_PJ_xx_C2, app2_R_PJ_xx_cs, k6e9bc523, app2_J0_zz, app2_mass, app2_k};
 // body app1: composite inertia (inward)
@@ -6890,9 +6591,9 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   w[246] = angle_c[5];
   w[247] = angle_s[5];
   w[248] = u[11];
-  w[287] = angle_c[6];
-  w[288] = angle_s[6];
-  w[289] = u[12];
+  w[301] = angle_c[6];
+  w[302] = angle_s[6];
+  w[303] = u[12];
   w[328] = angle_c[7];
   w[329] = angle_s[7];
   w[330] = u[13];
@@ -6908,9 +6609,9 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   w[492] = angle_c[11];
   w[493] = angle_s[11];
   w[494] = u[17];
-  w[533] = angle_c[12];
-  w[534] = angle_s[12];
-  w[535] = u[18];
+  w[547] = angle_c[12];
+  w[548] = angle_s[12];
+  w[549] = u[18];
   w[574] = angle_c[13];
   w[575] = angle_s[13];
   w[576] = u[19];
@@ -6926,10 +6627,10 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   w[648] = tau[20];
   w[577] = q[20];
   w[578] = tau[19];
-  w[536] = q[19];
-  w[537] = tau[18];
-  w[506] = q[18];
-  w[507] = tau[17];
+  w[550] = q[19];
+  w[551] = tau[18];
+  w[495] = q[18];
+  w[496] = tau[17];
   w[472] = q[17];
   w[473] = tau[16];
   w[413] = q[16];
@@ -6938,10 +6639,10 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   w[391] = tau[14];
   w[331] = q[14];
   w[332] = tau[13];
-  w[290] = q[13];
-  w[291] = tau[12];
-  w[260] = q[12];
-  w[261] = tau[11];
+  w[304] = q[13];
+  w[305] = tau[12];
+  w[249] = q[12];
+  w[250] = tau[11];
   w[226] = q[11];
   w[227] = tau[10];
   w[167] = q[10];
@@ -6978,35 +6679,35 @@ int udot(const T* q, const T* u, const T* tau, T* udot) {
   udot_kernel12(w + 615, static_cast<const int*>(nullptr), udot_c17);
   udot_kernel13(w + 574, static_cast<const int*>(nullptr), udot_c18);
   udot_kernel14(w + 533, static_cast<const int*>(nullptr), udot_c19);
-  udot_kernel15(w + 492, static_cast<const int*>(nullptr), udot_c20);
+  udot_kernel15(w + 492, udot_x20, udot_c20);
   udot_kernel16(w + 451, static_cast<const int*>(nullptr), udot_c21);
   udot_kernel17(w + 410, static_cast<const int*>(nullptr), udot_c22);
   udot_kernel18(w + 369, static_cast<const int*>(nullptr), udot_c23);
   udot_kernel13(w + 328, static_cast<const int*>(nullptr), udot_c24);
   udot_kernel19(w + 287, static_cast<const int*>(nullptr), udot_c25);
-  udot_kernel20(w + 246, static_cast<const int*>(nullptr), udot_c26);
-  udot_kernel21(w + 205, static_cast<const int*>(nullptr), udot_c27);
+  udot_kernel15(w + 246, udot_x26, udot_c26);
+  udot_kernel20(w + 205, static_cast<const int*>(nullptr), udot_c27);
   udot_kernel17(w + 164, static_cast<const int*>(nullptr), udot_c28);
-  udot_kernel22(w + 123, static_cast<const int*>(nullptr), udot_c29);
+  udot_kernel21(w + 123, static_cast<const int*>(nullptr), udot_c29);
   udot_kernel13(w + 82, static_cast<const int*>(nullptr), udot_c30);
-  udot_kernel23(w + 41, static_cast<const int*>(nullptr), udot_c31);
-  udot_kernel24(w + 0, static_cast<const int*>(nullptr), static_cast<const double*>(nullptr));
-  udot_kernel25(w + 697, static_cast<const int*>(nullptr), udot_c33);
-  const T t2461 = w[702];
-  if (!(t2461 > 1e-14*k6ff2167e)) return 1;
-  const T t2455 = w[701];
-  if (!(t2455 > 1e-14*k6ff2167e)) return 2;
-  const T t2445 = w[700];
-  if (!(t2445 > 1e-14*k6ff2167e)) return 3;
-  const T t1476 = w[58];
-  const T t2430 = w[699];
-  if (!(t2430 > 1e-14*t1476)) return 4;
-  const T t1478 = w[60];
-  const T t2409 = w[698];
-  if (!(t2409 > 1e-14*t1478)) return 5;
-  const T t1479 = w[61];
-  const T t2379 = w[697];
-  if (!(t2379 > 1e-14*t1479)) return 6;
+  udot_kernel22(w + 41, static_cast<const int*>(nullptr), udot_c31);
+  udot_kernel23(w + 0, static_cast<const int*>(nullptr), static_cast<const double*>(nullptr));
+  udot_kernel24(w + 697, static_cast<const int*>(nullptr), udot_c33);
+  const T t2423 = w[702];
+  if (!(t2423 > 1e-14*k6ff2167e)) return 1;
+  const T t2417 = w[701];
+  if (!(t2417 > 1e-14*k6ff2167e)) return 2;
+  const T t2407 = w[700];
+  if (!(t2407 > 1e-14*k6ff2167e)) return 3;
+  const T t1464 = w[58];
+  const T t2392 = w[699];
+  if (!(t2392 > 1e-14*t1464)) return 4;
+  const T t1466 = w[60];
+  const T t2371 = w[698];
+  if (!(t2371 > 1e-14*t1466)) return 5;
+  const T t1467 = w[61];
+  const T t2341 = w[697];
+  if (!(t2341 > 1e-14*t1467)) return 6;
   if (!(app1_J0_zz > 0.0)) return 7;
   if (!(app2_J0_zz > 0.0)) return 8;
   if (!(app3_J0_zz > 0.0)) return 9;
@@ -7088,364 +6789,358 @@ void energy(const T* q, const T* u, T* TV) {
   // ---- body app3: outward pass (velocities)
   const T t123 = app3_R_PJ_xy*u[3] + app3_R_PJ_yy*u[4];
   const T t124 = app3_R_PJ_xz*u[3] + app3_R_PJ_yz*u[4];
-  const T t125 = app3_p_J_z*t123;
-  const T t126 = app3_p_J_x*t124 - app3_p_J_z*u[5];
-  const T t127 = -app3_p_J_x*t123;
-  const T t128 = app3_R_PJ_xy*u[0] + app3_R_PJ_yy*u[1];
-  const T t129 = app3_R_PJ_xz*u[0] + app3_R_PJ_yz*u[1];
-  const T t130 = t125 + u[2];
-  const T t131 = t126 + t128;
-  const T t132 = t127 + t129;
-  const T t141 = angle_c[2]*u[5] + angle_s[2]*t123;
-  const T t142 = angle_c[2]*t123 - angle_s[2]*u[5];
+  const T t125 = app3_p_J_x*t124;
+  const T t126 = -app3_p_J_x*t123;
+  const T t127 = app3_R_PJ_xy*u[0] + app3_R_PJ_yy*u[1];
+  const T t128 = app3_R_PJ_xz*u[0] + app3_R_PJ_yz*u[1];
+  const T t129 = t125 + t127;
+  const T t130 = t126 + t128;
+  const T t139 = angle_c[2]*u[5] + angle_s[2]*t123;
+  const T t140 = angle_c[2]*t123 - angle_s[2]*u[5];
   const T w_B_app3_z = t124 + u[8];
-  const T t144 = angle_c[2]*t130 + angle_s[2]*t131;
-  const T t145 = angle_c[2]*t131 - angle_s[2]*t130;
+  const T t142 = angle_c[2]*u[2] + angle_s[2]*t129;
+  const T t143 = angle_c[2]*t129 - angle_s[2]*u[2];
   // ---- body app4: outward pass (velocities)
-  const T t170 = app4_R_PJ_xx*u[3] + app4_R_PJ_yx*u[4];
-  const T t171 = app4_R_PJ_xz*u[3] + app4_R_PJ_yz*u[4];
-  const T t172 = -app4_p_J_y*t171 - app4_p_J_z*u[5];
-  const T t173 = app4_p_J_x*t171 - app4_p_J_z*t170;
-  const T t174 = app4_p_J_x*u[5] + app4_p_J_y*t170;
-  const T t175 = app4_R_PJ_xx*u[0] + app4_R_PJ_yx*u[1];
-  const T t176 = app4_R_PJ_xz*u[0] + app4_R_PJ_yz*u[1];
-  const T t177 = t172 + t175;
-  const T t178 = t173 - u[2];
-  const T t179 = t174 + t176;
-  const T t188 = angle_c[3]*t170 - angle_s[3]*u[5];
-  const T t189 = -angle_c[3]*u[5] - angle_s[3]*t170;
-  const T w_B_app4_z = t171 + u[9];
-  const T t191 = angle_c[3]*t177 + angle_s[3]*t178;
-  const T t192 = angle_c[3]*t178 - angle_s[3]*t177;
+  const T t168 = app4_R_PJ_xx*u[3] + app4_R_PJ_yx*u[4];
+  const T t169 = app4_R_PJ_xz*u[3] + app4_R_PJ_yz*u[4];
+  const T t170 = -app4_p_J_y*t169 - app4_p_J_z*u[5];
+  const T t171 = app4_p_J_x*t169 - app4_p_J_z*t168;
+  const T t172 = app4_p_J_x*u[5] + app4_p_J_y*t168;
+  const T t173 = app4_R_PJ_xx*u[0] + app4_R_PJ_yx*u[1];
+  const T t174 = app4_R_PJ_xz*u[0] + app4_R_PJ_yz*u[1];
+  const T t175 = t170 + t173;
+  const T t176 = t171 - u[2];
+  const T t177 = t172 + t174;
+  const T t186 = angle_c[3]*t168 - angle_s[3]*u[5];
+  const T t187 = -angle_c[3]*u[5] - angle_s[3]*t168;
+  const T w_B_app4_z = t169 + u[9];
+  const T t189 = angle_c[3]*t175 + angle_s[3]*t176;
+  const T t190 = angle_c[3]*t176 - angle_s[3]*t175;
   // ---- body app5: outward pass (velocities)
-  const T t210 = -app5_p_J_z*u[3];
-  const T t211 = app5_p_J_x*u[5] - app5_p_J_z*u[4];
-  const T t212 = app5_p_J_x*u[3];
-  const T t213 = t210 + u[1];
-  const T t214 = t211 - u[0];
-  const T t215 = t212 + u[2];
-  const T t222 = angle_c[4]*u[4] - angle_s[4]*u[3];
-  const T t223 = -angle_c[4]*u[3] - angle_s[4]*u[4];
+  const T t208 = -app5_p_J_z*u[3];
+  const T t209 = app5_p_J_x*u[5] - app5_p_J_z*u[4];
+  const T t210 = app5_p_J_x*u[3];
+  const T t211 = t208 + u[1];
+  const T t212 = t209 - u[0];
+  const T t213 = t210 + u[2];
+  const T t220 = angle_c[4]*u[4] - angle_s[4]*u[3];
+  const T t221 = -angle_c[4]*u[3] - angle_s[4]*u[4];
   const T w_B_app5_z = u[10] + u[5];
-  const T t225 = angle_c[4]*t213 + angle_s[4]*t214;
-  const T t226 = angle_c[4]*t214 - angle_s[4]*t213;
+  const T t223 = angle_c[4]*t211 + angle_s[4]*t212;
+  const T t224 = angle_c[4]*t212 - angle_s[4]*t211;
   // ---- body app6: outward pass (velocities)
-  const T t251 = app6_R_PJ_xy*u[3] + app6_R_PJ_yy*u[4];
-  const T t252 = app6_R_PJ_xz*u[3] + app6_R_PJ_yz*u[4];
-  const T t253 = -app6_p_J_y*t252 + app6_p_J_z*t251;
-  const T t254 = app6_p_J_x*t252 - app6_p_J_z*u[5];
-  const T t255 = -app6_p_J_x*t251 + app6_p_J_y*u[5];
-  const T t256 = app6_R_PJ_xy*u[0] + app6_R_PJ_yy*u[1];
-  const T t257 = app6_R_PJ_xz*u[0] + app6_R_PJ_yz*u[1];
-  const T t258 = t253 + u[2];
-  const T t259 = t254 + t256;
-  const T t260 = t255 + t257;
-  const T t269 = angle_c[5]*u[5] + angle_s[5]*t251;
-  const T t270 = angle_c[5]*t251 - angle_s[5]*u[5];
-  const T w_B_app6_z = t252 + u[11];
-  const T t272 = angle_c[5]*t258 + angle_s[5]*t259;
-  const T t273 = angle_c[5]*t259 - angle_s[5]*t258;
+  const T t249 = app6_R_PJ_xy*u[3] + app6_R_PJ_yy*u[4];
+  const T t250 = app6_R_PJ_xz*u[3] + app6_R_PJ_yz*u[4];
+  const T t251 = -app6_p_J_y*t250;
+  const T t252 = app6_p_J_x*t250;
+  const T t253 = -app6_p_J_x*t249 + app6_p_J_y*u[5];
+  const T t254 = app6_R_PJ_xy*u[0] + app6_R_PJ_yy*u[1];
+  const T t255 = app6_R_PJ_xz*u[0] + app6_R_PJ_yz*u[1];
+  const T t256 = t251 + u[2];
+  const T t257 = t252 + t254;
+  const T t258 = t253 + t255;
+  const T t267 = angle_c[5]*u[5] + angle_s[5]*t249;
+  const T t268 = angle_c[5]*t249 - angle_s[5]*u[5];
+  const T w_B_app6_z = t250 + u[11];
+  const T t270 = angle_c[5]*t256 + angle_s[5]*t257;
+  const T t271 = angle_c[5]*t257 - angle_s[5]*t256;
   // ---- body app7: outward pass (velocities)
-  const T t298 = app7_R_PJ_xx*u[3] + app7_R_PJ_yx*u[4];
-  const T t299 = app7_R_PJ_xz*u[3] + app7_R_PJ_yz*u[4];
-  const T t300 = -app7_p_J_y*t299;
-  const T t301 = app7_p_J_x*t299;
-  const T t302 = app7_p_J_x*u[5] + app7_p_J_y*t298;
-  const T t303 = app7_R_PJ_xx*u[0] + app7_R_PJ_yx*u[1];
-  const T t304 = app7_R_PJ_xz*u[0] + app7_R_PJ_yz*u[1];
-  const T t305 = t300 + t303;
-  const T t306 = t301 - u[2];
-  const T t307 = t302 + t304;
-  const T t316 = angle_c[6]*t298 - angle_s[6]*u[5];
-  const T t317 = -angle_c[6]*u[5] - angle_s[6]*t298;
-  const T w_B_app7_z = t299 + u[12];
-  const T t319 = angle_c[6]*t305 + angle_s[6]*t306;
-  const T t320 = angle_c[6]*t306 - angle_s[6]*t305;
+  const T t296 = app7_R_PJ_xx*u[3] + app7_R_PJ_yx*u[4];
+  const T t297 = app7_R_PJ_xz*u[3] + app7_R_PJ_yz*u[4];
+  const T t298 = -app7_p_J_y*t297;
+  const T t299 = app7_p_J_x*t297;
+  const T t300 = app7_p_J_x*u[5] + app7_p_J_y*t296;
+  const T t301 = app7_R_PJ_xx*u[0] + app7_R_PJ_yx*u[1];
+  const T t302 = app7_R_PJ_xz*u[0] + app7_R_PJ_yz*u[1];
+  const T t303 = t298 + t301;
+  const T t304 = t299 - u[2];
+  const T t305 = t300 + t302;
+  const T t314 = angle_c[6]*t296 - angle_s[6]*u[5];
+  const T t315 = -angle_c[6]*u[5] - angle_s[6]*t296;
+  const T w_B_app7_z = t297 + u[12];
+  const T t317 = angle_c[6]*t303 + angle_s[6]*t304;
+  const T t318 = angle_c[6]*t304 - angle_s[6]*t303;
   // ---- body app8: outward pass (velocities)
-  const T t342 = app8_R_PJ_xx*u[3] + app8_R_PJ_yx*u[4];
-  const T t343 = app8_R_PJ_xy*u[3] + app8_R_PJ_yy*u[4];
-  const T t344 = -app8_p_J_y*u[5] + app8_p_J_z*t343;
-  const T t345 = app8_p_J_x*u[5] - app8_p_J_z*t342;
-  const T t346 = -app8_p_J_x*t343 + app8_p_J_y*t342;
-  const T t347 = app8_R_PJ_xx*u[0] + app8_R_PJ_yx*u[1];
-  const T t348 = app8_R_PJ_xy*u[0] + app8_R_PJ_yy*u[1];
-  const T t349 = t344 + t347;
-  const T t350 = t345 + t348;
-  const T t351 = t346 + u[2];
-  const T t360 = angle_c[7]*t342 + angle_s[7]*t343;
-  const T t361 = angle_c[7]*t343 - angle_s[7]*t342;
+  const T t340 = app8_R_PJ_xx*u[3] + app8_R_PJ_yx*u[4];
+  const T t341 = app8_R_PJ_xy*u[3] + app8_R_PJ_yy*u[4];
+  const T t342 = -app8_p_J_y*u[5] + app8_p_J_z*t341;
+  const T t343 = app8_p_J_x*u[5] - app8_p_J_z*t340;
+  const T t344 = -app8_p_J_x*t341 + app8_p_J_y*t340;
+  const T t345 = app8_R_PJ_xx*u[0] + app8_R_PJ_yx*u[1];
+  const T t346 = app8_R_PJ_xy*u[0] + app8_R_PJ_yy*u[1];
+  const T t347 = t342 + t345;
+  const T t348 = t343 + t346;
+  const T t349 = t344 + u[2];
+  const T t358 = angle_c[7]*t340 + angle_s[7]*t341;
+  const T t359 = angle_c[7]*t341 - angle_s[7]*t340;
   const T w_B_app8_z = u[13] + u[5];
-  const T t363 = angle_c[7]*t349 + angle_s[7]*t350;
-  const T t364 = angle_c[7]*t350 - angle_s[7]*t349;
+  const T t361 = angle_c[7]*t347 + angle_s[7]*t348;
+  const T t362 = angle_c[7]*t348 - angle_s[7]*t347;
   // ---- body app9: outward pass (velocities)
-  const T t382 = app9_p_J_z*u[4];
-  const T t383 = -app9_p_J_x*u[3] - app9_p_J_z*u[5];
-  const T t384 = -app9_p_J_x*u[4];
-  const T t385 = t382 + u[2];
-  const T t386 = t383 + u[1];
-  const T t387 = t384 - u[0];
-  const T t394 = angle_c[8]*u[5] + angle_s[8]*u[4];
-  const T t395 = angle_c[8]*u[4] - angle_s[8]*u[5];
+  const T t380 = -app9_p_J_x*u[3];
+  const T t381 = -app9_p_J_x*u[4];
+  const T t382 = t380 + u[1];
+  const T t383 = t381 - u[0];
+  const T t390 = angle_c[8]*u[5] + angle_s[8]*u[4];
+  const T t391 = angle_c[8]*u[4] - angle_s[8]*u[5];
   const T w_B_app9_z = u[14] - u[3];
-  const T t397 = angle_c[8]*t385 + angle_s[8]*t386;
-  const T t398 = angle_c[8]*t386 - angle_s[8]*t385;
+  const T t393 = angle_c[8]*u[2] + angle_s[8]*t382;
+  const T t394 = angle_c[8]*t382 - angle_s[8]*u[2];
   // ---- body app10: outward pass (velocities)
-  const T t423 = app10_R_PJ_xx*u[3] + app10_R_PJ_yx*u[4];
-  const T t424 = app10_R_PJ_xz*u[3] + app10_R_PJ_yz*u[4];
-  const T t425 = -app10_p_J_y*t424 - app10_p_J_z*u[5];
-  const T t426 = app10_p_J_x*t424 - app10_p_J_z*t423;
-  const T t427 = app10_p_J_x*u[5] + app10_p_J_y*t423;
-  const T t428 = app10_R_PJ_xx*u[0] + app10_R_PJ_yx*u[1];
-  const T t429 = app10_R_PJ_xz*u[0] + app10_R_PJ_yz*u[1];
-  const T t430 = t425 + t428;
-  const T t431 = t426 - u[2];
-  const T t432 = t427 + t429;
-  const T t441 = angle_c[9]*t423 - angle_s[9]*u[5];
-  const T t442 = -angle_c[9]*u[5] - angle_s[9]*t423;
-  const T w_B_app10_z = t424 + u[15];
-  const T t444 = angle_c[9]*t430 + angle_s[9]*t431;
-  const T t445 = angle_c[9]*t431 - angle_s[9]*t430;
+  const T t419 = app10_R_PJ_xx*u[3] + app10_R_PJ_yx*u[4];
+  const T t420 = app10_R_PJ_xz*u[3] + app10_R_PJ_yz*u[4];
+  const T t421 = -app10_p_J_y*t420 - app10_p_J_z*u[5];
+  const T t422 = app10_p_J_x*t420 - app10_p_J_z*t419;
+  const T t423 = app10_p_J_x*u[5] + app10_p_J_y*t419;
+  const T t424 = app10_R_PJ_xx*u[0] + app10_R_PJ_yx*u[1];
+  const T t425 = app10_R_PJ_xz*u[0] + app10_R_PJ_yz*u[1];
+  const T t426 = t421 + t424;
+  const T t427 = t422 - u[2];
+  const T t428 = t423 + t425;
+  const T t437 = angle_c[9]*t419 - angle_s[9]*u[5];
+  const T t438 = -angle_c[9]*u[5] - angle_s[9]*t419;
+  const T w_B_app10_z = t420 + u[15];
+  const T t440 = angle_c[9]*t426 + angle_s[9]*t427;
+  const T t441 = angle_c[9]*t427 - angle_s[9]*t426;
   // ---- body app11: outward pass (velocities)
-  const T t467 = app11_R_PJ_xx*u[3] + app11_R_PJ_yx*u[4];
-  const T t468 = app11_R_PJ_xy*u[3] + app11_R_PJ_yy*u[4];
-  const T t469 = app11_p_J_z*t468;
-  const T t470 = app11_p_J_x*u[5] - app11_p_J_z*t467;
-  const T t471 = -app11_p_J_x*t468;
-  const T t472 = app11_R_PJ_xx*u[0] + app11_R_PJ_yx*u[1];
-  const T t473 = app11_R_PJ_xy*u[0] + app11_R_PJ_yy*u[1];
-  const T t474 = t469 + t472;
-  const T t475 = t470 + t473;
-  const T t476 = t471 + u[2];
-  const T t485 = angle_c[10]*t467 + angle_s[10]*t468;
-  const T t486 = angle_c[10]*t468 - angle_s[10]*t467;
+  const T t463 = app11_R_PJ_xx*u[3] + app11_R_PJ_yx*u[4];
+  const T t464 = app11_R_PJ_xy*u[3] + app11_R_PJ_yy*u[4];
+  const T t465 = app11_p_J_z*t464;
+  const T t466 = app11_p_J_x*u[5] - app11_p_J_z*t463;
+  const T t467 = -app11_p_J_x*t464;
+  const T t468 = app11_R_PJ_xx*u[0] + app11_R_PJ_yx*u[1];
+  const T t469 = app11_R_PJ_xy*u[0] + app11_R_PJ_yy*u[1];
+  const T t470 = t465 + t468;
+  const T t471 = t466 + t469;
+  const T t472 = t467 + u[2];
+  const T t481 = angle_c[10]*t463 + angle_s[10]*t464;
+  const T t482 = angle_c[10]*t464 - angle_s[10]*t463;
   const T w_B_app11_z = u[16] + u[5];
-  const T t488 = angle_c[10]*t474 + angle_s[10]*t475;
-  const T t489 = angle_c[10]*t475 - angle_s[10]*t474;
+  const T t484 = angle_c[10]*t470 + angle_s[10]*t471;
+  const T t485 = angle_c[10]*t471 - angle_s[10]*t470;
   // ---- body app12: outward pass (velocities)
-  const T t514 = app12_R_PJ_xy*u[3] + app12_R_PJ_yy*u[4];
-  const T t515 = app12_R_PJ_xz*u[3] + app12_R_PJ_yz*u[4];
-  const T t516 = -app12_p_J_y*t515 + app12_p_J_z*t514;
-  const T t517 = app12_p_J_x*t515 - app12_p_J_z*u[5];
-  const T t518 = -app12_p_J_x*t514 + app12_p_J_y*u[5];
-  const T t519 = app12_R_PJ_xy*u[0] + app12_R_PJ_yy*u[1];
-  const T t520 = app12_R_PJ_xz*u[0] + app12_R_PJ_yz*u[1];
-  const T t521 = t516 + u[2];
-  const T t522 = t517 + t519;
-  const T t523 = t518 + t520;
-  const T t532 = angle_c[11]*u[5] + angle_s[11]*t514;
-  const T t533 = angle_c[11]*t514 - angle_s[11]*u[5];
-  const T w_B_app12_z = t515 + u[17];
-  const T t535 = angle_c[11]*t521 + angle_s[11]*t522;
-  const T t536 = angle_c[11]*t522 - angle_s[11]*t521;
+  const T t510 = app12_R_PJ_xy*u[3] + app12_R_PJ_yy*u[4];
+  const T t511 = app12_R_PJ_xz*u[3] + app12_R_PJ_yz*u[4];
+  const T t512 = -app12_p_J_y*t511;
+  const T t513 = app12_p_J_x*t511;
+  const T t514 = -app12_p_J_x*t510 + app12_p_J_y*u[5];
+  const T t515 = app12_R_PJ_xy*u[0] + app12_R_PJ_yy*u[1];
+  const T t516 = app12_R_PJ_xz*u[0] + app12_R_PJ_yz*u[1];
+  const T t517 = t512 + u[2];
+  const T t518 = t513 + t515;
+  const T t519 = t514 + t516;
+  const T t528 = angle_c[11]*u[5] + angle_s[11]*t510;
+  const T t529 = angle_c[11]*t510 - angle_s[11]*u[5];
+  const T w_B_app12_z = t511 + u[17];
+  const T t531 = angle_c[11]*t517 + angle_s[11]*t518;
+  const T t532 = angle_c[11]*t518 - angle_s[11]*t517;
   // ---- body app13: outward pass (velocities)
-  const T t554 = -app13_p_J_y*u[3];
-  const T t555 = app13_p_J_x*u[3];
-  const T t556 = app13_p_J_x*u[5] - app13_p_J_y*u[4];
-  const T t557 = t554 - u[1];
-  const T t558 = t555 - u[2];
-  const T t559 = t556 + u[0];
-  const T t566 = -angle_c[12]*u[4] - angle_s[12]*u[5];
-  const T t567 = -angle_c[12]*u[5] + angle_s[12]*u[4];
+  const T t550 = -app13_p_J_y*u[3];
+  const T t551 = app13_p_J_x*u[3];
+  const T t552 = app13_p_J_x*u[5] - app13_p_J_y*u[4];
+  const T t553 = t550 - u[1];
+  const T t554 = t551 - u[2];
+  const T t555 = t552 + u[0];
+  const T t562 = -angle_c[12]*u[4] - angle_s[12]*u[5];
+  const T t563 = -angle_c[12]*u[5] + angle_s[12]*u[4];
   const T w_B_app13_z = u[18] + u[3];
-  const T t569 = angle_c[12]*t557 + angle_s[12]*t558;
-  const T t570 = angle_c[12]*t558 - angle_s[12]*t557;
+  const T t565 = angle_c[12]*t553 + angle_s[12]*t554;
+  const T t566 = angle_c[12]*t554 - angle_s[12]*t553;
   // ---- body app14: outward pass (velocities)
-  const T t592 = app14_R_PJ_xx*u[3] + app14_R_PJ_yx*u[4];
-  const T t593 = app14_R_PJ_xy*u[3] + app14_R_PJ_yy*u[4];
-  const T t594 = -app14_p_J_y*u[5] + app14_p_J_z*t593;
-  const T t595 = app14_p_J_x*u[5] - app14_p_J_z*t592;
-  const T t596 = -app14_p_J_x*t593 + app14_p_J_y*t592;
-  const T t597 = app14_R_PJ_xx*u[0] + app14_R_PJ_yx*u[1];
-  const T t598 = app14_R_PJ_xy*u[0] + app14_R_PJ_yy*u[1];
-  const T t599 = t594 + t597;
-  const T t600 = t595 + t598;
-  const T t601 = t596 + u[2];
-  const T t610 = angle_c[13]*t592 + angle_s[13]*t593;
-  const T t611 = angle_c[13]*t593 - angle_s[13]*t592;
+  const T t588 = app14_R_PJ_xx*u[3] + app14_R_PJ_yx*u[4];
+  const T t589 = app14_R_PJ_xy*u[3] + app14_R_PJ_yy*u[4];
+  const T t590 = -app14_p_J_y*u[5] + app14_p_J_z*t589;
+  const T t591 = app14_p_J_x*u[5] - app14_p_J_z*t588;
+  const T t592 = -app14_p_J_x*t589 + app14_p_J_y*t588;
+  const T t593 = app14_R_PJ_xx*u[0] + app14_R_PJ_yx*u[1];
+  const T t594 = app14_R_PJ_xy*u[0] + app14_R_PJ_yy*u[1];
+  const T t595 = t590 + t593;
+  const T t596 = t591 + t594;
+  const T t597 = t592 + u[2];
+  const T t606 = angle_c[13]*t588 + angle_s[13]*t589;
+  const T t607 = angle_c[13]*t589 - angle_s[13]*t588;
   const T w_B_app14_z = u[19] + u[5];
-  const T t613 = angle_c[13]*t599 + angle_s[13]*t600;
-  const T t614 = angle_c[13]*t600 - angle_s[13]*t599;
+  const T t609 = angle_c[13]*t595 + angle_s[13]*t596;
+  const T t610 = angle_c[13]*t596 - angle_s[13]*t595;
   // ---- body app15: outward pass (velocities)
-  const T t639 = app15_R_PJ_xy*u[3] + app15_R_PJ_yy*u[4];
-  const T t640 = app15_R_PJ_xz*u[3] + app15_R_PJ_yz*u[4];
-  const T t641 = app15_p_J_z*t639;
-  const T t642 = app15_p_J_x*t640 - app15_p_J_z*u[5];
-  const T t643 = -app15_p_J_x*t639;
-  const T t644 = app15_R_PJ_xy*u[0] + app15_R_PJ_yy*u[1];
-  const T t645 = app15_R_PJ_xz*u[0] + app15_R_PJ_yz*u[1];
-  const T t646 = t641 + u[2];
-  const T t647 = t642 + t644;
-  const T t648 = t643 + t645;
-  const T t657 = angle_c[14]*u[5] + angle_s[14]*t639;
-  const T t658 = angle_c[14]*t639 - angle_s[14]*u[5];
-  const T w_B_app15_z = t640 + u[20];
-  const T t660 = angle_c[14]*t646 + angle_s[14]*t647;
-  const T t661 = angle_c[14]*t647 - angle_s[14]*t646;
+  const T t635 = app15_R_PJ_xy*u[3] + app15_R_PJ_yy*u[4];
+  const T t636 = app15_R_PJ_xz*u[3] + app15_R_PJ_yz*u[4];
+  const T t637 = app15_p_J_x*t636;
+  const T t638 = -app15_p_J_x*t635;
+  const T t639 = app15_R_PJ_xy*u[0] + app15_R_PJ_yy*u[1];
+  const T t640 = app15_R_PJ_xz*u[0] + app15_R_PJ_yz*u[1];
+  const T t641 = t637 + t639;
+  const T t642 = t638 + t640;
+  const T t651 = angle_c[14]*u[5] + angle_s[14]*t635;
+  const T t652 = angle_c[14]*t635 - angle_s[14]*u[5];
+  const T w_B_app15_z = t636 + u[20];
+  const T t654 = angle_c[14]*u[2] + angle_s[14]*t641;
+  const T t655 = angle_c[14]*t641 - angle_s[14]*u[2];
   // ---- body app16: outward pass (velocities)
-  const T t686 = app16_R_PJ_xx*u[3] + app16_R_PJ_yx*u[4];
-  const T t687 = app16_R_PJ_xz*u[3] + app16_R_PJ_yz*u[4];
-  const T t688 = -app16_p_J_y*t687 - app16_p_J_z*u[5];
-  const T t689 = app16_p_J_x*t687 - app16_p_J_z*t686;
-  const T t690 = app16_p_J_x*u[5] + app16_p_J_y*t686;
-  const T t691 = app16_R_PJ_xx*u[0] + app16_R_PJ_yx*u[1];
-  const T t692 = app16_R_PJ_xz*u[0] + app16_R_PJ_yz*u[1];
-  const T t693 = t688 + t691;
-  const T t694 = t689 - u[2];
-  const T t695 = t690 + t692;
-  const T t704 = angle_c[15]*t686 - angle_s[15]*u[5];
-  const T t705 = -angle_c[15]*u[5] - angle_s[15]*t686;
-  const T w_B_app16_z = t687 + u[21];
-  const T t707 = angle_c[15]*t693 + angle_s[15]*t694;
-  const T t708 = angle_c[15]*t694 - angle_s[15]*t693;
+  const T t680 = app16_R_PJ_xx*u[3] + app16_R_PJ_yx*u[4];
+  const T t681 = app16_R_PJ_xz*u[3] + app16_R_PJ_yz*u[4];
+  const T t682 = -app16_p_J_y*t681 - app16_p_J_z*u[5];
+  const T t683 = app16_p_J_x*t681 - app16_p_J_z*t680;
+  const T t684 = app16_p_J_x*u[5] + app16_p_J_y*t680;
+  const T t685 = app16_R_PJ_xx*u[0] + app16_R_PJ_yx*u[1];
+  const T t686 = app16_R_PJ_xz*u[0] + app16_R_PJ_yz*u[1];
+  const T t687 = t682 + t685;
+  const T t688 = t683 - u[2];
+  const T t689 = t684 + t686;
+  const T t698 = angle_c[15]*t680 - angle_s[15]*u[5];
+  const T t699 = -angle_c[15]*u[5] - angle_s[15]*t680;
+  const T w_B_app16_z = t681 + u[21];
+  const T t701 = angle_c[15]*t687 + angle_s[15]*t688;
+  const T t702 = angle_c[15]*t688 - angle_s[15]*t687;
   // ---- body app1: mass and velocity terms
-  const T t731 = app1_J0_xx*t50;
+  const T t725 = app1_J0_xx*t50;
   // ---- body app2: mass and velocity terms
-  const T t742 = app2_J0_xx*t94;
+  const T t736 = app2_J0_xx*t94;
   // ---- body app4: mass and velocity terms
-  const T t765 = app4_J0_xx*t188;
+  const T t759 = app4_J0_xx*t186;
   // ---- body app5: mass and velocity terms
-  const T t776 = app5_J0_xx*t222;
+  const T t770 = app5_J0_xx*t220;
   // ---- body app7: mass and velocity terms
-  const T t799 = app7_J0_xx*t316;
+  const T t793 = app7_J0_xx*t314;
   // ---- body app8: mass and velocity terms
-  const T t810 = app8_J0_xx*t360;
+  const T t804 = app8_J0_xx*t358;
   // ---- body app10: mass and velocity terms
-  const T t833 = app10_J0_xx*t441;
+  const T t827 = app10_J0_xx*t437;
   // ---- body app11: mass and velocity terms
-  const T t844 = app11_J0_xx*t485;
+  const T t838 = app11_J0_xx*t481;
   // ---- body app13: mass and velocity terms
-  const T t867 = app13_J0_xx*t566;
+  const T t861 = app13_J0_xx*t562;
   // ---- body app14: mass and velocity terms
-  const T t878 = app14_J0_xx*t610;
+  const T t872 = app14_J0_xx*t606;
   // ---- body app16: mass and velocity terms
-  const T t901 = app16_J0_xx*t704;
-  const T t907 = -hub_S0_y*u[5] + hub_mass*u[0];
-  const T t908 = hub_S0_x*u[5] + hub_mass*u[1];
-  const T t909 = -hub_S0_x*u[4] + hub_S0_y*u[3] + hub_mass*u[2];
-  const T t910 = (hub_J0_xx*u[3] + hub_J0_xy*u[4]) + (hub_J0_xz*u[5] + hub_S0_y*u[2]);
-  const T t911 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + hub_J0_yz*u[5]) - hub_S0_x*u[2];
-  const T t912 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + (hub_J0_zz*u[5] + hub_S0_x*u[1])) - hub_S0_y*u[0];
-  const T t913 = ((t907*u[0] + t908*u[1]) + t909*u[2]) + ((t910*u[3] + t911*u[4]) + t912*u[5]);
-  const T t914 = app1_mass*t53;
-  const T t915 = app1_S0_x*w_B_app1_z + app1_mass*t54;
-  const T t916 = -app1_S0_x*t51 + app1_mass*t43;
-  const T t917 = app1_J0_yy*t51 - app1_S0_x*t43;
-  const T t918 = app1_J0_zz*w_B_app1_z + app1_S0_x*t54;
-  const T t919 = ((t43*t916 + t50*t731) + t51*t917) + ((t53*t914 + t54*t915) + t918*w_B_app1_z);
-  const T t920 = app2_mass*t97;
-  const T t921 = app2_S0_x*w_B_app2_z + app2_mass*t98;
-  const T t922 = -app2_S0_x*t95 + app2_mass*t85;
-  const T t923 = app2_J0_yy*t95 - app2_S0_x*t85;
-  const T t924 = app2_J0_zz*w_B_app2_z + app2_S0_x*t98;
-  const T t925 = ((t742*t94 + t85*t922) + t920*t97) + ((t921*t98 + t923*t95) + t924*w_B_app2_z);
-  const T t926 = app3_S0_z*t142 + app3_mass*t144;
-  const T t927 = app3_S0_x*w_B_app3_z - app3_S0_z*t141 + app3_mass*t145;
-  const T t928 = -app3_S0_x*t142 + app3_mass*t132;
-  const T t929 = app3_J0_xx*t141 + app3_J0_xz*w_B_app3_z - app3_S0_z*t145;
-  const T t930 = app3_J0_yy*t142 - app3_S0_x*t132 + app3_S0_z*t144;
-  const T t931 = app3_J0_xz*t141 + app3_J0_zz*w_B_app3_z + app3_S0_x*t145;
-  const T t932 = ((t132*t928 + t141*t929) + t142*t930) + ((t144*t926 + t145*t927) + t931*w_B_app3_z);
-  const T t933 = app4_mass*t191;
-  const T t934 = app4_S0_x*w_B_app4_z + app4_mass*t192;
-  const T t935 = -app4_S0_x*t189 + app4_mass*t179;
-  const T t936 = app4_J0_yy*t189 - app4_S0_x*t179;
-  const T t937 = app4_J0_zz*w_B_app4_z + app4_S0_x*t192;
-  const T t938 = ((t179*t935 + t188*t765) + t189*t936) + ((t191*t933 + t192*t934) + t937*w_B_app4_z);
-  const T t939 = app5_mass*t225;
-  const T t940 = app5_S0_x*w_B_app5_z + app5_mass*t226;
-  const T t941 = -app5_S0_x*t223 + app5_mass*t215;
-  const T t942 = app5_J0_yy*t223 - app5_S0_x*t215;
-  const T t943 = app5_J0_zz*w_B_app5_z + app5_S0_x*t226;
-  const T t944 = ((t215*t941 + t222*t776) + t223*t942) + ((t225*t939 + t226*t940) + t943*w_B_app5_z);
-  const T t945 = app6_S0_z*t270 + app6_mass*t272;
-  const T t946 = app6_S0_x*w_B_app6_z - app6_S0_z*t269 + app6_mass*t273;
-  const T t947 = -app6_S0_x*t270 + app6_mass*t260;
-  const T t948 = app6_J0_xx*t269 + app6_J0_xz*w_B_app6_z - app6_S0_z*t273;
-  const T t949 = app6_J0_yy*t270 - app6_S0_x*t260 + app6_S0_z*t272;
-  const T t950 = app6_J0_xz*t269 + app6_J0_zz*w_B_app6_z + app6_S0_x*t273;
-  const T t951 = ((t260*t947 + t269*t948) + t270*t949) + ((t272*t945 + t273*t946) + t950*w_B_app6_z);
-  const T t952 = app7_mass*t319;
-  const T t953 = app7_S0_x*w_B_app7_z + app7_mass*t320;
-  const T t954 = -app7_S0_x*t317 + app7_mass*t307;
-  const T t955 = app7_J0_yy*t317 - app7_S0_x*t307;
-  const T t956 = app7_J0_zz*w_B_app7_z + app7_S0_x*t320;
-  const T t957 = ((t307*t954 + t316*t799) + t317*t955) + ((t319*t952 + t320*t953) + t956*w_B_app7_z);
-  const T t958 = app8_mass*t363;
-  const T t959 = app8_S0_x*w_B_app8_z + app8_mass*t364;
-  const T t960 = -app8_S0_x*t361 + app8_mass*t351;
-  const T t961 = app8_J0_yy*t361 - app8_S0_x*t351;
-  const T t962 = app8_J0_zz*w_B_app8_z + app8_S0_x*t364;
-  const T t963 = ((t351*t960 + t360*t810) + t361*t961) + ((t363*t958 + t364*t959) + t962*w_B_app8_z);
-  const T t964 = app9_S0_z*t395 + app9_mass*t397;
-  const T t965 = app9_S0_x*w_B_app9_z - app9_S0_z*t394 + app9_mass*t398;
-  const T t966 = -app9_S0_x*t395 + app9_mass*t387;
-  const T t967 = app9_J0_xx*t394 + app9_J0_xz*w_B_app9_z - app9_S0_z*t398;
-  const T t968 = app9_J0_yy*t395 - app9_S0_x*t387 + app9_S0_z*t397;
-  const T t969 = app9_J0_xz*t394 + app9_J0_zz*w_B_app9_z + app9_S0_x*t398;
-  const T t970 = ((t387*t966 + t394*t967) + t395*t968) + ((t397*t964 + t398*t965) + t969*w_B_app9_z);
-  const T t971 = app10_mass*t444;
-  const T t972 = app10_S0_x*w_B_app10_z + app10_mass*t445;
-  const T t973 = -app10_S0_x*t442 + app10_mass*t432;
-  const T t974 = app10_J0_yy*t442 - app10_S0_x*t432;
-  const T t975 = app10_J0_zz*w_B_app10_z + app10_S0_x*t445;
-  const T t976 = ((t432*t973 + t441*t833) + t442*t974) + ((t444*t971 + t445*t972) + t975*w_B_app10_z);
-  const T t977 = app11_mass*t488;
-  const T t978 = app11_S0_x*w_B_app11_z + app11_mass*t489;
-  const T t979 = -app11_S0_x*t486 + app11_mass*t476;
-  const T t980 = app11_J0_yy*t486 - app11_S0_x*t476;
-  const T t981 = app11_J0_zz*w_B_app11_z + app11_S0_x*t489;
-  const T t982 = ((t476*t979 + t485*t844) + t486*t980) + ((t488*t977 + t489*t978) + t981*w_B_app11_z);
-  const T t983 = app12_S0_z*t533 + app12_mass*t535;
-  const T t984 = app12_S0_x*w_B_app12_z - app12_S0_z*t532 + app12_mass*t536;
-  const T t985 = -app12_S0_x*t533 + app12_mass*t523;
-  const T t986 = app12_J0_xx*t532 + app12_J0_xz*w_B_app12_z - app12_S0_z*t536;
-  const T t987 = app12_J0_yy*t533 - app12_S0_x*t523 + app12_S0_z*t535;
-  const T t988 = app12_J0_xz*t532 + app12_J0_zz*w_B_app12_z + app12_S0_x*t536;
-  const T t989 = ((t523*t985 + t532*t986) + t533*t987) + ((t535*t983 + t536*t984) + t988*w_B_app12_z);
-  const T t990 = app13_mass*t569;
-  const T t991 = app13_S0_x*w_B_app13_z + app13_mass*t570;
-  const T t992 = -app13_S0_x*t567 + app13_mass*t559;
-  const T t993 = app13_J0_yy*t567 - app13_S0_x*t559;
-  const T t994 = app13_J0_zz*w_B_app13_z + app13_S0_x*t570;
-  const T t995 = ((t559*t992 + t566*t867) + t567*t993) + ((t569*t990 + t570*t991) + t994*w_B_app13_z);
-  const T t996 = app14_mass*t613;
-  const T t997 = app14_S0_x*w_B_app14_z + app14_mass*t614;
-  const T t998 = -app14_S0_x*t611 + app14_mass*t601;
-  const T t999 = app14_J0_yy*t611 - app14_S0_x*t601;
-  const T t1000 = app14_J0_zz*w_B_app14_z + app14_S0_x*t614;
-  const T t1001 = ((t1000*w_B_app14_z + t601*t998) + t610*t878) + ((t611*t999 + t613*t996) + t614*t997);
-  const T t1002 = app15_S0_z*t658 + app15_mass*t660;
-  const T t1003 = app15_S0_x*w_B_app15_z - app15_S0_z*t657 + app15_mass*t661;
-  const T t1004 = -app15_S0_x*t658 + app15_mass*t648;
-  const T t1005 = app15_J0_xx*t657 + app15_J0_xz*w_B_app15_z - app15_S0_z*t661;
-  const T t1006 = app15_J0_yy*t658 - app15_S0_x*t648 + app15_S0_z*t660;
-  const T t1007 = app15_J0_xz*t657 + app15_J0_zz*w_B_app15_z + app15_S0_x*t661;
-  const T t1008 = ((t1002*t660 + t1003*t661) + t1004*t648) + ((t1005*t657 + t1006*t658) + t1007*w_B_app15_z);
-  const T t1009 = app16_mass*t707;
-  const T t1010 = app16_S0_x*w_B_app16_z + app16_mass*t708;
-  const T t1011 = -app16_S0_x*t705 + app16_mass*t695;
-  const T t1012 = app16_J0_yy*t705 - app16_S0_x*t695;
-  const T t1013 = app16_J0_zz*w_B_app16_z + app16_S0_x*t708;
-  const T t1014 = ((t1009*t707 + t1010*t708) + t1011*t695) + ((t1012*t705 + t1013*w_B_app16_z) + t704*t901);
-  const T t1015 = ((((t1001/2.0 + t1008/2.0) + t1014/2.0) + (t913/2.0 + t919/2.0)) + ((t925/2.0 + t932/2.0) + (t938/2.0 + t944/2.0))) + (((t951/2.0 + t957/2.0) + (t963/2.0 + t970/2.0)) + ((t976/2.0 + t982/2.0) + (t989/2.0 + t995/2.0)));
-  const T t1016 = app1_k*q[7]*q[7]/2.0;
-  const T t1017 = app2_k*q[8]*q[8]/2.0 + t1016;
-  const T t1018 = q[9]*q[9]/2.0 + t1017;
-  const T t1019 = app4_k*q[10]*q[10]/2.0 + t1018;
-  const T t1020 = app5_k*q[11]*q[11]/2.0 + t1019;
-  const T t1021 = q[12]*q[12]/2.0 + t1020;
-  const T t1022 = app7_k*q[13]*q[13]/2.0 + t1021;
-  const T t1023 = app8_k*q[14]*q[14]/2.0 + t1022;
-  const T t1024 = q[15]*q[15]/2.0 + t1023;
-  const T t1025 = app10_k*q[16]*q[16]/2.0 + t1024;
-  const T t1026 = app11_k*q[17]*q[17]/2.0 + t1025;
-  const T t1027 = q[18]*q[18]/2.0 + t1026;
-  const T t1028 = app13_k*q[19]*q[19]/2.0 + t1027;
-  const T t1029 = app14_k*q[20]*q[20]/2.0 + t1028;
-  const T t1030 = q[21]*q[21]/2.0 + t1029;
-  const T t1031 = app16_k*q[22]*q[22]/2.0 + t1030;
-  TV[0] = t1015;
-  TV[1] = t1031;
+  const T t895 = app16_J0_xx*t698;
+  const T t901 = -hub_S0_y*u[5] + hub_mass*u[0];
+  const T t902 = hub_S0_x*u[5] + hub_mass*u[1];
+  const T t903 = -hub_S0_x*u[4] + hub_S0_y*u[3] + hub_mass*u[2];
+  const T t904 = (hub_J0_xx*u[3] + hub_J0_xy*u[4]) + (hub_J0_xz*u[5] + hub_S0_y*u[2]);
+  const T t905 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + hub_J0_yz*u[5]) - hub_S0_x*u[2];
+  const T t906 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + (hub_J0_zz*u[5] + hub_S0_x*u[1])) - hub_S0_y*u[0];
+  const T t907 = ((t901*u[0] + t902*u[1]) + t903*u[2]) + ((t904*u[3] + t905*u[4]) + t906*u[5]);
+  const T t908 = app1_mass*t53;
+  const T t909 = app1_S0_x*w_B_app1_z + app1_mass*t54;
+  const T t910 = -app1_S0_x*t51 + app1_mass*t43;
+  const T t911 = app1_J0_yy*t51 - app1_S0_x*t43;
+  const T t912 = app1_J0_zz*w_B_app1_z + app1_S0_x*t54;
+  const T t913 = ((t43*t910 + t50*t725) + t51*t911) + ((t53*t908 + t54*t909) + t912*w_B_app1_z);
+  const T t914 = app2_mass*t97;
+  const T t915 = app2_S0_x*w_B_app2_z + app2_mass*t98;
+  const T t916 = -app2_S0_x*t95 + app2_mass*t85;
+  const T t917 = app2_J0_yy*t95 - app2_S0_x*t85;
+  const T t918 = app2_J0_zz*w_B_app2_z + app2_S0_x*t98;
+  const T t919 = ((t736*t94 + t85*t916) + t914*t97) + ((t915*t98 + t917*t95) + t918*w_B_app2_z);
+  const T t920 = app3_S0_z*t140 + app3_mass*t142;
+  const T t921 = app3_S0_x*w_B_app3_z - app3_S0_z*t139 + app3_mass*t143;
+  const T t922 = -app3_S0_x*t140 + app3_mass*t130;
+  const T t923 = app3_J0_xx*t139 + app3_J0_xz*w_B_app3_z - app3_S0_z*t143;
+  const T t924 = app3_J0_yy*t140 - app3_S0_x*t130 + app3_S0_z*t142;
+  const T t925 = app3_J0_xz*t139 + app3_J0_zz*w_B_app3_z + app3_S0_x*t143;
+  const T t926 = ((t130*t922 + t139*t923) + t140*t924) + ((t142*t920 + t143*t921) + t925*w_B_app3_z);
+  const T t927 = app4_mass*t189;
+  const T t928 = app4_S0_x*w_B_app4_z + app4_mass*t190;
+  const T t929 = -app4_S0_x*t187 + app4_mass*t177;
+  const T t930 = app4_J0_yy*t187 - app4_S0_x*t177;
+  const T t931 = app4_J0_zz*w_B_app4_z + app4_S0_x*t190;
+  const T t932 = ((t177*t929 + t186*t759) + t187*t930) + ((t189*t927 + t190*t928) + t931*w_B_app4_z);
+  const T t933 = app5_mass*t223;
+  const T t934 = app5_S0_x*w_B_app5_z + app5_mass*t224;
+  const T t935 = -app5_S0_x*t221 + app5_mass*t213;
+  const T t936 = app5_J0_yy*t221 - app5_S0_x*t213;
+  const T t937 = app5_J0_zz*w_B_app5_z + app5_S0_x*t224;
+  const T t938 = ((t213*t935 + t220*t770) + t221*t936) + ((t223*t933 + t224*t934) + t937*w_B_app5_z);
+  const T t939 = app6_S0_z*t268 + app6_mass*t270;
+  const T t940 = app6_S0_x*w_B_app6_z - app6_S0_z*t267 + app6_mass*t271;
+  const T t941 = -app6_S0_x*t268 + app6_mass*t258;
+  const T t942 = app6_J0_xx*t267 + app6_J0_xz*w_B_app6_z - app6_S0_z*t271;
+  const T t943 = app6_J0_yy*t268 - app6_S0_x*t258 + app6_S0_z*t270;
+  const T t944 = app6_J0_xz*t267 + app6_J0_zz*w_B_app6_z + app6_S0_x*t271;
+  const T t945 = ((t258*t941 + t267*t942) + t268*t943) + ((t270*t939 + t271*t940) + t944*w_B_app6_z);
+  const T t946 = app7_mass*t317;
+  const T t947 = app7_S0_x*w_B_app7_z + app7_mass*t318;
+  const T t948 = -app7_S0_x*t315 + app7_mass*t305;
+  const T t949 = app7_J0_yy*t315 - app7_S0_x*t305;
+  const T t950 = app7_J0_zz*w_B_app7_z + app7_S0_x*t318;
+  const T t951 = ((t305*t948 + t314*t793) + t315*t949) + ((t317*t946 + t318*t947) + t950*w_B_app7_z);
+  const T t952 = app8_mass*t361;
+  const T t953 = app8_S0_x*w_B_app8_z + app8_mass*t362;
+  const T t954 = -app8_S0_x*t359 + app8_mass*t349;
+  const T t955 = app8_J0_yy*t359 - app8_S0_x*t349;
+  const T t956 = app8_J0_zz*w_B_app8_z + app8_S0_x*t362;
+  const T t957 = ((t349*t954 + t358*t804) + t359*t955) + ((t361*t952 + t362*t953) + t956*w_B_app8_z);
+  const T t958 = app9_S0_z*t391 + app9_mass*t393;
+  const T t959 = app9_S0_x*w_B_app9_z - app9_S0_z*t390 + app9_mass*t394;
+  const T t960 = -app9_S0_x*t391 + app9_mass*t383;
+  const T t961 = app9_J0_xx*t390 + app9_J0_xz*w_B_app9_z - app9_S0_z*t394;
+  const T t962 = app9_J0_yy*t391 - app9_S0_x*t383 + app9_S0_z*t393;
+  const T t963 = app9_J0_xz*t390 + app9_J0_zz*w_B_app9_z + app9_S0_x*t394;
+  const T t964 = ((t383*t960 + t390*t961) + t391*t962) + ((t393*t958 + t394*t959) + t963*w_B_app9_z);
+  const T t965 = app10_mass*t440;
+  const T t966 = app10_S0_x*w_B_app10_z + app10_mass*t441;
+  const T t967 = -app10_S0_x*t438 + app10_mass*t428;
+  const T t968 = app10_J0_yy*t438 - app10_S0_x*t428;
+  const T t969 = app10_J0_zz*w_B_app10_z + app10_S0_x*t441;
+  const T t970 = ((t428*t967 + t437*t827) + t438*t968) + ((t440*t965 + t441*t966) + t969*w_B_app10_z);
+  const T t971 = app11_mass*t484;
+  const T t972 = app11_S0_x*w_B_app11_z + app11_mass*t485;
+  const T t973 = -app11_S0_x*t482 + app11_mass*t472;
+  const T t974 = app11_J0_yy*t482 - app11_S0_x*t472;
+  const T t975 = app11_J0_zz*w_B_app11_z + app11_S0_x*t485;
+  const T t976 = ((t472*t973 + t481*t838) + t482*t974) + ((t484*t971 + t485*t972) + t975*w_B_app11_z);
+  const T t977 = app12_S0_z*t529 + app12_mass*t531;
+  const T t978 = app12_S0_x*w_B_app12_z - app12_S0_z*t528 + app12_mass*t532;
+  const T t979 = -app12_S0_x*t529 + app12_mass*t519;
+  const T t980 = app12_J0_xx*t528 + app12_J0_xz*w_B_app12_z - app12_S0_z*t532;
+  const T t981 = app12_J0_yy*t529 - app12_S0_x*t519 + app12_S0_z*t531;
+  const T t982 = app12_J0_xz*t528 + app12_J0_zz*w_B_app12_z + app12_S0_x*t532;
+  const T t983 = ((t519*t979 + t528*t980) + t529*t981) + ((t531*t977 + t532*t978) + t982*w_B_app12_z);
+  const T t984 = app13_mass*t565;
+  const T t985 = app13_S0_x*w_B_app13_z + app13_mass*t566;
+  const T t986 = -app13_S0_x*t563 + app13_mass*t555;
+  const T t987 = app13_J0_yy*t563 - app13_S0_x*t555;
+  const T t988 = app13_J0_zz*w_B_app13_z + app13_S0_x*t566;
+  const T t989 = ((t555*t986 + t562*t861) + t563*t987) + ((t565*t984 + t566*t985) + t988*w_B_app13_z);
+  const T t990 = app14_mass*t609;
+  const T t991 = app14_S0_x*w_B_app14_z + app14_mass*t610;
+  const T t992 = -app14_S0_x*t607 + app14_mass*t597;
+  const T t993 = app14_J0_yy*t607 - app14_S0_x*t597;
+  const T t994 = app14_J0_zz*w_B_app14_z + app14_S0_x*t610;
+  const T t995 = ((t597*t992 + t606*t872) + t607*t993) + ((t609*t990 + t610*t991) + t994*w_B_app14_z);
+  const T t996 = app15_S0_z*t652 + app15_mass*t654;
+  const T t997 = app15_S0_x*w_B_app15_z - app15_S0_z*t651 + app15_mass*t655;
+  const T t998 = -app15_S0_x*t652 + app15_mass*t642;
+  const T t999 = app15_J0_xx*t651 + app15_J0_xz*w_B_app15_z - app15_S0_z*t655;
+  const T t1000 = app15_J0_yy*t652 - app15_S0_x*t642 + app15_S0_z*t654;
+  const T t1001 = app15_J0_xz*t651 + app15_J0_zz*w_B_app15_z + app15_S0_x*t655;
+  const T t1002 = ((t1000*t652 + t1001*w_B_app15_z) + t642*t998) + ((t651*t999 + t654*t996) + t655*t997);
+  const T t1003 = app16_mass*t701;
+  const T t1004 = app16_S0_x*w_B_app16_z + app16_mass*t702;
+  const T t1005 = -app16_S0_x*t699 + app16_mass*t689;
+  const T t1006 = app16_J0_yy*t699 - app16_S0_x*t689;
+  const T t1007 = app16_J0_zz*w_B_app16_z + app16_S0_x*t702;
+  const T t1008 = ((t1003*t701 + t1004*t702) + t1005*t689) + ((t1006*t699 + t1007*w_B_app16_z) + t698*t895);
+  const T t1009 = ((((t1002/2.0 + t1008/2.0) + t907/2.0) + (t913/2.0 + t919/2.0)) + ((t926/2.0 + t932/2.0) + (t938/2.0 + t945/2.0))) + (((t951/2.0 + t957/2.0) + (t964/2.0 + t970/2.0)) + ((t976/2.0 + t983/2.0) + (t989/2.0 + t995/2.0)));
+  const T t1010 = app1_k*q[7]*q[7]/2.0;
+  const T t1011 = app2_k*q[8]*q[8]/2.0 + t1010;
+  const T t1012 = q[9]*q[9]/2.0 + t1011;
+  const T t1013 = app4_k*q[10]*q[10]/2.0 + t1012;
+  const T t1014 = app5_k*q[11]*q[11]/2.0 + t1013;
+  const T t1015 = q[12]*q[12]/2.0 + t1014;
+  const T t1016 = app7_k*q[13]*q[13]/2.0 + t1015;
+  const T t1017 = app8_k*q[14]*q[14]/2.0 + t1016;
+  const T t1018 = q[15]*q[15]/2.0 + t1017;
+  const T t1019 = app10_k*q[16]*q[16]/2.0 + t1018;
+  const T t1020 = app11_k*q[17]*q[17]/2.0 + t1019;
+  const T t1021 = q[18]*q[18]/2.0 + t1020;
+  const T t1022 = app13_k*q[19]*q[19]/2.0 + t1021;
+  const T t1023 = app14_k*q[20]*q[20]/2.0 + t1022;
+  const T t1024 = q[21]*q[21]/2.0 + t1023;
+  const T t1025 = app16_k*q[22]*q[22]/2.0 + t1024;
+  TV[0] = t1009;
+  TV[1] = t1025;
 }
 
 // ---- momentum: p_N[3], H_N[3] about N's origin ---------------------------------
@@ -7551,27 +7246,25 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app3_zx = R_PB_app3_xx*t20 + R_PB_app3_yx*t21 + angle_c[2]*t22;
   const T R_NB_app3_zy = R_PB_app3_xy*t20 + R_PB_app3_yy*t21 - angle_s[2]*t22;
   const T R_NB_app3_zz = app3_R_PJ_xz*t20 + app3_R_PJ_yz*t21;
-  const T t117 = app3_p_PJ_x*t14 + app3_p_PJ_y*t15 + app3_p_PJ_z*t16;
-  const T t118 = app3_p_PJ_x*t17 + app3_p_PJ_y*t18 + app3_p_PJ_z*t19;
-  const T t119 = app3_p_PJ_x*t20 + app3_p_PJ_y*t21 + app3_p_PJ_z*t22;
+  const T t117 = app3_p_PJ_z*t16;
+  const T t118 = app3_p_PJ_z*t19;
+  const T t119 = app3_p_PJ_z*t22;
   const T r_NO_N_app3_x = q[0] + t117;
   const T r_NO_N_app3_y = q[1] + t118;
   const T r_NO_N_app3_z = q[2] + t119;
   const T t123 = app3_R_PJ_xy*u[3] + app3_R_PJ_yy*u[4];
   const T t124 = app3_R_PJ_xz*u[3] + app3_R_PJ_yz*u[4];
-  const T t125 = app3_p_J_z*t123;
-  const T t126 = app3_p_J_x*t124 - app3_p_J_z*u[5];
-  const T t127 = -app3_p_J_x*t123;
-  const T t128 = app3_R_PJ_xy*u[0] + app3_R_PJ_yy*u[1];
-  const T t129 = app3_R_PJ_xz*u[0] + app3_R_PJ_yz*u[1];
-  const T t130 = t125 + u[2];
-  const T t131 = t126 + t128;
-  const T t132 = t127 + t129;
-  const T t141 = angle_c[2]*u[5] + angle_s[2]*t123;
-  const T t142 = angle_c[2]*t123 - angle_s[2]*u[5];
+  const T t125 = app3_p_J_x*t124;
+  const T t126 = -app3_p_J_x*t123;
+  const T t127 = app3_R_PJ_xy*u[0] + app3_R_PJ_yy*u[1];
+  const T t128 = app3_R_PJ_xz*u[0] + app3_R_PJ_yz*u[1];
+  const T t129 = t125 + t127;
+  const T t130 = t126 + t128;
+  const T t139 = angle_c[2]*u[5] + angle_s[2]*t123;
+  const T t140 = angle_c[2]*t123 - angle_s[2]*u[5];
   const T w_B_app3_z = t124 + u[8];
-  const T t144 = angle_c[2]*t130 + angle_s[2]*t131;
-  const T t145 = angle_c[2]*t131 - angle_s[2]*t130;
+  const T t142 = angle_c[2]*u[2] + angle_s[2]*t129;
+  const T t143 = angle_c[2]*t129 - angle_s[2]*u[2];
   // ---- body app4: outward pass (velocities)
   const T R_PB_app4_xx = angle_c[3]*app4_R_PJ_xx;
   const T R_PB_app4_xy = -angle_s[3]*app4_R_PJ_xx;
@@ -7586,27 +7279,27 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app4_zx = R_PB_app4_xx*t20 + R_PB_app4_yx*t21 - angle_s[3]*t22;
   const T R_NB_app4_zy = R_PB_app4_xy*t20 + R_PB_app4_yy*t21 - angle_c[3]*t22;
   const T R_NB_app4_zz = app4_R_PJ_xz*t20 + app4_R_PJ_yz*t21;
-  const T t164 = app4_p_PJ_x*t14 + app4_p_PJ_y*t15 + app4_p_PJ_z*t16;
-  const T t165 = app4_p_PJ_x*t17 + app4_p_PJ_y*t18 + app4_p_PJ_z*t19;
-  const T t166 = app4_p_PJ_x*t20 + app4_p_PJ_y*t21 + app4_p_PJ_z*t22;
-  const T r_NO_N_app4_x = q[0] + t164;
-  const T r_NO_N_app4_y = q[1] + t165;
-  const T r_NO_N_app4_z = q[2] + t166;
-  const T t170 = app4_R_PJ_xx*u[3] + app4_R_PJ_yx*u[4];
-  const T t171 = app4_R_PJ_xz*u[3] + app4_R_PJ_yz*u[4];
-  const T t172 = -app4_p_J_y*t171 - app4_p_J_z*u[5];
-  const T t173 = app4_p_J_x*t171 - app4_p_J_z*t170;
-  const T t174 = app4_p_J_x*u[5] + app4_p_J_y*t170;
-  const T t175 = app4_R_PJ_xx*u[0] + app4_R_PJ_yx*u[1];
-  const T t176 = app4_R_PJ_xz*u[0] + app4_R_PJ_yz*u[1];
-  const T t177 = t172 + t175;
-  const T t178 = t173 - u[2];
-  const T t179 = t174 + t176;
-  const T t188 = angle_c[3]*t170 - angle_s[3]*u[5];
-  const T t189 = -angle_c[3]*u[5] - angle_s[3]*t170;
-  const T w_B_app4_z = t171 + u[9];
-  const T t191 = angle_c[3]*t177 + angle_s[3]*t178;
-  const T t192 = angle_c[3]*t178 - angle_s[3]*t177;
+  const T t162 = app4_p_PJ_x*t14 + app4_p_PJ_y*t15 + app4_p_PJ_z*t16;
+  const T t163 = app4_p_PJ_x*t17 + app4_p_PJ_y*t18 + app4_p_PJ_z*t19;
+  const T t164 = app4_p_PJ_x*t20 + app4_p_PJ_y*t21 + app4_p_PJ_z*t22;
+  const T r_NO_N_app4_x = q[0] + t162;
+  const T r_NO_N_app4_y = q[1] + t163;
+  const T r_NO_N_app4_z = q[2] + t164;
+  const T t168 = app4_R_PJ_xx*u[3] + app4_R_PJ_yx*u[4];
+  const T t169 = app4_R_PJ_xz*u[3] + app4_R_PJ_yz*u[4];
+  const T t170 = -app4_p_J_y*t169 - app4_p_J_z*u[5];
+  const T t171 = app4_p_J_x*t169 - app4_p_J_z*t168;
+  const T t172 = app4_p_J_x*u[5] + app4_p_J_y*t168;
+  const T t173 = app4_R_PJ_xx*u[0] + app4_R_PJ_yx*u[1];
+  const T t174 = app4_R_PJ_xz*u[0] + app4_R_PJ_yz*u[1];
+  const T t175 = t170 + t173;
+  const T t176 = t171 - u[2];
+  const T t177 = t172 + t174;
+  const T t186 = angle_c[3]*t168 - angle_s[3]*u[5];
+  const T t187 = -angle_c[3]*u[5] - angle_s[3]*t168;
+  const T w_B_app4_z = t169 + u[9];
+  const T t189 = angle_c[3]*t175 + angle_s[3]*t176;
+  const T t190 = angle_c[3]*t176 - angle_s[3]*t175;
   // ---- body app5: outward pass (velocities)
   const T R_NB_app5_xx = angle_c[4]*t15 - angle_s[4]*t14;
   const T R_NB_app5_xy = -angle_c[4]*t14 - angle_s[4]*t15;
@@ -7614,23 +7307,23 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app5_yy = -angle_c[4]*t17 - angle_s[4]*t18;
   const T R_NB_app5_zx = angle_c[4]*t21 - angle_s[4]*t20;
   const T R_NB_app5_zy = -angle_c[4]*t20 - angle_s[4]*t21;
-  const T t204 = app5_p_PJ_y*t15 + app5_p_PJ_z*t16;
-  const T t205 = app5_p_PJ_y*t18 + app5_p_PJ_z*t19;
-  const T t206 = app5_p_PJ_y*t21 + app5_p_PJ_z*t22;
-  const T r_NO_N_app5_x = q[0] + t204;
-  const T r_NO_N_app5_y = q[1] + t205;
-  const T r_NO_N_app5_z = q[2] + t206;
-  const T t210 = -app5_p_J_z*u[3];
-  const T t211 = app5_p_J_x*u[5] - app5_p_J_z*u[4];
-  const T t212 = app5_p_J_x*u[3];
-  const T t213 = t210 + u[1];
-  const T t214 = t211 - u[0];
-  const T t215 = t212 + u[2];
-  const T t222 = angle_c[4]*u[4] - angle_s[4]*u[3];
-  const T t223 = -angle_c[4]*u[3] - angle_s[4]*u[4];
+  const T t202 = app5_p_PJ_y*t15 + app5_p_PJ_z*t16;
+  const T t203 = app5_p_PJ_y*t18 + app5_p_PJ_z*t19;
+  const T t204 = app5_p_PJ_y*t21 + app5_p_PJ_z*t22;
+  const T r_NO_N_app5_x = q[0] + t202;
+  const T r_NO_N_app5_y = q[1] + t203;
+  const T r_NO_N_app5_z = q[2] + t204;
+  const T t208 = -app5_p_J_z*u[3];
+  const T t209 = app5_p_J_x*u[5] - app5_p_J_z*u[4];
+  const T t210 = app5_p_J_x*u[3];
+  const T t211 = t208 + u[1];
+  const T t212 = t209 - u[0];
+  const T t213 = t210 + u[2];
+  const T t220 = angle_c[4]*u[4] - angle_s[4]*u[3];
+  const T t221 = -angle_c[4]*u[3] - angle_s[4]*u[4];
   const T w_B_app5_z = u[10] + u[5];
-  const T t225 = angle_c[4]*t213 + angle_s[4]*t214;
-  const T t226 = angle_c[4]*t214 - angle_s[4]*t213;
+  const T t223 = angle_c[4]*t211 + angle_s[4]*t212;
+  const T t224 = angle_c[4]*t212 - angle_s[4]*t211;
   // ---- body app6: outward pass (velocities)
   const T R_PB_app6_xx = angle_s[5]*app6_R_PJ_xy;
   const T R_PB_app6_xy = angle_c[5]*app6_R_PJ_xy;
@@ -7645,27 +7338,27 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app6_zx = R_PB_app6_xx*t20 + R_PB_app6_yx*t21 + angle_c[5]*t22;
   const T R_NB_app6_zy = R_PB_app6_xy*t20 + R_PB_app6_yy*t21 - angle_s[5]*t22;
   const T R_NB_app6_zz = app6_R_PJ_xz*t20 + app6_R_PJ_yz*t21;
-  const T t245 = app6_p_PJ_x*t14 + app6_p_PJ_y*t15 + app6_p_PJ_z*t16;
-  const T t246 = app6_p_PJ_x*t17 + app6_p_PJ_y*t18 + app6_p_PJ_z*t19;
-  const T t247 = app6_p_PJ_x*t20 + app6_p_PJ_y*t21 + app6_p_PJ_z*t22;
-  const T r_NO_N_app6_x = q[0] + t245;
-  const T r_NO_N_app6_y = q[1] + t246;
-  const T r_NO_N_app6_z = q[2] + t247;
-  const T t251 = app6_R_PJ_xy*u[3] + app6_R_PJ_yy*u[4];
-  const T t252 = app6_R_PJ_xz*u[3] + app6_R_PJ_yz*u[4];
-  const T t253 = -app6_p_J_y*t252 + app6_p_J_z*t251;
-  const T t254 = app6_p_J_x*t252 - app6_p_J_z*u[5];
-  const T t255 = -app6_p_J_x*t251 + app6_p_J_y*u[5];
-  const T t256 = app6_R_PJ_xy*u[0] + app6_R_PJ_yy*u[1];
-  const T t257 = app6_R_PJ_xz*u[0] + app6_R_PJ_yz*u[1];
-  const T t258 = t253 + u[2];
-  const T t259 = t254 + t256;
-  const T t260 = t255 + t257;
-  const T t269 = angle_c[5]*u[5] + angle_s[5]*t251;
-  const T t270 = angle_c[5]*t251 - angle_s[5]*u[5];
-  const T w_B_app6_z = t252 + u[11];
-  const T t272 = angle_c[5]*t258 + angle_s[5]*t259;
-  const T t273 = angle_c[5]*t259 - angle_s[5]*t258;
+  const T t243 = app6_p_PJ_x*t14 + app6_p_PJ_y*t15 + app6_p_PJ_z*t16;
+  const T t244 = app6_p_PJ_x*t17 + app6_p_PJ_y*t18 + app6_p_PJ_z*t19;
+  const T t245 = app6_p_PJ_x*t20 + app6_p_PJ_y*t21 + app6_p_PJ_z*t22;
+  const T r_NO_N_app6_x = q[0] + t243;
+  const T r_NO_N_app6_y = q[1] + t244;
+  const T r_NO_N_app6_z = q[2] + t245;
+  const T t249 = app6_R_PJ_xy*u[3] + app6_R_PJ_yy*u[4];
+  const T t250 = app6_R_PJ_xz*u[3] + app6_R_PJ_yz*u[4];
+  const T t251 = -app6_p_J_y*t250;
+  const T t252 = app6_p_J_x*t250;
+  const T t253 = -app6_p_J_x*t249 + app6_p_J_y*u[5];
+  const T t254 = app6_R_PJ_xy*u[0] + app6_R_PJ_yy*u[1];
+  const T t255 = app6_R_PJ_xz*u[0] + app6_R_PJ_yz*u[1];
+  const T t256 = t251 + u[2];
+  const T t257 = t252 + t254;
+  const T t258 = t253 + t255;
+  const T t267 = angle_c[5]*u[5] + angle_s[5]*t249;
+  const T t268 = angle_c[5]*t249 - angle_s[5]*u[5];
+  const T w_B_app6_z = t250 + u[11];
+  const T t270 = angle_c[5]*t256 + angle_s[5]*t257;
+  const T t271 = angle_c[5]*t257 - angle_s[5]*t256;
   // ---- body app7: outward pass (velocities)
   const T R_PB_app7_xx = angle_c[6]*app7_R_PJ_xx;
   const T R_PB_app7_xy = -angle_s[6]*app7_R_PJ_xx;
@@ -7680,27 +7373,27 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app7_zx = R_PB_app7_xx*t20 + R_PB_app7_yx*t21 - angle_s[6]*t22;
   const T R_NB_app7_zy = R_PB_app7_xy*t20 + R_PB_app7_yy*t21 - angle_c[6]*t22;
   const T R_NB_app7_zz = app7_R_PJ_xz*t20 + app7_R_PJ_yz*t21;
-  const T t292 = app7_p_PJ_x*t14 + app7_p_PJ_y*t15 + app7_p_PJ_z*t16;
-  const T t293 = app7_p_PJ_x*t17 + app7_p_PJ_y*t18 + app7_p_PJ_z*t19;
-  const T t294 = app7_p_PJ_x*t20 + app7_p_PJ_y*t21 + app7_p_PJ_z*t22;
-  const T r_NO_N_app7_x = q[0] + t292;
-  const T r_NO_N_app7_y = q[1] + t293;
-  const T r_NO_N_app7_z = q[2] + t294;
-  const T t298 = app7_R_PJ_xx*u[3] + app7_R_PJ_yx*u[4];
-  const T t299 = app7_R_PJ_xz*u[3] + app7_R_PJ_yz*u[4];
-  const T t300 = -app7_p_J_y*t299;
-  const T t301 = app7_p_J_x*t299;
-  const T t302 = app7_p_J_x*u[5] + app7_p_J_y*t298;
-  const T t303 = app7_R_PJ_xx*u[0] + app7_R_PJ_yx*u[1];
-  const T t304 = app7_R_PJ_xz*u[0] + app7_R_PJ_yz*u[1];
-  const T t305 = t300 + t303;
-  const T t306 = t301 - u[2];
-  const T t307 = t302 + t304;
-  const T t316 = angle_c[6]*t298 - angle_s[6]*u[5];
-  const T t317 = -angle_c[6]*u[5] - angle_s[6]*t298;
-  const T w_B_app7_z = t299 + u[12];
-  const T t319 = angle_c[6]*t305 + angle_s[6]*t306;
-  const T t320 = angle_c[6]*t306 - angle_s[6]*t305;
+  const T t290 = app7_p_PJ_x*t14 + app7_p_PJ_y*t15 + app7_p_PJ_z*t16;
+  const T t291 = app7_p_PJ_x*t17 + app7_p_PJ_y*t18 + app7_p_PJ_z*t19;
+  const T t292 = app7_p_PJ_x*t20 + app7_p_PJ_y*t21 + app7_p_PJ_z*t22;
+  const T r_NO_N_app7_x = q[0] + t290;
+  const T r_NO_N_app7_y = q[1] + t291;
+  const T r_NO_N_app7_z = q[2] + t292;
+  const T t296 = app7_R_PJ_xx*u[3] + app7_R_PJ_yx*u[4];
+  const T t297 = app7_R_PJ_xz*u[3] + app7_R_PJ_yz*u[4];
+  const T t298 = -app7_p_J_y*t297;
+  const T t299 = app7_p_J_x*t297;
+  const T t300 = app7_p_J_x*u[5] + app7_p_J_y*t296;
+  const T t301 = app7_R_PJ_xx*u[0] + app7_R_PJ_yx*u[1];
+  const T t302 = app7_R_PJ_xz*u[0] + app7_R_PJ_yz*u[1];
+  const T t303 = t298 + t301;
+  const T t304 = t299 - u[2];
+  const T t305 = t300 + t302;
+  const T t314 = angle_c[6]*t296 - angle_s[6]*u[5];
+  const T t315 = -angle_c[6]*u[5] - angle_s[6]*t296;
+  const T w_B_app7_z = t297 + u[12];
+  const T t317 = angle_c[6]*t303 + angle_s[6]*t304;
+  const T t318 = angle_c[6]*t304 - angle_s[6]*t303;
   // ---- body app8: outward pass (velocities)
   const T R_PB_app8_xx = angle_c[7]*app8_R_PJ_xx + angle_s[7]*app8_R_PJ_xy;
   const T R_PB_app8_xy = angle_c[7]*app8_R_PJ_xy - angle_s[7]*app8_R_PJ_xx;
@@ -7712,27 +7405,27 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app8_yy = R_PB_app8_xy*t17 + R_PB_app8_yy*t18;
   const T R_NB_app8_zx = R_PB_app8_xx*t20 + R_PB_app8_yx*t21;
   const T R_NB_app8_zy = R_PB_app8_xy*t20 + R_PB_app8_yy*t21;
-  const T t336 = app8_p_PJ_x*t14 + app8_p_PJ_y*t15 + app8_p_PJ_z*t16;
-  const T t337 = app8_p_PJ_x*t17 + app8_p_PJ_y*t18 + app8_p_PJ_z*t19;
-  const T t338 = app8_p_PJ_x*t20 + app8_p_PJ_y*t21 + app8_p_PJ_z*t22;
-  const T r_NO_N_app8_x = q[0] + t336;
-  const T r_NO_N_app8_y = q[1] + t337;
-  const T r_NO_N_app8_z = q[2] + t338;
-  const T t342 = app8_R_PJ_xx*u[3] + app8_R_PJ_yx*u[4];
-  const T t343 = app8_R_PJ_xy*u[3] + app8_R_PJ_yy*u[4];
-  const T t344 = -app8_p_J_y*u[5] + app8_p_J_z*t343;
-  const T t345 = app8_p_J_x*u[5] - app8_p_J_z*t342;
-  const T t346 = -app8_p_J_x*t343 + app8_p_J_y*t342;
-  const T t347 = app8_R_PJ_xx*u[0] + app8_R_PJ_yx*u[1];
-  const T t348 = app8_R_PJ_xy*u[0] + app8_R_PJ_yy*u[1];
-  const T t349 = t344 + t347;
-  const T t350 = t345 + t348;
-  const T t351 = t346 + u[2];
-  const T t360 = angle_c[7]*t342 + angle_s[7]*t343;
-  const T t361 = angle_c[7]*t343 - angle_s[7]*t342;
+  const T t334 = app8_p_PJ_x*t14 + app8_p_PJ_y*t15 + app8_p_PJ_z*t16;
+  const T t335 = app8_p_PJ_x*t17 + app8_p_PJ_y*t18 + app8_p_PJ_z*t19;
+  const T t336 = app8_p_PJ_x*t20 + app8_p_PJ_y*t21 + app8_p_PJ_z*t22;
+  const T r_NO_N_app8_x = q[0] + t334;
+  const T r_NO_N_app8_y = q[1] + t335;
+  const T r_NO_N_app8_z = q[2] + t336;
+  const T t340 = app8_R_PJ_xx*u[3] + app8_R_PJ_yx*u[4];
+  const T t341 = app8_R_PJ_xy*u[3] + app8_R_PJ_yy*u[4];
+  const T t342 = -app8_p_J_y*u[5] + app8_p_J_z*t341;
+  const T t343 = app8_p_J_x*u[5] - app8_p_J_z*t340;
+  const T t344 = -app8_p_J_x*t341 + app8_p_J_y*t340;
+  const T t345 = app8_R_PJ_xx*u[0] + app8_R_PJ_yx*u[1];
+  const T t346 = app8_R_PJ_xy*u[0] + app8_R_PJ_yy*u[1];
+  const T t347 = t342 + t345;
+  const T t348 = t343 + t346;
+  const T t349 = t344 + u[2];
+  const T t358 = angle_c[7]*t340 + angle_s[7]*t341;
+  const T t359 = angle_c[7]*t341 - angle_s[7]*t340;
   const T w_B_app8_z = u[13] + u[5];
-  const T t363 = angle_c[7]*t349 + angle_s[7]*t350;
-  const T t364 = angle_c[7]*t350 - angle_s[7]*t349;
+  const T t361 = angle_c[7]*t347 + angle_s[7]*t348;
+  const T t362 = angle_c[7]*t348 - angle_s[7]*t347;
   // ---- body app9: outward pass (velocities)
   const T R_NB_app9_xx = angle_c[8]*t16 + angle_s[8]*t15;
   const T R_NB_app9_xy = angle_c[8]*t15 - angle_s[8]*t16;
@@ -7740,23 +7433,21 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app9_yy = angle_c[8]*t18 - angle_s[8]*t19;
   const T R_NB_app9_zx = angle_c[8]*t22 + angle_s[8]*t21;
   const T R_NB_app9_zy = angle_c[8]*t21 - angle_s[8]*t22;
-  const T t376 = app9_p_PJ_x*t14 + app9_p_PJ_z*t16;
-  const T t377 = app9_p_PJ_x*t17 + app9_p_PJ_z*t19;
-  const T t378 = app9_p_PJ_x*t20 + app9_p_PJ_z*t22;
-  const T r_NO_N_app9_x = q[0] + t376;
-  const T r_NO_N_app9_y = q[1] + t377;
-  const T r_NO_N_app9_z = q[2] + t378;
-  const T t382 = app9_p_J_z*u[4];
-  const T t383 = -app9_p_J_x*u[3] - app9_p_J_z*u[5];
-  const T t384 = -app9_p_J_x*u[4];
-  const T t385 = t382 + u[2];
-  const T t386 = t383 + u[1];
-  const T t387 = t384 - u[0];
-  const T t394 = angle_c[8]*u[5] + angle_s[8]*u[4];
-  const T t395 = angle_c[8]*u[4] - angle_s[8]*u[5];
+  const T t374 = app9_p_PJ_z*t16;
+  const T t375 = app9_p_PJ_z*t19;
+  const T t376 = app9_p_PJ_z*t22;
+  const T r_NO_N_app9_x = q[0] + t374;
+  const T r_NO_N_app9_y = q[1] + t375;
+  const T r_NO_N_app9_z = q[2] + t376;
+  const T t380 = -app9_p_J_x*u[3];
+  const T t381 = -app9_p_J_x*u[4];
+  const T t382 = t380 + u[1];
+  const T t383 = t381 - u[0];
+  const T t390 = angle_c[8]*u[5] + angle_s[8]*u[4];
+  const T t391 = angle_c[8]*u[4] - angle_s[8]*u[5];
   const T w_B_app9_z = u[14] - u[3];
-  const T t397 = angle_c[8]*t385 + angle_s[8]*t386;
-  const T t398 = angle_c[8]*t386 - angle_s[8]*t385;
+  const T t393 = angle_c[8]*u[2] + angle_s[8]*t382;
+  const T t394 = angle_c[8]*t382 - angle_s[8]*u[2];
   // ---- body app10: outward pass (velocities)
   const T R_PB_app10_xx = angle_c[9]*app10_R_PJ_xx;
   const T R_PB_app10_xy = -angle_s[9]*app10_R_PJ_xx;
@@ -7771,27 +7462,27 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app10_zx = R_PB_app10_xx*t20 + R_PB_app10_yx*t21 - angle_s[9]*t22;
   const T R_NB_app10_zy = R_PB_app10_xy*t20 + R_PB_app10_yy*t21 - angle_c[9]*t22;
   const T R_NB_app10_zz = app10_R_PJ_xz*t20 + app10_R_PJ_yz*t21;
-  const T t417 = app10_p_PJ_x*t14 + app10_p_PJ_y*t15 + app10_p_PJ_z*t16;
-  const T t418 = app10_p_PJ_x*t17 + app10_p_PJ_y*t18 + app10_p_PJ_z*t19;
-  const T t419 = app10_p_PJ_x*t20 + app10_p_PJ_y*t21 + app10_p_PJ_z*t22;
-  const T r_NO_N_app10_x = q[0] + t417;
-  const T r_NO_N_app10_y = q[1] + t418;
-  const T r_NO_N_app10_z = q[2] + t419;
-  const T t423 = app10_R_PJ_xx*u[3] + app10_R_PJ_yx*u[4];
-  const T t424 = app10_R_PJ_xz*u[3] + app10_R_PJ_yz*u[4];
-  const T t425 = -app10_p_J_y*t424 - app10_p_J_z*u[5];
-  const T t426 = app10_p_J_x*t424 - app10_p_J_z*t423;
-  const T t427 = app10_p_J_x*u[5] + app10_p_J_y*t423;
-  const T t428 = app10_R_PJ_xx*u[0] + app10_R_PJ_yx*u[1];
-  const T t429 = app10_R_PJ_xz*u[0] + app10_R_PJ_yz*u[1];
-  const T t430 = t425 + t428;
-  const T t431 = t426 - u[2];
-  const T t432 = t427 + t429;
-  const T t441 = angle_c[9]*t423 - angle_s[9]*u[5];
-  const T t442 = -angle_c[9]*u[5] - angle_s[9]*t423;
-  const T w_B_app10_z = t424 + u[15];
-  const T t444 = angle_c[9]*t430 + angle_s[9]*t431;
-  const T t445 = angle_c[9]*t431 - angle_s[9]*t430;
+  const T t413 = app10_p_PJ_x*t14 + app10_p_PJ_y*t15 + app10_p_PJ_z*t16;
+  const T t414 = app10_p_PJ_x*t17 + app10_p_PJ_y*t18 + app10_p_PJ_z*t19;
+  const T t415 = app10_p_PJ_x*t20 + app10_p_PJ_y*t21 + app10_p_PJ_z*t22;
+  const T r_NO_N_app10_x = q[0] + t413;
+  const T r_NO_N_app10_y = q[1] + t414;
+  const T r_NO_N_app10_z = q[2] + t415;
+  const T t419 = app10_R_PJ_xx*u[3] + app10_R_PJ_yx*u[4];
+  const T t420 = app10_R_PJ_xz*u[3] + app10_R_PJ_yz*u[4];
+  const T t421 = -app10_p_J_y*t420 - app10_p_J_z*u[5];
+  const T t422 = app10_p_J_x*t420 - app10_p_J_z*t419;
+  const T t423 = app10_p_J_x*u[5] + app10_p_J_y*t419;
+  const T t424 = app10_R_PJ_xx*u[0] + app10_R_PJ_yx*u[1];
+  const T t425 = app10_R_PJ_xz*u[0] + app10_R_PJ_yz*u[1];
+  const T t426 = t421 + t424;
+  const T t427 = t422 - u[2];
+  const T t428 = t423 + t425;
+  const T t437 = angle_c[9]*t419 - angle_s[9]*u[5];
+  const T t438 = -angle_c[9]*u[5] - angle_s[9]*t419;
+  const T w_B_app10_z = t420 + u[15];
+  const T t440 = angle_c[9]*t426 + angle_s[9]*t427;
+  const T t441 = angle_c[9]*t427 - angle_s[9]*t426;
   // ---- body app11: outward pass (velocities)
   const T R_PB_app11_xx = angle_c[10]*app11_R_PJ_xx + angle_s[10]*app11_R_PJ_xy;
   const T R_PB_app11_xy = angle_c[10]*app11_R_PJ_xy - angle_s[10]*app11_R_PJ_xx;
@@ -7803,27 +7494,27 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app11_yy = R_PB_app11_xy*t17 + R_PB_app11_yy*t18;
   const T R_NB_app11_zx = R_PB_app11_xx*t20 + R_PB_app11_yx*t21;
   const T R_NB_app11_zy = R_PB_app11_xy*t20 + R_PB_app11_yy*t21;
-  const T t461 = app11_p_PJ_x*t14 + app11_p_PJ_y*t15 + app11_p_PJ_z*t16;
-  const T t462 = app11_p_PJ_x*t17 + app11_p_PJ_y*t18 + app11_p_PJ_z*t19;
-  const T t463 = app11_p_PJ_x*t20 + app11_p_PJ_y*t21 + app11_p_PJ_z*t22;
-  const T r_NO_N_app11_x = q[0] + t461;
-  const T r_NO_N_app11_y = q[1] + t462;
-  const T r_NO_N_app11_z = q[2] + t463;
-  const T t467 = app11_R_PJ_xx*u[3] + app11_R_PJ_yx*u[4];
-  const T t468 = app11_R_PJ_xy*u[3] + app11_R_PJ_yy*u[4];
-  const T t469 = app11_p_J_z*t468;
-  const T t470 = app11_p_J_x*u[5] - app11_p_J_z*t467;
-  const T t471 = -app11_p_J_x*t468;
-  const T t472 = app11_R_PJ_xx*u[0] + app11_R_PJ_yx*u[1];
-  const T t473 = app11_R_PJ_xy*u[0] + app11_R_PJ_yy*u[1];
-  const T t474 = t469 + t472;
-  const T t475 = t470 + t473;
-  const T t476 = t471 + u[2];
-  const T t485 = angle_c[10]*t467 + angle_s[10]*t468;
-  const T t486 = angle_c[10]*t468 - angle_s[10]*t467;
+  const T t457 = app11_p_PJ_x*t14 + app11_p_PJ_y*t15 + app11_p_PJ_z*t16;
+  const T t458 = app11_p_PJ_x*t17 + app11_p_PJ_y*t18 + app11_p_PJ_z*t19;
+  const T t459 = app11_p_PJ_x*t20 + app11_p_PJ_y*t21 + app11_p_PJ_z*t22;
+  const T r_NO_N_app11_x = q[0] + t457;
+  const T r_NO_N_app11_y = q[1] + t458;
+  const T r_NO_N_app11_z = q[2] + t459;
+  const T t463 = app11_R_PJ_xx*u[3] + app11_R_PJ_yx*u[4];
+  const T t464 = app11_R_PJ_xy*u[3] + app11_R_PJ_yy*u[4];
+  const T t465 = app11_p_J_z*t464;
+  const T t466 = app11_p_J_x*u[5] - app11_p_J_z*t463;
+  const T t467 = -app11_p_J_x*t464;
+  const T t468 = app11_R_PJ_xx*u[0] + app11_R_PJ_yx*u[1];
+  const T t469 = app11_R_PJ_xy*u[0] + app11_R_PJ_yy*u[1];
+  const T t470 = t465 + t468;
+  const T t471 = t466 + t469;
+  const T t472 = t467 + u[2];
+  const T t481 = angle_c[10]*t463 + angle_s[10]*t464;
+  const T t482 = angle_c[10]*t464 - angle_s[10]*t463;
   const T w_B_app11_z = u[16] + u[5];
-  const T t488 = angle_c[10]*t474 + angle_s[10]*t475;
-  const T t489 = angle_c[10]*t475 - angle_s[10]*t474;
+  const T t484 = angle_c[10]*t470 + angle_s[10]*t471;
+  const T t485 = angle_c[10]*t471 - angle_s[10]*t470;
   // ---- body app12: outward pass (velocities)
   const T R_PB_app12_xx = angle_s[11]*app12_R_PJ_xy;
   const T R_PB_app12_xy = angle_c[11]*app12_R_PJ_xy;
@@ -7838,27 +7529,27 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app12_zx = R_PB_app12_xx*t20 + R_PB_app12_yx*t21 + angle_c[11]*t22;
   const T R_NB_app12_zy = R_PB_app12_xy*t20 + R_PB_app12_yy*t21 - angle_s[11]*t22;
   const T R_NB_app12_zz = app12_R_PJ_xz*t20 + app12_R_PJ_yz*t21;
-  const T t508 = app12_p_PJ_x*t14 + app12_p_PJ_y*t15 + app12_p_PJ_z*t16;
-  const T t509 = app12_p_PJ_x*t17 + app12_p_PJ_y*t18 + app12_p_PJ_z*t19;
-  const T t510 = app12_p_PJ_x*t20 + app12_p_PJ_y*t21 + app12_p_PJ_z*t22;
-  const T r_NO_N_app12_x = q[0] + t508;
-  const T r_NO_N_app12_y = q[1] + t509;
-  const T r_NO_N_app12_z = q[2] + t510;
-  const T t514 = app12_R_PJ_xy*u[3] + app12_R_PJ_yy*u[4];
-  const T t515 = app12_R_PJ_xz*u[3] + app12_R_PJ_yz*u[4];
-  const T t516 = -app12_p_J_y*t515 + app12_p_J_z*t514;
-  const T t517 = app12_p_J_x*t515 - app12_p_J_z*u[5];
-  const T t518 = -app12_p_J_x*t514 + app12_p_J_y*u[5];
-  const T t519 = app12_R_PJ_xy*u[0] + app12_R_PJ_yy*u[1];
-  const T t520 = app12_R_PJ_xz*u[0] + app12_R_PJ_yz*u[1];
-  const T t521 = t516 + u[2];
-  const T t522 = t517 + t519;
-  const T t523 = t518 + t520;
-  const T t532 = angle_c[11]*u[5] + angle_s[11]*t514;
-  const T t533 = angle_c[11]*t514 - angle_s[11]*u[5];
-  const T w_B_app12_z = t515 + u[17];
-  const T t535 = angle_c[11]*t521 + angle_s[11]*t522;
-  const T t536 = angle_c[11]*t522 - angle_s[11]*t521;
+  const T t504 = app12_p_PJ_x*t14 + app12_p_PJ_y*t15 + app12_p_PJ_z*t16;
+  const T t505 = app12_p_PJ_x*t17 + app12_p_PJ_y*t18 + app12_p_PJ_z*t19;
+  const T t506 = app12_p_PJ_x*t20 + app12_p_PJ_y*t21 + app12_p_PJ_z*t22;
+  const T r_NO_N_app12_x = q[0] + t504;
+  const T r_NO_N_app12_y = q[1] + t505;
+  const T r_NO_N_app12_z = q[2] + t506;
+  const T t510 = app12_R_PJ_xy*u[3] + app12_R_PJ_yy*u[4];
+  const T t511 = app12_R_PJ_xz*u[3] + app12_R_PJ_yz*u[4];
+  const T t512 = -app12_p_J_y*t511;
+  const T t513 = app12_p_J_x*t511;
+  const T t514 = -app12_p_J_x*t510 + app12_p_J_y*u[5];
+  const T t515 = app12_R_PJ_xy*u[0] + app12_R_PJ_yy*u[1];
+  const T t516 = app12_R_PJ_xz*u[0] + app12_R_PJ_yz*u[1];
+  const T t517 = t512 + u[2];
+  const T t518 = t513 + t515;
+  const T t519 = t514 + t516;
+  const T t528 = angle_c[11]*u[5] + angle_s[11]*t510;
+  const T t529 = angle_c[11]*t510 - angle_s[11]*u[5];
+  const T w_B_app12_z = t511 + u[17];
+  const T t531 = angle_c[11]*t517 + angle_s[11]*t518;
+  const T t532 = angle_c[11]*t518 - angle_s[11]*t517;
   // ---- body app13: outward pass (velocities)
   const T R_NB_app13_xx = -angle_c[12]*t15 - angle_s[12]*t16;
   const T R_NB_app13_xy = -angle_c[12]*t16 + angle_s[12]*t15;
@@ -7866,23 +7557,23 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app13_yy = -angle_c[12]*t19 + angle_s[12]*t18;
   const T R_NB_app13_zx = -angle_c[12]*t21 - angle_s[12]*t22;
   const T R_NB_app13_zy = -angle_c[12]*t22 + angle_s[12]*t21;
-  const T t548 = app13_p_PJ_y*t15 + app13_p_PJ_z*t16;
-  const T t549 = app13_p_PJ_y*t18 + app13_p_PJ_z*t19;
-  const T t550 = app13_p_PJ_y*t21 + app13_p_PJ_z*t22;
-  const T r_NO_N_app13_x = q[0] + t548;
-  const T r_NO_N_app13_y = q[1] + t549;
-  const T r_NO_N_app13_z = q[2] + t550;
-  const T t554 = -app13_p_J_y*u[3];
-  const T t555 = app13_p_J_x*u[3];
-  const T t556 = app13_p_J_x*u[5] - app13_p_J_y*u[4];
-  const T t557 = t554 - u[1];
-  const T t558 = t555 - u[2];
-  const T t559 = t556 + u[0];
-  const T t566 = -angle_c[12]*u[4] - angle_s[12]*u[5];
-  const T t567 = -angle_c[12]*u[5] + angle_s[12]*u[4];
+  const T t544 = app13_p_PJ_y*t15 + app13_p_PJ_z*t16;
+  const T t545 = app13_p_PJ_y*t18 + app13_p_PJ_z*t19;
+  const T t546 = app13_p_PJ_y*t21 + app13_p_PJ_z*t22;
+  const T r_NO_N_app13_x = q[0] + t544;
+  const T r_NO_N_app13_y = q[1] + t545;
+  const T r_NO_N_app13_z = q[2] + t546;
+  const T t550 = -app13_p_J_y*u[3];
+  const T t551 = app13_p_J_x*u[3];
+  const T t552 = app13_p_J_x*u[5] - app13_p_J_y*u[4];
+  const T t553 = t550 - u[1];
+  const T t554 = t551 - u[2];
+  const T t555 = t552 + u[0];
+  const T t562 = -angle_c[12]*u[4] - angle_s[12]*u[5];
+  const T t563 = -angle_c[12]*u[5] + angle_s[12]*u[4];
   const T w_B_app13_z = u[18] + u[3];
-  const T t569 = angle_c[12]*t557 + angle_s[12]*t558;
-  const T t570 = angle_c[12]*t558 - angle_s[12]*t557;
+  const T t565 = angle_c[12]*t553 + angle_s[12]*t554;
+  const T t566 = angle_c[12]*t554 - angle_s[12]*t553;
   // ---- body app14: outward pass (velocities)
   const T R_PB_app14_xx = angle_c[13]*app14_R_PJ_xx + angle_s[13]*app14_R_PJ_xy;
   const T R_PB_app14_xy = angle_c[13]*app14_R_PJ_xy - angle_s[13]*app14_R_PJ_xx;
@@ -7894,27 +7585,27 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app14_yy = R_PB_app14_xy*t17 + R_PB_app14_yy*t18;
   const T R_NB_app14_zx = R_PB_app14_xx*t20 + R_PB_app14_yx*t21;
   const T R_NB_app14_zy = R_PB_app14_xy*t20 + R_PB_app14_yy*t21;
-  const T t586 = app14_p_PJ_x*t14 + app14_p_PJ_y*t15 + app14_p_PJ_z*t16;
-  const T t587 = app14_p_PJ_x*t17 + app14_p_PJ_y*t18 + app14_p_PJ_z*t19;
-  const T t588 = app14_p_PJ_x*t20 + app14_p_PJ_y*t21 + app14_p_PJ_z*t22;
-  const T r_NO_N_app14_x = q[0] + t586;
-  const T r_NO_N_app14_y = q[1] + t587;
-  const T r_NO_N_app14_z = q[2] + t588;
-  const T t592 = app14_R_PJ_xx*u[3] + app14_R_PJ_yx*u[4];
-  const T t593 = app14_R_PJ_xy*u[3] + app14_R_PJ_yy*u[4];
-  const T t594 = -app14_p_J_y*u[5] + app14_p_J_z*t593;
-  const T t595 = app14_p_J_x*u[5] - app14_p_J_z*t592;
-  const T t596 = -app14_p_J_x*t593 + app14_p_J_y*t592;
-  const T t597 = app14_R_PJ_xx*u[0] + app14_R_PJ_yx*u[1];
-  const T t598 = app14_R_PJ_xy*u[0] + app14_R_PJ_yy*u[1];
-  const T t599 = t594 + t597;
-  const T t600 = t595 + t598;
-  const T t601 = t596 + u[2];
-  const T t610 = angle_c[13]*t592 + angle_s[13]*t593;
-  const T t611 = angle_c[13]*t593 - angle_s[13]*t592;
+  const T t582 = app14_p_PJ_x*t14 + app14_p_PJ_y*t15 + app14_p_PJ_z*t16;
+  const T t583 = app14_p_PJ_x*t17 + app14_p_PJ_y*t18 + app14_p_PJ_z*t19;
+  const T t584 = app14_p_PJ_x*t20 + app14_p_PJ_y*t21 + app14_p_PJ_z*t22;
+  const T r_NO_N_app14_x = q[0] + t582;
+  const T r_NO_N_app14_y = q[1] + t583;
+  const T r_NO_N_app14_z = q[2] + t584;
+  const T t588 = app14_R_PJ_xx*u[3] + app14_R_PJ_yx*u[4];
+  const T t589 = app14_R_PJ_xy*u[3] + app14_R_PJ_yy*u[4];
+  const T t590 = -app14_p_J_y*u[5] + app14_p_J_z*t589;
+  const T t591 = app14_p_J_x*u[5] - app14_p_J_z*t588;
+  const T t592 = -app14_p_J_x*t589 + app14_p_J_y*t588;
+  const T t593 = app14_R_PJ_xx*u[0] + app14_R_PJ_yx*u[1];
+  const T t594 = app14_R_PJ_xy*u[0] + app14_R_PJ_yy*u[1];
+  const T t595 = t590 + t593;
+  const T t596 = t591 + t594;
+  const T t597 = t592 + u[2];
+  const T t606 = angle_c[13]*t588 + angle_s[13]*t589;
+  const T t607 = angle_c[13]*t589 - angle_s[13]*t588;
   const T w_B_app14_z = u[19] + u[5];
-  const T t613 = angle_c[13]*t599 + angle_s[13]*t600;
-  const T t614 = angle_c[13]*t600 - angle_s[13]*t599;
+  const T t609 = angle_c[13]*t595 + angle_s[13]*t596;
+  const T t610 = angle_c[13]*t596 - angle_s[13]*t595;
   // ---- body app15: outward pass (velocities)
   const T R_PB_app15_xx = angle_s[14]*app15_R_PJ_xy;
   const T R_PB_app15_xy = angle_c[14]*app15_R_PJ_xy;
@@ -7929,27 +7620,25 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app15_zx = R_PB_app15_xx*t20 + R_PB_app15_yx*t21 + angle_c[14]*t22;
   const T R_NB_app15_zy = R_PB_app15_xy*t20 + R_PB_app15_yy*t21 - angle_s[14]*t22;
   const T R_NB_app15_zz = app15_R_PJ_xz*t20 + app15_R_PJ_yz*t21;
-  const T t633 = app15_p_PJ_x*t14 + app15_p_PJ_y*t15 + app15_p_PJ_z*t16;
-  const T t634 = app15_p_PJ_x*t17 + app15_p_PJ_y*t18 + app15_p_PJ_z*t19;
-  const T t635 = app15_p_PJ_x*t20 + app15_p_PJ_y*t21 + app15_p_PJ_z*t22;
-  const T r_NO_N_app15_x = q[0] + t633;
-  const T r_NO_N_app15_y = q[1] + t634;
-  const T r_NO_N_app15_z = q[2] + t635;
-  const T t639 = app15_R_PJ_xy*u[3] + app15_R_PJ_yy*u[4];
-  const T t640 = app15_R_PJ_xz*u[3] + app15_R_PJ_yz*u[4];
-  const T t641 = app15_p_J_z*t639;
-  const T t642 = app15_p_J_x*t640 - app15_p_J_z*u[5];
-  const T t643 = -app15_p_J_x*t639;
-  const T t644 = app15_R_PJ_xy*u[0] + app15_R_PJ_yy*u[1];
-  const T t645 = app15_R_PJ_xz*u[0] + app15_R_PJ_yz*u[1];
-  const T t646 = t641 + u[2];
-  const T t647 = t642 + t644;
-  const T t648 = t643 + t645;
-  const T t657 = angle_c[14]*u[5] + angle_s[14]*t639;
-  const T t658 = angle_c[14]*t639 - angle_s[14]*u[5];
-  const T w_B_app15_z = t640 + u[20];
-  const T t660 = angle_c[14]*t646 + angle_s[14]*t647;
-  const T t661 = angle_c[14]*t647 - angle_s[14]*t646;
+  const T t629 = app15_p_PJ_z*t16;
+  const T t630 = app15_p_PJ_z*t19;
+  const T t631 = app15_p_PJ_z*t22;
+  const T r_NO_N_app15_x = q[0] + t629;
+  const T r_NO_N_app15_y = q[1] + t630;
+  const T r_NO_N_app15_z = q[2] + t631;
+  const T t635 = app15_R_PJ_xy*u[3] + app15_R_PJ_yy*u[4];
+  const T t636 = app15_R_PJ_xz*u[3] + app15_R_PJ_yz*u[4];
+  const T t637 = app15_p_J_x*t636;
+  const T t638 = -app15_p_J_x*t635;
+  const T t639 = app15_R_PJ_xy*u[0] + app15_R_PJ_yy*u[1];
+  const T t640 = app15_R_PJ_xz*u[0] + app15_R_PJ_yz*u[1];
+  const T t641 = t637 + t639;
+  const T t642 = t638 + t640;
+  const T t651 = angle_c[14]*u[5] + angle_s[14]*t635;
+  const T t652 = angle_c[14]*t635 - angle_s[14]*u[5];
+  const T w_B_app15_z = t636 + u[20];
+  const T t654 = angle_c[14]*u[2] + angle_s[14]*t641;
+  const T t655 = angle_c[14]*t641 - angle_s[14]*u[2];
   // ---- body app16: outward pass (velocities)
   const T R_PB_app16_xx = angle_c[15]*app16_R_PJ_xx;
   const T R_PB_app16_xy = -angle_s[15]*app16_R_PJ_xx;
@@ -7964,446 +7653,446 @@ void momentum(const T* q, const T* u, T* pH) {
   const T R_NB_app16_zx = R_PB_app16_xx*t20 + R_PB_app16_yx*t21 - angle_s[15]*t22;
   const T R_NB_app16_zy = R_PB_app16_xy*t20 + R_PB_app16_yy*t21 - angle_c[15]*t22;
   const T R_NB_app16_zz = app16_R_PJ_xz*t20 + app16_R_PJ_yz*t21;
-  const T t680 = app16_p_PJ_x*t14 + app16_p_PJ_y*t15 + app16_p_PJ_z*t16;
-  const T t681 = app16_p_PJ_x*t17 + app16_p_PJ_y*t18 + app16_p_PJ_z*t19;
-  const T t682 = app16_p_PJ_x*t20 + app16_p_PJ_y*t21 + app16_p_PJ_z*t22;
-  const T r_NO_N_app16_x = q[0] + t680;
-  const T r_NO_N_app16_y = q[1] + t681;
-  const T r_NO_N_app16_z = q[2] + t682;
-  const T t686 = app16_R_PJ_xx*u[3] + app16_R_PJ_yx*u[4];
-  const T t687 = app16_R_PJ_xz*u[3] + app16_R_PJ_yz*u[4];
-  const T t688 = -app16_p_J_y*t687 - app16_p_J_z*u[5];
-  const T t689 = app16_p_J_x*t687 - app16_p_J_z*t686;
-  const T t690 = app16_p_J_x*u[5] + app16_p_J_y*t686;
-  const T t691 = app16_R_PJ_xx*u[0] + app16_R_PJ_yx*u[1];
-  const T t692 = app16_R_PJ_xz*u[0] + app16_R_PJ_yz*u[1];
-  const T t693 = t688 + t691;
-  const T t694 = t689 - u[2];
-  const T t695 = t690 + t692;
-  const T t704 = angle_c[15]*t686 - angle_s[15]*u[5];
-  const T t705 = -angle_c[15]*u[5] - angle_s[15]*t686;
-  const T w_B_app16_z = t687 + u[21];
-  const T t707 = angle_c[15]*t693 + angle_s[15]*t694;
-  const T t708 = angle_c[15]*t694 - angle_s[15]*t693;
+  const T t674 = app16_p_PJ_x*t14 + app16_p_PJ_y*t15 + app16_p_PJ_z*t16;
+  const T t675 = app16_p_PJ_x*t17 + app16_p_PJ_y*t18 + app16_p_PJ_z*t19;
+  const T t676 = app16_p_PJ_x*t20 + app16_p_PJ_y*t21 + app16_p_PJ_z*t22;
+  const T r_NO_N_app16_x = q[0] + t674;
+  const T r_NO_N_app16_y = q[1] + t675;
+  const T r_NO_N_app16_z = q[2] + t676;
+  const T t680 = app16_R_PJ_xx*u[3] + app16_R_PJ_yx*u[4];
+  const T t681 = app16_R_PJ_xz*u[3] + app16_R_PJ_yz*u[4];
+  const T t682 = -app16_p_J_y*t681 - app16_p_J_z*u[5];
+  const T t683 = app16_p_J_x*t681 - app16_p_J_z*t680;
+  const T t684 = app16_p_J_x*u[5] + app16_p_J_y*t680;
+  const T t685 = app16_R_PJ_xx*u[0] + app16_R_PJ_yx*u[1];
+  const T t686 = app16_R_PJ_xz*u[0] + app16_R_PJ_yz*u[1];
+  const T t687 = t682 + t685;
+  const T t688 = t683 - u[2];
+  const T t689 = t684 + t686;
+  const T t698 = angle_c[15]*t680 - angle_s[15]*u[5];
+  const T t699 = -angle_c[15]*u[5] - angle_s[15]*t680;
+  const T w_B_app16_z = t681 + u[21];
+  const T t701 = angle_c[15]*t687 + angle_s[15]*t688;
+  const T t702 = angle_c[15]*t688 - angle_s[15]*t687;
   // ---- body app1: mass and velocity terms
-  const T t731 = app1_J0_xx*t50;
+  const T t725 = app1_J0_xx*t50;
   // ---- body app2: mass and velocity terms
-  const T t742 = app2_J0_xx*t94;
+  const T t736 = app2_J0_xx*t94;
   // ---- body app4: mass and velocity terms
-  const T t765 = app4_J0_xx*t188;
+  const T t759 = app4_J0_xx*t186;
   // ---- body app5: mass and velocity terms
-  const T t776 = app5_J0_xx*t222;
+  const T t770 = app5_J0_xx*t220;
   // ---- body app7: mass and velocity terms
-  const T t799 = app7_J0_xx*t316;
+  const T t793 = app7_J0_xx*t314;
   // ---- body app8: mass and velocity terms
-  const T t810 = app8_J0_xx*t360;
+  const T t804 = app8_J0_xx*t358;
   // ---- body app10: mass and velocity terms
-  const T t833 = app10_J0_xx*t441;
+  const T t827 = app10_J0_xx*t437;
   // ---- body app11: mass and velocity terms
-  const T t844 = app11_J0_xx*t485;
+  const T t838 = app11_J0_xx*t481;
   // ---- body app13: mass and velocity terms
-  const T t867 = app13_J0_xx*t566;
+  const T t861 = app13_J0_xx*t562;
   // ---- body app14: mass and velocity terms
-  const T t878 = app14_J0_xx*t610;
+  const T t872 = app14_J0_xx*t606;
   // ---- body app16: mass and velocity terms
-  const T t901 = app16_J0_xx*t704;
-  const T t907 = -hub_S0_y*u[5] + hub_mass*u[0];
-  const T t908 = hub_S0_x*u[5] + hub_mass*u[1];
-  const T t909 = -hub_S0_x*u[4] + hub_S0_y*u[3] + hub_mass*u[2];
-  const T t910 = (hub_J0_xx*u[3] + hub_J0_xy*u[4]) + (hub_J0_xz*u[5] + hub_S0_y*u[2]);
-  const T t911 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + hub_J0_yz*u[5]) - hub_S0_x*u[2];
-  const T t912 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + (hub_J0_zz*u[5] + hub_S0_x*u[1])) - hub_S0_y*u[0];
-  const T t913 = t14*t907 + t15*t908 + t16*t909;
-  const T t914 = t17*t907 + t18*t908 + t19*t909;
-  const T t915 = t20*t907 + t21*t908 + t22*t909;
-  const T t916 = t14*t910 + t15*t911 + t16*t912;
-  const T t917 = t17*t910 + t18*t911 + t19*t912;
-  const T t918 = t20*t910 + t21*t911 + t22*t912;
-  const T t919 = q[1]*t915 - q[2]*t914;
-  const T t920 = -q[0]*t915 + q[2]*t913;
-  const T t921 = q[0]*t914 - q[1]*t913;
-  const T t922 = t916 + t919;
-  const T t923 = t917 + t920;
-  const T t924 = t918 + t921;
-  const T t925 = app1_mass*t53;
-  const T t926 = app1_S0_x*w_B_app1_z + app1_mass*t54;
-  const T t927 = -app1_S0_x*t51 + app1_mass*t43;
-  const T t928 = app1_J0_yy*t51 - app1_S0_x*t43;
-  const T t929 = app1_J0_zz*w_B_app1_z + app1_S0_x*t54;
-  const T t930 = R_NB_app1_xx*t925 + R_NB_app1_xy*t926 + t15*t927;
-  const T t931 = R_NB_app1_yx*t925 + R_NB_app1_yy*t926 + t18*t927;
-  const T t932 = R_NB_app1_zx*t925 + R_NB_app1_zy*t926 + t21*t927;
-  const T t933 = R_NB_app1_xx*t731 + R_NB_app1_xy*t928 + t15*t929;
-  const T t934 = R_NB_app1_yx*t731 + R_NB_app1_yy*t928 + t18*t929;
-  const T t935 = R_NB_app1_zx*t731 + R_NB_app1_zy*t928 + t21*t929;
-  const T t936 = r_NO_N_app1_y*t932 - r_NO_N_app1_z*t931;
-  const T t937 = -r_NO_N_app1_x*t932 + r_NO_N_app1_z*t930;
-  const T t938 = r_NO_N_app1_x*t931 - r_NO_N_app1_y*t930;
-  const T t939 = t933 + t936;
-  const T t940 = t934 + t937;
-  const T t941 = t935 + t938;
-  const T t942 = t913 + t930;
-  const T t943 = t914 + t931;
-  const T t944 = t915 + t932;
-  const T t945 = t922 + t939;
-  const T t946 = t923 + t940;
-  const T t947 = t924 + t941;
-  const T t948 = app2_mass*t97;
-  const T t949 = app2_S0_x*w_B_app2_z + app2_mass*t98;
-  const T t950 = -app2_S0_x*t95 + app2_mass*t85;
-  const T t951 = app2_J0_yy*t95 - app2_S0_x*t85;
-  const T t952 = app2_J0_zz*w_B_app2_z + app2_S0_x*t98;
-  const T t953 = R_NB_app2_xx*t948 + R_NB_app2_xy*t949 + t16*t950;
-  const T t954 = R_NB_app2_yx*t948 + R_NB_app2_yy*t949 + t19*t950;
-  const T t955 = R_NB_app2_zx*t948 + R_NB_app2_zy*t949 + t22*t950;
-  const T t956 = R_NB_app2_xx*t742 + R_NB_app2_xy*t951 + t16*t952;
-  const T t957 = R_NB_app2_yx*t742 + R_NB_app2_yy*t951 + t19*t952;
-  const T t958 = R_NB_app2_zx*t742 + R_NB_app2_zy*t951 + t22*t952;
-  const T t959 = r_NO_N_app2_y*t955 - r_NO_N_app2_z*t954;
-  const T t960 = -r_NO_N_app2_x*t955 + r_NO_N_app2_z*t953;
-  const T t961 = r_NO_N_app2_x*t954 - r_NO_N_app2_y*t953;
-  const T t962 = t956 + t959;
-  const T t963 = t957 + t960;
-  const T t964 = t958 + t961;
-  const T t965 = t942 + t953;
-  const T t966 = t943 + t954;
-  const T t967 = t944 + t955;
-  const T t968 = t945 + t962;
-  const T t969 = t946 + t963;
-  const T t970 = t947 + t964;
-  const T t971 = app3_S0_z*t142 + app3_mass*t144;
-  const T t972 = app3_S0_x*w_B_app3_z - app3_S0_z*t141 + app3_mass*t145;
-  const T t973 = -app3_S0_x*t142 + app3_mass*t132;
-  const T t974 = app3_J0_xx*t141 + app3_J0_xz*w_B_app3_z - app3_S0_z*t145;
-  const T t975 = app3_J0_yy*t142 - app3_S0_x*t132 + app3_S0_z*t144;
-  const T t976 = app3_J0_xz*t141 + app3_J0_zz*w_B_app3_z + app3_S0_x*t145;
-  const T t977 = R_NB_app3_xx*t971 + R_NB_app3_xy*t972 + R_NB_app3_xz*t973;
-  const T t978 = R_NB_app3_yx*t971 + R_NB_app3_yy*t972 + R_NB_app3_yz*t973;
-  const T t979 = R_NB_app3_zx*t971 + R_NB_app3_zy*t972 + R_NB_app3_zz*t973;
-  const T t980 = R_NB_app3_xx*t974 + R_NB_app3_xy*t975 + R_NB_app3_xz*t976;
-  const T t981 = R_NB_app3_yx*t974 + R_NB_app3_yy*t975 + R_NB_app3_yz*t976;
-  const T t982 = R_NB_app3_zx*t974 + R_NB_app3_zy*t975 + R_NB_app3_zz*t976;
-  const T t983 = r_NO_N_app3_y*t979 - r_NO_N_app3_z*t978;
-  const T t984 = -r_NO_N_app3_x*t979 + r_NO_N_app3_z*t977;
-  const T t985 = r_NO_N_app3_x*t978 - r_NO_N_app3_y*t977;
-  const T t986 = t980 + t983;
-  const T t987 = t981 + t984;
-  const T t988 = t982 + t985;
-  const T t989 = t965 + t977;
-  const T t990 = t966 + t978;
-  const T t991 = t967 + t979;
-  const T t992 = t968 + t986;
-  const T t993 = t969 + t987;
-  const T t994 = t970 + t988;
-  const T t995 = app4_mass*t191;
-  const T t996 = app4_S0_x*w_B_app4_z + app4_mass*t192;
-  const T t997 = -app4_S0_x*t189 + app4_mass*t179;
-  const T t998 = app4_J0_yy*t189 - app4_S0_x*t179;
-  const T t999 = app4_J0_zz*w_B_app4_z + app4_S0_x*t192;
-  const T t1000 = R_NB_app4_xx*t995 + R_NB_app4_xy*t996 + R_NB_app4_xz*t997;
-  const T t1001 = R_NB_app4_yx*t995 + R_NB_app4_yy*t996 + R_NB_app4_yz*t997;
-  const T t1002 = R_NB_app4_zx*t995 + R_NB_app4_zy*t996 + R_NB_app4_zz*t997;
-  const T t1003 = R_NB_app4_xx*t765 + R_NB_app4_xy*t998 + R_NB_app4_xz*t999;
-  const T t1004 = R_NB_app4_yx*t765 + R_NB_app4_yy*t998 + R_NB_app4_yz*t999;
-  const T t1005 = R_NB_app4_zx*t765 + R_NB_app4_zy*t998 + R_NB_app4_zz*t999;
-  const T t1006 = r_NO_N_app4_y*t1002 - r_NO_N_app4_z*t1001;
-  const T t1007 = -r_NO_N_app4_x*t1002 + r_NO_N_app4_z*t1000;
-  const T t1008 = r_NO_N_app4_x*t1001 - r_NO_N_app4_y*t1000;
-  const T t1009 = t1003 + t1006;
-  const T t1010 = t1004 + t1007;
-  const T t1011 = t1005 + t1008;
-  const T t1012 = t1000 + t989;
-  const T t1013 = t1001 + t990;
-  const T t1014 = t1002 + t991;
-  const T t1015 = t1009 + t992;
-  const T t1016 = t1010 + t993;
-  const T t1017 = t1011 + t994;
-  const T t1018 = app5_mass*t225;
-  const T t1019 = app5_S0_x*w_B_app5_z + app5_mass*t226;
-  const T t1020 = -app5_S0_x*t223 + app5_mass*t215;
-  const T t1021 = app5_J0_yy*t223 - app5_S0_x*t215;
-  const T t1022 = app5_J0_zz*w_B_app5_z + app5_S0_x*t226;
-  const T t1023 = R_NB_app5_xx*t1018 + R_NB_app5_xy*t1019 + t1020*t16;
-  const T t1024 = R_NB_app5_yx*t1018 + R_NB_app5_yy*t1019 + t1020*t19;
-  const T t1025 = R_NB_app5_zx*t1018 + R_NB_app5_zy*t1019 + t1020*t22;
-  const T t1026 = R_NB_app5_xx*t776 + R_NB_app5_xy*t1021 + t1022*t16;
-  const T t1027 = R_NB_app5_yx*t776 + R_NB_app5_yy*t1021 + t1022*t19;
-  const T t1028 = R_NB_app5_zx*t776 + R_NB_app5_zy*t1021 + t1022*t22;
-  const T t1029 = r_NO_N_app5_y*t1025 - r_NO_N_app5_z*t1024;
-  const T t1030 = -r_NO_N_app5_x*t1025 + r_NO_N_app5_z*t1023;
-  const T t1031 = r_NO_N_app5_x*t1024 - r_NO_N_app5_y*t1023;
-  const T t1032 = t1026 + t1029;
-  const T t1033 = t1027 + t1030;
-  const T t1034 = t1028 + t1031;
-  const T t1035 = t1012 + t1023;
-  const T t1036 = t1013 + t1024;
-  const T t1037 = t1014 + t1025;
-  const T t1038 = t1015 + t1032;
-  const T t1039 = t1016 + t1033;
-  const T t1040 = t1017 + t1034;
-  const T t1041 = app6_S0_z*t270 + app6_mass*t272;
-  const T t1042 = app6_S0_x*w_B_app6_z - app6_S0_z*t269 + app6_mass*t273;
-  const T t1043 = -app6_S0_x*t270 + app6_mass*t260;
-  const T t1044 = app6_J0_xx*t269 + app6_J0_xz*w_B_app6_z - app6_S0_z*t273;
-  const T t1045 = app6_J0_yy*t270 - app6_S0_x*t260 + app6_S0_z*t272;
-  const T t1046 = app6_J0_xz*t269 + app6_J0_zz*w_B_app6_z + app6_S0_x*t273;
-  const T t1047 = R_NB_app6_xx*t1041 + R_NB_app6_xy*t1042 + R_NB_app6_xz*t1043;
-  const T t1048 = R_NB_app6_yx*t1041 + R_NB_app6_yy*t1042 + R_NB_app6_yz*t1043;
-  const T t1049 = R_NB_app6_zx*t1041 + R_NB_app6_zy*t1042 + R_NB_app6_zz*t1043;
-  const T t1050 = R_NB_app6_xx*t1044 + R_NB_app6_xy*t1045 + R_NB_app6_xz*t1046;
-  const T t1051 = R_NB_app6_yx*t1044 + R_NB_app6_yy*t1045 + R_NB_app6_yz*t1046;
-  const T t1052 = R_NB_app6_zx*t1044 + R_NB_app6_zy*t1045 + R_NB_app6_zz*t1046;
-  const T t1053 = r_NO_N_app6_y*t1049 - r_NO_N_app6_z*t1048;
-  const T t1054 = -r_NO_N_app6_x*t1049 + r_NO_N_app6_z*t1047;
-  const T t1055 = r_NO_N_app6_x*t1048 - r_NO_N_app6_y*t1047;
-  const T t1056 = t1050 + t1053;
-  const T t1057 = t1051 + t1054;
-  const T t1058 = t1052 + t1055;
-  const T t1059 = t1035 + t1047;
-  const T t1060 = t1036 + t1048;
-  const T t1061 = t1037 + t1049;
-  const T t1062 = t1038 + t1056;
-  const T t1063 = t1039 + t1057;
-  const T t1064 = t1040 + t1058;
-  const T t1065 = app7_mass*t319;
-  const T t1066 = app7_S0_x*w_B_app7_z + app7_mass*t320;
-  const T t1067 = -app7_S0_x*t317 + app7_mass*t307;
-  const T t1068 = app7_J0_yy*t317 - app7_S0_x*t307;
-  const T t1069 = app7_J0_zz*w_B_app7_z + app7_S0_x*t320;
-  const T t1070 = R_NB_app7_xx*t1065 + R_NB_app7_xy*t1066 + R_NB_app7_xz*t1067;
-  const T t1071 = R_NB_app7_yx*t1065 + R_NB_app7_yy*t1066 + R_NB_app7_yz*t1067;
-  const T t1072 = R_NB_app7_zx*t1065 + R_NB_app7_zy*t1066 + R_NB_app7_zz*t1067;
-  const T t1073 = R_NB_app7_xx*t799 + R_NB_app7_xy*t1068 + R_NB_app7_xz*t1069;
-  const T t1074 = R_NB_app7_yx*t799 + R_NB_app7_yy*t1068 + R_NB_app7_yz*t1069;
-  const T t1075 = R_NB_app7_zx*t799 + R_NB_app7_zy*t1068 + R_NB_app7_zz*t1069;
-  const T t1076 = r_NO_N_app7_y*t1072 - r_NO_N_app7_z*t1071;
-  const T t1077 = -r_NO_N_app7_x*t1072 + r_NO_N_app7_z*t1070;
-  const T t1078 = r_NO_N_app7_x*t1071 - r_NO_N_app7_y*t1070;
-  const T t1079 = t1073 + t1076;
-  const T t1080 = t1074 + t1077;
-  const T t1081 = t1075 + t1078;
-  const T t1082 = t1059 + t1070;
-  const T t1083 = t1060 + t1071;
-  const T t1084 = t1061 + t1072;
-  const T t1085 = t1062 + t1079;
-  const T t1086 = t1063 + t1080;
-  const T t1087 = t1064 + t1081;
-  const T t1088 = app8_mass*t363;
-  const T t1089 = app8_S0_x*w_B_app8_z + app8_mass*t364;
-  const T t1090 = -app8_S0_x*t361 + app8_mass*t351;
-  const T t1091 = app8_J0_yy*t361 - app8_S0_x*t351;
-  const T t1092 = app8_J0_zz*w_B_app8_z + app8_S0_x*t364;
-  const T t1093 = R_NB_app8_xx*t1088 + R_NB_app8_xy*t1089 + t1090*t16;
-  const T t1094 = R_NB_app8_yx*t1088 + R_NB_app8_yy*t1089 + t1090*t19;
-  const T t1095 = R_NB_app8_zx*t1088 + R_NB_app8_zy*t1089 + t1090*t22;
-  const T t1096 = R_NB_app8_xx*t810 + R_NB_app8_xy*t1091 + t1092*t16;
-  const T t1097 = R_NB_app8_yx*t810 + R_NB_app8_yy*t1091 + t1092*t19;
-  const T t1098 = R_NB_app8_zx*t810 + R_NB_app8_zy*t1091 + t1092*t22;
-  const T t1099 = r_NO_N_app8_y*t1095 - r_NO_N_app8_z*t1094;
-  const T t1100 = -r_NO_N_app8_x*t1095 + r_NO_N_app8_z*t1093;
-  const T t1101 = r_NO_N_app8_x*t1094 - r_NO_N_app8_y*t1093;
-  const T t1102 = t1096 + t1099;
-  const T t1103 = t1097 + t1100;
-  const T t1104 = t1098 + t1101;
-  const T t1105 = t1082 + t1093;
-  const T t1106 = t1083 + t1094;
-  const T t1107 = t1084 + t1095;
-  const T t1108 = t1085 + t1102;
-  const T t1109 = t1086 + t1103;
-  const T t1110 = t1087 + t1104;
-  const T t1111 = app9_S0_z*t395 + app9_mass*t397;
-  const T t1112 = app9_S0_x*w_B_app9_z - app9_S0_z*t394 + app9_mass*t398;
-  const T t1113 = -app9_S0_x*t395 + app9_mass*t387;
-  const T t1114 = app9_J0_xx*t394 + app9_J0_xz*w_B_app9_z - app9_S0_z*t398;
-  const T t1115 = app9_J0_yy*t395 - app9_S0_x*t387 + app9_S0_z*t397;
-  const T t1116 = app9_J0_xz*t394 + app9_J0_zz*w_B_app9_z + app9_S0_x*t398;
-  const T t1117 = R_NB_app9_xx*t1111 + R_NB_app9_xy*t1112 - t1113*t14;
-  const T t1118 = R_NB_app9_yx*t1111 + R_NB_app9_yy*t1112 - t1113*t17;
-  const T t1119 = R_NB_app9_zx*t1111 + R_NB_app9_zy*t1112 - t1113*t20;
-  const T t1120 = R_NB_app9_xx*t1114 + R_NB_app9_xy*t1115 - t1116*t14;
-  const T t1121 = R_NB_app9_yx*t1114 + R_NB_app9_yy*t1115 - t1116*t17;
-  const T t1122 = R_NB_app9_zx*t1114 + R_NB_app9_zy*t1115 - t1116*t20;
-  const T t1123 = r_NO_N_app9_y*t1119 - r_NO_N_app9_z*t1118;
-  const T t1124 = -r_NO_N_app9_x*t1119 + r_NO_N_app9_z*t1117;
-  const T t1125 = r_NO_N_app9_x*t1118 - r_NO_N_app9_y*t1117;
-  const T t1126 = t1120 + t1123;
-  const T t1127 = t1121 + t1124;
-  const T t1128 = t1122 + t1125;
-  const T t1129 = t1105 + t1117;
-  const T t1130 = t1106 + t1118;
-  const T t1131 = t1107 + t1119;
-  const T t1132 = t1108 + t1126;
-  const T t1133 = t1109 + t1127;
-  const T t1134 = t1110 + t1128;
-  const T t1135 = app10_mass*t444;
-  const T t1136 = app10_S0_x*w_B_app10_z + app10_mass*t445;
-  const T t1137 = -app10_S0_x*t442 + app10_mass*t432;
-  const T t1138 = app10_J0_yy*t442 - app10_S0_x*t432;
-  const T t1139 = app10_J0_zz*w_B_app10_z + app10_S0_x*t445;
-  const T t1140 = R_NB_app10_xx*t1135 + R_NB_app10_xy*t1136 + R_NB_app10_xz*t1137;
-  const T t1141 = R_NB_app10_yx*t1135 + R_NB_app10_yy*t1136 + R_NB_app10_yz*t1137;
-  const T t1142 = R_NB_app10_zx*t1135 + R_NB_app10_zy*t1136 + R_NB_app10_zz*t1137;
-  const T t1143 = R_NB_app10_xx*t833 + R_NB_app10_xy*t1138 + R_NB_app10_xz*t1139;
-  const T t1144 = R_NB_app10_yx*t833 + R_NB_app10_yy*t1138 + R_NB_app10_yz*t1139;
-  const T t1145 = R_NB_app10_zx*t833 + R_NB_app10_zy*t1138 + R_NB_app10_zz*t1139;
-  const T t1146 = r_NO_N_app10_y*t1142 - r_NO_N_app10_z*t1141;
-  const T t1147 = -r_NO_N_app10_x*t1142 + r_NO_N_app10_z*t1140;
-  const T t1148 = r_NO_N_app10_x*t1141 - r_NO_N_app10_y*t1140;
-  const T t1149 = t1143 + t1146;
-  const T t1150 = t1144 + t1147;
-  const T t1151 = t1145 + t1148;
-  const T t1152 = t1129 + t1140;
-  const T t1153 = t1130 + t1141;
-  const T t1154 = t1131 + t1142;
-  const T t1155 = t1132 + t1149;
-  const T t1156 = t1133 + t1150;
-  const T t1157 = t1134 + t1151;
-  const T t1158 = app11_mass*t488;
-  const T t1159 = app11_S0_x*w_B_app11_z + app11_mass*t489;
-  const T t1160 = -app11_S0_x*t486 + app11_mass*t476;
-  const T t1161 = app11_J0_yy*t486 - app11_S0_x*t476;
-  const T t1162 = app11_J0_zz*w_B_app11_z + app11_S0_x*t489;
-  const T t1163 = R_NB_app11_xx*t1158 + R_NB_app11_xy*t1159 + t1160*t16;
-  const T t1164 = R_NB_app11_yx*t1158 + R_NB_app11_yy*t1159 + t1160*t19;
-  const T t1165 = R_NB_app11_zx*t1158 + R_NB_app11_zy*t1159 + t1160*t22;
-  const T t1166 = R_NB_app11_xx*t844 + R_NB_app11_xy*t1161 + t1162*t16;
-  const T t1167 = R_NB_app11_yx*t844 + R_NB_app11_yy*t1161 + t1162*t19;
-  const T t1168 = R_NB_app11_zx*t844 + R_NB_app11_zy*t1161 + t1162*t22;
-  const T t1169 = r_NO_N_app11_y*t1165 - r_NO_N_app11_z*t1164;
-  const T t1170 = -r_NO_N_app11_x*t1165 + r_NO_N_app11_z*t1163;
-  const T t1171 = r_NO_N_app11_x*t1164 - r_NO_N_app11_y*t1163;
-  const T t1172 = t1166 + t1169;
-  const T t1173 = t1167 + t1170;
-  const T t1174 = t1168 + t1171;
-  const T t1175 = t1152 + t1163;
-  const T t1176 = t1153 + t1164;
-  const T t1177 = t1154 + t1165;
-  const T t1178 = t1155 + t1172;
-  const T t1179 = t1156 + t1173;
-  const T t1180 = t1157 + t1174;
-  const T t1181 = app12_S0_z*t533 + app12_mass*t535;
-  const T t1182 = app12_S0_x*w_B_app12_z - app12_S0_z*t532 + app12_mass*t536;
-  const T t1183 = -app12_S0_x*t533 + app12_mass*t523;
-  const T t1184 = app12_J0_xx*t532 + app12_J0_xz*w_B_app12_z - app12_S0_z*t536;
-  const T t1185 = app12_J0_yy*t533 - app12_S0_x*t523 + app12_S0_z*t535;
-  const T t1186 = app12_J0_xz*t532 + app12_J0_zz*w_B_app12_z + app12_S0_x*t536;
-  const T t1187 = R_NB_app12_xx*t1181 + R_NB_app12_xy*t1182 + R_NB_app12_xz*t1183;
-  const T t1188 = R_NB_app12_yx*t1181 + R_NB_app12_yy*t1182 + R_NB_app12_yz*t1183;
-  const T t1189 = R_NB_app12_zx*t1181 + R_NB_app12_zy*t1182 + R_NB_app12_zz*t1183;
-  const T t1190 = R_NB_app12_xx*t1184 + R_NB_app12_xy*t1185 + R_NB_app12_xz*t1186;
-  const T t1191 = R_NB_app12_yx*t1184 + R_NB_app12_yy*t1185 + R_NB_app12_yz*t1186;
-  const T t1192 = R_NB_app12_zx*t1184 + R_NB_app12_zy*t1185 + R_NB_app12_zz*t1186;
-  const T t1193 = r_NO_N_app12_y*t1189 - r_NO_N_app12_z*t1188;
-  const T t1194 = -r_NO_N_app12_x*t1189 + r_NO_N_app12_z*t1187;
-  const T t1195 = r_NO_N_app12_x*t1188 - r_NO_N_app12_y*t1187;
-  const T t1196 = t1190 + t1193;
-  const T t1197 = t1191 + t1194;
-  const T t1198 = t1192 + t1195;
-  const T t1199 = t1175 + t1187;
-  const T t1200 = t1176 + t1188;
-  const T t1201 = t1177 + t1189;
-  const T t1202 = t1178 + t1196;
-  const T t1203 = t1179 + t1197;
-  const T t1204 = t1180 + t1198;
-  const T t1205 = app13_mass*t569;
-  const T t1206 = app13_S0_x*w_B_app13_z + app13_mass*t570;
-  const T t1207 = -app13_S0_x*t567 + app13_mass*t559;
-  const T t1208 = app13_J0_yy*t567 - app13_S0_x*t559;
-  const T t1209 = app13_J0_zz*w_B_app13_z + app13_S0_x*t570;
-  const T t1210 = R_NB_app13_xx*t1205 + R_NB_app13_xy*t1206 + t1207*t14;
-  const T t1211 = R_NB_app13_yx*t1205 + R_NB_app13_yy*t1206 + t1207*t17;
-  const T t1212 = R_NB_app13_zx*t1205 + R_NB_app13_zy*t1206 + t1207*t20;
-  const T t1213 = R_NB_app13_xx*t867 + R_NB_app13_xy*t1208 + t1209*t14;
-  const T t1214 = R_NB_app13_yx*t867 + R_NB_app13_yy*t1208 + t1209*t17;
-  const T t1215 = R_NB_app13_zx*t867 + R_NB_app13_zy*t1208 + t1209*t20;
-  const T t1216 = r_NO_N_app13_y*t1212 - r_NO_N_app13_z*t1211;
-  const T t1217 = -r_NO_N_app13_x*t1212 + r_NO_N_app13_z*t1210;
-  const T t1218 = r_NO_N_app13_x*t1211 - r_NO_N_app13_y*t1210;
-  const T t1219 = t1213 + t1216;
-  const T t1220 = t1214 + t1217;
-  const T t1221 = t1215 + t1218;
-  const T t1222 = t1199 + t1210;
-  const T t1223 = t1200 + t1211;
-  const T t1224 = t1201 + t1212;
-  const T t1225 = t1202 + t1219;
-  const T t1226 = t1203 + t1220;
-  const T t1227 = t1204 + t1221;
-  const T t1228 = app14_mass*t613;
-  const T t1229 = app14_S0_x*w_B_app14_z + app14_mass*t614;
-  const T t1230 = -app14_S0_x*t611 + app14_mass*t601;
-  const T t1231 = app14_J0_yy*t611 - app14_S0_x*t601;
-  const T t1232 = app14_J0_zz*w_B_app14_z + app14_S0_x*t614;
-  const T t1233 = R_NB_app14_xx*t1228 + R_NB_app14_xy*t1229 + t1230*t16;
-  const T t1234 = R_NB_app14_yx*t1228 + R_NB_app14_yy*t1229 + t1230*t19;
-  const T t1235 = R_NB_app14_zx*t1228 + R_NB_app14_zy*t1229 + t1230*t22;
-  const T t1236 = R_NB_app14_xx*t878 + R_NB_app14_xy*t1231 + t1232*t16;
-  const T t1237 = R_NB_app14_yx*t878 + R_NB_app14_yy*t1231 + t1232*t19;
-  const T t1238 = R_NB_app14_zx*t878 + R_NB_app14_zy*t1231 + t1232*t22;
-  const T t1239 = r_NO_N_app14_y*t1235 - r_NO_N_app14_z*t1234;
-  const T t1240 = -r_NO_N_app14_x*t1235 + r_NO_N_app14_z*t1233;
-  const T t1241 = r_NO_N_app14_x*t1234 - r_NO_N_app14_y*t1233;
-  const T t1242 = t1236 + t1239;
-  const T t1243 = t1237 + t1240;
-  const T t1244 = t1238 + t1241;
-  const T t1245 = t1222 + t1233;
-  const T t1246 = t1223 + t1234;
-  const T t1247 = t1224 + t1235;
-  const T t1248 = t1225 + t1242;
-  const T t1249 = t1226 + t1243;
-  const T t1250 = t1227 + t1244;
-  const T t1251 = app15_S0_z*t658 + app15_mass*t660;
-  const T t1252 = app15_S0_x*w_B_app15_z - app15_S0_z*t657 + app15_mass*t661;
-  const T t1253 = -app15_S0_x*t658 + app15_mass*t648;
-  const T t1254 = app15_J0_xx*t657 + app15_J0_xz*w_B_app15_z - app15_S0_z*t661;
-  const T t1255 = app15_J0_yy*t658 - app15_S0_x*t648 + app15_S0_z*t660;
-  const T t1256 = app15_J0_xz*t657 + app15_J0_zz*w_B_app15_z + app15_S0_x*t661;
-  const T t1257 = R_NB_app15_xx*t1251 + R_NB_app15_xy*t1252 + R_NB_app15_xz*t1253;
-  const T t1258 = R_NB_app15_yx*t1251 + R_NB_app15_yy*t1252 + R_NB_app15_yz*t1253;
-  const T t1259 = R_NB_app15_zx*t1251 + R_NB_app15_zy*t1252 + R_NB_app15_zz*t1253;
-  const T t1260 = R_NB_app15_xx*t1254 + R_NB_app15_xy*t1255 + R_NB_app15_xz*t1256;
-  const T t1261 = R_NB_app15_yx*t1254 + R_NB_app15_yy*t1255 + R_NB_app15_yz*t1256;
-  const T t1262 = R_NB_app15_zx*t1254 + R_NB_app15_zy*t1255 + R_NB_app15_zz*t1256;
-  const T t1263 = r_NO_N_app15_y*t1259 - r_NO_N_app15_z*t1258;
-  const T t1264 = -r_NO_N_app15_x*t1259 + r_NO_N_app15_z*t1257;
-  const T t1265 = r_NO_N_app15_x*t1258 - r_NO_N_app15_y*t1257;
-  const T t1266 = t1260 + t1263;
-  const T t1267 = t1261 + t1264;
-  const T t1268 = t1262 + t1265;
-  const T t1269 = t1245 + t1257;
-  const T t1270 = t1246 + t1258;
-  const T t1271 = t1247 + t1259;
-  const T t1272 = t1248 + t1266;
-  const T t1273 = t1249 + t1267;
-  const T t1274 = t1250 + t1268;
-  const T t1275 = app16_mass*t707;
-  const T t1276 = app16_S0_x*w_B_app16_z + app16_mass*t708;
-  const T t1277 = -app16_S0_x*t705 + app16_mass*t695;
-  const T t1278 = app16_J0_yy*t705 - app16_S0_x*t695;
-  const T t1279 = app16_J0_zz*w_B_app16_z + app16_S0_x*t708;
-  const T t1280 = R_NB_app16_xx*t1275 + R_NB_app16_xy*t1276 + R_NB_app16_xz*t1277;
-  const T t1281 = R_NB_app16_yx*t1275 + R_NB_app16_yy*t1276 + R_NB_app16_yz*t1277;
-  const T t1282 = R_NB_app16_zx*t1275 + R_NB_app16_zy*t1276 + R_NB_app16_zz*t1277;
-  const T t1283 = R_NB_app16_xx*t901 + R_NB_app16_xy*t1278 + R_NB_app16_xz*t1279;
-  const T t1284 = R_NB_app16_yx*t901 + R_NB_app16_yy*t1278 + R_NB_app16_yz*t1279;
-  const T t1285 = R_NB_app16_zx*t901 + R_NB_app16_zy*t1278 + R_NB_app16_zz*t1279;
-  const T t1286 = r_NO_N_app16_y*t1282 - r_NO_N_app16_z*t1281;
-  const T t1287 = -r_NO_N_app16_x*t1282 + r_NO_N_app16_z*t1280;
-  const T t1288 = r_NO_N_app16_x*t1281 - r_NO_N_app16_y*t1280;
-  const T t1289 = t1283 + t1286;
-  const T t1290 = t1284 + t1287;
-  const T t1291 = t1285 + t1288;
-  const T t1292 = t1269 + t1280;
-  const T t1293 = t1270 + t1281;
-  const T t1294 = t1271 + t1282;
-  const T t1295 = t1272 + t1289;
-  const T t1296 = t1273 + t1290;
-  const T t1297 = t1274 + t1291;
-  pH[0] = t1292;
-  pH[1] = t1293;
-  pH[2] = t1294;
-  pH[3] = t1295;
-  pH[4] = t1296;
-  pH[5] = t1297;
+  const T t895 = app16_J0_xx*t698;
+  const T t901 = -hub_S0_y*u[5] + hub_mass*u[0];
+  const T t902 = hub_S0_x*u[5] + hub_mass*u[1];
+  const T t903 = -hub_S0_x*u[4] + hub_S0_y*u[3] + hub_mass*u[2];
+  const T t904 = (hub_J0_xx*u[3] + hub_J0_xy*u[4]) + (hub_J0_xz*u[5] + hub_S0_y*u[2]);
+  const T t905 = ((hub_J0_xy*u[3] + hub_J0_yy*u[4]) + hub_J0_yz*u[5]) - hub_S0_x*u[2];
+  const T t906 = ((hub_J0_xz*u[3] + hub_J0_yz*u[4]) + (hub_J0_zz*u[5] + hub_S0_x*u[1])) - hub_S0_y*u[0];
+  const T t907 = t14*t901 + t15*t902 + t16*t903;
+  const T t908 = t17*t901 + t18*t902 + t19*t903;
+  const T t909 = t20*t901 + t21*t902 + t22*t903;
+  const T t910 = t14*t904 + t15*t905 + t16*t906;
+  const T t911 = t17*t904 + t18*t905 + t19*t906;
+  const T t912 = t20*t904 + t21*t905 + t22*t906;
+  const T t913 = q[1]*t909 - q[2]*t908;
+  const T t914 = -q[0]*t909 + q[2]*t907;
+  const T t915 = q[0]*t908 - q[1]*t907;
+  const T t916 = t910 + t913;
+  const T t917 = t911 + t914;
+  const T t918 = t912 + t915;
+  const T t919 = app1_mass*t53;
+  const T t920 = app1_S0_x*w_B_app1_z + app1_mass*t54;
+  const T t921 = -app1_S0_x*t51 + app1_mass*t43;
+  const T t922 = app1_J0_yy*t51 - app1_S0_x*t43;
+  const T t923 = app1_J0_zz*w_B_app1_z + app1_S0_x*t54;
+  const T t924 = R_NB_app1_xx*t919 + R_NB_app1_xy*t920 + t15*t921;
+  const T t925 = R_NB_app1_yx*t919 + R_NB_app1_yy*t920 + t18*t921;
+  const T t926 = R_NB_app1_zx*t919 + R_NB_app1_zy*t920 + t21*t921;
+  const T t927 = R_NB_app1_xx*t725 + R_NB_app1_xy*t922 + t15*t923;
+  const T t928 = R_NB_app1_yx*t725 + R_NB_app1_yy*t922 + t18*t923;
+  const T t929 = R_NB_app1_zx*t725 + R_NB_app1_zy*t922 + t21*t923;
+  const T t930 = r_NO_N_app1_y*t926 - r_NO_N_app1_z*t925;
+  const T t931 = -r_NO_N_app1_x*t926 + r_NO_N_app1_z*t924;
+  const T t932 = r_NO_N_app1_x*t925 - r_NO_N_app1_y*t924;
+  const T t933 = t927 + t930;
+  const T t934 = t928 + t931;
+  const T t935 = t929 + t932;
+  const T t936 = t907 + t924;
+  const T t937 = t908 + t925;
+  const T t938 = t909 + t926;
+  const T t939 = t916 + t933;
+  const T t940 = t917 + t934;
+  const T t941 = t918 + t935;
+  const T t942 = app2_mass*t97;
+  const T t943 = app2_S0_x*w_B_app2_z + app2_mass*t98;
+  const T t944 = -app2_S0_x*t95 + app2_mass*t85;
+  const T t945 = app2_J0_yy*t95 - app2_S0_x*t85;
+  const T t946 = app2_J0_zz*w_B_app2_z + app2_S0_x*t98;
+  const T t947 = R_NB_app2_xx*t942 + R_NB_app2_xy*t943 + t16*t944;
+  const T t948 = R_NB_app2_yx*t942 + R_NB_app2_yy*t943 + t19*t944;
+  const T t949 = R_NB_app2_zx*t942 + R_NB_app2_zy*t943 + t22*t944;
+  const T t950 = R_NB_app2_xx*t736 + R_NB_app2_xy*t945 + t16*t946;
+  const T t951 = R_NB_app2_yx*t736 + R_NB_app2_yy*t945 + t19*t946;
+  const T t952 = R_NB_app2_zx*t736 + R_NB_app2_zy*t945 + t22*t946;
+  const T t953 = r_NO_N_app2_y*t949 - r_NO_N_app2_z*t948;
+  const T t954 = -r_NO_N_app2_x*t949 + r_NO_N_app2_z*t947;
+  const T t955 = r_NO_N_app2_x*t948 - r_NO_N_app2_y*t947;
+  const T t956 = t950 + t953;
+  const T t957 = t951 + t954;
+  const T t958 = t952 + t955;
+  const T t959 = t936 + t947;
+  const T t960 = t937 + t948;
+  const T t961 = t938 + t949;
+  const T t962 = t939 + t956;
+  const T t963 = t940 + t957;
+  const T t964 = t941 + t958;
+  const T t965 = app3_S0_z*t140 + app3_mass*t142;
+  const T t966 = app3_S0_x*w_B_app3_z - app3_S0_z*t139 + app3_mass*t143;
+  const T t967 = -app3_S0_x*t140 + app3_mass*t130;
+  const T t968 = app3_J0_xx*t139 + app3_J0_xz*w_B_app3_z - app3_S0_z*t143;
+  const T t969 = app3_J0_yy*t140 - app3_S0_x*t130 + app3_S0_z*t142;
+  const T t970 = app3_J0_xz*t139 + app3_J0_zz*w_B_app3_z + app3_S0_x*t143;
+  const T t971 = R_NB_app3_xx*t965 + R_NB_app3_xy*t966 + R_NB_app3_xz*t967;
+  const T t972 = R_NB_app3_yx*t965 + R_NB_app3_yy*t966 + R_NB_app3_yz*t967;
+  const T t973 = R_NB_app3_zx*t965 + R_NB_app3_zy*t966 + R_NB_app3_zz*t967;
+  const T t974 = R_NB_app3_xx*t968 + R_NB_app3_xy*t969 + R_NB_app3_xz*t970;
+  const T t975 = R_NB_app3_yx*t968 + R_NB_app3_yy*t969 + R_NB_app3_yz*t970;
+  const T t976 = R_NB_app3_zx*t968 + R_NB_app3_zy*t969 + R_NB_app3_zz*t970;
+  const T t977 = r_NO_N_app3_y*t973 - r_NO_N_app3_z*t972;
+  const T t978 = -r_NO_N_app3_x*t973 + r_NO_N_app3_z*t971;
+  const T t979 = r_NO_N_app3_x*t972 - r_NO_N_app3_y*t971;
+  const T t980 = t974 + t977;
+  const T t981 = t975 + t978;
+  const T t982 = t976 + t979;
+  const T t983 = t959 + t971;
+  const T t984 = t960 + t972;
+  const T t985 = t961 + t973;
+  const T t986 = t962 + t980;
+  const T t987 = t963 + t981;
+  const T t988 = t964 + t982;
+  const T t989 = app4_mass*t189;
+  const T t990 = app4_S0_x*w_B_app4_z + app4_mass*t190;
+  const T t991 = -app4_S0_x*t187 + app4_mass*t177;
+  const T t992 = app4_J0_yy*t187 - app4_S0_x*t177;
+  const T t993 = app4_J0_zz*w_B_app4_z + app4_S0_x*t190;
+  const T t994 = R_NB_app4_xx*t989 + R_NB_app4_xy*t990 + R_NB_app4_xz*t991;
+  const T t995 = R_NB_app4_yx*t989 + R_NB_app4_yy*t990 + R_NB_app4_yz*t991;
+  const T t996 = R_NB_app4_zx*t989 + R_NB_app4_zy*t990 + R_NB_app4_zz*t991;
+  const T t997 = R_NB_app4_xx*t759 + R_NB_app4_xy*t992 + R_NB_app4_xz*t993;
+  const T t998 = R_NB_app4_yx*t759 + R_NB_app4_yy*t992 + R_NB_app4_yz*t993;
+  const T t999 = R_NB_app4_zx*t759 + R_NB_app4_zy*t992 + R_NB_app4_zz*t993;
+  const T t1000 = r_NO_N_app4_y*t996 - r_NO_N_app4_z*t995;
+  const T t1001 = -r_NO_N_app4_x*t996 + r_NO_N_app4_z*t994;
+  const T t1002 = r_NO_N_app4_x*t995 - r_NO_N_app4_y*t994;
+  const T t1003 = t1000 + t997;
+  const T t1004 = t1001 + t998;
+  const T t1005 = t1002 + t999;
+  const T t1006 = t983 + t994;
+  const T t1007 = t984 + t995;
+  const T t1008 = t985 + t996;
+  const T t1009 = t1003 + t986;
+  const T t1010 = t1004 + t987;
+  const T t1011 = t1005 + t988;
+  const T t1012 = app5_mass*t223;
+  const T t1013 = app5_S0_x*w_B_app5_z + app5_mass*t224;
+  const T t1014 = -app5_S0_x*t221 + app5_mass*t213;
+  const T t1015 = app5_J0_yy*t221 - app5_S0_x*t213;
+  const T t1016 = app5_J0_zz*w_B_app5_z + app5_S0_x*t224;
+  const T t1017 = R_NB_app5_xx*t1012 + R_NB_app5_xy*t1013 + t1014*t16;
+  const T t1018 = R_NB_app5_yx*t1012 + R_NB_app5_yy*t1013 + t1014*t19;
+  const T t1019 = R_NB_app5_zx*t1012 + R_NB_app5_zy*t1013 + t1014*t22;
+  const T t1020 = R_NB_app5_xx*t770 + R_NB_app5_xy*t1015 + t1016*t16;
+  const T t1021 = R_NB_app5_yx*t770 + R_NB_app5_yy*t1015 + t1016*t19;
+  const T t1022 = R_NB_app5_zx*t770 + R_NB_app5_zy*t1015 + t1016*t22;
+  const T t1023 = r_NO_N_app5_y*t1019 - r_NO_N_app5_z*t1018;
+  const T t1024 = -r_NO_N_app5_x*t1019 + r_NO_N_app5_z*t1017;
+  const T t1025 = r_NO_N_app5_x*t1018 - r_NO_N_app5_y*t1017;
+  const T t1026 = t1020 + t1023;
+  const T t1027 = t1021 + t1024;
+  const T t1028 = t1022 + t1025;
+  const T t1029 = t1006 + t1017;
+  const T t1030 = t1007 + t1018;
+  const T t1031 = t1008 + t1019;
+  const T t1032 = t1009 + t1026;
+  const T t1033 = t1010 + t1027;
+  const T t1034 = t1011 + t1028;
+  const T t1035 = app6_S0_z*t268 + app6_mass*t270;
+  const T t1036 = app6_S0_x*w_B_app6_z - app6_S0_z*t267 + app6_mass*t271;
+  const T t1037 = -app6_S0_x*t268 + app6_mass*t258;
+  const T t1038 = app6_J0_xx*t267 + app6_J0_xz*w_B_app6_z - app6_S0_z*t271;
+  const T t1039 = app6_J0_yy*t268 - app6_S0_x*t258 + app6_S0_z*t270;
+  const T t1040 = app6_J0_xz*t267 + app6_J0_zz*w_B_app6_z + app6_S0_x*t271;
+  const T t1041 = R_NB_app6_xx*t1035 + R_NB_app6_xy*t1036 + R_NB_app6_xz*t1037;
+  const T t1042 = R_NB_app6_yx*t1035 + R_NB_app6_yy*t1036 + R_NB_app6_yz*t1037;
+  const T t1043 = R_NB_app6_zx*t1035 + R_NB_app6_zy*t1036 + R_NB_app6_zz*t1037;
+  const T t1044 = R_NB_app6_xx*t1038 + R_NB_app6_xy*t1039 + R_NB_app6_xz*t1040;
+  const T t1045 = R_NB_app6_yx*t1038 + R_NB_app6_yy*t1039 + R_NB_app6_yz*t1040;
+  const T t1046 = R_NB_app6_zx*t1038 + R_NB_app6_zy*t1039 + R_NB_app6_zz*t1040;
+  const T t1047 = r_NO_N_app6_y*t1043 - r_NO_N_app6_z*t1042;
+  const T t1048 = -r_NO_N_app6_x*t1043 + r_NO_N_app6_z*t1041;
+  const T t1049 = r_NO_N_app6_x*t1042 - r_NO_N_app6_y*t1041;
+  const T t1050 = t1044 + t1047;
+  const T t1051 = t1045 + t1048;
+  const T t1052 = t1046 + t1049;
+  const T t1053 = t1029 + t1041;
+  const T t1054 = t1030 + t1042;
+  const T t1055 = t1031 + t1043;
+  const T t1056 = t1032 + t1050;
+  const T t1057 = t1033 + t1051;
+  const T t1058 = t1034 + t1052;
+  const T t1059 = app7_mass*t317;
+  const T t1060 = app7_S0_x*w_B_app7_z + app7_mass*t318;
+  const T t1061 = -app7_S0_x*t315 + app7_mass*t305;
+  const T t1062 = app7_J0_yy*t315 - app7_S0_x*t305;
+  const T t1063 = app7_J0_zz*w_B_app7_z + app7_S0_x*t318;
+  const T t1064 = R_NB_app7_xx*t1059 + R_NB_app7_xy*t1060 + R_NB_app7_xz*t1061;
+  const T t1065 = R_NB_app7_yx*t1059 + R_NB_app7_yy*t1060 + R_NB_app7_yz*t1061;
+  const T t1066 = R_NB_app7_zx*t1059 + R_NB_app7_zy*t1060 + R_NB_app7_zz*t1061;
+  const T t1067 = R_NB_app7_xx*t793 + R_NB_app7_xy*t1062 + R_NB_app7_xz*t1063;
+  const T t1068 = R_NB_app7_yx*t793 + R_NB_app7_yy*t1062 + R_NB_app7_yz*t1063;
+  const T t1069 = R_NB_app7_zx*t793 + R_NB_app7_zy*t1062 + R_NB_app7_zz*t1063;
+  const T t1070 = r_NO_N_app7_y*t1066 - r_NO_N_app7_z*t1065;
+  const T t1071 = -r_NO_N_app7_x*t1066 + r_NO_N_app7_z*t1064;
+  const T t1072 = r_NO_N_app7_x*t1065 - r_NO_N_app7_y*t1064;
+  const T t1073 = t1067 + t1070;
+  const T t1074 = t1068 + t1071;
+  const T t1075 = t1069 + t1072;
+  const T t1076 = t1053 + t1064;
+  const T t1077 = t1054 + t1065;
+  const T t1078 = t1055 + t1066;
+  const T t1079 = t1056 + t1073;
+  const T t1080 = t1057 + t1074;
+  const T t1081 = t1058 + t1075;
+  const T t1082 = app8_mass*t361;
+  const T t1083 = app8_S0_x*w_B_app8_z + app8_mass*t362;
+  const T t1084 = -app8_S0_x*t359 + app8_mass*t349;
+  const T t1085 = app8_J0_yy*t359 - app8_S0_x*t349;
+  const T t1086 = app8_J0_zz*w_B_app8_z + app8_S0_x*t362;
+  const T t1087 = R_NB_app8_xx*t1082 + R_NB_app8_xy*t1083 + t1084*t16;
+  const T t1088 = R_NB_app8_yx*t1082 + R_NB_app8_yy*t1083 + t1084*t19;
+  const T t1089 = R_NB_app8_zx*t1082 + R_NB_app8_zy*t1083 + t1084*t22;
+  const T t1090 = R_NB_app8_xx*t804 + R_NB_app8_xy*t1085 + t1086*t16;
+  const T t1091 = R_NB_app8_yx*t804 + R_NB_app8_yy*t1085 + t1086*t19;
+  const T t1092 = R_NB_app8_zx*t804 + R_NB_app8_zy*t1085 + t1086*t22;
+  const T t1093 = r_NO_N_app8_y*t1089 - r_NO_N_app8_z*t1088;
+  const T t1094 = -r_NO_N_app8_x*t1089 + r_NO_N_app8_z*t1087;
+  const T t1095 = r_NO_N_app8_x*t1088 - r_NO_N_app8_y*t1087;
+  const T t1096 = t1090 + t1093;
+  const T t1097 = t1091 + t1094;
+  const T t1098 = t1092 + t1095;
+  const T t1099 = t1076 + t1087;
+  const T t1100 = t1077 + t1088;
+  const T t1101 = t1078 + t1089;
+  const T t1102 = t1079 + t1096;
+  const T t1103 = t1080 + t1097;
+  const T t1104 = t1081 + t1098;
+  const T t1105 = app9_S0_z*t391 + app9_mass*t393;
+  const T t1106 = app9_S0_x*w_B_app9_z - app9_S0_z*t390 + app9_mass*t394;
+  const T t1107 = -app9_S0_x*t391 + app9_mass*t383;
+  const T t1108 = app9_J0_xx*t390 + app9_J0_xz*w_B_app9_z - app9_S0_z*t394;
+  const T t1109 = app9_J0_yy*t391 - app9_S0_x*t383 + app9_S0_z*t393;
+  const T t1110 = app9_J0_xz*t390 + app9_J0_zz*w_B_app9_z + app9_S0_x*t394;
+  const T t1111 = R_NB_app9_xx*t1105 + R_NB_app9_xy*t1106 - t1107*t14;
+  const T t1112 = R_NB_app9_yx*t1105 + R_NB_app9_yy*t1106 - t1107*t17;
+  const T t1113 = R_NB_app9_zx*t1105 + R_NB_app9_zy*t1106 - t1107*t20;
+  const T t1114 = R_NB_app9_xx*t1108 + R_NB_app9_xy*t1109 - t1110*t14;
+  const T t1115 = R_NB_app9_yx*t1108 + R_NB_app9_yy*t1109 - t1110*t17;
+  const T t1116 = R_NB_app9_zx*t1108 + R_NB_app9_zy*t1109 - t1110*t20;
+  const T t1117 = r_NO_N_app9_y*t1113 - r_NO_N_app9_z*t1112;
+  const T t1118 = -r_NO_N_app9_x*t1113 + r_NO_N_app9_z*t1111;
+  const T t1119 = r_NO_N_app9_x*t1112 - r_NO_N_app9_y*t1111;
+  const T t1120 = t1114 + t1117;
+  const T t1121 = t1115 + t1118;
+  const T t1122 = t1116 + t1119;
+  const T t1123 = t1099 + t1111;
+  const T t1124 = t1100 + t1112;
+  const T t1125 = t1101 + t1113;
+  const T t1126 = t1102 + t1120;
+  const T t1127 = t1103 + t1121;
+  const T t1128 = t1104 + t1122;
+  const T t1129 = app10_mass*t440;
+  const T t1130 = app10_S0_x*w_B_app10_z + app10_mass*t441;
+  const T t1131 = -app10_S0_x*t438 + app10_mass*t428;
+  const T t1132 = app10_J0_yy*t438 - app10_S0_x*t428;
+  const T t1133 = app10_J0_zz*w_B_app10_z + app10_S0_x*t441;
+  const T t1134 = R_NB_app10_xx*t1129 + R_NB_app10_xy*t1130 + R_NB_app10_xz*t1131;
+  const T t1135 = R_NB_app10_yx*t1129 + R_NB_app10_yy*t1130 + R_NB_app10_yz*t1131;
+  const T t1136 = R_NB_app10_zx*t1129 + R_NB_app10_zy*t1130 + R_NB_app10_zz*t1131;
+  const T t1137 = R_NB_app10_xx*t827 + R_NB_app10_xy*t1132 + R_NB_app10_xz*t1133;
+  const T t1138 = R_NB_app10_yx*t827 + R_NB_app10_yy*t1132 + R_NB_app10_yz*t1133;
+  const T t1139 = R_NB_app10_zx*t827 + R_NB_app10_zy*t1132 + R_NB_app10_zz*t1133;
+  const T t1140 = r_NO_N_app10_y*t1136 - r_NO_N_app10_z*t1135;
+  const T t1141 = -r_NO_N_app10_x*t1136 + r_NO_N_app10_z*t1134;
+  const T t1142 = r_NO_N_app10_x*t1135 - r_NO_N_app10_y*t1134;
+  const T t1143 = t1137 + t1140;
+  const T t1144 = t1138 + t1141;
+  const T t1145 = t1139 + t1142;
+  const T t1146 = t1123 + t1134;
+  const T t1147 = t1124 + t1135;
+  const T t1148 = t1125 + t1136;
+  const T t1149 = t1126 + t1143;
+  const T t1150 = t1127 + t1144;
+  const T t1151 = t1128 + t1145;
+  const T t1152 = app11_mass*t484;
+  const T t1153 = app11_S0_x*w_B_app11_z + app11_mass*t485;
+  const T t1154 = -app11_S0_x*t482 + app11_mass*t472;
+  const T t1155 = app11_J0_yy*t482 - app11_S0_x*t472;
+  const T t1156 = app11_J0_zz*w_B_app11_z + app11_S0_x*t485;
+  const T t1157 = R_NB_app11_xx*t1152 + R_NB_app11_xy*t1153 + t1154*t16;
+  const T t1158 = R_NB_app11_yx*t1152 + R_NB_app11_yy*t1153 + t1154*t19;
+  const T t1159 = R_NB_app11_zx*t1152 + R_NB_app11_zy*t1153 + t1154*t22;
+  const T t1160 = R_NB_app11_xx*t838 + R_NB_app11_xy*t1155 + t1156*t16;
+  const T t1161 = R_NB_app11_yx*t838 + R_NB_app11_yy*t1155 + t1156*t19;
+  const T t1162 = R_NB_app11_zx*t838 + R_NB_app11_zy*t1155 + t1156*t22;
+  const T t1163 = r_NO_N_app11_y*t1159 - r_NO_N_app11_z*t1158;
+  const T t1164 = -r_NO_N_app11_x*t1159 + r_NO_N_app11_z*t1157;
+  const T t1165 = r_NO_N_app11_x*t1158 - r_NO_N_app11_y*t1157;
+  const T t1166 = t1160 + t1163;
+  const T t1167 = t1161 + t1164;
+  const T t1168 = t1162 + t1165;
+  const T t1169 = t1146 + t1157;
+  const T t1170 = t1147 + t1158;
+  const T t1171 = t1148 + t1159;
+  const T t1172 = t1149 + t1166;
+  const T t1173 = t1150 + t1167;
+  const T t1174 = t1151 + t1168;
+  const T t1175 = app12_S0_z*t529 + app12_mass*t531;
+  const T t1176 = app12_S0_x*w_B_app12_z - app12_S0_z*t528 + app12_mass*t532;
+  const T t1177 = -app12_S0_x*t529 + app12_mass*t519;
+  const T t1178 = app12_J0_xx*t528 + app12_J0_xz*w_B_app12_z - app12_S0_z*t532;
+  const T t1179 = app12_J0_yy*t529 - app12_S0_x*t519 + app12_S0_z*t531;
+  const T t1180 = app12_J0_xz*t528 + app12_J0_zz*w_B_app12_z + app12_S0_x*t532;
+  const T t1181 = R_NB_app12_xx*t1175 + R_NB_app12_xy*t1176 + R_NB_app12_xz*t1177;
+  const T t1182 = R_NB_app12_yx*t1175 + R_NB_app12_yy*t1176 + R_NB_app12_yz*t1177;
+  const T t1183 = R_NB_app12_zx*t1175 + R_NB_app12_zy*t1176 + R_NB_app12_zz*t1177;
+  const T t1184 = R_NB_app12_xx*t1178 + R_NB_app12_xy*t1179 + R_NB_app12_xz*t1180;
+  const T t1185 = R_NB_app12_yx*t1178 + R_NB_app12_yy*t1179 + R_NB_app12_yz*t1180;
+  const T t1186 = R_NB_app12_zx*t1178 + R_NB_app12_zy*t1179 + R_NB_app12_zz*t1180;
+  const T t1187 = r_NO_N_app12_y*t1183 - r_NO_N_app12_z*t1182;
+  const T t1188 = -r_NO_N_app12_x*t1183 + r_NO_N_app12_z*t1181;
+  const T t1189 = r_NO_N_app12_x*t1182 - r_NO_N_app12_y*t1181;
+  const T t1190 = t1184 + t1187;
+  const T t1191 = t1185 + t1188;
+  const T t1192 = t1186 + t1189;
+  const T t1193 = t1169 + t1181;
+  const T t1194 = t1170 + t1182;
+  const T t1195 = t1171 + t1183;
+  const T t1196 = t1172 + t1190;
+  const T t1197 = t1173 + t1191;
+  const T t1198 = t1174 + t1192;
+  const T t1199 = app13_mass*t565;
+  const T t1200 = app13_S0_x*w_B_app13_z + app13_mass*t566;
+  const T t1201 = -app13_S0_x*t563 + app13_mass*t555;
+  const T t1202 = app13_J0_yy*t563 - app13_S0_x*t555;
+  const T t1203 = app13_J0_zz*w_B_app13_z + app13_S0_x*t566;
+  const T t1204 = R_NB_app13_xx*t1199 + R_NB_app13_xy*t1200 + t1201*t14;
+  const T t1205 = R_NB_app13_yx*t1199 + R_NB_app13_yy*t1200 + t1201*t17;
+  const T t1206 = R_NB_app13_zx*t1199 + R_NB_app13_zy*t1200 + t1201*t20;
+  const T t1207 = R_NB_app13_xx*t861 + R_NB_app13_xy*t1202 + t1203*t14;
+  const T t1208 = R_NB_app13_yx*t861 + R_NB_app13_yy*t1202 + t1203*t17;
+  const T t1209 = R_NB_app13_zx*t861 + R_NB_app13_zy*t1202 + t1203*t20;
+  const T t1210 = r_NO_N_app13_y*t1206 - r_NO_N_app13_z*t1205;
+  const T t1211 = -r_NO_N_app13_x*t1206 + r_NO_N_app13_z*t1204;
+  const T t1212 = r_NO_N_app13_x*t1205 - r_NO_N_app13_y*t1204;
+  const T t1213 = t1207 + t1210;
+  const T t1214 = t1208 + t1211;
+  const T t1215 = t1209 + t1212;
+  const T t1216 = t1193 + t1204;
+  const T t1217 = t1194 + t1205;
+  const T t1218 = t1195 + t1206;
+  const T t1219 = t1196 + t1213;
+  const T t1220 = t1197 + t1214;
+  const T t1221 = t1198 + t1215;
+  const T t1222 = app14_mass*t609;
+  const T t1223 = app14_S0_x*w_B_app14_z + app14_mass*t610;
+  const T t1224 = -app14_S0_x*t607 + app14_mass*t597;
+  const T t1225 = app14_J0_yy*t607 - app14_S0_x*t597;
+  const T t1226 = app14_J0_zz*w_B_app14_z + app14_S0_x*t610;
+  const T t1227 = R_NB_app14_xx*t1222 + R_NB_app14_xy*t1223 + t1224*t16;
+  const T t1228 = R_NB_app14_yx*t1222 + R_NB_app14_yy*t1223 + t1224*t19;
+  const T t1229 = R_NB_app14_zx*t1222 + R_NB_app14_zy*t1223 + t1224*t22;
+  const T t1230 = R_NB_app14_xx*t872 + R_NB_app14_xy*t1225 + t1226*t16;
+  const T t1231 = R_NB_app14_yx*t872 + R_NB_app14_yy*t1225 + t1226*t19;
+  const T t1232 = R_NB_app14_zx*t872 + R_NB_app14_zy*t1225 + t1226*t22;
+  const T t1233 = r_NO_N_app14_y*t1229 - r_NO_N_app14_z*t1228;
+  const T t1234 = -r_NO_N_app14_x*t1229 + r_NO_N_app14_z*t1227;
+  const T t1235 = r_NO_N_app14_x*t1228 - r_NO_N_app14_y*t1227;
+  const T t1236 = t1230 + t1233;
+  const T t1237 = t1231 + t1234;
+  const T t1238 = t1232 + t1235;
+  const T t1239 = t1216 + t1227;
+  const T t1240 = t1217 + t1228;
+  const T t1241 = t1218 + t1229;
+  const T t1242 = t1219 + t1236;
+  const T t1243 = t1220 + t1237;
+  const T t1244 = t1221 + t1238;
+  const T t1245 = app15_S0_z*t652 + app15_mass*t654;
+  const T t1246 = app15_S0_x*w_B_app15_z - app15_S0_z*t651 + app15_mass*t655;
+  const T t1247 = -app15_S0_x*t652 + app15_mass*t642;
+  const T t1248 = app15_J0_xx*t651 + app15_J0_xz*w_B_app15_z - app15_S0_z*t655;
+  const T t1249 = app15_J0_yy*t652 - app15_S0_x*t642 + app15_S0_z*t654;
+  const T t1250 = app15_J0_xz*t651 + app15_J0_zz*w_B_app15_z + app15_S0_x*t655;
+  const T t1251 = R_NB_app15_xx*t1245 + R_NB_app15_xy*t1246 + R_NB_app15_xz*t1247;
+  const T t1252 = R_NB_app15_yx*t1245 + R_NB_app15_yy*t1246 + R_NB_app15_yz*t1247;
+  const T t1253 = R_NB_app15_zx*t1245 + R_NB_app15_zy*t1246 + R_NB_app15_zz*t1247;
+  const T t1254 = R_NB_app15_xx*t1248 + R_NB_app15_xy*t1249 + R_NB_app15_xz*t1250;
+  const T t1255 = R_NB_app15_yx*t1248 + R_NB_app15_yy*t1249 + R_NB_app15_yz*t1250;
+  const T t1256 = R_NB_app15_zx*t1248 + R_NB_app15_zy*t1249 + R_NB_app15_zz*t1250;
+  const T t1257 = r_NO_N_app15_y*t1253 - r_NO_N_app15_z*t1252;
+  const T t1258 = -r_NO_N_app15_x*t1253 + r_NO_N_app15_z*t1251;
+  const T t1259 = r_NO_N_app15_x*t1252 - r_NO_N_app15_y*t1251;
+  const T t1260 = t1254 + t1257;
+  const T t1261 = t1255 + t1258;
+  const T t1262 = t1256 + t1259;
+  const T t1263 = t1239 + t1251;
+  const T t1264 = t1240 + t1252;
+  const T t1265 = t1241 + t1253;
+  const T t1266 = t1242 + t1260;
+  const T t1267 = t1243 + t1261;
+  const T t1268 = t1244 + t1262;
+  const T t1269 = app16_mass*t701;
+  const T t1270 = app16_S0_x*w_B_app16_z + app16_mass*t702;
+  const T t1271 = -app16_S0_x*t699 + app16_mass*t689;
+  const T t1272 = app16_J0_yy*t699 - app16_S0_x*t689;
+  const T t1273 = app16_J0_zz*w_B_app16_z + app16_S0_x*t702;
+  const T t1274 = R_NB_app16_xx*t1269 + R_NB_app16_xy*t1270 + R_NB_app16_xz*t1271;
+  const T t1275 = R_NB_app16_yx*t1269 + R_NB_app16_yy*t1270 + R_NB_app16_yz*t1271;
+  const T t1276 = R_NB_app16_zx*t1269 + R_NB_app16_zy*t1270 + R_NB_app16_zz*t1271;
+  const T t1277 = R_NB_app16_xx*t895 + R_NB_app16_xy*t1272 + R_NB_app16_xz*t1273;
+  const T t1278 = R_NB_app16_yx*t895 + R_NB_app16_yy*t1272 + R_NB_app16_yz*t1273;
+  const T t1279 = R_NB_app16_zx*t895 + R_NB_app16_zy*t1272 + R_NB_app16_zz*t1273;
+  const T t1280 = r_NO_N_app16_y*t1276 - r_NO_N_app16_z*t1275;
+  const T t1281 = -r_NO_N_app16_x*t1276 + r_NO_N_app16_z*t1274;
+  const T t1282 = r_NO_N_app16_x*t1275 - r_NO_N_app16_y*t1274;
+  const T t1283 = t1277 + t1280;
+  const T t1284 = t1278 + t1281;
+  const T t1285 = t1279 + t1282;
+  const T t1286 = t1263 + t1274;
+  const T t1287 = t1264 + t1275;
+  const T t1288 = t1265 + t1276;
+  const T t1289 = t1266 + t1283;
+  const T t1290 = t1267 + t1284;
+  const T t1291 = t1268 + t1285;
+  pH[0] = t1286;
+  pH[1] = t1287;
+  pH[2] = t1288;
+  pH[3] = t1289;
+  pH[4] = t1290;
+  pH[5] = t1291;
 }
 
 // ---- Jacobian of x_dot = [q_dot; u_dot] w.r.t. x = [q; u], column-major --------

@@ -65,7 +65,8 @@ TEST_CASE("compact u-dot code: a chain's middle links share kernels, which do no
     // the same for 8, 16 and 24 links
     CHECK(f.kernels.size() <= 12);
     kernel_ops.push_back(f.kernel_ops.total());
-    CHECK(f.kernel_ops.total() < 0.5 * f.ops.total());
+    // (their code is a fixed ~1,500 operations: over half an 8-link chain's 2,950, a sixth of 24 links')
+    CHECK(f.kernel_ops.total() < (n >= 16 ? 0.3 : 0.6) * f.ops.total());
     // every body's values at like offsets in its region of the workspace: each kernel addresses every value it
     // reads or writes by a constant offset from its call's region, none through a table
     for (const std::string& k : f.kernels) CHECK(k.find("w[x[") == std::string::npos);

@@ -72,6 +72,14 @@ TEST_CASE("joint frames: a tree's other revolute children turn by Rz(beta) Rx(al
       CHECK(std::abs(R_SJ(0, 1)) + std::abs(R_SJ(0, 2)) + std::abs(R_SJ(1, 0)) + std::abs(R_SJ(2, 0)) <= 1e-15);
       CHECK(std::abs(R_SJ(1, 1) - R_SJ(2, 2)) <= 1e-15);
     }
+    // a leaf's origin at the foot of the perpendicular from its parent's: no offset along its axis
+    // ((a, 0, 0) from a main child's parent, whose origin is at the foot of their common normal)
+    const Vec3 p_J = b.joint.R_PJ.transpose() * b.joint.p_PJ;
+    INFO("p_J = " << p_J.transpose());
+    if (c >= 7) {  // links 8 to 15
+      CHECK(std::abs(p_J.z()) <= 1e-14 * p_J.norm());
+      if (main_child) CHECK(std::abs(p_J.y()) <= 1e-14 * p_J.norm());
+    }
   }
   CHECK(screws == 6);  // links 3, 7, 9, 11, 13, 15 (link 5, the other child of link 2, is prismatic)
 }
