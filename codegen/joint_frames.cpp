@@ -50,9 +50,14 @@ bool origin_pinned(const Model& m, int j) {
   });
 }
 
-/// Exact zeros (to kRoundoffResidue of the largest entry) of v.
-int zeros(const Vec3& v) {
-  const double scale = v.cwiseAbs().maxCoeff();
+/// v's entries at most `tiny` in magnitude set to 0.
+void snap_below(Vec3& v, double tiny) {
+  for (int a = 0; a < 3; ++a)
+    if (std::abs(v(a)) <= tiny) v(a) = 0.0;
+}
+
+/// Exact zeros of v, a sum of terms of magnitude up to `scale` (to kRoundoffResidue of it).
+int zeros(const Vec3& v, double scale) {
   int k = 0;
   for (int a = 0; a < 3; ++a) k += std::abs(v(a)) <= kRoundoffResidue * scale ? 1 : 0;
   return k;
@@ -75,10 +80,13 @@ double leaf_origin(const Model& in, const FramedModel& out, int j, const Vec3& z
   for (const double t : candidates) {
     const Vec3 d = b.joint.p_PJ + b.joint.R_PJ * (z * t) - o_P;  // O_B' from O_P', the parent's model axes
     const Vec3 d_J = b.joint.R_PJ.transpose() * d, c = b.rigid.com_B - z * t;
-    const int zeros_S = zeros(Vec3(x.dot(c), y.dot(c), z.dot(c)));
+    const double scale_d = b.joint.p_PJ.norm() + std::abs(t) + o_P.norm(),
+                 scale_c = b.rigid.com_B.norm() + std::abs(t);
+    const int zeros_S = zeros(Vec3(x.dot(c), y.dot(c), z.dot(c)), scale_c);
     if (zeros_S0 < 0) zeros_S0 = zeros_S;
     if (zeros_S < zeros_S0) continue;  // the first moment enters more products than the offset
-    const int k = zeros(Qp.transpose() * d) + zeros(Vec3(x.dot(d_J), y.dot(d_J), z.dot(d_J))) + zeros_S;
+    const int k = zeros(Qp.transpose() * d, scale_d) + zeros(Vec3(x.dot(d_J), y.dot(d_J), z.dot(d_J)), scale_d) +
+                  zeros_S;
     if (k > most) most = k, best = t;
   }
   return best;
@@ -155,6 +163,8 @@ FramedModel choose_joint_frames(const Model& in) {
     o.joint.R_PJ = Qp.transpose() * b.joint.R_PJ * Q;
     // O_B' = O_B + o_B (o_B along the joint axis: the same point for every q), from O_P' = O_P + o_P
     o.joint.p_PJ = Qp.transpose() * (b.joint.p_PJ + b.joint.R_PJ * out.o_B[j] - o_P);
+    // round-off of the terms (a short offset between long ones: the common normal's a) is no component
+    snap_below(o.joint.p_PJ, kRoundoffResidue * (b.joint.p_PJ.norm() + out.o_B[j].norm() + o_P.norm()));
     if (reframable(b)) o.joint.axis_J = Vec3::UnitZ();
     move_ports(out.model.inputs, out.model.sensors, j, j, -(Q.transpose() * out.o_B[j]), Q.transpose());
     o.rigid.com_B = Q.transpose() * (b.rigid.com_B - out.o_B[j]);
