@@ -3,6 +3,7 @@
 // forces and the applied generalized forces that every symbolic pass shares.
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -145,6 +146,48 @@ std::optional<AxisTurn> axis_turn(KaneContext& ctx, const SM3& R) {
   return std::nullopt;
 }
 
+/// The turn about coordinate axis k by the constants c = cos and s = sin of an angle, named after `base`
+/// with `suffix` (every model constant has one role: outlined_code.hpp), or nullopt where c or s is 0 or 1
+/// (no constant symbol to name the double angle's after).
+std::optional<AxisTurn> constant_turn(KaneContext& ctx, int k, const ex& base, const std::string& suffix,
+                                      double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  if (std::abs(c) < 1e-12 || std::abs(s) < 1e-12) return std::nullopt;
+  const std::string what = "a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)";
+  AxisTurn t{(k + 1) % 3, (k + 2) % 3, k, ctx.C.companion(base, suffix + "_c", c, what),
+             ctx.C.companion(base, suffix + "_s", s, what), 0, 0, 0, 0};
+  auto snap = [](double x) { return std::abs(x) < 4 * std::numeric_limits<double>::epsilon() ? 0.0 : x; };
+  t.ss = ctx.C.companion(t.c, "ss", s * s, "a turn's sin^2");
+  t.cs = ctx.C.companion(t.c, "cs", c * s, "a turn's cos sin");
+  t.S2 = ctx.C.companion(t.c, "S2", 2 * c * s, "a turn's sin of the double angle");
+  t.C2 = ctx.C.companion(t.c, "C2", snap(c * c - s * s), "a turn's cos of the double angle");  // 0 at 45 degrees
+  return t;
+}
+
+/// A constant rotation with no coordinate axis of its own (a prismatic child's joint frame, which cannot
+/// join a joint angle) as three turns about coordinate axes, R = Rz(a) Rx(b) Rz(c) (z-x-z angles), the
+/// innermost first: an inertia turned by them costs 3 x 15 operations instead of 75.
+std::optional<std::array<AxisTurn, 3>> euler_turns(KaneContext& ctx, const SM3& R) {
+  Mat3 v;
+  const ex* base = nullptr;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      const auto x = ctx.C.numeric_value(R(r, c));
+      if (!x) return std::nullopt;
+      v(r, c) = *x;
+      if (!base && is_a<symbol>(R(r, c))) base = &R(r, c);
+    }
+  if (!base || !(v.transpose() * v).isIdentity(1e-12) || v.determinant() < 0) return std::nullopt;
+  const double a = std::atan2(v(0, 2), -v(1, 2)), b = std::atan2(std::hypot(v(0, 2), v(1, 2)), v(2, 2)),
+               c = std::atan2(v(2, 0), v(2, 1));
+  const Mat3 back = rot_z(a) * rot_x(b) * rot_z(c);
+  if (!back.isApprox(v, 1e-13)) return std::nullopt;
+  const auto t1 = constant_turn(ctx, 2, *base, "zxz1", c), t2 = constant_turn(ctx, 0, *base, "zxz2", b),
+             t3 = constant_turn(ctx, 2, *base, "zxz3", a);
+  if (!t1 || !t2 || !t3) return std::nullopt;
+  return std::array<AxisTurn, 3>{*t1, *t2, *t3};
+}
+
 /// R J R^T for a turn about a coordinate axis, J symmetric: with d = J_ii - J_jj and w = d ss + J_ij S2 the
 /// (i, j) block is [J_ii - w, d cs + J_ij C2; ., J_jj + w] (9 operations instead of 21); column k by R.
 SM3 turn_symmetric(KaneContext& ctx, const AxisTurn& t, const SM3& J) {
@@ -185,6 +228,11 @@ SM3 turn_matrix(KaneContext& ctx, const AxisTurn& t, const SM3& B) {
 
 SM3 rotate_symmetric(KaneContext& ctx, const SM3& R, const SM3& J) {
   if (const auto t = axis_turn(ctx, R)) return turn_symmetric(ctx, *t, J);
+  if (const auto e = euler_turns(ctx, R)) {
+    SM3 out = J;
+    for (const AxisTurn& t : *e) out = turn_symmetric(ctx, t, out);
+    return out;
+  }
   SM3 RJ = ctx.A.mul(R, J), out;
   for (int a = 0; a < 3; ++a)
     for (int c = a; c < 3; ++c)
@@ -194,6 +242,11 @@ SM3 rotate_symmetric(KaneContext& ctx, const SM3& R, const SM3& J) {
 
 SM3 rotate_matrix(KaneContext& ctx, const SM3& R, const SM3& B) {
   if (const auto t = axis_turn(ctx, R)) return turn_matrix(ctx, *t, B);
+  if (const auto e = euler_turns(ctx, R)) {
+    SM3 out = B;
+    for (const AxisTurn& t : *e) out = turn_matrix(ctx, t, out);
+    return out;
+  }
   return ctx.A.mul(ctx.A.mul(R, B), R.transpose());
 }
 

@@ -72,6 +72,12 @@ inline constexpr double probe_S0_z = 0.0003661529674038157;  // first mass momen
 inline constexpr double probe_J0_xx = 0.00013489799553861973;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double probe_J0_yy = 0.00013489799553861973;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double probe_J0_zz = 1e-09;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double probe_R_PJ_xy_zxz3_c = -0.29552020666133955;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double probe_R_PJ_xy_zxz3_s = 0.955336489125606;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double probe_R_PJ_xy_zxz3_c_ss = 0.9126678074548391;  // a turn's sin^2
+inline constexpr double probe_R_PJ_xy_zxz3_c_cs = -0.28232123669751763;  // a turn's cos sin
+inline constexpr double probe_R_PJ_xy_zxz3_c_S2 = -0.5646424733950353;  // a turn's sin of the double angle
+inline constexpr double probe_R_PJ_xy_zxz3_c_C2 = -0.8253356149096782;  // a turn's cos of the double angle
 inline constexpr double probe_k = 1e-06;  // joint spring stiffness [N m/rad or N/m]
 
 // body bus: free joint to ground, mass 20 kg

@@ -107,6 +107,10 @@ inline constexpr double app3_J0_xx = 0.7979998484095953;  // inertia about O (un
 inline constexpr double app3_J0_xz = -0.02339999766783981;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app3_J0_yy = 0.7987198484095952;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app3_J0_zz = 0.0008800000000000096;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app3_R_PJ_xy_zxz3_c = -0.7071067811865475;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app3_R_PJ_xy_zxz3_s = 0.7071067811865476;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app3_R_PJ_xy_zxz3_c_ss = 0.5000000000000001;  // a turn's sin^2
+inline constexpr double app3_R_PJ_xy_zxz3_c_cs = -0.5;  // a turn's cos sin
 
 // body app4: revolute joint to hub, mass 0.9 kg
 inline constexpr double app4_R_PJ_xx = 0.38268343236509206;  // joint frame orientation in the parent
@@ -124,6 +128,12 @@ inline constexpr double app4_S0_x = 0.27;  // first mass moment about O (undefor
 inline constexpr double app4_J0_xx = 0.00018;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app4_J0_yy = 0.108;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app4_J0_zz = 0.108;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app4_R_PJ_xx_zxz3_c = -0.38268343236509217;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app4_R_PJ_xx_zxz3_s = -0.9238795325112857;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app4_R_PJ_xx_zxz3_c_ss = 0.8535533905932718;  // a turn's sin^2
+inline constexpr double app4_R_PJ_xx_zxz3_c_cs = 0.35355339059327556;  // a turn's cos sin
+inline constexpr double app4_R_PJ_xx_zxz3_c_S2 = 0.7071067811865511;  // a turn's sin of the double angle
+inline constexpr double app4_R_PJ_xx_zxz3_c_C2 = -0.7071067811865438;  // a turn's cos of the double angle
 inline constexpr double app4_k = 1.5;  // joint spring stiffness [N m/rad or N/m]
 
 // body app5: revolute joint to hub, mass 0.5 kg
@@ -155,6 +165,12 @@ inline constexpr double app6_J0_xx = 0.5660002694997552;  // inertia about O (un
 inline constexpr double app6_J0_xz = -0.017100004255258764;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app6_J0_yy = 0.5665402694997552;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app6_J0_zz = 0.0006600000000000072;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app6_R_PJ_xy_zxz3_c = -0.9238795325112871;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app6_R_PJ_xy_zxz3_s = -0.38268343236508906;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app6_R_PJ_xy_zxz3_c_ss = 0.1464466094067257;  // a turn's sin^2
+inline constexpr double app6_R_PJ_xy_zxz3_c_cs = 0.35355339059327323;  // a turn's cos sin
+inline constexpr double app6_R_PJ_xy_zxz3_c_S2 = 0.7071067811865465;  // a turn's sin of the double angle
+inline constexpr double app6_R_PJ_xy_zxz3_c_C2 = 0.7071067811865487;  // a turn's cos of the double angle
 
 // body app7: revolute joint to hub, mass 0.7 kg
 inline constexpr double app7_R_PJ_xx = -0.7071067811865441;  // joint frame orientation in the parent
@@ -171,6 +187,11 @@ inline constexpr double app7_S0_x = 0.26249999999999996;  // first mass moment a
 inline constexpr double app7_J0_xx = 0.00014;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app7_J0_yy = 0.1312495;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app7_J0_zz = 0.1312495;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app7_R_PJ_xx_zxz3_c = 0.7071067811865441;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app7_R_PJ_xx_zxz3_s = -0.7071067811865509;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app7_R_PJ_xx_zxz3_c_ss = 0.5000000000000048;  // a turn's sin^2
+inline constexpr double app7_R_PJ_xx_zxz3_c_cs = -0.5;  // a turn's cos sin
+inline constexpr double app7_R_PJ_xx_zxz3_c_C2 = -9.547918011776346e-15;  // a turn's cos of the double angle
 inline constexpr double app7_k = 1.5;  // joint spring stiffness [N m/rad or N/m]
 
 // body app8: revolute joint to hub, mass 0.8 kg
@@ -222,6 +243,12 @@ inline constexpr double app10_S0_x = 0.175;  // first mass moment about O (undef
 inline constexpr double app10_J0_xx = 0.0001;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app10_J0_yy = 0.08166699999999999;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app10_J0_zz = 0.08166699999999999;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app10_R_PJ_xx_zxz3_c = 0.9238795325112859;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app10_R_PJ_xx_zxz3_s = 0.38268343236509206;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app10_R_PJ_xx_zxz3_c_ss = 0.146446609406728;  // a turn's sin^2
+inline constexpr double app10_R_PJ_xx_zxz3_c_cs = 0.3535533905932755;  // a turn's cos sin
+inline constexpr double app10_R_PJ_xx_zxz3_c_S2 = 0.707106781186551;  // a turn's sin of the double angle
+inline constexpr double app10_R_PJ_xx_zxz3_c_C2 = 0.7071067811865441;  // a turn's cos of the double angle
 inline constexpr double app10_k = 1.5;  // joint spring stiffness [N m/rad or N/m]
 
 // body app11: revolute joint to hub, mass 0.6 kg
@@ -262,6 +289,12 @@ inline constexpr double app12_J0_xx = 0.5880002978681529;  // inertia about O (u
 inline constexpr double app12_J0_xz = -0.018900004964468562;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app12_J0_yy = 0.5886302978681528;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app12_J0_zz = 0.0007700000000000083;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app12_R_PJ_xy_zxz3_c = 0.9238795325112885;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app12_R_PJ_xy_zxz3_s = -0.3826834323650854;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app12_R_PJ_xy_zxz3_c_ss = 0.14644660940672288;  // a turn's sin^2
+inline constexpr double app12_R_PJ_xy_zxz3_c_cs = -0.3535533905932704;  // a turn's cos sin
+inline constexpr double app12_R_PJ_xy_zxz3_c_S2 = -0.7071067811865408;  // a turn's sin of the double angle
+inline constexpr double app12_R_PJ_xy_zxz3_c_C2 = 0.7071067811865541;  // a turn's cos of the double angle
 
 // body app13: revolute joint to hub, mass 0.8 kg
 inline constexpr double app13_p_PJ_y = -0.6;  // joint frame origin in the parent y [m]
@@ -311,6 +344,11 @@ inline constexpr double app15_J0_xx = 0.498750405255997;  // inertia about O (un
 inline constexpr double app15_J0_xz = -0.01462499854239988;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app15_J0_yy = 0.499200405255997;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app15_J0_zz = 0.000550000000000006;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app15_R_PJ_xy_zxz3_c = 0.7071067811865465;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app15_R_PJ_xy_zxz3_s = 0.7071067811865486;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app15_R_PJ_xy_zxz3_c_ss = 0.5000000000000014;  // a turn's sin^2
+inline constexpr double app15_R_PJ_xy_zxz3_c_cs = 0.5;  // a turn's cos sin
+inline constexpr double app15_R_PJ_xy_zxz3_c_C2 = -2.942091015256665e-15;  // a turn's cos of the double angle
 
 // body app16: revolute joint to hub, mass 0.6 kg
 inline constexpr double app16_R_PJ_xx = 0.9238795325112859;  // joint frame orientation in the parent
@@ -328,6 +366,12 @@ inline constexpr double app16_S0_x = 0.18;  // first mass moment about O (undefo
 inline constexpr double app16_J0_xx = 0.00012;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app16_J0_yy = 0.072;  // inertia about O (undeformed) [kg m^2]
 inline constexpr double app16_J0_zz = 0.072;  // inertia about O (undeformed) [kg m^2]
+inline constexpr double app16_R_PJ_xx_zxz3_c = -0.9238795325112859;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app16_R_PJ_xx_zxz3_s = 0.38268343236509195;  // a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)
+inline constexpr double app16_R_PJ_xx_zxz3_c_ss = 0.1464466094067279;  // a turn's sin^2
+inline constexpr double app16_R_PJ_xx_zxz3_c_cs = -0.35355339059327545;  // a turn's cos sin
+inline constexpr double app16_R_PJ_xx_zxz3_c_S2 = -0.7071067811865509;  // a turn's sin of the double angle
+inline constexpr double app16_R_PJ_xx_zxz3_c_C2 = 0.7071067811865441;  // a turn's cos of the double angle
 inline constexpr double app16_k = 1.5;  // joint spring stiffness [N m/rad or N/m]
 
 // body hub: free joint to ground, mass 60 kg
