@@ -73,7 +73,14 @@ double leaf_origin(const Model& in, const FramedModel& out, int j, const Vec3& z
   const Body& b = in.bodies[j];
   const Vec3 o_P = b.parent >= 0 ? out.o_B[b.parent] : Vec3::Zero();
   const Mat3 Qp = b.parent >= 0 ? out.R_BBp[b.parent] : Mat3::Identity();
-  const Vec3 y = z.cross(x);
+  // the axes the generator uses for the offset: the joint's, x along the common normal to the parent's
+  // axis where the parent's frame is re-chosen (its Rz(delta) joined to the joint angle), else the body's
+  Vec3 x_J = x;
+  if (b.parent >= 0 && reframable(in.bodies[b.parent]) && b.joint.type == JointType::revolute) {
+    const Vec3 n = (b.joint.R_PJ.transpose() * in.bodies[b.parent].joint.axis_J.normalized()).cross(z);
+    if (n.norm() > 1e-9) x_J = n.normalized();
+  }
+  const Vec3 y = z.cross(x), y_J = z.cross(x_J);
   const double candidates[3] = {0.0, -(b.joint.R_PJ * z).dot(b.joint.p_PJ - o_P), z.dot(b.rigid.com_B)};
   double best = 0.0;
   int most = -1, zeros_S0 = -1;
@@ -85,8 +92,8 @@ double leaf_origin(const Model& in, const FramedModel& out, int j, const Vec3& z
     const int zeros_S = zeros(Vec3(x.dot(c), y.dot(c), z.dot(c)), scale_c);
     if (zeros_S0 < 0) zeros_S0 = zeros_S;
     if (zeros_S < zeros_S0) continue;  // the first moment enters more products than the offset
-    const int k = zeros(Qp.transpose() * d, scale_d) + zeros(Vec3(x.dot(d_J), y.dot(d_J), z.dot(d_J)), scale_d) +
-                  zeros_S;
+    const int k = zeros(Qp.transpose() * d, scale_d) +
+                  zeros(Vec3(x_J.dot(d_J), y_J.dot(d_J), z.dot(d_J)), scale_d) + zeros_S;
     if (k > most) most = k, best = t;
   }
   return best;
@@ -98,6 +105,7 @@ Mat3 rot_x(double a) {
   Mat3 R = Mat3::Identity();
   const double c = std::cos(a), s = std::sin(a);
   R(1, 1) = c, R(1, 2) = -s, R(2, 1) = s, R(2, 2) = c;
+  snap_unit_residues(R);  // a quarter turn's cos(pi/2) = 6e-17 is 0
   return R;
 }
 
@@ -105,6 +113,7 @@ Mat3 rot_z(double a) {
   Mat3 R = Mat3::Identity();
   const double c = std::cos(a), s = std::sin(a);
   R(0, 0) = c, R(0, 1) = -s, R(1, 0) = s, R(1, 1) = c;
+  snap_unit_residues(R);
   return R;
 }
 
@@ -189,6 +198,14 @@ FramedModel choose_joint_frames(const Model& in) {
       out.angle_offset[j] = std::atan2(Rz(1, 0), Rz(0, 0));
       out.screw_angle[j] = beta;
       o.joint.R_PJ = beta == 0.0 ? rot_x(alpha) : Mat3(rot_z(beta) * rot_x(alpha));
+    }
+    // likewise the offset in the joint's axes (which the generator uses): a zero there is exact
+    Vec3 p_J = o.joint.R_PJ.transpose() * o.joint.p_PJ;
+    const double terms = b.joint.p_PJ.norm() + out.o_B[j].norm() + o_P.norm();
+    if (zeros(p_J, terms) > zeros(p_J, p_J.cwiseAbs().maxCoeff())) {
+      snap_below(p_J, kRoundoffResidue * terms);
+      o.joint.p_PJ = o.joint.R_PJ * p_J;
+      snap_below(o.joint.p_PJ, kRoundoffResidue * terms);
     }
     snap_roundoff_residues(o);
   }

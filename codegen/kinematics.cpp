@@ -4,6 +4,7 @@
 //   v_O_B = R_BP (v_P + w_P x p_PO_P + v_rel),  and the remainder accelerations.
 #include <fmt/format.h>
 
+#include <stdexcept>
 #include <utility>
 
 #include "codegen/kane_context.hpp"
@@ -167,6 +168,8 @@ void compute_kinematics(KaneContext& ctx, bool with_velocity) {
     // Joint frame; with a screw (joint_frames.hpp) R_PJ is the frame in the parent's axes turned by R_PS.
     const double beta = i < ctx.screw_angle.size() ? ctx.screw_angle[i] : 0.0;
     s.screw = beta != 0.0;
+    if (s.screw && b.joint.node >= 0)  // joint_frames.cpp turns only children of re-chosen (rigid) parents
+      throw std::logic_error("generator: a screw turn on a joint at a flexible parent's node (" + n + ")");
     s.R_PS = SM3::identity();
     SM3 R_PJ;
     if (s.screw) {

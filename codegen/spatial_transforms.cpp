@@ -152,10 +152,11 @@ std::optional<AxisTurn> axis_turn(KaneContext& ctx, const SM3& R) {
 std::optional<AxisTurn> constant_turn(KaneContext& ctx, int k, const ex& base, const std::string& suffix,
                                       double angle) {
   const double c = std::cos(angle), s = std::sin(angle);
-  if (std::abs(c) < 1e-12 || std::abs(s) < 1e-12) return std::nullopt;
+  if (std::abs(c) < 1e-7 || std::abs(s) < 1e-7) return std::nullopt;  // cos or sin would round to 1
   const std::string what = "a turn of a constant rotation's z-x-z factors (spatial_transforms.cpp)";
   AxisTurn t{(k + 1) % 3, (k + 2) % 3, k, ctx.C.companion(base, suffix + "_c", c, what),
              ctx.C.companion(base, suffix + "_s", s, what), 0, 0, 0, 0};
+  if (!is_a<symbol>(t.c) || !is_a<symbol>(t.s)) return std::nullopt;  // (an exact 0 or 1 is no constant)
   auto snap = [](double x) { return std::abs(x) < 4 * std::numeric_limits<double>::epsilon() ? 0.0 : x; };
   t.ss = ctx.C.companion(t.c, "ss", s * s, "a turn's sin^2");
   t.cs = ctx.C.companion(t.c, "cs", c * s, "a turn's cos sin");

@@ -56,8 +56,12 @@ void snap_relative(M& m, double scale) {
 
 void snap_roundoff_residues(Vec3& v) { snap_relative(v, v.cwiseAbs().maxCoeff()); }
 
+void snap_unit_residues(Mat3& R) {
+  for (Eigen::Index i = 0; i < 9; ++i) snap_unit(R(i));
+}
+
 void snap_roundoff_residues(Body& b) {
-  for (Eigen::Index i = 0; i < 9; ++i) snap_unit(b.joint.R_PJ(i));
+  snap_unit_residues(b.joint.R_PJ);
   for (Eigen::Index i = 0; i < 3; ++i) snap_unit(b.joint.axis_J(i));
   snap_roundoff_residues(b.joint.p_PJ);
   snap_roundoff_residues(b.rigid.com_B);

@@ -198,6 +198,8 @@ inline constexpr double kRoundoffResidue = 1e-14;
 /// largest entry of the same vector (inertia: its largest diagonal) become 0.
 /// Changes the dynamics by less than the rounding of its own evaluation.
 void snap_roundoff_residues(Body& body);
+/// A rotation's (or unit vector's) entries within kRoundoffResidue of 0, 1 or -1 set to them.
+void snap_unit_residues(Mat3& R);
 /// The same for gravity.
 void snap_roundoff_residues(Vec3& g_N);
 
