@@ -16,8 +16,7 @@
 #include "engine/generic_engine.hpp"
 #include "engine/generated_engine.hpp"
 #include "engine/load_model.hpp"
-#include "model/parameters.hpp"
-#include "sim/crosscheck.hpp"
+#include "tests/support/crosscheck_checks.hpp"
 #include "tests/support/random_chain.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -100,10 +99,7 @@ TEST_CASE("joint frames: a tree with screw turns, generated in both u-dot forms,
   for (auto& e : test::generated_engines_in_both_forms(model)) {
     INFO("form " << e->udot_form());
     const CrosscheckResult r = crosscheck(*e, generic, 6, 17);
-    for (const auto& [q, v] : r.worst) {
-      INFO(q << " " << v);
-      CHECK(v <= CrosscheckResult::tolerance(q));
-    }
+    test::check_within_tolerances(r);
     CHECK(r.worst.count("reactions") == 1);
     CHECK(r.worst.count("outputs") == 1);
   }
@@ -125,16 +121,7 @@ TEST_CASE("joint frames: a screw-turned child's position and a moved leaf's mass
   p(0) += 0.05, p(1) -= 0.03, p(2) += 0.02;  // link3.position
   p(3) *= 1.5;                                // link9.mass
   p(4) *= 1.2, p(5) *= 1.1, p(6) *= 1.15, p(7) = 1e-4, p(8) = -2e-4, p(9) = 1e-4;
-  generated->set_parameters(p);
-  Model changed = model;
-  apply_parameters(changed, model.parameters, p);
-  changed.parameters.clear();
-  GenericEngine reference(changed);
-  const CrosscheckResult r = crosscheck(*generated, reference, 5, 23);
-  for (const auto& [q, v] : r.worst) {
-    INFO(q << " " << v);
-    CHECK(v <= CrosscheckResult::tolerance(q));
-  }
+  test::check_within_tolerances(test::crosscheck_at_parameters(*generated, model, p, 5, 23));
 }
 
 TEST_CASE("joint frames: axis-aligned turns leave no round-off constants", "[generator][joint-frames][jit]") {
@@ -166,11 +153,8 @@ bodies:
   CHECK(constants > 50);
   GenericEngine generic(model);
   for (auto& e : test::generated_engines_in_both_forms(model)) {
-    const CrosscheckResult r = crosscheck(*e, generic, 4, 31);
-    for (const auto& [q, v] : r.worst) {
-      INFO(e->udot_form() << ": " << q << " " << v);
-      CHECK(v <= CrosscheckResult::tolerance(q));
-    }
+    INFO("form " << e->udot_form());
+    test::check_within_tolerances(crosscheck(*e, generic, 4, 31));
   }
 }
 

@@ -11,6 +11,7 @@
 #include "engine/load_model.hpp"
 #include "model/parameters.hpp"
 #include "sim/crosscheck.hpp"
+#include "tests/support/crosscheck_checks.hpp"
 #include "tests/support/test_support.hpp"
 
 using namespace kanegen;
@@ -115,16 +116,7 @@ TEST_CASE("runtime parameters: the rigid part of a flexible body whose nodes for
   // mass, com, inertia (xx yy zz xy xz yz about the com) changed well away from nominal
   p(0) *= 1.7, p(1) += 0.04, p(2) -= 0.1, p(3) += 0.03;
   p(4) *= 3.0, p(5) *= 1.05, p(6) *= 1.07, p(7) = 0.02, p(8) = -0.01, p(9) = 0.015;
-  generated->set_parameters(p);
-  Model changed = model;
-  apply_parameters(changed, model.parameters, p);
-  changed.parameters.clear();
-  GenericEngine reference(changed);
-  const CrosscheckResult r = crosscheck(*generated, reference, 5, 41);
-  for (const auto& [q, v] : r.worst) {
-    INFO(q << " " << v);
-    CHECK(v <= CrosscheckResult::tolerance(q));
-  }
+  test::check_within_tolerances(test::crosscheck_at_parameters(*generated, model, p, 5, 41));
   // the values matter
   VecX ud_nominal, ud_changed;
   GenericEngine(model).udot(model.q0, model.u0, VecX::Zero(model.nu), ud_nominal);
