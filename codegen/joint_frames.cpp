@@ -50,12 +50,6 @@ bool origin_pinned(const Model& m, int j) {
   });
 }
 
-/// v's entries at most `tiny` in magnitude set to 0.
-void snap_below(Vec3& v, double tiny) {
-  for (int a = 0; a < 3; ++a)
-    if (std::abs(v(a)) <= tiny) v(a) = 0.0;
-}
-
 /// Exact zeros of v, a sum of terms of magnitude up to `scale` (to kRoundoffResidue of it).
 int zeros(const Vec3& v, double scale) {
   int k = 0;
@@ -173,7 +167,8 @@ FramedModel choose_joint_frames(const Model& in) {
     // O_B' = O_B + o_B (o_B along the joint axis: the same point for every q), from O_P' = O_P + o_P
     o.joint.p_PJ = Qp.transpose() * (b.joint.p_PJ + b.joint.R_PJ * out.o_B[j] - o_P);
     // round-off of the terms (a short offset between long ones: the common normal's a) is no component
-    snap_below(o.joint.p_PJ, kRoundoffResidue * (b.joint.p_PJ.norm() + out.o_B[j].norm() + o_P.norm()));
+    const double terms = b.joint.p_PJ.norm() + out.o_B[j].norm() + o_P.norm();
+    snap_roundoff_residues(o.joint.p_PJ, terms);
     if (reframable(b)) o.joint.axis_J = Vec3::UnitZ();
     move_ports(out.model.inputs, out.model.sensors, j, j, -(Q.transpose() * out.o_B[j]), Q.transpose());
     o.rigid.com_B = Q.transpose() * (b.rigid.com_B - out.o_B[j]);
@@ -201,11 +196,10 @@ FramedModel choose_joint_frames(const Model& in) {
     }
     // likewise the offset in the joint's axes (which the generator uses): a zero there is exact
     Vec3 p_J = o.joint.R_PJ.transpose() * o.joint.p_PJ;
-    const double terms = b.joint.p_PJ.norm() + out.o_B[j].norm() + o_P.norm();
     if (zeros(p_J, terms) > zeros(p_J, p_J.cwiseAbs().maxCoeff())) {
-      snap_below(p_J, kRoundoffResidue * terms);
+      snap_roundoff_residues(p_J, terms);
       o.joint.p_PJ = o.joint.R_PJ * p_J;
-      snap_below(o.joint.p_PJ, kRoundoffResidue * terms);
+      snap_roundoff_residues(o.joint.p_PJ, terms);
     }
     snap_roundoff_residues(o);
   }

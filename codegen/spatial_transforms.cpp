@@ -112,6 +112,15 @@ struct AxisTurn {
   ex ss, cs, S2, C2;
 };
 
+/// A constant turn's products of c and s as constants named after its cosine t.c (a constant symbol); its
+/// cos of the double angle is given (as computed, or snapped to 0 at 45 degrees).
+void name_turn_products(KaneContext& ctx, AxisTurn& t, double c, double s, double C2) {
+  t.ss = ctx.C.companion(t.c, "ss", s * s, "a turn's sin^2");
+  t.cs = ctx.C.companion(t.c, "cs", c * s, "a turn's cos sin");
+  t.S2 = ctx.C.companion(t.c, "S2", 2 * c * s, "a turn's sin of the double angle");
+  t.C2 = ctx.C.companion(t.c, "C2", C2, "a turn's cos of the double angle");
+}
+
 std::optional<AxisTurn> axis_turn(KaneContext& ctx, const SM3& R) {
   auto same = [&](const ex& a, const ex& b) {
     if ((a - b).is_zero()) return true;
@@ -131,10 +140,7 @@ std::optional<AxisTurn> axis_turn(KaneContext& ctx, const SM3& R) {
     // user's matrix orthonormal to 1e-9, and that one is turned as given)
     if (vc && vs && std::abs(*vc * *vc + *vs * *vs - 1.0) > 4 * std::numeric_limits<double>::epsilon()) continue;
     if (vc && vs && is_a<symbol>(t.c)) {
-      t.ss = ctx.C.companion(t.c, "ss", *vs * *vs, "a turn's sin^2");
-      t.cs = ctx.C.companion(t.c, "cs", *vc * *vs, "a turn's cos sin");
-      t.S2 = ctx.C.companion(t.c, "S2", 2 * *vc * *vs, "a turn's sin of the double angle");
-      t.C2 = ctx.C.companion(t.c, "C2", *vc * *vc - *vs * *vs, "a turn's cos of the double angle");
+      name_turn_products(ctx, t, *vc, *vs, *vc * *vc - *vs * *vs);
     } else {
       t.ss = ctx.A.let(t.s * t.s);
       t.cs = ctx.A.let(t.c * t.s);
@@ -157,11 +163,8 @@ std::optional<AxisTurn> constant_turn(KaneContext& ctx, int k, const ex& base, c
   AxisTurn t{(k + 1) % 3, (k + 2) % 3, k, ctx.C.companion(base, suffix + "_c", c, what),
              ctx.C.companion(base, suffix + "_s", s, what), 0, 0, 0, 0};
   if (!is_a<symbol>(t.c) || !is_a<symbol>(t.s)) return std::nullopt;  // (an exact 0 or 1 is no constant)
-  auto snap = [](double x) { return std::abs(x) < 4 * std::numeric_limits<double>::epsilon() ? 0.0 : x; };
-  t.ss = ctx.C.companion(t.c, "ss", s * s, "a turn's sin^2");
-  t.cs = ctx.C.companion(t.c, "cs", c * s, "a turn's cos sin");
-  t.S2 = ctx.C.companion(t.c, "S2", 2 * c * s, "a turn's sin of the double angle");
-  t.C2 = ctx.C.companion(t.c, "C2", snap(c * c - s * s), "a turn's cos of the double angle");  // 0 at 45 degrees
+  const double C2 = c * c - s * s;
+  name_turn_products(ctx, t, c, s, std::abs(C2) < 4 * std::numeric_limits<double>::epsilon() ? 0.0 : C2);  // 45 deg
   return t;
 }
 

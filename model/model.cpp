@@ -56,6 +56,8 @@ void snap_relative(M& m, double scale) {
 
 void snap_roundoff_residues(Vec3& v) { snap_relative(v, v.cwiseAbs().maxCoeff()); }
 
+void snap_roundoff_residues(Vec3& v, double scale) { snap_relative(v, scale); }
+
 void snap_unit_residues(Mat3& R) {
   for (Eigen::Index i = 0; i < 9; ++i) snap_unit(R(i));
 }

@@ -202,6 +202,8 @@ void snap_roundoff_residues(Body& body);
 void snap_unit_residues(Mat3& R);
 /// The same for gravity.
 void snap_roundoff_residues(Vec3& g_N);
+/// v's entries at most kRoundoffResidue times `scale` set to 0: v a sum of terms of size up to `scale`.
+void snap_roundoff_residues(Vec3& v, double scale);
 
 /// Fills q/u layout, names, children, the offsets and names of the inputs
 /// and sensors, and chain_u of an otherwise complete

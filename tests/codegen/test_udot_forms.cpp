@@ -12,6 +12,7 @@
 #include "engine/load_model.hpp"
 #include "model/state_io.hpp"
 #include "sim/crosscheck.hpp"
+#include "tests/support/crosscheck_checks.hpp"
 #include "tests/support/test_support.hpp"
 
 using namespace kanegen;
@@ -32,10 +33,7 @@ TEST_CASE("both u-dot forms agree with the generic engine on every model", "[.][
     for (const auto& e : engines) {
       INFO(fs::path(f).filename().string() << " " << e->udot_form());
       const CrosscheckResult r = crosscheck(*e, generic, 4, 11);
-      for (const auto& [q, v] : r.worst) {
-        INFO(q << " " << v);
-        CHECK(v <= CrosscheckResult::tolerance(q));
-      }
+      test::check_within_tolerances(r);
     }
     CHECK(engines[0]->udot_form() != engines[1]->udot_form());  // one of each
   }
